@@ -1,0 +1,1 @@
+"""One module per ``alte`` command: ``add_parser(subparsers)`` sets ``func=run``."""

@@ -1,0 +1,170 @@
+"""``alte map``: a bag (frame by frame) or a point file (batch) -> a terrain map and its metrics.
+
+A bag is read and registered frame by frame, each frame inserted into the mapper
+as it would be in flight; a point file is built in one call. ``elapsed_s`` times
+only the mapper's ``insert``/``build`` calls (thesis 5.2.1: mapping only, without
+reading, registration or down-sampling).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from alte.errors import MapperError, ParameterError
+from alte.fsutil import atomic_path, refuse_overwrite
+
+__all__ = ["add_parser", "parse_origin", "parse_sets", "run", "run_map"]
+
+EXPORT_SUFFIXES = (".npz", ".bt")
+
+
+def add_parser(subparsers: argparse._SubParsersAction) -> None:
+    """Register ``alte map``."""
+    p = subparsers.add_parser(
+        "map", help="build a terrain map from a bag or a point cloud file",
+        description="Build a map with one of the mappers (quadtree, octomap, alte2d, alte3d). "
+                    "A bag is registered and inserted frame by frame; a point file is built in "
+                    "one batch. Values that start with '-' need '=': --origin=-1,0,2.")
+    p.add_argument("input", type=Path, help="ROS bag (file or folder) or point file")
+    p.add_argument("--mapper", required=True, help="quadtree, octomap, alte2d or alte3d")
+    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", dest="sets",
+                   help="mapper parameter (repeatable), e.g. --set kappa=0.1")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument("--export", type=Path, default=None, metavar="FILE",
+                   help="write the cells (.npz) or an OctoMap tree (.bt, octomap only)")
+    p.add_argument("--force", action="store_true", help="overwrite --export if it exists")
+    p.add_argument("--voxel", type=float, default=None, metavar="M",
+                   help="grid-average down-sampling cell (m), per frame for bags")
+    p.add_argument("--origin", default="0,0,0", metavar="X,Y,Z",
+                   help="sensor origin for a point file (default 0,0,0)")
+    p.add_argument("--mount", default=None, metavar="X,Y,Z,ROLL,PITCH,YAW",
+                   help="sensor mount for a bag (default: the bag's)")
+    p.set_defaults(func=run)
+
+
+def parse_sets(items: list[str]) -> dict[str, str]:
+    """``["k=v", ...]`` -> ``{"k": "v"}``; an item without '=' raises."""
+    out: dict[str, str] = {}
+    for item in items:
+        key, sep, value = item.partition("=")
+        if not sep or not key.strip():
+            raise ParameterError(f"--set {item!r}: expected KEY=VALUE")
+        out[key.strip()] = value.strip()
+    return out
+
+
+def parse_origin(text: str) -> np.ndarray:
+    """``"x,y,z"`` -> (3,) array."""
+    try:
+        values = np.array([float(v) for v in text.split(",")])
+    except ValueError as err:
+        raise ParameterError(f"--origin {text!r}: expected 3 numbers x,y,z") from err
+    if values.shape != (3,) or not np.isfinite(values).all():
+        raise ParameterError(f"--origin {text!r}: expected 3 finite numbers x,y,z")
+    return values
+
+
+def _is_point_file(path: Path) -> bool:
+    from alte.io.pointfiles import READ_SUFFIXES
+
+    return path.is_file() and path.name.lower().endswith(READ_SUFFIXES)
+
+
+def _map_points(mapper: Any, path: Path, voxel: float | None, origin: np.ndarray) -> dict:
+    from alte.io.pointfiles import read_points
+    from alte.registration import grid_average
+
+    points = read_points(path)
+    if voxel is not None:
+        points = grid_average(points, voxel)
+    start = time.perf_counter()
+    mapper.build(points, origin)
+    return {"frames": 1, "points": len(points), "elapsed_s": time.perf_counter() - start}
+
+
+def _map_bag(mapper: Any, path: Path, voxel: float | None, mount_text: str | None) -> dict:
+    from alte.io.bag import read_frames
+    from alte.registration import register_frames
+    from alte.types import Mount
+
+    mount = Mount.from_string(mount_text) if mount_text else None
+    frameset = read_frames(path, mount=mount, progress=True)
+    frames = points = 0
+    elapsed = 0.0
+    for _frame, pts, origin in register_frames(frameset.frames, frameset.mount, voxel=voxel,
+                                               progress=True):
+        start = time.perf_counter()
+        mapper.insert(pts, origin)
+        elapsed += time.perf_counter() - start
+        frames += 1
+        points += len(pts)
+    return {"frames": frames, "points": points, "elapsed_s": elapsed}
+
+
+def export_cells(mapper: Any, path: Path, overwrite: bool) -> None:
+    """Write ``mapper``'s cells to ``path`` (.npz) or its OctoMap tree (.bt), atomically."""
+    suffix = path.suffix.lower()
+    if suffix not in EXPORT_SUFFIXES:
+        raise MapperError(f"--export {path}: unknown type; use {', '.join(EXPORT_SUFFIXES)}")
+    if suffix == ".bt":
+        write_bt = getattr(mapper, "write_bt", None)
+        if write_bt is None:
+            raise MapperError(f"--export {path}: mapper {mapper.name!r} cannot write .bt "
+                              "(only octomap can); export .npz instead")
+        with atomic_path(path, overwrite=overwrite) as tmp:
+            write_bt(tmp)
+        return
+    with atomic_path(path, overwrite=overwrite) as tmp, tmp.open("wb") as fh:
+        np.savez(fh, **mapper.cells().as_dict())
+
+
+def run_map(mapper: Any, path: Path, voxel: float | None = None,
+            origin: np.ndarray | None = None, mount: str | None = None) -> dict[str, Any]:
+    """Feed ``path`` (bag or point file) to ``mapper``; return the summary dict."""
+    if voxel is not None and not (np.isfinite(voxel) and voxel > 0):
+        raise ParameterError(f"--voxel {voxel!r}: must be > 0")
+    if _is_point_file(path):
+        origin = np.zeros(3) if origin is None else origin
+        counts = _map_points(mapper, path, voxel, origin)
+    else:
+        counts = _map_bag(mapper, path, voxel, mount)
+    cells = mapper.cells()
+    return {
+        "mapper": mapper.name, "params": mapper.params, "input": str(path), **counts,
+        "basis_functions": int(mapper.basis_functions), "cells": len(cells),
+        "occupied_cells": int(np.count_nonzero(cells.occupied)),
+        "memory_bytes": int(mapper.memory_bytes),
+        "points_outside": int(getattr(mapper, "points_outside", 0)),
+    }
+
+
+def run(args: argparse.Namespace) -> int:
+    """Build the map, print the summary, export when asked."""
+    from alte.mappers import make_mapper
+
+    params = parse_sets(args.sets)
+    origin = parse_origin(args.origin)
+    if args.export is not None:
+        if args.export.suffix.lower() not in EXPORT_SUFFIXES:
+            raise MapperError(f"--export {args.export}: unknown type; use "
+                              f"{', '.join(EXPORT_SUFFIXES)}")
+        refuse_overwrite(args.export, args.force)  # fail before the long work
+    mapper = make_mapper(args.mapper, **params)
+    summary = run_map(mapper, args.input, args.voxel, origin, args.mount)
+    if args.export is not None:
+        export_cells(mapper, args.export, args.force)
+        summary["export"] = str(args.export)
+    if args.json:
+        print(json.dumps(summary, sort_keys=True))
+    else:
+        for key in ("mapper", "params", "input", "frames", "points", "elapsed_s",
+                    "basis_functions", "occupied_cells", "memory_bytes", "export"):
+            if key in summary:
+                print(f"{key}: {summary[key]}")
+    return 0

@@ -1,0 +1,168 @@
+"""``sensor_msgs/msg/PointCloud2`` <-> (N, 3) float64 arrays, any field layout.
+
+Decoding builds one numpy structured dtype from the message's ``fields`` (offsets,
+datatypes, counts, endianness, ``point_step`` padding) and views the data buffer
+through it, so no Python loop ever touches a point. Organized clouds with row
+padding (``row_step > width * point_step``) are cut to their payload first.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from alte.errors import BagError
+
+__all__ = ["POINTFIELD_DTYPES", "decode_pointcloud2", "encode_pointcloud2", "make_header"]
+
+#: ``sensor_msgs/PointField`` datatype code -> numpy scalar type.
+POINTFIELD_DTYPES: dict[int, np.dtype] = {
+    1: np.dtype(np.int8),
+    2: np.dtype(np.uint8),
+    3: np.dtype(np.int16),
+    4: np.dtype(np.uint16),
+    5: np.dtype(np.int32),
+    6: np.dtype(np.uint32),
+    7: np.dtype(np.float32),
+    8: np.dtype(np.float64),
+}
+_CODES = {dt: code for code, dt in POINTFIELD_DTYPES.items()}
+_XYZ = ("x", "y", "z")
+
+
+def _xyz_dtype(msg: Any, topic: str) -> np.dtype:
+    """Structured dtype holding x, y, z at their offsets, ``itemsize == point_step``."""
+    order = ">" if msg.is_bigendian else "<"
+    fields = {}
+    needed = 0
+    for field in msg.fields:
+        base = POINTFIELD_DTYPES.get(int(field.datatype))
+        if base is None:
+            raise BagError(f"{topic}: field {field.name!r} has unknown datatype {field.datatype}")
+        count = max(int(field.count), 1)
+        needed = max(needed, int(field.offset) + base.itemsize * count)
+        if field.name in _XYZ and field.name not in fields:
+            fields[field.name] = (base.newbyteorder(order), int(field.offset))
+    missing = [name for name in _XYZ if name not in fields]
+    if missing:
+        names = [f.name for f in msg.fields]
+        raise BagError(f"{topic}: PointCloud2 has no {'/'.join(missing)} field (fields: {names})")
+    if int(msg.point_step) < needed:
+        raise BagError(
+            f"{topic}: point_step {msg.point_step} is smaller than the {needed} bytes"
+            " its fields need"
+        )
+    return np.dtype(
+        {
+            "names": list(_XYZ),
+            "formats": [fields[n][0] for n in _XYZ],
+            "offsets": [fields[n][1] for n in _XYZ],
+            "itemsize": int(msg.point_step),
+        }
+    )
+
+
+def _payload(msg: Any, topic: str) -> np.ndarray:
+    """The point bytes without row padding, checked against width/height/steps."""
+    width, height = int(msg.width), int(msg.height)
+    point_step, row_step = int(msg.point_step), int(msg.row_step)
+    data = np.frombuffer(memoryview(msg.data), dtype=np.uint8)
+    row_bytes = width * point_step
+    if height > 1 or row_step:
+        if row_step < row_bytes:
+            raise BagError(
+                f"{topic}: row_step {row_step} < width {width} * point_step {point_step}"
+            )
+    else:
+        row_step = row_bytes
+    if data.size != height * row_step:
+        raise BagError(
+            f"{topic}: data has {data.size} bytes, expected height {height} * row_step "
+            f"{row_step} = {height * row_step} (width {width}, point_step {point_step})"
+        )
+    if row_step == row_bytes:
+        return data
+    return np.ascontiguousarray(data.reshape(height, row_step)[:, :row_bytes]).reshape(-1)
+
+
+def decode_pointcloud2(msg: Any, topic: str = "PointCloud2") -> tuple[np.ndarray, int]:
+    """Return the finite (N, 3) float64 x, y, z of ``msg`` and how many points were dropped.
+
+    Points with a NaN or infinite coordinate (``is_dense = false`` clouds mark
+    missing returns that way) are dropped and counted. ``topic`` names the source
+    in error messages.
+    """
+    dtype = _xyz_dtype(msg, topic)
+    payload = _payload(msg, topic)
+    count = int(msg.width) * int(msg.height)
+    if count == 0:
+        return np.empty((0, 3)), 0
+    records = np.frombuffer(payload, dtype=dtype, count=count)
+    points = np.empty((count, 3), dtype=np.float64)
+    for axis, name in enumerate(_XYZ):
+        points[:, axis] = records[name]
+    finite = np.isfinite(points).all(axis=1)
+    dropped = int(count - np.count_nonzero(finite))
+    if dropped:
+        points = points[finite]
+    return points, dropped
+
+
+def encode_pointcloud2(
+    points: np.ndarray,
+    stamp_ns: int,
+    frame_id: str,
+    typestore: Any,
+    *,
+    dtype: Any = np.float32,
+    extra_fields: dict[str, np.ndarray] | None = None,
+) -> Any:
+    """Build an unorganized little-endian PointCloud2 message (x, y, z, then ``extra_fields``).
+
+    ``dtype`` is the storage type of x, y, z (float32 like real drivers, float64
+    for a lossless round trip); each extra field keeps its own numpy dtype.
+    """
+    pts = np.asarray(points, dtype=np.float64)
+    if pts.ndim != 2 or pts.shape[1] != 3:
+        raise BagError(f"cloud for frame {frame_id!r} must have shape (N, 3), got {pts.shape}")
+    columns = {name: pts[:, axis] for axis, name in enumerate(_XYZ)}
+    formats = {name: np.dtype(dtype).newbyteorder("<") for name in _XYZ}
+    for name, values in (extra_fields or {}).items():
+        arr = np.asarray(values).reshape(-1)
+        if arr.shape[0] != pts.shape[0] or arr.dtype.newbyteorder("=") not in _CODES:
+            raise BagError(f"extra field {name!r} must be N={pts.shape[0]} numeric values")
+        columns[name] = arr
+        formats[name] = arr.dtype.newbyteorder("<")
+    record = np.dtype([(name, fmt) for name, fmt in formats.items()])
+    table = np.empty(pts.shape[0], dtype=record)
+    for name, values in columns.items():
+        table[name] = values
+    types = typestore.types
+    fields = [
+        types["sensor_msgs/msg/PointField"](
+            name=name,
+            offset=record.fields[name][1],
+            datatype=_CODES[fmt.newbyteorder("=")],
+            count=1,
+        )
+        for name, fmt in formats.items()
+    ]
+    return types["sensor_msgs/msg/PointCloud2"](
+        header=make_header(stamp_ns, frame_id, typestore),
+        height=1,
+        width=pts.shape[0],
+        fields=fields,
+        is_bigendian=False,
+        point_step=record.itemsize,
+        row_step=record.itemsize * pts.shape[0],
+        data=np.frombuffer(table.tobytes(), dtype=np.uint8),
+        is_dense=bool(np.isfinite(pts).all()),
+    )
+
+
+def make_header(stamp_ns: int, frame_id: str, typestore: Any) -> Any:
+    """A ``std_msgs/msg/Header`` for ``stamp_ns``."""
+    sec, nanosec = divmod(int(stamp_ns), 1_000_000_000)
+    stamp = typestore.types["builtin_interfaces/msg/Time"](sec=sec, nanosec=nanosec)
+    return typestore.types["std_msgs/msg/Header"](stamp=stamp, frame_id=frame_id)

@@ -1,0 +1,159 @@
+"""Sparse voxel storage, pruning and the ``.bt`` format for the native Octomap.
+
+The map is two parallel arrays sorted by 48-bit Morton key: ``keys`` (uint64) of
+the finest (depth-16) voxels ever observed and their float32 ``log_odds``. Memory
+therefore grows with the observed volume, never with the bounding box. OctoMap's
+pruned tree is a lossless compression of exactly this per-voxel state (a node
+collapses when its 8 children are leaves with bit-identical log-odds, and expands
+again with the same value on the next update), so leaves, leaf counts and the
+``.bt`` file are derived from the arrays on demand by :func:`prune`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from alte.mappers._raycast import TREE_DEPTH, TREE_MAX_VAL, morton_decode
+
+__all__ = ["Leaves", "apply_update", "leaf_geometry", "prune", "write_bt"]
+
+_THREE = np.uint64(3)
+
+
+@dataclass(frozen=True)
+class Leaves:
+    """Leaves of a pruned octree: Morton prefix at its ``depth``, and a value."""
+
+    prefix: np.ndarray
+    depth: np.ndarray
+    value: np.ndarray
+
+    def __len__(self) -> int:
+        return int(self.prefix.size)
+
+
+def apply_update(
+    keys: np.ndarray,
+    log_odds: np.ndarray,
+    update_keys: np.ndarray,
+    updates: np.ndarray,
+    clamp: tuple[np.float32, np.float32],
+) -> tuple[np.ndarray, np.ndarray]:
+    """Add float32 ``updates`` at sorted unique ``update_keys``, clamped like ``updateNodeLogOdds``.
+
+    New voxels start at log-odds 0 (OctoMap's new node). Returns the new sorted arrays;
+    cost is a binary search per update plus one merge copy for the new voxels.
+    """
+    lo, hi = clamp
+    pos = np.searchsorted(keys, update_keys)
+    found = pos < keys.size
+    found[found] = keys[pos[found]] == update_keys[found]
+    hit = pos[found]
+    log_odds[hit] = np.clip(log_odds[hit] + updates[found], lo, hi)
+    fresh = ~found
+    if not fresh.any():
+        return keys, log_odds
+    new_values = np.clip(np.float32(0.0) + updates[fresh], lo, hi).astype(np.float32)
+    keys = np.insert(keys, pos[fresh], update_keys[fresh])
+    log_odds = np.insert(log_odds, pos[fresh], new_values)
+    return keys, log_odds
+
+
+def prune(leaves: Leaves) -> Leaves:
+    """Collapse every node whose 8 children are leaves with equal values, bottom-up.
+
+    Starting from depth-16 voxels this gives the canonical fully pruned tree that
+    OctoMap's on-the-fly ``pruneNode`` maintains; starting from mixed-depth leaves
+    with boolean values it is ``toMaxLikelihood`` followed by ``prune``.
+    """
+    out = []
+    carry = Leaves(np.empty(0, np.uint64), np.empty(0, np.int64), leaves.value[:0])
+    for depth in range(TREE_DEPTH, -1, -1):
+        at = leaves.depth == depth
+        keys = np.concatenate([leaves.prefix[at], carry.prefix])
+        values = np.concatenate([leaves.value[at], carry.value])
+        order = np.argsort(keys, kind="stable")
+        keys, values = keys[order], values[order]
+        if depth == 0 or keys.size == 0:
+            out.append(Leaves(keys, np.full(keys.size, depth), values))
+            carry = Leaves(keys[:0], np.empty(0, np.int64), values[:0])
+            continue
+        parent = keys >> _THREE
+        starts = np.flatnonzero(np.r_[True, parent[1:] != parent[:-1]])
+        counts = np.diff(np.r_[starts, parent.size])
+        vmin = np.minimum.reduceat(values, starts)
+        collapse = (counts == 8) & (vmin == np.maximum.reduceat(values, starts))
+        keep = ~np.repeat(collapse, counts)
+        out.append(Leaves(keys[keep], np.full(int(keep.sum()), depth), values[keep]))
+        carry = Leaves(parent[starts[collapse]], np.empty(0, np.int64), vmin[collapse])
+    return Leaves(
+        np.concatenate([lv.prefix for lv in out]),
+        np.concatenate([lv.depth for lv in out]).astype(np.int64),
+        np.concatenate([lv.value for lv in out]),
+    )
+
+
+def leaf_geometry(leaves: Leaves, voxel: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Minimum depth-16 key (K, 3), side in voxels (K,) and centre in metres (K, 3)."""
+    shift = (TREE_DEPTH - leaves.depth).astype(np.uint64)
+    min_keys = morton_decode(leaves.prefix << (_THREE * shift))
+    side = np.left_shift(1, TREE_DEPTH - leaves.depth)
+    centers = (min_keys - TREE_MAX_VAL + side[:, None] / 2.0) * voxel
+    return min_keys, side, centers
+
+
+def _inner_nodes(leaves: Leaves) -> list[np.ndarray]:
+    """Sorted Morton prefixes of the inner nodes at each depth (index = depth)."""
+    inner: list[np.ndarray] = [np.empty(0, np.uint64) for _ in range(TREE_DEPTH + 1)]
+    for depth in range(TREE_DEPTH, 0, -1):
+        here = np.concatenate([leaves.prefix[leaves.depth == depth], inner[depth]])
+        inner[depth - 1] = np.unique(here >> _THREE)
+    return inner
+
+
+def _child_codes(leaves: Leaves, occupied: np.ndarray, inner: list[np.ndarray]) -> list:
+    """16-bit child descriptor of each inner node: 2 bits per child (1 free, 2 occ, 3 inner)."""
+    codes = []
+    for depth in range(TREE_DEPTH):
+        parents = inner[depth]
+        at = leaves.depth == depth + 1
+        kids = np.concatenate([leaves.prefix[at], inner[depth + 1]])
+        kind = np.concatenate([np.where(occupied[at], 2, 1), np.full(inner[depth + 1].size, 3)])
+        slot = (kids & np.uint64(7)).astype(np.int64)
+        owner = np.searchsorted(parents, kids >> _THREE)
+        bits = np.bincount(owner, weights=kind << (2 * slot), minlength=parents.size)
+        codes.append(bits.astype(np.uint16))
+    return codes
+
+
+def write_bt(path: Path, leaves: Leaves, occupied: np.ndarray, voxel: float) -> int:
+    """Write OctoMap's maximum-likelihood binary tree; return the number of nodes.
+
+    Like ``OcTree::writeBinary``, values are first reduced to occupied/free and the
+    tree re-pruned on that binary state. Inner nodes are written depth-first
+    (children in index order, x = bit 0, y = bit 1, z = bit 2), each as two bytes:
+    children 0-3 then 4-7, 2 bits per child (01 free, 10 occupied, 11 has children).
+    """
+    ml = prune(Leaves(leaves.prefix, leaves.depth, np.asarray(occupied, dtype=bool)))
+    inner = _inner_nodes(ml) if len(ml) and not (ml.depth == 0).all() else []
+    n_nodes = len(ml) + sum(int(level.size) for level in inner)
+    header = (
+        "# Octomap OcTree binary file\n"
+        "# (feel free to add / change comments, but leave the first line as it is!)\n#\n"
+        f"id OcTree\nsize {n_nodes}\nres {voxel!r}\ndata\n"
+    )
+    payload = b""
+    if inner:
+        codes = _child_codes(ml, ml.value, inner)
+        depth = np.concatenate([np.full(lv.size, d) for d, lv in enumerate(inner[:-1])])
+        prefix = np.concatenate(inner[:-1])
+        first_voxel = prefix << (_THREE * (TREE_DEPTH - depth).astype(np.uint64))
+        order = np.lexsort((depth, first_voxel))
+        payload = np.concatenate(codes)[order].astype("<u2").tobytes()
+    with open(path, "wb") as handle:
+        handle.write(header.encode("ascii"))
+        handle.write(payload)
+    return n_nodes

@@ -1,0 +1,177 @@
+"""Common machinery of the two 2D mappers: domain, insertion, leaves, cells, corners.
+
+A subclass names the value columns it keeps per cell (:meth:`QuadMap._values`),
+decides splits from the statistics (:meth:`QuadMap._split`) and turns leaf
+statistics into heights, values and occupancy (:meth:`QuadMap._leaf_values`).
+
+Domain. ``domain="xmin,ymin,size"`` fixes the root square before data arrive:
+points outside it are dropped and counted in :attr:`QuadMap.points_outside`. With
+no domain, :meth:`~QuadMap.build` uses the bounding square of the cloud, and the
+first :meth:`~QuadMap.insert` uses a power-of-two square aligned on its own size holding
+the first frame; later frames reaching outside it (upper edges excluded) grow the
+root by doubling it towards them, which keeps
+every existing cell boundary (cells move one level down; the finest level is
+dropped, since depth limits count from the root). The map after such growth equals
+a batch build with ``domain`` set to the grown root (:attr:`QuadMap.square`).
+"""
+
+from __future__ import annotations
+
+from typing import Any, ClassVar
+
+import numpy as np
+
+from alte.mappers.base import Cells, Param, check_points, parse_params
+from alte.mappers.quadgrid import LevelStats, Square, parse_domain
+
+__all__ = ["QuadMap", "rectangle_corners"]
+
+
+def rectangle_corners(cells: Cells, mask: np.ndarray) -> np.ndarray:
+    """The 4 corners (at the cell's height) of the masked 2D cells, de-duplicated."""
+    c = cells.centers[mask]
+    half = cells.sizes[mask, :2] / 2
+    signs = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]], dtype=np.float64)
+    xy = (c[:, None, :2] + signs[None] * half[:, None]).reshape(-1, 2)
+    pts = np.column_stack([xy, np.repeat(c[:, 2], 4)])
+    return np.unique(pts, axis=0) if len(pts) else np.empty((0, 3))
+
+
+class QuadMap:
+    """Base of the 2D mappers (Quadtree, 2D-ALTE); see the module docstring."""
+
+    name: ClassVar[str] = "quadmap"
+    dims: ClassVar[int] = 2
+    incremental: ClassVar[bool] = True
+    SPECS: ClassVar[dict[str, Param]] = {}
+    _NVALUES: ClassVar[int] = 1
+
+    def __init__(self, **params: Any) -> None:
+        self._params = parse_params(self.name, self.SPECS, params)
+        self._fixed = parse_domain(self._params["domain"])
+        self._reset(self._fixed)
+
+    # -- hooks ---------------------------------------------------------------------------
+    @property
+    def depth(self) -> int:
+        """Deepest tree level allowed (root = 0)."""
+        raise NotImplementedError
+
+    def _values(self, points: np.ndarray) -> np.ndarray:
+        raise NotImplementedError
+
+    def _split(self, level: int, rows: np.ndarray) -> np.ndarray:
+        raise NotImplementedError
+
+    def _update_splits(self, touched: list[np.ndarray] | None) -> None:
+        """Recompute the split flags of the ``touched`` rows per level (None: all rows)."""
+        for level in range(self.depth + 1):
+            rows = np.arange(len(self.stats.keys[level])) if touched is None else touched[level]
+            self.stats.split[level][rows] = self._split(level, rows)
+
+    def _leaf_values(self, level: np.ndarray, rows: np.ndarray, centers: np.ndarray,
+                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        raise NotImplementedError
+
+    # -- protocol ------------------------------------------------------------------------
+    @property
+    def params(self) -> dict[str, Any]:
+        """The validated parameters, defaults filled in."""
+        return dict(self._params)
+
+    def _reset(self, square: Square | None) -> None:
+        self.square: Square | None = square
+        self.stats = LevelStats(self.depth, self._NVALUES)
+        self.points_outside = 0
+        self.points_inserted = 0
+        self._cells: Cells | None = None
+
+    def insert(self, points: np.ndarray, origin: np.ndarray) -> None:
+        """Add one registered frame; ``origin`` is checked but unused by a height map."""
+        pts = check_points(points, self.name)
+        check_points(np.reshape(origin, (1, -1)), self.name, "origin")
+        if not len(pts):
+            return
+        if self.square is None:
+            self.square = Square.dyadic(pts[:, :2])
+        if self._fixed is None:
+            self._grow(pts[:, :2])
+        self._add(pts)
+
+    def build(self, points: np.ndarray, origins: np.ndarray | None = None) -> None:
+        """Replace the map by one built from a whole cloud (``origins`` unused)."""
+        pts = check_points(points, self.name)
+        square = self._fixed
+        if square is None and len(pts):
+            square = Square.bounding(pts[:, :2])
+        self._reset(square)
+        if len(pts):
+            self._add(pts)
+
+    def _grow(self, xy: np.ndarray) -> None:
+        grown = False
+        while not self.square.contains(xy, closed=False).all():
+            self.square, quadrant = self.square.doubled(xy)
+            self.stats.shift_up(quadrant)
+            grown = True
+        if grown:
+            self._update_splits(None)
+
+    def _add(self, pts: np.ndarray) -> None:
+        inside = self.square.contains(pts[:, :2])
+        self.points_outside += int((~inside).sum())
+        pts = pts[inside]
+        self._cells = None
+        if not len(pts):
+            return
+        self.points_inserted += len(pts)
+        self._update_splits(self.stats.add(self.square.keys(pts[:, :2], self.depth),
+                                           self._values(pts)))
+
+    def cells(self) -> Cells:
+        """Leaves of the partition; unknown (empty) leaves have NaN height and value."""
+        if self._cells is None:
+            self._cells = self._make_cells()
+        return self._cells
+
+    def _make_cells(self) -> Cells:
+        if self.square is None:
+            empty = np.empty((0, 3))
+            return Cells(empty, empty.copy(), np.empty(0), np.empty(0, bool),
+                         np.empty(0, np.int64))
+        level, keys, rows = self.stats.leaves()
+        xy, edge = self.square.cell_geometry(level, keys)
+        z, value, occupied = self._leaf_values(level, rows, xy)
+        centers = np.column_stack([xy, z])
+        sizes = np.column_stack([edge, edge, np.zeros(len(edge))])
+        return Cells(centers, sizes, value, occupied, level)
+
+    def leaf_counts(self) -> np.ndarray:
+        """Points in each leaf, in the order of :meth:`cells` (0 for unknown leaves)."""
+        if self.square is None:
+            return np.empty(0, np.int64)
+        level, _keys, rows = self.stats.leaves()
+        return np.nan_to_num(self.leaf_stat(level, rows, "n")).astype(np.int64)
+
+    def leaf_stat(self, level: np.ndarray, rows: np.ndarray, what: str, j: int = 0) -> np.ndarray:
+        """Statistic ``what`` of value ``j`` for leaves (NaN for unknown leaves)."""
+        out = np.full(len(rows), np.nan)
+        for lev in np.unique(level):
+            sel = (level == lev) & (rows >= 0)
+            out[sel] = self.stats.column(int(lev), what, j)[rows[sel]]
+        return out
+
+    @property
+    def basis_functions(self) -> int:
+        """Number of leaves of the partition, known and unknown (all cells of f)."""
+        return len(self.cells())
+
+    @property
+    def memory_bytes(self) -> int:
+        """Bytes of the per-level key, statistics and split-flag arrays."""
+        return self.stats.nbytes
+
+    def corners(self) -> np.ndarray:
+        """Corners of the occupied leaves at their height (M, 3), de-duplicated."""
+        cells = self.cells()
+        return rectangle_corners(cells, cells.occupied)

@@ -1,0 +1,128 @@
+"""Quadtree occupancy grid (thesis 3.1, after Pankratov's MATLAB ``quadtree``).
+
+A cell splits into four while it holds more than ``max_points`` points (thesis
+values 25-1000) and is shallower than ``max_depth`` (a guard against duplicate
+points, which no split can separate). Leaves then become free or occupied from the
+heights of their points above the ground plane:
+
+* ``occupancy="mean"`` (default): occupied when the *mean* height above the plane
+  exceeds ``height_threshold``. A large leaf that is only partly covered by an
+  obstacle averages it away, which is the free space inside obstacles of the
+  thesis' figure 4.17 and why coarse settings lose fidelity (table 5.7).
+* ``occupancy="max"``: occupied when any point rises over the threshold
+  (conservative, but a single outlier marks a whole leaf).
+
+The ground plane is a parameter, fixed for the whole map: ``ground="z0"`` (the plane
+``z = z0``), ``ground="a,b,c,d"`` (``a x + b y + c z + d = 0``) or ``ground="fit"``
+(:func:`alte.ground.fit_plane_msac` on the cloud; :meth:`Quadtree.build` only, since
+refitting per frame would change heights already inserted). The core works on the
+plane as an array, :attr:`Quadtree.plane`.
+
+The thesis' Quadtree runs once on the final cloud; this one also inserts frame by
+frame, revisiting only the cells the frame touches, and ends with the same map as
+the batch build (the split rule depends on a cell's own count only). Leaves without
+points (siblings of split cells) are *unknown*: NaN height and value, not occupied.
+"""
+
+from __future__ import annotations
+
+from typing import Any, ClassVar
+
+import numpy as np
+
+from alte.errors import AlteError, MapperError
+from alte.mappers.alte2d import plane_height
+from alte.mappers.base import Param
+from alte.mappers.quadgrid import domain_ok
+from alte.mappers.quadmap import QuadMap
+
+__all__ = ["Quadtree", "parse_ground"]
+
+RULES = ("mean", "max")
+
+
+def parse_ground(text: str) -> np.ndarray | None:
+    """``"z0"`` -> plane (0, 0, 1, -z0); ``"a,b,c,d"`` -> that plane; ``"fit"`` -> None."""
+    if text.strip().lower() == "fit":
+        return None
+    values = np.array([float(v) for v in text.split(",")])
+    if values.shape == (1,):
+        values = np.array([0.0, 0.0, 1.0, -values[0]])
+    plane_height(values, np.zeros((1, 2)))  # raises ValueError when unusable
+    return values
+
+
+def _ground_ok(text: str) -> bool:
+    try:
+        parse_ground(text)
+    except ValueError:
+        return False
+    return True
+
+
+class Quadtree(QuadMap):
+    """Point-count quadtree with a height-above-ground occupancy rule (module docstring)."""
+
+    name: ClassVar[str] = "quadtree"
+    SPECS: ClassVar[dict[str, Param]] = {
+        "max_points": Param(int, 200, lambda v: v >= 1, "max_points >= 1",
+                            "split a cell holding more points than this"),
+        "max_depth": Param(int, 12, lambda v: 0 <= v <= 24, "0 <= max_depth <= 24",
+                           "deepest level (guard against duplicate points)"),
+        "height_threshold": Param(float, 0.5, lambda v: v >= 0, "height_threshold >= 0",
+                                  "m above the ground plane for an occupied leaf"),
+        "occupancy": Param(str, "mean", lambda v: v in RULES, "mean or max",
+                           "statistic of the leaf's heights compared with the threshold"),
+        "ground": Param(str, "0", _ground_ok, "z0, a,b,c,d (non-vertical) or fit",
+                        "ground plane the heights are measured from"),
+        "domain": Param(str, "", domain_ok, "'' or xmin,ymin,size with size > 0",
+                        "fixed root square; '' = grow from the data"),
+    }
+    _NVALUES: ClassVar[int] = 2  # z, height above the plane
+
+    def __init__(self, **params: Any) -> None:
+        super().__init__(**params)
+        #: Ground plane (a, b, c, d); None until ``build`` fits it (``ground="fit"``).
+        self.plane: np.ndarray | None = parse_ground(self._params["ground"])
+
+    @property
+    def depth(self) -> int:
+        """``max_depth``: the deepest level."""
+        return int(self._params["max_depth"])
+
+    def insert(self, points: np.ndarray, origin: np.ndarray) -> None:
+        """Add one frame; needs a fixed ground plane (not ``ground=fit``)."""
+        if self.plane is None:
+            raise MapperError("quadtree: ground=fit needs the whole cloud (build); give "
+                              "insert a fixed plane, e.g. --set ground=0 or ground=a,b,c,d")
+        super().insert(points, origin)
+
+    def build(self, points: np.ndarray, origins: np.ndarray | None = None) -> None:
+        """Build from a whole cloud, fitting the ground plane first when ``ground=fit``."""
+        if self._params["ground"].strip().lower() == "fit" and len(np.atleast_2d(points)) >= 3:
+            from alte.ground import fit_plane_msac
+
+            try:
+                fit = fit_plane_msac(np.asarray(points, dtype=np.float64),
+                                     reference_normal=np.array([0.0, 0.0, 1.0]), max_angle_deg=30)
+            except AlteError as err:
+                raise MapperError(f"quadtree: {err}") from err
+            self.plane = np.r_[fit.normal, fit.d]
+        elif self.plane is None:
+            raise MapperError("quadtree: ground=fit needs at least 3 points")
+        super().build(points, origins)
+
+    def _values(self, points: np.ndarray) -> np.ndarray:
+        above = points[:, 2] - plane_height(self.plane, points[:, :2])
+        return np.column_stack([points[:, 2], above])
+
+    def _split(self, level: int, rows: np.ndarray) -> np.ndarray:
+        n = self.stats.column(level, "n")[rows]
+        return (n > self._params["max_points"]) & (level < self.depth)
+
+    def _leaf_values(self, level: np.ndarray, rows: np.ndarray, centers: np.ndarray,
+                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        z = self.leaf_stat(level, rows, "mean", 0)
+        value = self.leaf_stat(level, rows, self._params["occupancy"], 1)
+        occupied = np.isfinite(value) & (value > self._params["height_threshold"])
+        return z, value, occupied

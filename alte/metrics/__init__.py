@@ -1,0 +1,42 @@
+"""Map quality metrics: the thesis' (5.2.1) and ground-truth ones from the simulator.
+
+Thesis metrics: elapsed mapping time (measured by :mod:`alte.analysis` around the
+mapper calls only), number of basis functions (``Mapper.basis_functions``), and the
+Hausdorff / modified Hausdorff distances between the registered cloud and the corners
+of the occupied cells (:func:`hausdorff`). Ground-truth metrics (accuracy,
+completeness, 2D height RMSE and unknown share, Octomap free-space truth) are defined
+in :mod:`alte.metrics.truth`.
+"""
+
+from alte.metrics.hausdorff import HausdorffResult, directed_distances, hausdorff
+from alte.metrics.surface import SurfaceSamples, TrueSurface
+from alte.metrics.truth import (
+    accuracy,
+    cell_at_xy,
+    completeness,
+    completeness_by_class,
+    completeness_by_object,
+    distance_to_boxes,
+    free_space_truth,
+    ground_truth_metrics,
+    height_metrics_2d,
+    seen_mask,
+)
+
+__all__ = [
+    "HausdorffResult",
+    "SurfaceSamples",
+    "TrueSurface",
+    "accuracy",
+    "cell_at_xy",
+    "completeness",
+    "completeness_by_class",
+    "completeness_by_object",
+    "directed_distances",
+    "distance_to_boxes",
+    "free_space_truth",
+    "ground_truth_metrics",
+    "hausdorff",
+    "height_metrics_2d",
+    "seen_mask",
+]

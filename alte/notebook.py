@@ -1,0 +1,83 @@
+"""Helpers the chapter notebooks call, so that the notebooks hold no logic.
+
+``setup()`` chooses the rendering mode once: static off-screen images when no
+browser or display is attached (papermill, nbval, CI), pyvista's interactive trame
+backend in a JupyterLab session. ``save_results`` writes the notebook's named
+results to JSON atomically (the report runner collects them).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from alte.fsutil import atomic_path
+
+__all__ = ["interactive", "save_figure", "save_results", "setup"]
+
+_STATE = {"interactive": False}
+
+
+def interactive() -> bool:
+    """True when 3D views should be interactive (a browser is attached)."""
+    return _STATE["interactive"]
+
+
+def setup(mode: str | None = None) -> str:
+    """Select matplotlib/pyvista back-ends; returns ``"static"`` or ``"interactive"``.
+
+    ``mode`` overrides the ``ALTE_RENDER`` environment variable; without either,
+    a kernel started by papermill/nbval (no ``JPY_SESSION_NAME``) renders statically.
+    """
+    import matplotlib
+    import pyvista as pv
+
+    chosen = mode or os.environ.get("ALTE_RENDER") or (
+        "interactive" if os.environ.get("JPY_SESSION_NAME") else "static"
+    )
+    if chosen not in {"static", "interactive"}:
+        raise ValueError(f"render mode {chosen!r}: expected 'static' or 'interactive'")
+    _STATE["interactive"] = chosen == "interactive"
+    if chosen == "static":
+        matplotlib.use("Agg")
+        pv.OFF_SCREEN = True
+        pv.set_jupyter_backend("static")
+    else:
+        pv.set_jupyter_backend("trame")
+    return chosen
+
+
+def _jsonable(value: Any) -> Any:
+    if isinstance(value, Mapping):
+        return {str(k): _jsonable(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_jsonable(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return _jsonable(value.tolist())
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, Path):
+        return str(value)
+    return value
+
+
+def save_results(out_dir: str | os.PathLike[str], results: Mapping[str, Any]) -> Path:
+    """Write ``results`` to ``out_dir/results.json`` (sorted keys, atomic, overwrites)."""
+    path = Path(out_dir) / "results.json"
+    with atomic_path(path, overwrite=True) as tmp:
+        tmp.write_text(json.dumps(_jsonable(results), indent=2, sort_keys=True) + "\n")
+    return path
+
+
+def save_figure(fig: Any, out_dir: str | os.PathLike[str], name: str) -> Path:
+    """Save a matplotlib figure as ``out_dir/figures/name.png`` (atomic, overwrites)."""
+    path = Path(out_dir) / "figures" / f"{name}.png"
+    with atomic_path(path, overwrite=True) as tmp:
+        fig.savefig(tmp, format="png", dpi=110, bbox_inches="tight",
+                    metadata={"Software": None})
+    return path

@@ -1,0 +1,172 @@
+"""Map figures: 2D segments and occupancy (fig. 4.17), 3D cell boxes (fig. 3.15), counts.
+
+Every cell set is drawn as one collection (matplotlib ``PolyCollection`` or one
+pyvista ``UnstructuredGrid``), never one artist per cell, so maps with tens of
+thousands of cells draw quickly. Unknown cells (NaN value, the 2D mappers'
+cells without points) are drawn grey, never like ground.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from alte.mappers.base import Cells
+
+__all__ = [
+    "UNKNOWN_COLOR",
+    "add_cells_3d",
+    "add_timelapse_3d",
+    "cells_mesh",
+    "plot_basis_functions_over_time",
+    "plot_map_2d",
+    "plot_timelapse_2d",
+]
+
+UNKNOWN_COLOR = (0.8, 0.8, 0.8, 1.0)
+_SIGNS_2D = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]], dtype=np.float64)
+# VTK hexahedron order: bottom face counter-clockwise, then the top face.
+_SIGNS_3D = np.array([[-1, -1, -1], [1, -1, -1], [1, 1, -1], [-1, 1, -1],
+                      [-1, -1, 1], [1, -1, 1], [1, 1, 1], [-1, 1, 1]], dtype=np.float64)
+
+
+def _rectangles(cells: Cells) -> np.ndarray:
+    """(K, 4, 2) footprints of the cells."""
+    half = cells.sizes[:, None, :2] / 2
+    return cells.centers[:, None, :2] + _SIGNS_2D[None] * half
+
+
+def _frame_axes(ax: Any, verts: np.ndarray, title: str | None) -> None:
+    if len(verts):
+        lo, hi = verts.reshape(-1, 2).min(axis=0), verts.reshape(-1, 2).max(axis=0)
+        ax.set_xlim(lo[0], hi[0])
+        ax.set_ylim(lo[1], hi[1])
+    ax.set_aspect("equal")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    if title:
+        ax.set_title(title)
+
+
+def plot_map_2d(cells: Cells, ax_segments: Any, ax_occupancy: Any | None = None,
+                title: str | None = None, cmap: str = "viridis") -> tuple[Any, Any | None]:
+    """Segments coloured by height (left) and the occupancy grid (right), as fig. 4.17.
+
+    Heights come from ``centers[:, 2]``; unknown cells are grey in both panels,
+    occupied cells black and free cells white in the occupancy panel. Returns the
+    two ``PolyCollection`` objects (the second None without ``ax_occupancy``).
+    """
+    import matplotlib as mpl
+    from matplotlib.collections import PolyCollection
+
+    verts = _rectangles(cells)
+    z = cells.centers[:, 2]
+    known = np.isfinite(z)
+    norm = mpl.colors.Normalize(*(np.nanmin(z), np.nanmax(z)) if known.any() else (0, 1))
+    colours = np.tile(UNKNOWN_COLOR, (len(cells), 1))
+    colours[known] = mpl.colormaps[cmap](norm(z[known]))
+    seg = PolyCollection(verts, facecolors=colours, edgecolors="k", linewidths=0.2)
+    ax_segments.add_collection(seg)
+    mappable = mpl.cm.ScalarMappable(norm=norm, cmap=cmap)
+    ax_segments.figure.colorbar(mappable, ax=ax_segments, label="height [m]", shrink=0.8)
+    _frame_axes(ax_segments, verts, f"{title} - segments" if title else "segments")
+    if ax_occupancy is None:
+        return seg, None
+    occ_colours = np.where(cells.occupied[:, None], (0.0, 0.0, 0.0, 1.0), (1.0, 1.0, 1.0, 1.0))
+    occ_colours[~known & ~cells.occupied] = UNKNOWN_COLOR
+    occ = PolyCollection(verts, facecolors=occ_colours, edgecolors=(0.5, 0.5, 0.5, 1.0),
+                         linewidths=0.2)
+    ax_occupancy.add_collection(occ)
+    handles = [mpl.patches.Patch(facecolor=c, edgecolor="k", label=lab) for c, lab in
+               (((0, 0, 0, 1), "occupied"), ((1, 1, 1, 1), "free"), (UNKNOWN_COLOR, "unknown"))]
+    ax_occupancy.legend(handles=handles, loc="upper right", fontsize="small")
+    _frame_axes(ax_occupancy, verts, f"{title} - occupancy" if title else "occupancy")
+    return seg, occ
+
+
+def cells_mesh(cells: Cells, occupied_only: bool = True, color_by: str = "height") -> Any:
+    """One pyvista ``UnstructuredGrid``: boxes for 3D cells, flat squares for 2D cells.
+
+    ``color_by``: ``height`` (top of the cell, fig. 3.15), ``value`` or ``level``;
+    the scalars are stored under that name. Unknown (NaN-height) cells are skipped.
+    """
+    import pyvista as pv
+
+    if color_by not in {"height", "value", "level"}:
+        raise ValueError(f"color_by={color_by!r}: expected height, value or level")
+    mask = np.isfinite(cells.centers).all(axis=1)
+    if occupied_only:
+        mask &= cells.occupied
+    centers, sizes = cells.centers[mask], cells.sizes[mask]
+    flat = sizes[:, 2] <= 0
+    blocks, points, offset = {}, [], 0
+    for cell_type, signs, sel in ((pv.CellType.HEXAHEDRON, _SIGNS_3D, ~flat),
+                                  (pv.CellType.QUAD, np.c_[_SIGNS_2D, np.zeros(4)], flat)):
+        k = int(sel.sum())
+        if k:
+            corners = centers[sel, None] + signs[None] * sizes[sel, None] / 2
+            points.append(corners.reshape(-1, 3))
+            blocks[cell_type] = offset + np.arange(k * len(signs)).reshape(k, len(signs))
+            offset += k * len(signs)
+    if not blocks:
+        return pv.UnstructuredGrid()
+    order = np.r_[np.flatnonzero(~flat), np.flatnonzero(flat)]
+    grid = pv.UnstructuredGrid(blocks, np.concatenate(points))
+    scalars = {"height": (centers + sizes / 2)[:, 2], "value": cells.value[mask],
+               "level": cells.level[mask].astype(np.float64)}[color_by]
+    grid.cell_data[color_by] = scalars[order]
+    return grid
+
+
+def add_cells_3d(plotter: Any, cells: Cells, occupied_only: bool = True,
+                 color_by: str = "height", cmap: str = "viridis", **kwargs: Any) -> Any:
+    """Add the cells to a pyvista ``plotter`` coloured by ``color_by``; returns the mesh."""
+    grid = cells_mesh(cells, occupied_only, color_by)
+    if grid.n_cells == 0:
+        return grid
+    options = {"show_edges": True, "edge_color": "black", "line_width": 0.5, **kwargs}
+    plotter.add_mesh(grid, scalars=color_by, cmap=cmap, **options)
+    return grid
+
+
+def plot_basis_functions_over_time(times: Any, counts: Any, ax: Any,
+                                   label: str | None = None) -> Any:
+    """Step plot of the number of basis functions against mission time; returns the line."""
+    (line,) = ax.step(np.asarray(times, dtype=np.float64), np.asarray(counts), where="post",
+                      label=label)
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("basis functions")
+    if label:
+        ax.legend()
+    return line
+
+
+def plot_timelapse_2d(snapshots: Sequence[Any], title: str = "") -> Any:
+    """One row per snapshot (``.time``, ``.cells``): segments left, occupancy right.
+
+    The thesis' time-lapse figures 3.3 and 3.14; returns the matplotlib figure.
+    """
+    import matplotlib.pyplot as plt
+
+    rows = max(len(snapshots), 1)
+    fig, axes = plt.subplots(rows, 2, figsize=(11, 4.2 * rows), squeeze=False)
+    for (ax_seg, ax_occ), snap in zip(axes, snapshots, strict=False):
+        plot_map_2d(snap.cells, ax_seg, ax_occ, title=f"{title} t = {snap.time:.1f} s")
+    fig.tight_layout()
+    return fig
+
+
+def add_timelapse_3d(plotter: Any, snapshots: Sequence[Any], title: str = "",
+                     **kwargs: Any) -> None:
+    """Fill a ``(1, len(snapshots))`` plotter with the occupied cells of each snapshot.
+
+    The thesis' time-lapse figures 3.7 and 3.17 (cells coloured by height).
+    """
+    for col, snap in enumerate(snapshots):
+        plotter.subplot(0, col)
+        add_cells_3d(plotter, snap.cells, **kwargs)
+        plotter.add_text(f"{title} t = {snap.time:.1f} s", font_size=9)
+        plotter.show_axes()
+    plotter.link_views()

@@ -1,0 +1,187 @@
+"""What ``alte report`` runs, as data: one :class:`Entry` per notebook run.
+
+An entry names a notebook and the parameters it gets in quick and full mode
+(``None`` = not run in that mode). :func:`build_plan` turns entries into concrete
+:class:`Run` objects, checked against the parameters each notebook declares
+(``papermill.inspect_notebook``), so a misspelt parameter is an error, never ignored.
+"""
+
+from __future__ import annotations
+
+import ast
+import json
+import os
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from alte.errors import ParameterError, ReportError
+
+__all__ = [
+    "PLAN",
+    "RUNNER_PARAMETERS",
+    "TERRAINS",
+    "Entry",
+    "Run",
+    "build_plan",
+    "load_plan",
+    "notebook_parameters",
+    "parse_param",
+]
+
+#: The eight mission profiles of chapter 4 (simulated and experimental, navigation and landing).
+TERRAINS: tuple[str, ...] = (
+    "sim_nav_1", "sim_nav_2", "sim_lan_1", "sim_lan_2",
+    "exp_nav_1", "exp_nav_2", "exp_lan_1", "exp_lan_2",
+)
+#: Terrains chapter 4 is run on in quick mode (one navigation, one landing profile).
+QUICK_TERRAINS: tuple[str, ...] = ("sim_nav_1", "sim_lan_1")
+#: Parameters the runner sets itself (output locations); users cannot override them.
+RUNNER_PARAMETERS: tuple[str, ...] = ("OUT_DIR", "TABLES_DIR", "DATA_DIR")
+
+
+@dataclass(frozen=True)
+class Entry:
+    """One planned notebook run; ``quick``/``full`` are its parameters (None = skipped)."""
+
+    name: str
+    notebook: str
+    quick: Mapping[str, Any] | None = field(default_factory=dict)
+    full: Mapping[str, Any] | None = field(default_factory=dict)
+    terrains: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
+class Run:
+    """A concrete run: notebook path, user parameters and the terrains it needs."""
+
+    name: str
+    notebook: Path
+    parameters: Mapping[str, Any]
+    defaults: Mapping[str, Any]
+    terrains: tuple[str, ...]
+
+    def value(self, name: str) -> Any:
+        """The value ``name`` takes in this run (planned, else the notebook's default)."""
+        return self.parameters.get(name, self.defaults.get(name))
+
+
+def _ch4(terrain: str) -> Entry:
+    quick = {"TERRAIN": terrain} if terrain in QUICK_TERRAINS else None
+    return Entry(f"ch4_{terrain}", "ch4_terrain.ipynb", quick,
+                 {"TERRAIN": terrain, "FRAMES": None})
+
+
+#: The report: chapters 2 and 3 once, chapter 4 once per terrain, chapter 5 once.
+PLAN: tuple[Entry, ...] = (
+    Entry("ch2_test_benchmark", "ch2_test_benchmark.ipynb", {}, {"FRAMES": None}),
+    Entry("ch3_mapping_techniques", "ch3_mapping_techniques.ipynb", {}, {"FRAMES": None}),
+    *(_ch4(terrain) for terrain in TERRAINS),
+    Entry("ch5_analysis", "ch5_analysis.ipynb", {}, {"FRAMES": None, "ROWS": None},
+          terrains=("sim_nav_1", "sim_lan_2", "sim_nav_2")),
+)
+
+
+def parse_param(text: str) -> tuple[str, Any]:
+    """``"NAME=VALUE"`` -> (NAME, value); VALUE is a Python literal or else a string."""
+    name, sep, raw = text.partition("=")
+    name = name.strip()
+    if not sep or not name.isidentifier():
+        raise ParameterError(f"--param {text!r}: expected NAME=VALUE")
+    try:
+        value = ast.literal_eval(raw)
+    except (ValueError, SyntaxError):
+        value = raw
+    return name, value
+
+
+def notebook_parameters(path: str | os.PathLike[str]) -> dict[str, Any]:
+    """The parameters a notebook's ``parameters`` cell declares, with their default values."""
+    import papermill
+
+    path = Path(path)
+    if not path.is_file():
+        raise ReportError(f"notebook {path} does not exist")
+    try:
+        inferred = papermill.inspect_notebook(str(path))
+    except Exception as err:
+        raise ReportError(f"notebook {path}: cannot read its parameters ({err})") from err
+    out: dict[str, Any] = {}
+    for name, info in inferred.items():
+        try:
+            out[name] = ast.literal_eval(info["default"])
+        except (ValueError, SyntaxError):
+            out[name] = info["default"]
+    return out
+
+
+def load_plan(path: str | os.PathLike[str]) -> tuple[Entry, ...]:
+    """Read a plan from JSON: a list of objects with the :class:`Entry` fields."""
+    path = Path(path)
+    try:
+        items = json.loads(path.read_text())
+        return tuple(Entry(**{**item, "terrains": tuple(item.get("terrains", ()))})
+                     for item in items)
+    except (OSError, ValueError, TypeError) as err:
+        raise ReportError(f"plan {path}: {err}") from err
+
+
+def _select(entries: Sequence[Entry], quick: bool, only: Iterable[str]) -> list[Entry]:
+    mode = [e for e in entries if (e.quick if quick else e.full) is not None]
+    only = list(only)
+    if not only:
+        return mode
+    known = {e.name for e in mode} | {Path(e.notebook).stem for e in mode}
+    unknown = [name for name in only if name not in known]
+    if unknown:
+        raise ParameterError(f"--only {', '.join(unknown)}: no such run; valid: "
+                             f"{', '.join(sorted(known))}")
+    return [e for e in mode if e.name in only or Path(e.notebook).stem in only]
+
+
+def _check_overrides(overrides: Mapping[str, Any], declared: Mapping[str, Iterable[str]]) -> None:
+    fixed = sorted(set(overrides) & set(RUNNER_PARAMETERS))
+    if fixed:
+        raise ParameterError(f"--param {', '.join(fixed)}: set by the runner (use --out/--data)")
+    valid = set().union(*declared.values()) - set(RUNNER_PARAMETERS) if declared else set()
+    unknown = sorted(set(overrides) - valid)
+    if unknown:
+        raise ParameterError(f"unknown notebook parameter {', '.join(unknown)}; valid parameters: "
+                             f"{', '.join(sorted(valid)) or '(none)'}")
+
+
+def _terrains(entry: Entry, params: Mapping[str, Any]) -> tuple[str, ...]:
+    terrain = params.get("TERRAIN")
+    named = (terrain,) if isinstance(terrain, str) and terrain else ()
+    return tuple(dict.fromkeys((*named, *entry.terrains)))
+
+
+def build_plan(entries: Sequence[Entry] = PLAN, *, quick: bool,
+               notebooks_dir: str | os.PathLike[str], only: Iterable[str] = (),
+               overrides: Mapping[str, Any] | None = None) -> list[Run]:
+    """Concrete runs for the mode, ``--only`` selection and ``--param`` overrides.
+
+    Every plan parameter must be declared by its notebook and every override by at
+    least one selected notebook (else :class:`ParameterError` listing the valid names).
+    """
+    overrides = dict(overrides or {})
+    selected = _select(entries, quick, only)
+    declared = {e.notebook: notebook_parameters(Path(notebooks_dir) / e.notebook)
+                for e in selected}
+    _check_overrides(overrides, {nb: list(p) for nb, p in declared.items()})
+    runs = []
+    for entry in selected:
+        defaults = declared[entry.notebook]
+        planned = dict((entry.quick if quick else entry.full) or {})
+        bad = sorted(set(planned) - set(defaults))
+        if bad:
+            raise ParameterError(f"plan entry {entry.name}: {entry.notebook} has no parameter "
+                                 f"{', '.join(bad)}; valid parameters: "
+                                 f"{', '.join(sorted(defaults))}")
+        if "OUT_DIR" not in defaults:
+            raise ReportError(f"notebook {entry.notebook} declares no OUT_DIR parameter")
+        planned |= {k: v for k, v in overrides.items() if k in defaults}
+        runs.append(Run(entry.name, Path(notebooks_dir) / entry.notebook, planned,
+                        defaults, _terrains(entry, defaults | planned)))
+    return runs

@@ -1,0 +1,131 @@
+"""Fly (or push) one terrain's mission: poses -> rays -> scans and the pose stream.
+
+Pure arrays, no files. Scans are taken at 10 Hz along the whole mission; with
+``frames=N`` an evenly spaced subset of the same scans is simulated (same path,
+speeds and dynamics, fewer scans), and every scan draws its noise from its own
+``SeedSequence(seed, spawn_key=(terrain, 0, scan index))`` stream, so a scan's
+points do not depend on ``frames`` or on which other terrains were simulated.
+Experimental cases stamp each scan ``time_offset_s`` + N(0, ``jitter_s``) earlier
+than it was really taken, the desynchronization of thesis fig. 4.34.
+"""
+
+from __future__ import annotations
+
+import zlib
+from dataclasses import dataclass
+
+import numpy as np
+from tqdm.auto import tqdm
+
+from alte.errors import ParameterError
+from alte.sim.platform import Cart, Trajectory, mocap_stream
+from alte.sim.scene import CLASSES
+from alte.sim.sensor import VLP16, cast, measure
+from alte.sim.terrains import Terrain
+from alte.types import Mount
+
+__all__ = ["START_NS", "Simulation", "scan_indices", "simulate"]
+
+#: Stamp of the mission start (2023-11-14T22:13:20Z), fixed for byte-identical bags.
+START_NS = 1_700_000_000_000_000_000
+_SCAN_PHASE_NS = 53_000_000
+_BATCH = 48
+
+
+@dataclass(frozen=True, eq=False)
+class Simulation:
+    """Simulated scans (sensor frame) with their stamps, and the pose stream of the body."""
+
+    stamps: np.ndarray
+    scans: list[np.ndarray]
+    scan_index: np.ndarray
+    pose_stamps: np.ndarray
+    positions: np.ndarray
+    quaternions: np.ndarray
+    mount: Mount
+    counts: dict[str, int]
+    duration_s: float
+
+
+def scan_indices(total: int, frames: int | None) -> np.ndarray:
+    """Indices of the simulated scans among the mission's ``total`` (evenly spaced)."""
+    if frames is None:
+        return np.arange(total)
+    if isinstance(frames, bool) or not isinstance(frames, int | np.integer) or frames < 1:
+        raise ParameterError(f"frames={frames!r}: expected a positive integer or None")
+    if frames > total:
+        raise ParameterError(f"frames={frames} exceeds the mission's {total} scans")
+    return np.unique(np.round(np.linspace(0, total - 1, frames)).astype(np.int64))
+
+
+def _rng(seed: int, name: str, *stream: int) -> np.random.Generator:
+    """Generator of ``stream`` (0 = scan noise, 1 = desync, 2 = motion capture) of a terrain."""
+    if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
+        raise ParameterError(f"seed={seed!r}: expected a non-negative integer")
+    key = zlib.crc32(name.encode())
+    return np.random.default_rng(np.random.SeedSequence(int(seed), spawn_key=(key, *stream)))
+
+
+def _acquisition_times(terrain: Terrain, seed: int, stamps_s: np.ndarray,
+                       index: np.ndarray) -> np.ndarray:
+    """True scan times: the stamps, late by the pose/scan offset and jitter (cart only)."""
+    platform = terrain.spec.platform
+    if not isinstance(platform, Cart):
+        return stamps_s
+    rng = _rng(seed, terrain.spec.name, 1)
+    jitter = rng.normal(0.0, platform.jitter_s, terrain.spec.frames)[index]
+    return stamps_s + platform.time_offset_s + jitter
+
+
+def _pose_stream(terrain: Terrain, traj: Trajectory, seed: int,
+                 stamps: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Gazebo's true state at the scan stamps, or 100 Hz motion capture (cart)."""
+    platform = terrain.spec.platform
+    if not isinstance(platform, Cart):
+        pos, rot = traj.pose((stamps - START_NS) / 1e9)
+        return stamps, pos, rot.as_quat(canonical=False)
+    step = round(1e9 / platform.mocap_hz)
+    pose_stamps = START_NS + step * np.arange(int((traj.duration + 0.1) * 1e9) // step + 1)
+    rng = _rng(seed, terrain.spec.name, 2)
+    pos, quat = mocap_stream(traj, (pose_stamps - START_NS) / 1e9, platform, rng)
+    return pose_stamps.astype(np.int64), pos, quat
+
+
+def simulate(terrain: Terrain, seed: int = 0, frames: int | None = None,
+             sensor: VLP16 | None = None, progress: bool = False) -> Simulation:
+    """Simulate ``terrain``'s mission (all scans, or ``frames`` evenly spaced ones)."""
+    sensor = sensor or VLP16()
+    spec, mount = terrain.spec, terrain.spec.mount
+    _rng(seed, spec.name)  # validates the seed
+    index = scan_indices(spec.frames, frames)
+    period = round(1e9 / sensor.rate_hz)
+    stamps = START_NS + _SCAN_PHASE_NS + period * index
+    traj = Trajectory(spec.platform, spec.frames * period / 1e9)
+    acq = _acquisition_times(terrain, seed, (stamps - START_NS) / 1e9, index)
+    body_pos, body_rot = traj.pose(acq)
+    sensor_pos = body_pos + body_rot.apply(mount.translation)
+    sensor_rot = body_rot * mount.rotation
+    directions, raycaster = sensor.directions(), terrain.scene.raycaster()
+    class_ids = terrain.scene.class_ids
+    scans: list[np.ndarray] = []
+    counts: dict[str, int] = {}
+    for lo in tqdm(range(0, len(index), _BATCH), desc=spec.name, unit="batch",
+                   disable=not progress):
+        sl = slice(lo, lo + _BATCH)
+        hits = cast(raycaster, sensor_pos[sl], sensor_rot[sl], directions)
+        rngs = [_rng(seed, spec.name, 0, int(i)) for i in index[sl]]
+        ranges, part = measure(hits, sensor, rngs)
+        valid = np.isfinite(ranges)
+        scans += [directions[v] * r[v, None] for v, r in zip(valid, ranges, strict=True)]
+        part.update(_class_counts(class_ids[hits.triangle[valid]]))
+        counts = {k: counts.get(k, 0) + part.get(k, 0) for k in {*counts, *part}}
+    pose_stamps, positions, quats = _pose_stream(terrain, traj, seed, stamps)
+    counts["frames"], counts["poses"] = len(index), len(pose_stamps)
+    return Simulation(stamps.astype(np.int64), scans, index, pose_stamps, positions, quats, mount,
+                      dict(sorted(counts.items())), traj.duration)
+
+
+def _class_counts(class_ids: np.ndarray) -> dict[str, int]:
+    """Returns per object class, keyed ``returns_<class>``."""
+    per = np.bincount(class_ids, minlength=len(CLASSES))
+    return {f"returns_{c}": int(n) for c, n in zip(CLASSES, per, strict=True) if n}

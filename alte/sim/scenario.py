@@ -1,0 +1,209 @@
+"""Terrain folders on disk: ``DIR/NAME/`` = ROS 2 bag + ground truth + scenario.json.
+
+:func:`ensure_terrain` simulates a terrain unless a finished folder with the same
+spec hash and seed already exists; the folder is built under a temporary name and
+renamed when complete (:func:`alte.fsutil.atomic_dir`), and scenario.json records
+the size and SHA-256 of every file, so an interrupted or altered run is never
+mistaken for a finished one. :func:`load_scenario` reads a folder back.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from alte.errors import AlteError, SimulationError
+from alte.fsutil import atomic_dir
+from alte.sim.groundtruth import GROUND_TRUTH_FILE, load_ground_truth, write_ground_truth
+from alte.sim.mission import Simulation, simulate
+from alte.sim.scene import Scene
+from alte.sim.sensor import VLP16
+from alte.sim.terrains import TERRAINS, Terrain
+from alte.types import Mount
+
+__all__ = ["BAG_DIR", "SCENARIO_FILE", "SIM_VERSION", "Scenario", "ensure_terrain", "get_terrain",
+           "is_current", "load_scenario", "spec_hash", "update_terrain", "write_scenario"]
+
+#: Bump when the simulator's output changes for the same spec (invalidates caches).
+SIM_VERSION = 1
+SCENARIO_FILE = "scenario.json"
+BAG_DIR = "bag"
+CLOUD_TOPIC = "/velodyne_points"
+POSE_TOPIC = "/pose"
+
+
+def get_terrain(name: str) -> Terrain:
+    """Build the registered terrain ``name``; SimulationError lists the valid names."""
+    try:
+        builder = TERRAINS[name]
+    except KeyError as err:
+        raise SimulationError(f"unknown terrain {name!r}; valid: {', '.join(TERRAINS)}") from err
+    return builder()
+
+
+def spec_hash(terrain: Terrain, frames: int | None, storage: str,
+              sensor: VLP16 | None = None) -> str:
+    """SHA-256 of everything that defines the output except the seed (the cache key)."""
+    sensor = sensor or VLP16()
+    spec = {"version": SIM_VERSION, "spec": terrain.spec.to_dict(), "sensor": sensor.to_dict(),
+            "frames": frames, "storage": storage, "mount": terrain.spec.mount.to_string()}
+    digest = hashlib.sha256(json.dumps(spec, sort_keys=True).encode())
+    scene = terrain.scene
+    for arr in (scene.vertices, scene.triangles, scene.object_ids):
+        digest.update(np.ascontiguousarray(arr).tobytes())
+    digest.update(json.dumps([[o.name, o.cls] for o in scene.objects]).encode())
+    return digest.hexdigest()
+
+
+def _file_table(root: Path) -> dict[str, dict[str, Any]]:
+    table = {}
+    for path in sorted(p for p in root.rglob("*") if p.is_file()):
+        rel = path.relative_to(root).as_posix()
+        if rel != SCENARIO_FILE:
+            table[rel] = {"size": path.stat().st_size,
+                          "sha256": hashlib.sha256(path.read_bytes()).hexdigest()}
+    return table
+
+
+def _mount_dict(mount: Mount) -> dict[str, Any]:
+    return {"translation": mount.translation.tolist(), "quaternion": mount.quaternion.tolist(),
+            "xyz_rpy_deg": mount.to_string()}
+
+
+def _metadata(terrain: Terrain, sim: Simulation, seed: int, frames: int | None,
+              key: str, storage: str) -> dict[str, Any]:
+    spec = terrain.spec
+    control = list(spec.crop_box) if spec.kind == "exp" else None
+    return {
+        "alte_sim_version": SIM_VERSION, "name": spec.name, "section": spec.section,
+        "title": spec.title, "case": spec.case, "kind": spec.kind, "seed": int(seed),
+        "frames_requested": frames, "spec_hash": key, "storage": storage,
+        "bag": BAG_DIR, "ground_truth": GROUND_TRUTH_FILE,
+        "cloud_topic": CLOUD_TOPIC, "pose_topic": POSE_TOPIC,
+        "crop_box": list(spec.crop_box), "control_volume": control,
+        "extent": terrain.scene.bounds().tolist(), "landing_zone": spec.landing_zone,
+        "registration_voxel": spec.registration_voxel, "mount": _mount_dict(spec.mount),
+        "duration_s": sim.duration_s, "spec": spec.to_dict(), "sensor": VLP16().to_dict(),
+        "counts": sim.counts,
+        "objects": [{"id": i, "name": o.name, "class": o.cls}
+                    for i, o in enumerate(terrain.scene.objects)],
+    }
+
+
+def write_scenario(target: str | os.PathLike[str], terrain: Terrain, sim: Simulation, seed: int,
+                   frames: int | None, storage: str = "sqlite3", progress: bool = False) -> Path:
+    """Write bag, ground truth and scenario.json into ``target`` atomically (replacing it)."""
+    from alte.io.writer import write_bag
+
+    key = spec_hash(terrain, frames, storage)
+    with atomic_dir(target, overwrite=True) as tmp:
+        tmp.mkdir()
+        write_bag(tmp / BAG_DIR, zip(sim.stamps.tolist(), sim.scans, strict=True),
+                  sim.pose_stamps, sim.positions, sim.quaternions, sim.mount,
+                  cloud_topic=CLOUD_TOPIC, pose_topic=POSE_TOPIC, storage=storage,
+                  progress=progress)
+        write_ground_truth(tmp / GROUND_TRUTH_FILE, terrain.scene)
+        meta = _metadata(terrain, sim, seed, frames, key, storage)
+        meta["files"] = _file_table(tmp)
+        (tmp / SCENARIO_FILE).write_text(json.dumps(meta, indent=2, sort_keys=True) + "\n")
+    return Path(target)
+
+
+def is_current(folder: Path, key: str, seed: int) -> bool:
+    """True when ``folder`` holds a finished simulation with this spec hash and seed."""
+    try:
+        meta = json.loads((folder / SCENARIO_FILE).read_text())
+    except (OSError, ValueError):
+        return False
+    if meta.get("spec_hash") != key or meta.get("seed") != seed or not meta.get("files"):
+        return False
+    return _file_table(folder) == meta["files"]
+
+
+def ensure_terrain(name: str, out_dir: str | os.PathLike[str] = "data", seed: int = 0,
+                   frames: int | None = None, *, storage: str = "sqlite3", force: bool = False,
+                   progress: bool = False) -> Path:
+    """Simulate terrain ``name`` into ``out_dir/name`` unless it is already current."""
+    return update_terrain(name, out_dir, seed, frames, storage=storage, force=force,
+                          progress=progress)[0]
+
+
+def update_terrain(name: str, out_dir: str | os.PathLike[str] = "data", seed: int = 0,
+                   frames: int | None = None, *, storage: str = "sqlite3", force: bool = False,
+                   progress: bool = False) -> tuple[Path, bool]:
+    """As :func:`ensure_terrain`; also says whether the terrain was (re)simulated."""
+    terrain = get_terrain(name)
+    target = Path(out_dir) / name
+    key = spec_hash(terrain, frames, storage)
+    if not force and is_current(target, key, seed):
+        return target, False
+    if target.exists() and not force and not (target / SCENARIO_FILE).is_file():
+        raise SimulationError(f"{target} exists but is not a simulated terrain folder; "
+                              "remove it or pass force=True (--force)")
+    sim = simulate(terrain, seed=seed, frames=frames, progress=progress)
+    return write_scenario(target, terrain, sim, seed, frames, storage, progress=progress), True
+
+
+@dataclass(frozen=True, eq=False)
+class Scenario:
+    """A simulated terrain read back from its folder."""
+
+    path: Path
+    bag: Path
+    metadata: dict[str, Any]
+    ground_truth: Scene
+
+    @property
+    def name(self) -> str:
+        """Terrain name."""
+        return str(self.metadata["name"])
+
+    @property
+    def case(self) -> str:
+        """``"nav"`` (3D maps) or ``"lan"`` (2D maps)."""
+        return str(self.metadata["case"])
+
+    @property
+    def crop_box(self) -> tuple[float, ...]:
+        """Region kept by registration: the control volume or the scene's extent."""
+        return tuple(float(v) for v in self.metadata["crop_box"])
+
+    @property
+    def registration_voxel(self) -> float:
+        """Recommended grid-average voxel (m) for thesis-sized clouds."""
+        return float(self.metadata["registration_voxel"])
+
+    @property
+    def mount(self) -> Mount:
+        """Sensor mount (also stored in the bag's ``/tf_static``)."""
+        mount = self.metadata["mount"]
+        return Mount(np.asarray(mount["translation"]), np.asarray(mount["quaternion"]))
+
+
+def load_scenario(directory: str | os.PathLike[str]) -> Scenario:
+    """Read ``DIR/NAME`` (scenario.json, bag path, ground truth)."""
+    folder = Path(directory)
+    try:
+        meta = json.loads((folder / SCENARIO_FILE).read_text())
+    except OSError as err:
+        raise SimulationError(f"{folder}: no {SCENARIO_FILE}; run `alte simulate`") from err
+    except ValueError as err:
+        raise SimulationError(f"{folder / SCENARIO_FILE}: not valid JSON ({err})") from err
+    missing = [k for k in ("name", "case", "bag", "crop_box", "registration_voxel", "mount")
+               if k not in meta]
+    if missing:
+        raise SimulationError(f"{folder / SCENARIO_FILE}: missing keys {missing}")
+    bag = folder / meta["bag"]
+    if not bag.is_dir():
+        raise SimulationError(f"{folder}: bag folder {bag.name!r} is missing")
+    try:
+        truth = load_ground_truth(folder)
+    except AlteError as err:
+        raise SimulationError(f"{folder}: {err}") from err
+    return Scenario(folder, bag, meta, truth)

@@ -1,0 +1,155 @@
+"""Tests for ``alte register``: a real bag end to end, and the command's own logic."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from alte.cli import main
+from alte.commands import register as command
+from alte.commands.register import format_counts, parse_box
+from alte.errors import ParameterError
+from alte.io import read_frames, write_frames
+from alte.io.pointfiles import read_points
+from alte.registration import crop, grid_average, register_frame
+from alte.types import Mount
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from test_registration import make_frame, scene
+
+BOX = (-4.0, -4.0, -4.0, 4.0, 4.0, 4.0)
+
+
+def test_register_bag_end_to_end(tmp_path, capsys):
+    truth, frames, mount = scene(seed=5, frames=5, n=300)
+    bag = write_frames(tmp_path / "scans", frames, mount, dtype=np.float64)
+    out = tmp_path / "cloud.npz"
+    box = ",".join(str(v) for v in BOX)
+    argv = ["register", str(bag), "--out", str(out), "--voxel", "0.5", f"--crop={box}"]
+    assert main(argv) == 0
+    expected = grid_average(np.vstack([crop(t, BOX) for t in truth]), 0.5)
+    got = read_points(out)
+    def rows(a):
+        return a[np.lexsort(a.T[::-1])]
+
+    assert got.shape == expected.shape
+    np.testing.assert_allclose(rows(got), rows(expected), atol=1e-9)
+    text = capsys.readouterr().out
+    assert "frames: 5 in, 5 kept" in text
+    assert f"{len(expected)} out" in text
+    assert main(argv) == 2  # exists, no --force
+    assert "already exists" in capsys.readouterr().err
+    assert main([*argv, "--force"]) == 0
+
+
+@pytest.fixture
+def fake_io(monkeypatch):
+    """Replace the bag reader and point writer by in-memory fakes."""
+    _truth, frames, mount = scene(seed=1, frames=3, n=100)
+    frames.append(make_frame(frames[0].points, frames[0].position, frames[0].quaternion,
+                             rate=9.0))
+    calls: dict[str, object] = {}
+
+    def read_frames(path, **kwargs):
+        calls["read"] = (path, kwargs)
+        return SimpleNamespace(frames=frames, mount=kwargs["mount"] or mount,
+                               counts={"scans_read": 4})
+
+    def write_points(path, points, overwrite=False):
+        calls["write"] = (path, points, overwrite)
+        Path(path).write_text("cloud")
+
+    monkeypatch.setattr(command, "read_frames", read_frames)
+    monkeypatch.setattr(command, "write_points", write_points)
+    return calls
+
+
+def test_command_passes_options_and_prints_counts(tmp_path, capsys, fake_io):
+    out = tmp_path / "c.ply"
+    argv = ["register", "bag", "--out", str(out), "--max-rate", "1", "--cloud-topic", "/c",
+            "--pose-topic", "/p", "--mount", "0,0,0,0,0,90"]
+    assert main(argv) == 0
+    path, kwargs = fake_io["read"]
+    assert str(path) == "bag"
+    assert (kwargs["cloud_topic"], kwargs["pose_topic"], kwargs["progress"]) == ("/c", "/p", True)
+    np.testing.assert_allclose(kwargs["mount"].quaternion, Mount.from_string(
+        "0,0,0,0,0,90").quaternion)
+    written = fake_io["write"]
+    assert written[1].shape == (300, 3)
+    assert written[2] is False
+    text = capsys.readouterr().out
+    assert "bag: scans read 4" in text
+    assert "frames: 4 in, 3 kept; dropped 1 (angular rate)" in text
+    assert "points: 300 in" in text
+    assert f"wrote 300 points to {out}" in text
+
+
+@pytest.mark.parametrize(("extra", "match"), [
+    (["--crop", "1,2,3"], "--crop '1,2,3': expected 6 numbers"),
+    (["--crop", "a,b,c,d,e,f"], "expected 6 numbers"),
+    (["--crop", "1,1,1,0,0,0"], "crop box"),
+    (["--voxel", "0"], "voxel=0.0"),
+    (["--max-offset", "-1"], "max_offset_s"),
+    (["--mount", "1,2"], "--mount '1,2'"),
+    (["--out", "c.png"], "unknown point file type"),
+])
+def test_bad_options_fail_before_reading(tmp_path, capsys, fake_io, extra, match):
+    assert main(["register", "bag", "--out", str(tmp_path / "c.ply"), *extra]) == 2
+    assert match in capsys.readouterr().err
+    assert "read" not in fake_io
+
+
+def test_existing_output_refused_before_reading(tmp_path, capsys, fake_io):
+    out = tmp_path / "c.ply"
+    out.write_text("mine")
+    assert main(["register", "bag", "--out", str(out)]) == 2
+    assert "already exists" in capsys.readouterr().err
+    assert "read" not in fake_io
+    assert main(["register", "bag", "--out", str(out), "--force"]) == 0
+    assert fake_io["write"][2] is True
+
+
+def test_all_frames_dropped_is_an_error(tmp_path, capsys, fake_io):
+    argv = ["register", "bag", "--out", str(tmp_path / "c.ply"), "--crop=100,100,100,101,101,101"]
+    assert main(argv) == 2
+    assert "all 4 frames dropped (4 empty)" in capsys.readouterr().err
+    assert "write" not in fake_io
+
+
+def test_parse_box_and_format_counts():
+    assert parse_box("-1,-2,-3,1,2,3") == (-1, -2, -3, 1, 2, 3)
+    with pytest.raises(ParameterError, match="expected 6 numbers"):
+        parse_box("1,2")
+    counts = dict.fromkeys(
+        ["frames_in", "frames_kept", "frames_dropped_rate", "frames_dropped_offset",
+         "frames_dropped_empty", "points_in", "points_dropped_nonfinite",
+         "points_dropped_crop", "points_registered", "points_out"], 0)
+    counts.update(frames_in=3, frames_dropped_offset=2, points_dropped_crop=7)
+    lines = format_counts(counts)
+    assert "2 (pose offset)" in lines[0]
+    assert "7 (outside crop box)" in lines[1]
+
+
+REALDATA = Path(__file__).resolve().parents[2] / ".." / "shared" / "realdata"
+
+
+@pytest.mark.realdata
+def test_register_real_ros1_bag_without_poses(tmp_path, capsys):
+    bag = REALDATA / "ros1_bag" / "test.bag"
+    if not bag.exists():
+        pytest.skip(f"{bag} absent")
+    out = tmp_path / "luminar.pcd"
+    assert main(["register", str(bag), "--out", str(out), "--voxel", "0.5", "--no-pose"]) == 0
+    frames = read_frames(bag, pose_topic="", allow_no_pose=True)
+    raw = np.vstack([register_frame(f, frames.mount) for f in frames.frames])
+    expected = grid_average(raw, 0.5)
+    got = read_points(out)
+    assert got.shape == expected.shape
+    np.testing.assert_allclose(got, expected, atol=1e-9)  # PCD float64 keeps the order
+    text = capsys.readouterr().out
+    assert f"points: {len(raw)} in" in text
+    assert "frames: 5 in, 5 kept" in text

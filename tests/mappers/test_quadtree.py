@@ -1,0 +1,184 @@
+"""Tests of the Quadtree mapper and the shared 2D machinery (quadgrid, quadmap)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from hypothesis.extra.numpy import arrays
+
+from alte.errors import MapperError, ParameterError
+from alte.mappers.quadgrid import morton_decode, morton_encode
+from alte.mappers.quadtree import Quadtree
+
+DOMAIN = "0,0,16"
+coords = st.floats(0.0, 16.0, allow_nan=False, width=32)
+clouds = arrays(np.float64, st.tuples(st.integers(1, 120), st.just(3)), elements=coords)
+
+
+def box_terrain(n: int = 4000, seed: int = 0) -> np.ndarray:
+    """Flat ground at z=0 on [0,16]^2 with a 3 m box on [4,8]x[4,8]."""
+    rng = np.random.default_rng(seed)
+    xy = rng.uniform(0, 16, (n, 2))
+    box = (xy[:, 0] > 4) & (xy[:, 0] < 8) & (xy[:, 1] > 4) & (xy[:, 1] < 8)
+    return np.column_stack([xy, np.where(box, 3.0, 0.0) + rng.normal(0, 0.02, n)])
+
+
+def assert_partition(cells, size: float = 16.0) -> None:
+    """Leaves cover the square exactly once: areas add up and probes hit one cell each."""
+    assert np.isclose((cells.sizes[:, 0] * cells.sizes[:, 1]).sum(), size * size)
+    probes = np.random.default_rng(1).uniform(0, size, (200, 2))
+    lo = cells.centers[:, :2] - cells.sizes[:, :2] / 2
+    hi = cells.centers[:, :2] + cells.sizes[:, :2] / 2
+    inside = ((probes[:, None] >= lo) & (probes[:, None] < hi)).all(axis=2)
+    assert (inside.sum(axis=1) == 1).all()
+
+
+def same_cells(a, b) -> bool:
+    return (len(a) == len(b) and np.array_equal(a.level, b.level)
+            and np.allclose(a.centers, b.centers, equal_nan=True)
+            and np.allclose(a.value, b.value, equal_nan=True)
+            and np.array_equal(a.occupied, b.occupied))
+
+
+def test_morton_round_trip() -> None:
+    ix = np.array([0, 1, 5, 2**20 - 1, 12345])
+    iy = np.array([0, 7, 3, 2**20 - 3, 999])
+    x, y = morton_decode(morton_encode(ix, iy))
+    assert np.array_equal(x, ix) and np.array_equal(y, iy)
+
+
+@settings(max_examples=40, deadline=None)
+@given(clouds, st.integers(1, 20), st.integers(0, 6))
+def test_partition_counts_and_limits(points, max_points, max_depth) -> None:
+    qt = Quadtree(max_points=max_points, max_depth=max_depth, domain=DOMAIN)
+    qt.build(points)
+    cells, counts = qt.cells(), qt.leaf_counts()
+    assert_partition(cells)
+    assert counts.sum() == len(points)
+    assert (cells.level <= max_depth).all()
+    assert (counts[cells.level < max_depth] <= max_points).all()
+    assert np.isnan(cells.value[counts == 0]).all()
+    assert not cells.occupied[counts == 0].any()
+    assert qt.basis_functions == len(cells)
+
+
+@settings(max_examples=30, deadline=None)
+@given(clouds, st.integers(1, 10), st.integers(1, 5), st.randoms(use_true_random=False))
+def test_incremental_equals_batch_and_order_invariant(points, max_points, splits, rnd) -> None:
+    batch = Quadtree(max_points=max_points, max_depth=6, domain=DOMAIN)
+    batch.build(points)
+    order = list(range(len(points)))
+    rnd.shuffle(order)
+    incr = Quadtree(max_points=max_points, max_depth=6, domain=DOMAIN)
+    for chunk in np.array_split(points[order], splits):
+        incr.insert(chunk, np.zeros(3))
+    assert same_cells(batch.cells(), incr.cells())
+
+
+def test_growth_without_domain_equals_batch_on_grown_root() -> None:
+    pts = box_terrain() - (3.3, 1.7, 0.0)
+    sweep = pts[np.argsort(-pts[:, 0] - 0.5 * pts[:, 1])]
+    incr = Quadtree(max_points=50)
+    sizes = []
+    for chunk in np.array_split(sweep, 10):
+        incr.insert(chunk, np.zeros(3))
+        sizes.append(incr.square.size)
+    sq = incr.square
+    assert sizes[-1] >= 4 * sizes[0]  # the root grew at least twice
+    assert incr.points_outside == 0
+    batch = Quadtree(max_points=50, domain=f"{sq.xmin},{sq.ymin},{sq.size}")
+    batch.build(pts)
+    assert same_cells(incr.cells(), batch.cells())
+
+
+def test_occupancy_marks_the_box_and_leaves_ground_free() -> None:
+    qt = Quadtree(max_points=20, height_threshold=1.0, domain=DOMAIN)
+    qt.build(box_terrain())
+    cells = qt.cells()
+    on_box = (np.abs(cells.centers[:, 0] - 6) < 2) & (np.abs(cells.centers[:, 1] - 6) < 2)
+    assert cells.occupied[on_box & (cells.sizes[:, 0] < 1)].mean() > 0.9
+    far = (np.abs(cells.centers[:, 0] - 6) > 3) | (np.abs(cells.centers[:, 1] - 6) > 3)
+    assert not cells.occupied[far].any()
+    corners = qt.corners()
+    assert len(corners) >= 4 and np.allclose(corners[:, 2], 3.0, atol=0.2)
+
+
+def test_mean_rule_averages_a_small_obstacle_away_but_max_keeps_it() -> None:
+    pts = np.array([[1.0, 1.0, 0.0]] * 9 + [[1.5, 1.5, 2.0]])
+    mean = Quadtree(domain="0,0,4", occupancy="mean", height_threshold=0.5)
+    mean.build(pts)
+    mx = Quadtree(domain="0,0,4", occupancy="max", height_threshold=0.5)
+    mx.build(pts)
+    assert mean.cells().occupied.sum() == 0
+    assert mx.cells().occupied.sum() == 1
+
+
+def test_ground_plane_and_fit() -> None:
+    rng = np.random.default_rng(2)
+    xy = rng.uniform(0, 16, (3000, 2))
+    z = 0.1 * xy[:, 0] + 1.0 + rng.normal(0, 0.01, 3000)
+    pts = np.column_stack([xy, z])
+    flat = Quadtree(domain=DOMAIN, height_threshold=0.5)
+    flat.build(pts)
+    assert flat.cells().occupied.any()  # the slope rises over z=0
+    tilted = Quadtree(domain=DOMAIN, height_threshold=0.5, ground="-0.1,0,1,-1")
+    tilted.build(pts)
+    assert not tilted.cells().occupied.any()
+    fitted = Quadtree(domain=DOMAIN, height_threshold=0.5, ground="fit")
+    fitted.build(pts)
+    assert not fitted.cells().occupied.any()
+    assert np.allclose(fitted.plane[:3] / fitted.plane[2], [-0.1, 0, 1], atol=0.01)
+
+
+def test_points_outside_fixed_domain_are_counted() -> None:
+    qt = Quadtree(domain="0,0,1")
+    qt.insert(np.array([[0.5, 0.5, 0.0], [3.0, 0.5, 0.0]]), np.zeros(3))
+    assert qt.points_outside == 1 and qt.leaf_counts().sum() == 1
+
+
+def test_empty_map_and_empty_frames() -> None:
+    qt = Quadtree()
+    qt.insert(np.empty((0, 3)), np.zeros(3))
+    assert len(qt.cells()) == 0 and len(qt.corners()) == 0
+    fixed = Quadtree(domain=DOMAIN)
+    assert len(fixed.cells()) == 1 and np.isnan(fixed.cells().value[0])
+    assert fixed.memory_bytes >= 0
+
+
+@pytest.mark.parametrize(("key", "value", "match"), [
+    ("max_points", 0, "max_points"),
+    ("max_depth", 25, "max_depth"),
+    ("max_depth", -1, "max_depth"),
+    ("height_threshold", -1.0, "height_threshold"),
+    ("occupancy", "median", "occupancy"),
+    ("ground", "0,0,0,1", "ground"),
+    ("ground", "a,b", "ground"),
+    ("domain", "0,0,-1", "domain"),
+    ("domain", "0,0", "domain"),
+    ("colour", 1, "unknown parameter.*valid: "),
+])
+def test_bad_parameters(key, value, match) -> None:
+    with pytest.raises(ParameterError, match=match):
+        Quadtree(**{key: value})
+
+
+@pytest.mark.parametrize(("points", "match"), [
+    (np.zeros((3, 2)), "shape"),
+    (np.array([[0.0, np.nan, 0.0]]), "NaN"),
+])
+def test_bad_points(points, match) -> None:
+    with pytest.raises(MapperError, match=match):
+        Quadtree().build(points)
+    with pytest.raises(MapperError, match=match):
+        Quadtree(domain=DOMAIN).insert(points, np.zeros(3))
+
+
+def test_bad_origin_and_fit_on_insert() -> None:
+    with pytest.raises(MapperError, match="origin"):
+        Quadtree().insert(np.zeros((1, 3)), np.array([np.inf, 0, 0]))
+    with pytest.raises(MapperError, match="ground=fit"):
+        Quadtree(ground="fit").insert(np.zeros((1, 3)), np.zeros(3))
+    with pytest.raises(MapperError, match="ground=fit"):
+        Quadtree(ground="fit").build(np.zeros((2, 3)))
