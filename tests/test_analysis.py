@@ -184,3 +184,28 @@ def test_load_dataset_reads_a_simulated_terrain(tmp_path):
     assert np.all(data.surface.distance(data.cloud) < 1.0)
     with pytest.raises(ParameterError, match="frames=0"):
         load_dataset(folder, frames=0)
+
+
+def test_alte3d_gets_the_control_volume_cube_as_domain():
+    data = _steps_dataset()
+    data.case = "nav"
+    run = run_mapper(data, "alte3d", {"max_res": 4, "min_pts": 2, "min_pts_split": 5,
+                                      "occupancy_level": 4},
+                     truth=TruthOptions(n_samples=2000))
+    assert "domain" not in run.params
+    assert run.metrics["basis_functions"] > 0 and 0 < run.metrics["completeness"] <= 1
+    assert run.mapper.params["domain"] == "0,0,-1,16"
+
+
+def test_comparison_rule_skips_rows_with_missing_criteria():
+    table = pd.DataFrame({"elapsed_s": [1.0, 2.0, 3.0], "basis_functions": [1, 20, 30],
+                          "mhd_m": [np.nan, 0.5, 0.6], "hd_minus_mhd_m": [np.nan, 1.0, 1.0]})
+    assert best_row(table) == 1 and np.isinf(comparison_scores(table)[0])
+    with pytest.raises(ParameterError, match="no row has every criterion"):
+        best_row(table.iloc[:1])
+
+
+def test_empty_map_gets_nan_hausdorff():
+    data = _steps_dataset()
+    run = run_mapper(data, "alte3d", {"max_res": 2, "min_pts": 10_000, "min_pts_split": 5})
+    assert run.metrics["occupied_cells"] == 0 and np.isnan(run.metrics["mhd_m"])

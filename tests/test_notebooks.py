@@ -45,10 +45,23 @@ def test_one_parameters_cell_with_upper_case_names(path: Path) -> None:
 
 
 @pytest.mark.parametrize("path", CASES)
+def test_papermill_sees_every_assignment(path: Path) -> None:
+    """Each name the parameters cell assigns is a parameter papermill can report and inject."""
+    nb = _read(path)
+    tree = ast.parse(nb.cells[_tagged(nb, "parameters")[0]].source)
+    assigned = [t.id for node in tree.body if isinstance(node, ast.Assign | ast.AnnAssign)
+                for t in (node.targets if isinstance(node, ast.Assign) else [node.target])
+                if isinstance(t, ast.Name)]
+    missed = sorted(set(assigned) - set(papermill.inspect_notebook(str(path))))
+    assert not missed, f"{path.name}: papermill cannot parse the lines assigning {missed}"
+
+
+@pytest.mark.parametrize("path", CASES)
 def test_papermill_injects_every_parameter(path: Path) -> None:
     declared = papermill.inspect_notebook(str(path))
     values = {name: f"injected-{name}" for name in declared}
-    nb = parameterize_notebook(load_notebook_node(str(path)), values, kernel_name="python3", language="python")
+    nb = parameterize_notebook(load_notebook_node(str(path)), values, kernel_name="python3",
+                               language="python")
     injected = _tagged(nb, "injected-parameters")
     assert len(injected) == 1
     assert injected[0] == _tagged(nb, "parameters")[0] + 1

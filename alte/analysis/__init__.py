@@ -8,6 +8,7 @@ CSV output), :mod:`~alte.analysis.qualitative` tables 5.1-5.4 and
 
 from alte.analysis.experiments import (
     BATCH_MAPPERS,
+    CUBE_DOMAIN_MAPPERS,
     Dataset,
     MapRun,
     TruthOptions,
@@ -47,6 +48,7 @@ from alte.analysis.tables import (
 __all__ = [
     "BATCH_MAPPERS",
     "COMPARISON_TRENDS",
+    "CUBE_DOMAIN_MAPPERS",
     "MEASURES",
     "SWEEP_TRENDS",
     "THESIS_CRITERIA",

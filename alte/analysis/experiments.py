@@ -29,12 +29,16 @@ from alte.registration import register, register_frames
 from alte.sim import load_scenario
 from alte.thesis import SWEEPS, sweep_table
 
-__all__ = ["BATCH_MAPPERS", "Dataset", "MapRun", "TruthOptions", "flat_metrics",
-           "load_dataset", "map_metrics", "run_mapper",
-           "surface_from_scene", "sweep"]
+__all__ = ["BATCH_MAPPERS", "CUBE_DOMAIN_MAPPERS", "Dataset", "MapRun", "TruthOptions",
+           "flat_metrics", "load_dataset", "map_metrics", "run_mapper", "surface_from_scene",
+           "sweep"]
 
 #: Mappers the thesis ran once on the final cloud instead of frame by frame.
 BATCH_MAPPERS = frozenset({"quadtree"})
+
+#: Mappers whose frame-by-frame insert needs a fixed cubic domain; unless the caller
+#: passes ``domain``, they get the cube over the terrain's control volume.
+CUBE_DOMAIN_MAPPERS = frozenset({"alte3d"})
 
 
 @dataclass(frozen=True)
@@ -153,14 +157,23 @@ def _size_spread(mapper: Mapper) -> dict[str, float]:
 
 
 def map_metrics(mapper: Mapper, data: Dataset, truth: TruthOptions | None) -> dict[str, Any]:
-    """Thesis metrics (basis functions, HD, MHD) plus, with ``truth``, ground-truth ones."""
-    hd = hausdorff(data.cloud, mapper.corners())
+    """Thesis metrics (basis functions, HD, MHD) plus, with ``truth``, ground-truth ones.
+
+    A map with no occupied cell (e.g. 3D-ALTE at a coarse max_res) gets NaN HD/MHD.
+    """
+    corners = mapper.corners()
     out: dict[str, Any] = {
         "basis_functions": int(mapper.basis_functions), "memory_bytes": int(mapper.memory_bytes),
-        "hd_m": hd.hd, "mhd_m": hd.mhd, "hd_minus_mhd_m": hd.hd - hd.mhd,
-        "h_ab_m": hd.h_ab, "h_ba_m": hd.h_ba, "mh_ab_m": hd.mh_ab, "mh_ba_m": hd.mh_ba,
-        **_size_spread(mapper),
+        "occupied_cells": int(mapper.cells().occupied.sum()), **_size_spread(mapper),
     }
+    if len(corners) == 0:  # nothing occupied: HD/MHD are undefined, not zero
+        out.update(dict.fromkeys(("hd_m", "mhd_m", "hd_minus_mhd_m", "h_ab_m", "h_ba_m",
+                                  "mh_ab_m", "mh_ba_m"), float("nan")))
+    else:
+        hd = hausdorff(data.cloud, corners)
+        out.update({"hd_m": hd.hd, "mhd_m": hd.mhd, "hd_minus_mhd_m": hd.hd - hd.mhd,
+                    "h_ab_m": hd.h_ab, "h_ba_m": hd.h_ba, "mh_ab_m": hd.mh_ab,
+                    "mh_ba_m": hd.mh_ba})
     if truth is not None and data.surface is not None:
         out.update(ground_truth_metrics(
             mapper.cells(), data.surface, dims=mapper.dims, cloud=data.cloud, bounds=data.bounds,
@@ -178,11 +191,23 @@ def flat_metrics(metrics: Mapping[str, Any]) -> dict[str, Any]:
     return out
 
 
+def _auto_domain(name: str, params: Mapping[str, Any], data: Dataset) -> dict[str, str]:
+    """``domain`` = the cube (xmin, ymin, zmin, edge) over the control volume, when needed."""
+    if name not in CUBE_DOMAIN_MAPPERS or "domain" in params or data.bounds is None:
+        return {}
+    lo, hi = data.bounds
+    return {"domain": f"{lo[0]:.6g},{lo[1]:.6g},{lo[2]:.6g},{float(np.max(hi - lo)):.6g}"}
+
+
 def run_mapper(data: Dataset, name: str, params: Mapping[str, Any] | None = None, *,
                truth: TruthOptions | None = None, progress: bool = False) -> MapRun:
-    """Map ``data`` with mapper ``name`` and ``params``; time it and measure the map."""
+    """Map ``data`` with mapper ``name`` and ``params``; time it and measure the map.
+
+    Mappers in :data:`CUBE_DOMAIN_MAPPERS` get the control volume's cube as ``domain``
+    unless ``params`` has one (the run records ``params`` as given).
+    """
     params = dict(params or {})
-    mapper = make_mapper(name, **params)
+    mapper = make_mapper(name, **params, **_auto_domain(name, params, data))
     elapsed = _feed(mapper, name, data, progress)
     metrics = {"elapsed_s": elapsed, **map_metrics(mapper, data, truth)}
     return MapRun(name, params, mapper, metrics)

@@ -86,13 +86,17 @@ def comparison_scores(table: pd.DataFrame,
     if len(table) == 0:
         raise ParameterError("comparison rule: the table has no rows")
     values = table[list(criteria)].to_numpy(dtype=np.float64)
-    span = np.ptp(values, axis=0)
-    norm = (values - values.min(axis=0)) / np.where(span > 0, span, 1.0)
-    return norm.sum(axis=1)
+    valid = np.isfinite(values).all(axis=1)
+    if not valid.any():
+        raise ParameterError("comparison rule: no row has every criterion (empty maps?)")
+    lo, hi = values[valid].min(axis=0), values[valid].max(axis=0)
+    norm = (values - lo) / np.where(hi > lo, hi - lo, 1.0)
+    return np.where(valid, norm.sum(axis=1), np.inf)
 
 
 def best_row(table: pd.DataFrame, criteria: Sequence[str] = THESIS_CRITERIA) -> int:
-    """Position of the row the comparison rule picks (first on ties)."""
+    """Position of the row the comparison rule picks (first on ties; rows with a missing
+    criterion, e.g. NaN HD of an empty map, never win)."""
     return int(np.argmin(comparison_scores(table, criteria)))
 
 

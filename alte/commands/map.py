@@ -19,7 +19,8 @@ import numpy as np
 from alte.errors import MapperError, ParameterError
 from alte.fsutil import atomic_path, refuse_overwrite
 
-__all__ = ["add_parser", "parse_origin", "parse_sets", "run", "run_map"]
+__all__ = ["add_parser", "check_export", "export_cells", "parse_origin", "parse_sets", "run",
+           "run_map"]
 
 EXPORT_SUFFIXES = (".npz", ".bt")
 
@@ -76,6 +77,20 @@ def _is_point_file(path: Path) -> bool:
     return path.is_file() and path.name.lower().endswith(READ_SUFFIXES)
 
 
+def _local_origin(mapper: Any, points: np.ndarray) -> np.ndarray:
+    """Shift for mappers with a fixed key space around 0 (no ``domain``: Octomap).
+
+    UTM-scale clouds (1e6-1e7 m) fall outside such a key space and lose centimetres
+    in float32; they are mapped relative to a round local origin, added back on export.
+    Domain-anchored mappers are exact at any offset and keep their coordinates.
+    """
+    from alte.io.pointfiles import local_origin
+
+    if "domain" in mapper.params or not len(points):
+        return np.zeros(3)
+    return local_origin(points)
+
+
 def _map_points(mapper: Any, path: Path, voxel: float | None, origin: np.ndarray) -> dict:
     from alte.io.pointfiles import read_points
     from alte.registration import grid_average
@@ -83,9 +98,11 @@ def _map_points(mapper: Any, path: Path, voxel: float | None, origin: np.ndarray
     points = read_points(path)
     if voxel is not None:
         points = grid_average(points, voxel)
+    shift = _local_origin(mapper, points)
     start = time.perf_counter()
-    mapper.build(points, origin)
-    return {"frames": 1, "points": len(points), "elapsed_s": time.perf_counter() - start}
+    mapper.build(points - shift, origin - shift)
+    return {"frames": 1, "points": len(points), "elapsed_s": time.perf_counter() - start,
+            "local_origin": shift.tolist()}
 
 
 def _map_bag(mapper: Any, path: Path, voxel: float | None, mount_text: str | None) -> dict:
@@ -97,31 +114,48 @@ def _map_bag(mapper: Any, path: Path, voxel: float | None, mount_text: str | Non
     frameset = read_frames(path, mount=mount, progress=True)
     frames = points = 0
     elapsed = 0.0
+    shift = None
     for _frame, pts, origin in register_frames(frameset.frames, frameset.mount, voxel=voxel,
                                                progress=True):
+        shift = _local_origin(mapper, pts) if shift is None else shift
         start = time.perf_counter()
-        mapper.insert(pts, origin)
+        mapper.insert(pts - shift, origin - shift)
         elapsed += time.perf_counter() - start
         frames += 1
         points += len(pts)
-    return {"frames": frames, "points": points, "elapsed_s": elapsed}
+    shift = np.zeros(3) if shift is None else shift
+    return {"frames": frames, "points": points, "elapsed_s": elapsed,
+            "local_origin": shift.tolist()}
 
 
-def export_cells(mapper: Any, path: Path, overwrite: bool) -> None:
-    """Write ``mapper``'s cells to ``path`` (.npz) or its OctoMap tree (.bt), atomically."""
+def check_export(path: Path, mapper: Any, overwrite: bool) -> None:
+    """Fail before mapping when ``path`` cannot be written (type, .bt support, exists)."""
     suffix = path.suffix.lower()
     if suffix not in EXPORT_SUFFIXES:
         raise MapperError(f"--export {path}: unknown type; use {', '.join(EXPORT_SUFFIXES)}")
-    if suffix == ".bt":
-        write_bt = getattr(mapper, "write_bt", None)
-        if write_bt is None:
-            raise MapperError(f"--export {path}: mapper {mapper.name!r} cannot write .bt "
-                              "(only octomap can); export .npz instead")
-        with atomic_path(path, overwrite=overwrite) as tmp:
-            write_bt(tmp)
+    if suffix == ".bt" and not hasattr(mapper, "write_bt"):
+        raise MapperError(f"--export {path}: mapper {mapper.name!r} cannot write .bt "
+                          "(only octomap can); export .npz instead")
+    refuse_overwrite(path, overwrite)
+
+
+def export_cells(mapper: Any, path: Path, overwrite: bool = False,
+                 shift: np.ndarray | None = None) -> None:
+    """Write ``mapper``'s cells to ``path`` (.npz) or its OctoMap tree (.bt), atomically.
+
+    ``shift`` (the local origin the points were mapped relative to) is added back to
+    the exported cell centres. A ``.bt`` goes through the mapper's own
+    ``write_bt(path, overwrite=...)`` and stays in the mapper's (local) coordinates.
+    """
+    check_export(path, mapper, overwrite)
+    if path.suffix.lower() == ".bt":
+        mapper.write_bt(path, overwrite=overwrite)
         return
+    arrays = mapper.cells().as_dict()
+    if shift is not None:
+        arrays["centers"] = arrays["centers"] + np.asarray(shift, dtype=np.float64)
     with atomic_path(path, overwrite=overwrite) as tmp, tmp.open("wb") as fh:
-        np.savez(fh, **mapper.cells().as_dict())
+        np.savez(fh, **arrays)
 
 
 def run_map(mapper: Any, path: Path, voxel: float | None = None,
@@ -150,15 +184,12 @@ def run(args: argparse.Namespace) -> int:
 
     params = parse_sets(args.sets)
     origin = parse_origin(args.origin)
-    if args.export is not None:
-        if args.export.suffix.lower() not in EXPORT_SUFFIXES:
-            raise MapperError(f"--export {args.export}: unknown type; use "
-                              f"{', '.join(EXPORT_SUFFIXES)}")
-        refuse_overwrite(args.export, args.force)  # fail before the long work
     mapper = make_mapper(args.mapper, **params)
+    if args.export is not None:
+        check_export(args.export, mapper, args.force)  # fail before the long work
     summary = run_map(mapper, args.input, args.voxel, origin, args.mount)
     if args.export is not None:
-        export_cells(mapper, args.export, args.force)
+        export_cells(mapper, args.export, args.force, np.asarray(summary["local_origin"]))
         summary["export"] = str(args.export)
     if args.json:
         print(json.dumps(summary, sort_keys=True))

@@ -14,6 +14,7 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
+import apsw
 from rosbags.highlevel import AnyReader, AnyReaderError
 from rosbags.rosbag1 import ReaderError as Reader1Error
 from rosbags.rosbag2 import ReaderError as Reader2Error
@@ -52,6 +53,7 @@ _READ_ERRORS = (
     SerdeError,
     TypesysError,
     sqlite3.Error,
+    apsw.Error,
     OSError,
     EOFError,
     struct.error,
@@ -73,7 +75,7 @@ def open_bag(path: str | Path) -> Iterator[AnyReader]:
     bag = Path(path)
     if not bag.exists():
         raise BagError(f"bag {bag} does not exist")
-    pass  # _check_sqlite_size(bag)
+    _check_sqlite_size(bag)
     try:
         reader = AnyReader([bag], default_typestore=get_typestore(Stores.ROS2_HUMBLE))
         reader.open()

@@ -16,9 +16,10 @@ from pathlib import Path
 
 import numpy as np
 
+from alte.errors import MapperError
 from alte.mappers._raycast import TREE_DEPTH, TREE_MAX_VAL, morton_decode
 
-__all__ = ["Leaves", "apply_update", "leaf_geometry", "prune", "write_bt"]
+__all__ = ["Leaves", "apply_update", "check_origin", "leaf_geometry", "prune", "write_bt"]
 
 _THREE = np.uint64(3)
 
@@ -33,6 +34,16 @@ class Leaves:
 
     def __len__(self) -> int:
         return int(self.prefix.size)
+
+
+def check_origin(origin: object, owner: str) -> np.ndarray:
+    """Return a finite float64 (3,) sensor origin or raise :class:`MapperError`."""
+    arr = np.asarray(origin, dtype=np.float64)
+    if arr.shape != (3,):
+        raise MapperError(f"{owner}: origin must have shape (3,), got {arr.shape}")
+    if not np.isfinite(arr).all():
+        raise MapperError(f"{owner}: origin contains NaN or inf values")
+    return arr
 
 
 def apply_update(

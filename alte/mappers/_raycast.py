@@ -9,6 +9,11 @@ and :func:`scan_keys` walks each ray exactly like ``OcTreeBaseImpl::computeRayKe
 (max-range truncation, endpoint marked occupied only when within range).
 Keys leave the kernels as 48-bit Morton codes (x in the lowest bit of each triple),
 so sorting them puts the eight children of every octree node next to each other.
+
+Per-scan de-duplication of ray voxels (OctoMap's ``KeySet``) is a set of 8x8x8 bit
+blocks: an open-addressing hash table maps a block code (key >> 9) to a row of 512
+bits. Consecutive voxels of a ray mostly share a block, so one probe serves several
+voxels; memory follows the blocks a scan touches, not its bounding box.
 """
 
 from __future__ import annotations
@@ -187,36 +192,39 @@ def _row(slots, rows, blocks, block, n_blocks):
 
 
 @numba.njit(cache=True)
-def _setup(origin, end, res, cur):
-    """Amanatides & Woo initialisation exactly as OctoMap: length, step, tMax, tDelta."""
-    d = np.empty(3, dtype=np.float32)
-    for i in range(3):
-        d[i] = end[i] - origin[i]
+def _setup(origin, end, res, okey, work, iwork):
+    """Amanatides & Woo initialisation exactly as OctoMap; returns the ray length.
+
+    Fills the per-scan workspaces: ``work`` = (tMax, tDelta), ``iwork`` = (key, step).
+    """
+    d = (end[0] - origin[0], end[1] - origin[1], end[2] - origin[2])
     lf = np.float32(_norm(d[0], d[1], d[2]))  # float length = (float) direction.norm()
-    length = np.float64(lf)
-    step = np.zeros(3, dtype=np.int64)
-    t_max = np.full(3, np.finfo(np.float64).max)
-    t_delta = np.full(3, np.finfo(np.float64).max)
     for i in range(3):
+        iwork[0, i] = okey[i]
+        iwork[1, i] = 0
+        work[0, i] = np.finfo(np.float64).max
+        work[1, i] = np.finfo(np.float64).max
         di = d[i] / lf
         if di != 0.0:
-            step[i] = 1 if di > 0.0 else -1
-            half = np.float64(np.float32(step[i] * res * 0.5))  # (float) cast as in OctoMap
-            border = (np.float64(cur[i] - TREE_MAX_VAL) + 0.5) * res + half
-            t_max[i] = (border - np.float64(origin[i])) / np.float64(di)
-            t_delta[i] = res / abs(np.float64(di))
-    return length, step, t_max, t_delta
+            iwork[1, i] = 1 if di > 0.0 else -1
+            half = np.float64(np.float32(iwork[1, i] * res * 0.5))  # (float) cast as in OctoMap
+            border = (np.float64(okey[i] - TREE_MAX_VAL) + 0.5) * res + half
+            work[0, i] = (border - np.float64(origin[i])) / np.float64(di)
+            work[1, i] = res / abs(np.float64(di))
+    return np.float64(lf)
 
 
 @numba.njit(cache=True)
-def _walk(origin, okey, end, ekey, res, limit, slots, rows, bits, blocks, n_blocks):
+def _walk(ray, res, limit, table, n_blocks):
     """Add the keys of ``computeRayKeys(origin, end)`` to the set; return (new keys, n_blocks).
 
     A ray visits at most |dk| + 1 voxels; ``limit`` (|dk| + 4) only stops a ray
     that float round-off carries past its end voxel (it then stops on the length test).
     """
-    cur = okey.copy()
-    length, step, t_max, t_delta = _setup(origin, end, res, cur)
+    origin, okey, end, ekey, work, iwork = ray
+    slots, rows, bits, blocks = table
+    length = _setup(origin, end, res, okey, work, iwork)
+    t_max, t_delta, cur, step = work[0], work[1], iwork[0], iwork[1]
     added, last, row = 0, _EMPTY, 0
     for it in range(limit):
         if it > 0:
@@ -226,7 +234,7 @@ def _walk(origin, okey, end, ekey, res, limit, slots, rows, bits, blocks, n_bloc
             t_max[dim] += t_delta[dim]
             if cur[0] == ekey[0] and cur[1] == ekey[1] and cur[2] == ekey[2]:
                 break
-            if min(t_max[0], min(t_max[1], t_max[2])) > length:
+            if min(t_max[0], t_max[1], t_max[2]) > length:
                 break
         key = _morton(cur[0], cur[1], cur[2])
         if key >> np.uint64(9) != last:
@@ -261,6 +269,8 @@ def _free_keys(origin, okey, ends, ekeys, res):
         np.zeros((1 << 11, 8), dtype=np.uint64),
         np.zeros(1 << 11, dtype=np.uint64),
     )
+    work = np.empty((2, 3), dtype=np.float64)
+    iwork = np.empty((2, 3), dtype=np.int64)
     n_blocks = 0
     count = 0
     if okey.min() < 0:
@@ -270,12 +280,11 @@ def _free_keys(origin, okey, ends, ekeys, res):
         if k[0] < 0 or (k[0] == okey[0] and k[1] == okey[1] and k[2] == okey[2]):
             continue
         limit = abs(k[0] - okey[0]) + abs(k[1] - okey[1]) + abs(k[2] - okey[2]) + 5
-        slots, rows, bits, blocks = _reserve(table, n_blocks, limit + 1)
-        table = (slots, rows, bits, blocks)
-        added, n_blocks = _walk(origin, okey, ends[i], k, res, limit, slots, rows, bits, blocks,
-                                n_blocks)
+        table = _reserve(table, n_blocks, limit + 1)
+        ray = (origin, okey, ends[i], k, work, iwork)
+        added, n_blocks = _walk(ray, res, limit, table, n_blocks)
         count += added
-    return _collect(bits, blocks, n_blocks, count)
+    return _collect(table[2], table[3], n_blocks, count)
 
 
 @numba.njit(cache=True)

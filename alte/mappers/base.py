@@ -109,7 +109,7 @@ def _coerce(name: str, spec: Param, value: Any, owner: str) -> Any:
                 raise ParameterError(f"{owner}: {name}={value!r} is not a boolean")
             return lowered in {"true", "1", "yes"}
         try:
-            return spec.kind(float(value)) if spec.kind is int else spec.kind(value)
+            value = float(value) if spec.kind is int else spec.kind(value)
         except ValueError as err:
             raise ParameterError(
                 f"{owner}: {name}={value!r} is not a valid {spec.kind.__name__}"

@@ -8,8 +8,11 @@ value column its mean, ``M2`` (sum of squared deviations, merged with Chan's par
 formula: no cancellation when heights are equal) and maximum.
 
 Adding points sorts them once at the finest level and merges aggregates upwards, so
-the cost is proportional to the new points (times the depth) plus a memory move when
-new cells appear. The statistics of a cloud do not depend on how it was cut into
+the arithmetic is proportional to the new points (times the depth); new cells are
+spliced into the sorted arrays with ``np.insert``, a memory move of the level's
+arrays. That move dominates deep, fine trees (Quadtree, depth 12, 465k points:
+about 40 ms per 930-point frame) and is negligible for 2D-ALTE's few thousand cells.
+The statistics of a cloud do not depend on how it was cut into
 frames (up to floating-point rounding of the sums), which is what makes the mappers'
 incremental insertion equal their batch build.
 """

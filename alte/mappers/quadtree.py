@@ -22,6 +22,12 @@ The thesis' Quadtree runs once on the final cloud; this one also inserts frame b
 frame, revisiting only the cells the frame touches, and ends with the same map as
 the batch build (the split rule depends on a cell's own count only). Leaves without
 points (siblings of split cells) are *unknown*: NaN height and value, not occupied.
+
+Cells: ``centers[:, 2]`` is the leaf's mean z, ``value`` the thresholded statistic
+(mean or max height above the plane). ``basis_functions`` counts every leaf (free,
+occupied and unknown: the variable-size occupancy grid a planner walks);
+``corners()`` gives the 4 corners of the occupied leaves at their mean z. Memory
+holds per-level statistics down to ``max_depth`` (needed to split a leaf later).
 """
 
 from __future__ import annotations

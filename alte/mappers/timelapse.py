@@ -18,7 +18,8 @@ from tqdm.auto import tqdm
 from alte.errors import MapperError
 from alte.mappers.base import Cells, Mapper
 
-__all__ = ["Snapshot", "Timelapse", "snapshot_indices", "square_domain", "timelapse"]
+__all__ = ["Snapshot", "Timelapse", "cube_domain", "snapshot_indices", "square_domain",
+           "timelapse"]
 
 
 @dataclass(frozen=True)
@@ -70,6 +71,15 @@ def square_domain(bounds: np.ndarray) -> str:
     if not np.isfinite(box).all() or size <= 0:
         raise MapperError(f"square_domain: bounds {box.tolist()} have no x/y extent")
     return f"{float(box[0, 0])!r},{float(box[0, 1])!r},{size!r}"
+
+
+def cube_domain(bounds: np.ndarray) -> str:
+    """``"xmin,ymin,zmin,size"`` of the cube over ``bounds`` (2, 3) or (6,) (3D mappers)."""
+    box = np.asarray(bounds, dtype=np.float64).reshape(2, 3)
+    size = float((box[1] - box[0]).max())
+    if not np.isfinite(box).all() or size <= 0:
+        raise MapperError(f"cube_domain: bounds {box.tolist()} have no extent")
+    return ",".join(repr(float(v)) for v in (*box[0], size))
 
 
 def timelapse(mapper: Mapper, frames: Sequence[tuple[np.ndarray, np.ndarray]],

@@ -63,7 +63,8 @@ def hausdorff(a: object, b: object) -> HausdorffResult:
     d_ab = directed_distances(set_a, set_b)
     d_ba = directed_distances(set_b, set_a)
     h_ab, h_ba = float(d_ab.max()), float(d_ba.max())
-    mh_ab, mh_ba = float(d_ab.mean()), float(d_ba.mean())
+    # A mean never exceeds the maximum; clamp the last-ulp rounding of summation.
+    mh_ab, mh_ba = min(float(d_ab.mean()), h_ab), min(float(d_ba.mean()), h_ba)
     return HausdorffResult(
         hd=max(h_ab, h_ba), mhd=max(mh_ab, mh_ba), h_ab=h_ab, h_ba=h_ba, mh_ab=mh_ab, mh_ba=mh_ba
     )

@@ -13,6 +13,7 @@ from typing import Any
 
 import numpy as np
 
+from alte.mappers.alte2d import plane_height
 from alte.mappers.base import Cells
 
 __all__ = [
@@ -50,13 +51,40 @@ def _frame_axes(ax: Any, verts: np.ndarray, title: str | None) -> None:
         ax.set_title(title)
 
 
-def plot_map_2d(cells: Cells, ax_segments: Any, ax_occupancy: Any | None = None,
-                title: str | None = None, cmap: str = "viridis") -> tuple[Any, Any | None]:
+def _occupancy_panel(cells: Cells, ax: Any, verts: np.ndarray, height_threshold: float | None,
+                     ground: float | np.ndarray) -> Any:
+    """Black occupied, white free, grey unknown cells (occupancy from heights if asked)."""
+    import matplotlib as mpl
+    from matplotlib.collections import PolyCollection
+
+    known = np.isfinite(cells.centers[:, 2])
+    occupied = cells.occupied
+    if height_threshold is not None:
+        above = cells.centers[:, 2] - plane_height(ground, cells.centers[:, :2])
+        occupied = known & (np.nan_to_num(above, nan=-np.inf) > height_threshold)
+    colours = np.where(occupied[:, None], (0.0, 0.0, 0.0, 1.0), (1.0, 1.0, 1.0, 1.0))
+    colours[~known & ~occupied] = UNKNOWN_COLOR
+    occ = PolyCollection(verts, facecolors=colours, edgecolors=(0.5, 0.5, 0.5, 1.0),
+                         linewidths=0.2)
+    ax.add_collection(occ)
+    handles = [mpl.patches.Patch(facecolor=c, edgecolor="k", label=lab) for c, lab in
+               (((0, 0, 0, 1), "occupied"), ((1, 1, 1, 1), "free"), (UNKNOWN_COLOR, "unknown"))]
+    ax.legend(handles=handles, loc="upper right", fontsize="small")
+    return occ
+
+
+def plot_map_2d(cells: Cells, ax_segments: Any, ax_occupancy: Any | None = None, *,
+                title: str | None = None, cmap: str = "viridis",
+                height_threshold: float | None = None,
+                ground: float | np.ndarray = 0.0) -> tuple[Any, Any | None]:
     """Segments coloured by height (left) and the occupancy grid (right), as fig. 4.17.
 
     Heights come from ``centers[:, 2]``; unknown cells are grey in both panels,
-    occupied cells black and free cells white in the occupancy panel. Returns the
-    two ``PolyCollection`` objects (the second None without ``ax_occupancy``).
+    occupied cells black and free cells white in the occupancy panel. The grid is
+    ``cells.occupied`` unless ``height_threshold`` is given: then a cell is occupied
+    when its height rises that much over ``ground`` (z or plane a,b,c,d), the binary
+    grid of thesis ch. 6 for 2D-ALTE's height map. Returns the two
+    ``PolyCollection`` objects (the second None without ``ax_occupancy``).
     """
     import matplotlib as mpl
     from matplotlib.collections import PolyCollection
@@ -74,14 +102,7 @@ def plot_map_2d(cells: Cells, ax_segments: Any, ax_occupancy: Any | None = None,
     _frame_axes(ax_segments, verts, f"{title} - segments" if title else "segments")
     if ax_occupancy is None:
         return seg, None
-    occ_colours = np.where(cells.occupied[:, None], (0.0, 0.0, 0.0, 1.0), (1.0, 1.0, 1.0, 1.0))
-    occ_colours[~known & ~cells.occupied] = UNKNOWN_COLOR
-    occ = PolyCollection(verts, facecolors=occ_colours, edgecolors=(0.5, 0.5, 0.5, 1.0),
-                         linewidths=0.2)
-    ax_occupancy.add_collection(occ)
-    handles = [mpl.patches.Patch(facecolor=c, edgecolor="k", label=lab) for c, lab in
-               (((0, 0, 0, 1), "occupied"), ((1, 1, 1, 1), "free"), (UNKNOWN_COLOR, "unknown"))]
-    ax_occupancy.legend(handles=handles, loc="upper right", fontsize="small")
+    occ = _occupancy_panel(cells, ax_occupancy, verts, height_threshold, ground)
     _frame_axes(ax_occupancy, verts, f"{title} - occupancy" if title else "occupancy")
     return seg, occ
 
@@ -143,17 +164,18 @@ def plot_basis_functions_over_time(times: Any, counts: Any, ax: Any,
     return line
 
 
-def plot_timelapse_2d(snapshots: Sequence[Any], title: str = "") -> Any:
+def plot_timelapse_2d(snapshots: Sequence[Any], title: str = "", **kwargs: Any) -> Any:
     """One row per snapshot (``.time``, ``.cells``): segments left, occupancy right.
 
-    The thesis' time-lapse figures 3.3 and 3.14; returns the matplotlib figure.
+    The thesis' time-lapse figures 3.3 and 3.14 (``kwargs`` go to :func:`plot_map_2d`);
+    returns the matplotlib figure.
     """
     import matplotlib.pyplot as plt
 
     rows = max(len(snapshots), 1)
     fig, axes = plt.subplots(rows, 2, figsize=(11, 4.2 * rows), squeeze=False)
     for (ax_seg, ax_occ), snap in zip(axes, snapshots, strict=False):
-        plot_map_2d(snap.cells, ax_seg, ax_occ, title=f"{title} t = {snap.time:.1f} s")
+        plot_map_2d(snap.cells, ax_seg, ax_occ, title=f"{title} t = {snap.time:.1f} s", **kwargs)
     fig.tight_layout()
     return fig
 

@@ -96,6 +96,8 @@ def ensure_terrains(runs: Sequence[Run], data_dir: Path, ensure: EnsureTerrain |
             ensure(name, out_dir=data_dir, seed=terrain_seed, frames=frames)
         except AlteError as err:
             errors[name] = f"terrain {name}: {err}"
+        except Exception as err:  # a simulator bug must not stop the other terrains
+            errors[name] = f"terrain {name}: {type(err).__name__}: {err}"
     return errors
 
 

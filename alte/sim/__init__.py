@@ -8,7 +8,14 @@ ground truth: ``ensure_terrain(name)`` makes ``data/NAME/`` (cached by spec and 
 
 from alte.sim.groundtruth import load_ground_truth, mesh_distance, write_ground_truth
 from alte.sim.mission import Simulation, simulate
-from alte.sim.platform import Cart, Quadrotor, Trajectory, observer_euler, tripod_mount
+from alte.sim.platform import (
+    Cart,
+    Quadrotor,
+    Trajectory,
+    observer_euler,
+    pose_history,
+    tripod_mount,
+)
 from alte.sim.scenario import (
     Scenario,
     ensure_terrain,
@@ -40,6 +47,7 @@ __all__ = [
     "load_scenario",
     "mesh_distance",
     "observer_euler",
+    "pose_history",
     "simulate",
     "spec_hash",
     "tripod_mount",

@@ -41,11 +41,10 @@ def write_ground_truth(path: str | os.PathLike[str], scene: Scene,
     faces = np.empty(len(scene.triangles), dtype=_FACE)
     faces["n"], faces["v"] = 3, scene.triangles
     faces["object_id"], faces["class_id"] = scene.object_ids, scene.class_ids
-    with atomic_path(path, overwrite=overwrite) as tmp:
-        with open(tmp, "wb") as fh:
-            fh.write(("\n".join(header) + "\n").encode("ascii"))
-            fh.write(verts.tobytes())
-            fh.write(faces.tobytes())
+    with atomic_path(path, overwrite=overwrite) as tmp, open(tmp, "wb") as fh:
+        fh.write(("\n".join(header) + "\n").encode("ascii"))
+        fh.write(verts.tobytes())
+        fh.write(faces.tobytes())
     return Path(path)
 
 

@@ -76,14 +76,12 @@ def _mount_dict(mount: Mount) -> dict[str, Any]:
             "xyz_rpy_deg": mount.to_string()}
 
 
-def _metadata(terrain: Terrain, sim: Simulation, seed: int, frames: int | None,
-              key: str, storage: str) -> dict[str, Any]:
+def _metadata(terrain: Terrain, sim: Simulation, run: dict[str, Any]) -> dict[str, Any]:
     spec = terrain.spec
     control = list(spec.crop_box) if spec.kind == "exp" else None
     return {
         "alte_sim_version": SIM_VERSION, "name": spec.name, "section": spec.section,
-        "title": spec.title, "case": spec.case, "kind": spec.kind, "seed": int(seed),
-        "frames_requested": frames, "spec_hash": key, "storage": storage,
+        "title": spec.title, "case": spec.case, "kind": spec.kind, **run,
         "bag": BAG_DIR, "ground_truth": GROUND_TRUTH_FILE,
         "cloud_topic": CLOUD_TOPIC, "pose_topic": POSE_TOPIC,
         "crop_box": list(spec.crop_box), "control_volume": control,
@@ -96,8 +94,9 @@ def _metadata(terrain: Terrain, sim: Simulation, seed: int, frames: int | None,
     }
 
 
-def write_scenario(target: str | os.PathLike[str], terrain: Terrain, sim: Simulation, seed: int,
-                   frames: int | None, storage: str = "sqlite3", progress: bool = False) -> Path:
+def write_scenario(target: str | os.PathLike[str], terrain: Terrain, sim: Simulation, *,
+                   seed: int, frames: int | None, storage: str = "sqlite3",
+                   progress: bool = False) -> Path:
     """Write bag, ground truth and scenario.json into ``target`` atomically (replacing it)."""
     from alte.io.writer import write_bag
 
@@ -109,7 +108,9 @@ def write_scenario(target: str | os.PathLike[str], terrain: Terrain, sim: Simula
                   cloud_topic=CLOUD_TOPIC, pose_topic=POSE_TOPIC, storage=storage,
                   progress=progress)
         write_ground_truth(tmp / GROUND_TRUTH_FILE, terrain.scene)
-        meta = _metadata(terrain, sim, seed, frames, key, storage)
+        run = {"seed": int(seed), "frames_requested": frames, "spec_hash": key,
+               "storage": storage}
+        meta = _metadata(terrain, sim, run)
         meta["files"] = _file_table(tmp)
         (tmp / SCENARIO_FILE).write_text(json.dumps(meta, indent=2, sort_keys=True) + "\n")
     return Path(target)
@@ -147,7 +148,9 @@ def update_terrain(name: str, out_dir: str | os.PathLike[str] = "data", seed: in
         raise SimulationError(f"{target} exists but is not a simulated terrain folder; "
                               "remove it or pass force=True (--force)")
     sim = simulate(terrain, seed=seed, frames=frames, progress=progress)
-    return write_scenario(target, terrain, sim, seed, frames, storage, progress=progress), True
+    folder = write_scenario(target, terrain, sim, seed=seed, frames=frames, storage=storage,
+                            progress=progress)
+    return folder, True
 
 
 @dataclass(frozen=True, eq=False)

@@ -9,6 +9,7 @@ prisms, spheres, ground rectangles); every block is one object with a class from
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -59,7 +60,7 @@ class Scene:
         """Object id -> object class."""
         return {i: o.cls for i, o in enumerate(self.objects)}
 
-    def raycaster(self):  # noqa: ANN201 - open3d type
+    def raycaster(self) -> Any:
         """An ``open3d.t.geometry.RaycastingScene`` holding the mesh (geometry id 0)."""
         import open3d as o3d
 
@@ -126,14 +127,16 @@ class SceneBuilder:
         return self.add(name, cls, _yawed(local, yaw_deg) + np.asarray(center), _BOX_TRIS)
 
     def slab(self, name: str, cls: str, xy: tuple[float, float], size_xy: tuple[float, float],
-             z0: float, z1: float, yaw_deg: float = 0.0) -> int:
-        """A box given by its footprint centre, footprint size and bottom/top heights."""
+             *, z: tuple[float, float], yaw_deg: float = 0.0) -> int:
+        """A box given by its footprint centre, footprint size and bottom/top heights ``z``."""
+        z0, z1 = z
         return self.box(name, cls, (xy[0], xy[1], 0.5 * (z0 + z1)),
                         (size_xy[0], size_xy[1], z1 - z0), yaw_deg)
 
     def cylinder(self, name: str, cls: str, xy: tuple[float, float], radius: float,
-                 z0: float, z1: float, segments: int = 24) -> int:
-        """A vertical capped cylinder from ``z0`` to ``z1``."""
+                 *, z: tuple[float, float], segments: int = 24) -> int:
+        """A vertical capped cylinder from ``z[0]`` to ``z[1]``."""
+        z0, z1 = z
         ring = _ring(radius, segments) + np.asarray(xy, dtype=float)
         verts = np.vstack([np.column_stack([ring, np.full(segments, z0)]),
                            np.column_stack([ring, np.full(segments, z1)]),
@@ -146,10 +149,11 @@ class SceneBuilder:
                           np.column_stack([i + n, j + n, np.full(n, 2 * n + 1)])])
         return self.add(name, cls, verts, tris)
 
-    def gable(self, name: str, cls: str, xy: tuple[float, float], length: float, width: float,
-              z0: float, ridge: float, yaw_deg: float = 0.0) -> int:
-        """A gable roof: triangular prism along local x, eaves at ``z0``, ridge at ``ridge``."""
-        hl, hw = 0.5 * length, 0.5 * width
+    def gable(self, name: str, cls: str, xy: tuple[float, float], *, size: tuple[float, float],
+              z: tuple[float, float], yaw_deg: float = 0.0) -> int:
+        """A gable roof: prism along local x, ``size`` = (length, width), ``z`` = (eaves, ridge)."""
+        hl, hw = 0.5 * size[0], 0.5 * size[1]
+        z0, ridge = z
         local = np.array([[-hl, -hw, z0], [-hl, hw, z0], [-hl, 0, ridge],
                           [hl, -hw, z0], [hl, hw, z0], [hl, 0, ridge]])
         tris = np.array([[0, 1, 2], [3, 4, 5], [0, 3, 4], [0, 4, 1], [0, 2, 5], [0, 5, 3],

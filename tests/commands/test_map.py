@@ -87,6 +87,20 @@ def test_errors_are_one_line(capsys, cloud_file: Path, tmp_path: Path, extra, me
     assert not (tmp_path / "tree.bt").exists()
 
 
+def test_export_bt_through_octomap(capsys, tmp_path: Path) -> None:
+    pytest.importorskip("alte.mappers.octomap")
+    cloud = tmp_path / "small.npz"
+    np.savez(cloud, points=terrain(300) + np.array([0.0, 0.0, 1.0]))
+    target = tmp_path / "tree.bt"
+    argv = ["map", str(cloud), "--mapper", "octomap", "--set", "resolution=1",
+            "--origin", "8,8,10", "--export", str(target)]
+    assert main(argv) == 0
+    assert target.is_file() and target.stat().st_size > 0
+    capsys.readouterr()
+    assert main(argv) == 2 and "exists" in capsys.readouterr().err
+    assert main([*argv, "--force"]) == 0
+
+
 def test_missing_input(capsys, tmp_path: Path) -> None:
     assert main(["map", str(tmp_path / "nothing.bag"), "--mapper", "alte2d"]) == 2
     assert "nothing.bag" in capsys.readouterr().err

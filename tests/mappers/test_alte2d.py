@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -220,3 +222,33 @@ def test_bad_points(points, match) -> None:
         Alte2D().insert(points, np.zeros(3))
     with pytest.raises(MapperError, match="origin"):
         Alte2D().insert(np.zeros((2, 3)), np.zeros(2))
+
+
+REALDATA = Path(__file__).resolve().parents[2] / ".." / "shared" / "realdata"
+
+
+@pytest.mark.realdata
+def test_isprs_airborne_sample() -> None:
+    """Real ALS terrain (ISPRS samp11): leaves stop only by the criterion or the limits,
+    and inserting the strips in file order gives the batch map."""
+    path = REALDATA / "isprs_terrain" / "samp11-utm.pcd"
+    if not path.is_file():
+        pytest.skip(f"{path} absent")
+    from alte.io.pointfiles import read_points
+
+    pts = read_points(path)
+    pts = pts - pts.min(axis=0)
+    kw = {"kappa": 5.0, "max_res": 7, "min_pts": 10}
+    batch = Alte2D(**kw)
+    batch.build(pts)
+    level, _keys, rows = batch.stats.leaves()
+    n = batch.leaf_stat(level, rows, "n")
+    m2 = batch.leaf_stat(level, rows, "m2")
+    free = (level < 7) & (n >= 10)
+    assert free.any() and (m2[free] <= 5.0).all()
+    assert 50 < batch.basis_functions < 4**7
+    sq = batch.square
+    incr = Alte2D(**kw, domain=f"{sq.xmin},{sq.ymin},{sq.size}")
+    for chunk in np.array_split(pts, 10):
+        incr.insert(chunk, np.zeros(3))
+    assert same_cells(batch.cells(), incr.cells())

@@ -26,6 +26,8 @@ def test_unknown_key_lists_valid_ones():
     ({"kappa": -1.0}, r"kappa=-1\.0 out of range \(>= 0\)"),
     ({"max_res": 0}, r"max_res=0 out of range \(1\.\.20\)"),
     ({"max_res": 2.5}, r"max_res=2\.5 must be an integer"),
+    ({"max_res": "1.5"}, r"max_res=1\.5 must be an integer"),
+    ({"max_res": "inf"}, r"max_res=inf must be an integer"),
     ({"max_res": "two"}, r"max_res='two' is not a valid int"),
     ({"kappa": "nan"}, r"kappa=nan must be finite"),
     ({"prune": "maybe"}, r"prune='maybe' is not a boolean"),

@@ -75,6 +75,9 @@ def test_incremental_equals_batch_and_order_invariant(points, max_points, splits
     for chunk in np.array_split(points[order], splits):
         incr.insert(chunk, np.zeros(3))
     assert same_cells(batch.cells(), incr.cells())
+    for level in range(7):  # the merged statistics (n, means, M2, max) match too
+        assert np.array_equal(batch.stats.keys[level], incr.stats.keys[level])
+        assert np.allclose(batch.stats.rows[level], incr.stats.rows[level], atol=1e-9)
 
 
 def test_growth_without_domain_equals_batch_on_grown_root() -> None:

@@ -7,7 +7,7 @@ import pytest
 
 from alte.errors import MapperError
 from alte.mappers.alte2d import Alte2D
-from alte.mappers.timelapse import snapshot_indices, square_domain, timelapse
+from alte.mappers.timelapse import cube_domain, snapshot_indices, square_domain, timelapse
 
 
 def sweep_frames(n: int = 6) -> list[tuple[np.ndarray, np.ndarray]]:
@@ -41,6 +41,9 @@ def test_snapshot_indices_and_domain() -> None:
     assert snapshot_indices(3, 10).tolist() == [0, 1, 2]
     assert snapshot_indices(0, 3).tolist() == []
     assert square_domain(np.array([[-1.0, 2.0, 0.0], [5.0, 4.0, 3.0]])) == "-1.0,2.0,6.0"
+    assert cube_domain(np.array([-1.0, 2.0, 0.0, 5.0, 4.0, 9.0])) == "-1.0,2.0,0.0,9.0"
+    with pytest.raises(MapperError, match="no extent"):
+        cube_domain(np.ones(6))
     with pytest.raises(MapperError, match="snapshots=0"):
         snapshot_indices(5, 0)
     with pytest.raises(MapperError, match="no x/y extent"):

@@ -51,6 +51,18 @@ def test_plot_map_2d_segments_and_occupancy() -> None:
     plt.close(fig)
 
 
+def test_plot_map_2d_occupancy_from_heights() -> None:
+    fig, (left, right) = plt.subplots(1, 2)
+    _seg, occ = plot_map_2d(cells_2d(), left, right, height_threshold=0.05)
+    faces = occ.get_facecolor()
+    black = np.all(np.isclose(faces, (0, 0, 0, 1)), axis=1)
+    assert black.tolist() == [False, True, False, True]  # 3.0 and 0.1 m rise over 0.05 m
+    assert np.allclose(faces[2], UNKNOWN_COLOR)
+    _seg, occ = plot_map_2d(cells_2d(), left, right, height_threshold=0.05, ground=0.5)
+    assert np.all(np.isclose(occ.get_facecolor(), (0, 0, 0, 1)), axis=1).sum() == 1
+    plt.close(fig)
+
+
 def test_plot_map_2d_without_occupancy_and_all_unknown() -> None:
     fig, ax = plt.subplots()
     c = cells_2d()

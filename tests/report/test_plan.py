@@ -9,6 +9,7 @@ import pytest
 from alte.errors import ParameterError, ReportError
 from alte.report.plan import (
     PLAN,
+    QUICK_FRAMES,
     TERRAINS,
     Entry,
     build_plan,
@@ -137,6 +138,7 @@ def test_builtin_plan_shape() -> None:
     assert [e.full["TERRAIN"] for e in ch4] == list(TERRAINS)
     assert 0 < sum(e.quick is not None for e in ch4) < len(TERRAINS)
     assert all(e.full.get("FRAMES", None) is None for e in PLAN)
+    assert {e.quick["FRAMES"] for e in PLAN if e.quick is not None} == {QUICK_FRAMES}
     assert {e.notebook for e in PLAN} >= {"ch2_test_benchmark.ipynb", "ch5_analysis.ipynb"}
 
 
@@ -154,3 +156,5 @@ def test_builtin_plan_matches_real_notebooks(quick: bool) -> None:
         pytest.skip(f"notebooks absent: {', '.join(sorted(set(missing)))}")
     runs = build_plan(PLAN, quick=quick, notebooks_dir=folder)
     assert runs and all(r.notebook.exists() for r in runs)
+    if quick:  # one simulation per terrain serves every notebook using it
+        assert {r.value("FRAMES") for r in runs} == {QUICK_FRAMES}

@@ -93,15 +93,20 @@ def test_ensure_terrains_frames_and_errors(tmp_path: Path) -> None:
         calls.append((name, kwargs))
         if name == "exp_lan_2":
             raise SimulationError("exp_lan_2: broken scene")
+        if name == "sim_lan_2":
+            raise TypeError("bug in the simulator")
 
     runs = [_run("a", ("sim_nav_1",), FRAMES=40, SEED=7), _run("b", ("sim_nav_1", "exp_lan_2")),
             _run("c", ("sim_lan_1",), FRAMES=None, SEED=1), _run("d", ("sim_lan_1",), FRAMES=0,
-                                                                   SEED=2)]
+                                                                   SEED=2),
+            _run("e", ("sim_lan_2",))]
     errors = ensure_terrains(runs, tmp_path, ensure, seed=3, progress=False)
-    assert errors == {"exp_lan_2": "terrain exp_lan_2: exp_lan_2: broken scene"}
+    assert errors == {"exp_lan_2": "terrain exp_lan_2: exp_lan_2: broken scene",
+                      "sim_lan_2": "terrain sim_lan_2: TypeError: bug in the simulator"}
     assert calls == [("sim_nav_1", {"out_dir": tmp_path, "seed": 7, "frames": 40}),
                      ("exp_lan_2", {"out_dir": tmp_path, "seed": 3, "frames": 10}),
-                     ("sim_lan_1", {"out_dir": tmp_path, "seed": 3, "frames": None})]
+                     ("sim_lan_1", {"out_dir": tmp_path, "seed": 3, "frames": None}),
+                     ("sim_lan_2", {"out_dir": tmp_path, "seed": 3, "frames": 10})]
     assert ensure_terrains([_run("e", ())], tmp_path, None, progress=False) == {}
 
 

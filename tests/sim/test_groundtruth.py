@@ -17,8 +17,8 @@ from alte.sim.scene import SceneBuilder
 def scene():
     b = SceneBuilder()
     b.ground("floor", (-5, -5, 5, 5))
-    b.slab("house front", "building", (1, 1), (2, 2), 0.0, 3.0)
-    b.cylinder("post", "pillar", (-2, -2), 0.2, 0.0, 1.0, segments=8)
+    b.slab("house front", "building", (1, 1), (2, 2), z=(0.0, 3.0))
+    b.cylinder("post", "pillar", (-2, -2), 0.2, z=(0.0, 1.0), segments=8)
     return b.build()
 
 

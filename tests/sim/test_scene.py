@@ -13,9 +13,9 @@ def _signed_volume(vertices, triangles):
 
 @pytest.mark.parametrize(("make", "volume"), [
     (lambda b: b.box("b", "building", (1, 2, 3), (2, 3, 4), yaw_deg=30), 24.0),
-    (lambda b: b.slab("s", "wall", (0, 0), (1, 2), 1.0, 4.0), 6.0),
-    (lambda b: b.gable("r", "building", (0, 0), 4.0, 2.0, 1.0, 2.0), 4.0),
-    (lambda b: b.cylinder("c", "pillar", (5, 5), 1.0, 0.0, 2.0, segments=64), 2 * np.pi),
+    (lambda b: b.slab("s", "wall", (0, 0), (1, 2), z=(1.0, 4.0)), 6.0),
+    (lambda b: b.gable("r", "building", (0, 0), size=(4.0, 2.0), z=(1.0, 2.0)), 4.0),
+    (lambda b: b.cylinder("c", "pillar", (5, 5), 1.0, z=(0.0, 2.0), segments=64), 2 * np.pi),
 ])
 def test_parts_are_closed_outward_and_have_the_right_volume(make, volume):
     b = SceneBuilder()

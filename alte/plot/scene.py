@@ -1,0 +1,135 @@
+"""Figures of the test benchmark (thesis ch. 2): scene, trajectory, scans, cloud,
+ground/clusters, pose history and the obstacle map.
+
+3D views go to a pyvista plotter (off-screen unless interactive, see
+:mod:`alte.plot.render`); 2D plots are matplotlib figures. Helpers only draw
+arrays they are given.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+__all__ = [
+    "add_cloud",
+    "add_ground_and_clusters",
+    "add_scene",
+    "plot_obstacle_map",
+    "plot_pose_history",
+    "plot_scans",
+    "plot_trajectory",
+]
+
+
+def add_scene(plotter: Any, vertices: np.ndarray, triangles: np.ndarray, class_ids: np.ndarray,
+              *, class_names: Sequence[str], opacity: float = 1.0) -> Any:
+    """Add a ground-truth mesh coloured by object class (one mesh, per-face scalars)."""
+    import pyvista as pv
+
+    faces = np.column_stack([np.full(len(triangles), 3), triangles]).ravel()
+    mesh = pv.PolyData(np.asarray(vertices, dtype=np.float64), faces)
+    mesh.cell_data["class"] = np.asarray(class_ids)
+    plotter.add_mesh(mesh, scalars="class", cmap="tab20", opacity=opacity,
+                     clim=[0, len(class_names) - 1], show_scalar_bar=False)
+    return mesh
+
+
+def add_cloud(plotter: Any, points: np.ndarray, scalars: np.ndarray | None = None,
+              point_size: float = 2.0, cmap: str = "viridis", **kwargs: Any) -> None:
+    """Add a point cloud coloured by ``scalars`` (default: height)."""
+    import pyvista as pv
+
+    cloud = pv.PolyData(np.asarray(points, dtype=np.float64))
+    cloud["value"] = points[:, 2] if scalars is None else np.asarray(scalars)
+    plotter.add_mesh(cloud, scalars="value", cmap=cmap, point_size=point_size,
+                     render_points_as_spheres=False, **kwargs)
+
+
+def add_ground_and_clusters(plotter: Any, points: np.ndarray, ground: np.ndarray,
+                            labels: np.ndarray) -> None:
+    """Ground inliers in black, obstacle clusters coloured by label (thesis fig. 2.10)."""
+    add_cloud(plotter, points[ground], scalars=np.zeros(int(ground.sum())), cmap="gray",
+              show_scalar_bar=False)
+    keep = ~ground & (labels >= 0)
+    if keep.any():
+        add_cloud(plotter, points[keep], scalars=labels[keep] % 20, cmap="tab20",
+                  point_size=3.0, show_scalar_bar=False)
+
+
+def plot_trajectory(positions: np.ndarray, sensor: np.ndarray | None = None,
+                    title: str = "Mission trajectory") -> Any:
+    """3D trajectory of the body (and sensor) with start/end marks (thesis fig. 2.7)."""
+    import matplotlib.pyplot as plt
+
+    fig = plt.figure(figsize=(6.5, 5))
+    ax = fig.add_subplot(projection="3d")
+    ax.plot(*positions.T, color="tab:blue", label="body")
+    if sensor is not None:
+        ax.plot(*sensor.T, color="tab:orange", lw=0.8, label="sensor")
+    ax.scatter(*positions[0], color="green", label="start")
+    ax.scatter(*positions[-1], color="red", label="end")
+    ax.set(xlabel="x [m]", ylabel="y [m]", zlabel="z [m]", title=title)
+    ax.legend(loc="upper left")
+    return fig
+
+
+def plot_scans(scans: Sequence[np.ndarray], times: Sequence[float], max_points: int = 4000) -> Any:
+    """Inertial scans at a few times, one 3D panel each (thesis fig. 2.8)."""
+    import matplotlib.pyplot as plt
+
+    n = len(scans)
+    cols = 2 if n > 1 else 1
+    rows = int(np.ceil(n / cols))
+    fig = plt.figure(figsize=(5.5 * cols, 4.5 * rows))
+    for i, (pts, t) in enumerate(zip(scans, times, strict=True)):
+        ax = fig.add_subplot(rows, cols, i + 1, projection="3d")
+        step = max(1, len(pts) // max_points)
+        sub = pts[::step]
+        ax.scatter(*sub.T, c=sub[:, 2], s=1, cmap="viridis")
+        ax.set(title=f"t = {t:.1f} s ({len(pts)} points)", xlabel="x", ylabel="y", zlabel="z")
+    fig.tight_layout()
+    return fig
+
+
+def plot_pose_history(times: np.ndarray, positions: np.ndarray, angles_deg: np.ndarray,
+                      angle_names: Sequence[str] = ("roll", "pitch", "yaw")) -> Any:
+    """Position and attitude against time (thesis figs. 4.2, 4.26, 4.32)."""
+    import matplotlib.pyplot as plt
+
+    fig, (top, bottom) = plt.subplots(2, 1, figsize=(8, 5.5), sharex=True)
+    for i, axis in enumerate("xyz"):
+        top.plot(times, positions[:, i], label=axis)
+    for i, name in enumerate(angle_names):
+        bottom.plot(times, angles_deg[:, i], label=name)
+    top.set(ylabel="position [m]")
+    bottom.set(ylabel="attitude [deg]", xlabel="time [s]")
+    top.legend(loc="upper right")
+    bottom.legend(loc="upper right")
+    return fig
+
+
+def plot_obstacle_map(points: np.ndarray, obstacles: Any, ground: np.ndarray | None = None,
+                      max_points: int = 50_000) -> Any:
+    """Top view: points, obstacle centroids and radius circles (thesis fig. 3.13).
+
+    ``obstacles`` has columns ``x``, ``y``, ``radius`` (``alte.clustering.obstacle_map``).
+    """
+    import matplotlib.pyplot as plt
+    from matplotlib.collections import PatchCollection
+    from matplotlib.patches import Circle
+
+    fig, ax = plt.subplots(figsize=(6.5, 6))
+    step = max(1, len(points) // max_points)
+    pts = points[::step]
+    colour = "0.75" if ground is None else np.where(ground[::step], "0.8", "tab:blue")
+    ax.scatter(pts[:, 0], pts[:, 1], s=0.5, c=colour)
+    circles = [Circle((x, y), r) for x, y, r in zip(obstacles["x"], obstacles["y"],
+                                                     obstacles["radius"], strict=True)]
+    ax.add_collection(PatchCollection(circles, facecolor="none", edgecolor="tab:red", lw=1.5))
+    ax.scatter(obstacles["x"], obstacles["y"], marker="+", color="tab:red", s=60)
+    ax.set(aspect="equal", xlabel="x [m]", ylabel="y [m]",
+           title=f"Obstacle map: {len(circles)} obstacles")
+    return fig
