@@ -159,8 +159,8 @@ def test_qualitative_table_marks_sources():
     assert t2.loc["octomap", "outlier_rejection"] == "Low"
     assert t2.loc["octomap", "development_source"] == "thesis"
     t4 = qualitative_table(4, inputs).set_index("mapper")
-    assert t4.loc["octomap", "free_space_mapping"] == "Yes"
     assert t4.loc["alte3d", "free_space_mapping"] == "No"
+    assert t4.loc["alte3d", "free_space_mapping_source"] == "thesis"
     assert t4.loc["alte3d", "map_size"] == "Mid"
     assert t4.loc["alte3d", "overhanging_structures_source"].startswith("thesis (no measurement")
 

@@ -14,12 +14,13 @@ Each criterion gets our label, the measured value behind it, its source
   >= 0.5 Mid, else Low;
 * map size (5.4): basis functions relative to the larger map of the pair: >= 0.5 High,
   >= 0.1 Mid, else Low;
-* free-space mapping (5.4): Yes when the map holds free leaves (value: share truly free);
 * overhanging structures (5.4): completeness on the ``overhang`` objects of sim_nav_2;
   >= 0.5 Yes.
 
-Development and obstacle identification have no measurement here and come from the
-thesis, marked as such.
+Development, obstacle identification and free-space mapping have no measurement here
+and come from the thesis, marked as such. (Free space is not measurable from the cells
+alone: 3D-ALTE's unoccupied leaves are "not occupied", not observed-free; the metric
+``free_truly_free_share`` in the sweep tables is meaningful for Octomap only.)
 """
 
 from __future__ import annotations
@@ -80,11 +81,6 @@ def _size(m: Inputs, pair: Mapping[str, Inputs]) -> tuple[str, float]:
                   0.1), v
 
 
-def _free(m: Inputs, _pair: Mapping[str, Inputs]) -> tuple[str, float]:
-    v = float(m["best"].get("free_truly_free_share", np.nan))
-    return ("Yes" if np.isfinite(v) else "No"), v
-
-
 def _overhang(m: Inputs, _pair: Mapping[str, Inputs]) -> tuple[str, float]:
     v = float(m.get("overhang_completeness", np.nan))
     return ("n/a" if not np.isfinite(v) else "Yes" if v >= 0.5 else "No"), v
@@ -98,7 +94,6 @@ MEASURES: dict[str, tuple[str, Callable[[Inputs, Mapping[str, Inputs]], tuple[st
     "outlier_rejection": ("HD - MHD of the chosen map (m)", _outliers),
     "map_quality": ("2D completeness vs true top surface", _quality),
     "map_size": ("basis functions of the chosen map", _size),
-    "free_space_mapping": ("share of free leaves truly free", _free),
     "overhanging_structures": ("completeness on sim_nav_2 overhangs", _overhang),
 }
 

@@ -28,7 +28,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
                    help="output folder (default: data)")
     p.add_argument("--seed", type=int, default=0, help="noise seed (default: 0)")
     p.add_argument("--frames", type=int, default=None, metavar="N",
-                   help="simulate N evenly spaced scans of the mission (quick runs)")
+                   help="simulate N evenly spaced scans of the mission (quick runs; "
+                        "written to DIR/NAME-Nf so the full mission is kept)")
     p.add_argument("--storage", choices=("sqlite3", "mcap"), default="sqlite3",
                    help="rosbag2 storage plugin (default: sqlite3)")
     p.add_argument("--force", action="store_true", help="simulate even if the folder is current")

@@ -192,11 +192,12 @@ def _row(slots, rows, blocks, block, n_blocks):
 
 
 @numba.njit(cache=True)
-def _setup(origin, end, res, okey, work, iwork):
+def _setup(ray, res):
     """Amanatides & Woo initialisation exactly as OctoMap; returns the ray length.
 
     Fills the per-scan workspaces: ``work`` = (tMax, tDelta), ``iwork`` = (key, step).
     """
+    origin, okey, end, _, work, iwork = ray
     d = (end[0] - origin[0], end[1] - origin[1], end[2] - origin[2])
     lf = np.float32(_norm(d[0], d[1], d[2]))  # float length = (float) direction.norm()
     for i in range(3):
@@ -221,9 +222,9 @@ def _walk(ray, res, limit, table, n_blocks):
     A ray visits at most |dk| + 1 voxels; ``limit`` (|dk| + 4) only stops a ray
     that float round-off carries past its end voxel (it then stops on the length test).
     """
-    origin, okey, end, ekey, work, iwork = ray
+    ekey, work, iwork = ray[3], ray[4], ray[5]
     slots, rows, bits, blocks = table
-    length = _setup(origin, end, res, okey, work, iwork)
+    length = _setup(ray, res)
     t_max, t_delta, cur, step = work[0], work[1], iwork[0], iwork[1]
     added, last, row = 0, _EMPTY, 0
     for it in range(limit):

@@ -22,6 +22,7 @@ from alte.sim.scenario import (
     get_terrain,
     load_scenario,
     spec_hash,
+    terrain_folder,
     write_scenario,
 )
 from alte.sim.scene import CLASSES, Scene, SceneBuilder
@@ -50,6 +51,7 @@ __all__ = [
     "pose_history",
     "simulate",
     "spec_hash",
+    "terrain_folder",
     "tripod_mount",
     "write_ground_truth",
     "write_scenario",

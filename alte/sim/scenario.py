@@ -127,10 +127,19 @@ def is_current(folder: Path, key: str, seed: int) -> bool:
     return _file_table(folder) == meta["files"]
 
 
+def terrain_folder(out_dir: str | os.PathLike[str], name: str, frames: int | None = None) -> Path:
+    """Where a terrain lives: ``out_dir/NAME`` (full mission) or ``out_dir/NAME-Nf`` (N scans).
+
+    Reduced missions (quick runs, tests) get their own folder so they never replace
+    the full one, and concurrent runs asking for different sizes cannot collide.
+    """
+    return Path(out_dir) / (name if frames is None else f"{name}-{int(frames)}f")
+
+
 def ensure_terrain(name: str, out_dir: str | os.PathLike[str] = "data", seed: int = 0,
                    frames: int | None = None, *, storage: str = "sqlite3", force: bool = False,
                    progress: bool = False) -> Path:
-    """Simulate terrain ``name`` into ``out_dir/name`` unless it is already current."""
+    """Simulate terrain ``name`` into :func:`terrain_folder` unless it is already current."""
     return update_terrain(name, out_dir, seed, frames, storage=storage, force=force,
                           progress=progress)[0]
 
@@ -140,7 +149,7 @@ def update_terrain(name: str, out_dir: str | os.PathLike[str] = "data", seed: in
                    progress: bool = False) -> tuple[Path, bool]:
     """As :func:`ensure_terrain`; also says whether the terrain was (re)simulated."""
     terrain = get_terrain(name)
-    target = Path(out_dir) / name
+    target = terrain_folder(out_dir, name, frames)
     key = spec_hash(terrain, frames, storage)
     if not force and is_current(target, key, seed):
         return target, False

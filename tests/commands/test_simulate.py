@@ -12,7 +12,7 @@ def test_simulate_one_then_up_to_date(tmp_path, capsys):
     assert "sim_lan_1: 3 frames" in out and "simulated in" in out
     assert main(["simulate", "sim_lan_1", "--out", str(tmp_path), "--frames", "3"]) == 0
     assert "up to date" in capsys.readouterr().out
-    meta = json.loads((tmp_path / "sim_lan_1" / "scenario.json").read_text())
+    meta = json.loads((tmp_path / "sim_lan_1-3f" / "scenario.json").read_text())
     assert meta["storage"] == "sqlite3" and meta["frames_requested"] == 3
 
 
@@ -22,8 +22,8 @@ def test_simulate_all_with_mcap(tmp_path, capsys):
     out = capsys.readouterr().out
     for name in TERRAINS:
         assert f"{name}: 2 frames" in out
-        assert (tmp_path / name / "bag" / "bag.mcap").is_file()
-        assert json.loads((tmp_path / name / "scenario.json").read_text())["seed"] == 5
+        assert (tmp_path / f"{name}-2f" / "bag" / "bag.mcap").is_file()
+        assert json.loads((tmp_path / f"{name}-2f" / "scenario.json").read_text())["seed"] == 5
 
 
 def test_unknown_terrain_is_a_one_line_error(tmp_path, capsys):

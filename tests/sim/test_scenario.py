@@ -8,7 +8,7 @@ import pytest
 from alte.errors import ParameterError, SimulationError
 from alte.sim import TERRAINS, ensure_terrain, get_terrain, load_scenario, simulate
 from alte.sim.mission import scan_indices
-from alte.sim.scenario import update_terrain
+from alte.sim.scenario import terrain_folder, update_terrain
 
 
 def _bytes(folder):
@@ -56,8 +56,10 @@ def test_cache_is_reused_only_when_spec_seed_and_files_match(tmp_path):
     assert update_terrain("sim_lan_1", tmp_path, seed=0, frames=4) == (folder, False)
     assert (folder / "bag" / "bag.db3").stat().st_mtime_ns == stamp
     assert update_terrain("sim_lan_1", tmp_path, seed=1, frames=4)[1]  # other seed
-    assert update_terrain("sim_lan_1", tmp_path, seed=1, frames=5)[1]  # other mission
-    with open(folder / "bag" / "bag.db3", "r+b") as fh:  # damaged after the fact
+    other, made = update_terrain("sim_lan_1", tmp_path, seed=1, frames=5)  # other mission
+    assert made and other == terrain_folder(tmp_path, "sim_lan_1", 5) != folder
+    assert folder.is_dir()  # a reduced mission never replaces another one
+    with open(other / "bag" / "bag.db3", "r+b") as fh:  # damaged after the fact
         fh.seek(200)
         fh.write(b"\xff\xff")
     assert update_terrain("sim_lan_1", tmp_path, seed=1, frames=5)[1]
@@ -83,8 +85,9 @@ def test_errors(tmp_path):
         scan_indices(10, 11)
     with pytest.raises(ParameterError, match="seed=-1"):
         simulate(get_terrain("sim_lan_1"), seed=-1, frames=1)
-    (tmp_path / "sim_lan_1").mkdir()
-    (tmp_path / "sim_lan_1" / "mine.txt").write_text("user data")
+    mine = terrain_folder(tmp_path, "sim_lan_1", 2)
+    mine.mkdir()
+    (mine / "mine.txt").write_text("user data")
     with pytest.raises(SimulationError, match="not a simulated terrain folder"):
         ensure_terrain("sim_lan_1", tmp_path, frames=2)
 
