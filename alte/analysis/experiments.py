@@ -36,9 +36,11 @@ __all__ = ["BATCH_MAPPERS", "CUBE_DOMAIN_MAPPERS", "Dataset", "MapRun", "TruthOp
 #: Mappers the thesis ran once on the final cloud instead of frame by frame.
 BATCH_MAPPERS = frozenset({"quadtree"})
 
-#: Mappers whose frame-by-frame insert needs a fixed cubic domain; unless the caller
-#: passes ``domain``, they get the cube over the terrain's control volume.
-CUBE_DOMAIN_MAPPERS = frozenset({"alte3d"})
+#: Mappers whose frame-by-frame insert needs a fixed domain (thesis 3.3: "an overall
+#: domain is defined"); unless the caller passes ``domain``, they get the cube (2D-ALTE:
+#: its square footprint) over the terrain's control volume, so ``max_res`` refines the
+#: terrain rather than a power-of-two box grown around it.
+CUBE_DOMAIN_MAPPERS = frozenset({"alte2d", "alte3d"})
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,130 @@
+"""Timing primitives of the benchmark: interleaved medians, per-call latencies, the machine.
+
+Every figure is the median of ``repeats`` runs taken after ``warmup`` discarded ones
+(numba compilation, caches, page faults). Ours and the peer run in the same process,
+interleaved repeat by repeat with alternating order, so slow drift of a loaded
+machine hits both alike.
+"""
+
+from __future__ import annotations
+
+import os
+import platform
+import resource
+import time
+from collections.abc import Callable, Iterable, Mapping, Sequence
+from dataclasses import dataclass
+from importlib import metadata
+from typing import Any
+
+import numpy as np
+
+from alte.errors import ParameterError
+
+__all__ = ["Sample", "fit_exponent", "interleave", "machine_info", "measure", "nlogn_exponent",
+           "peak_rss_bytes"]
+
+
+@dataclass(frozen=True)
+class Sample:
+    """Seconds of each timed repeat (warm-up excluded) and their summary."""
+
+    times: tuple[float, ...]
+
+    @property
+    def median(self) -> float:
+        """Median seconds over the repeats."""
+        return float(np.median(self.times))
+
+    @property
+    def spread(self) -> float:
+        """Interquartile range over the repeats (seconds)."""
+        q1, q3 = np.percentile(self.times, [25, 75])
+        return float(q3 - q1)
+
+    def as_dict(self) -> dict[str, Any]:
+        """JSON-ready summary."""
+        return {"median_s": self.median, "iqr_s": self.spread, "repeats": len(self.times),
+                "times_s": list(self.times)}
+
+
+def check_counts(repeats: int, warmup: int) -> None:
+    """``repeats >= 1`` and ``warmup >= 0`` or :class:`ParameterError`."""
+    if repeats < 1:
+        raise ParameterError(f"bench: repeats={repeats} must be >= 1")
+    if warmup < 0:
+        raise ParameterError(f"bench: warmup={warmup} must be >= 0")
+
+
+def interleave(names: Sequence[str], rounds: int) -> Iterable[tuple[int, str]]:
+    """``(round, name)`` pairs; the order flips every round (A B, B A, A B, ...)."""
+    for r in range(rounds):
+        for name in (names if r % 2 == 0 else names[::-1]):
+            yield r, name
+
+
+def measure(funcs: Mapping[str, Callable[[], object]], repeats: int = 5,
+            warmup: int = 1) -> dict[str, Sample]:
+    """Time every callable ``warmup + repeats`` times, interleaved; medians of the last ``repeats``."""
+    check_counts(repeats, warmup)
+    times: dict[str, list[float]] = {name: [] for name in funcs}
+    for r, name in interleave(list(funcs), warmup + repeats):
+        start = time.perf_counter()
+        funcs[name]()
+        elapsed = time.perf_counter() - start
+        if r >= warmup:
+            times[name].append(elapsed)
+    return {name: Sample(tuple(t)) for name, t in times.items()}
+
+
+def fit_exponent(sizes: Sequence[float], seconds: Sequence[float]) -> float:
+    """Slope of log(seconds) against log(size): the empirical complexity exponent."""
+    x, y = np.log(np.asarray(sizes, float)), np.log(np.asarray(seconds, float))
+    if x.size < 2 or not np.isfinite(y).all():
+        raise ParameterError(f"fit_exponent: need >= 2 finite timings, got {list(seconds)}")
+    return float(np.polyfit(x, y, 1)[0])
+
+
+def nlogn_exponent(sizes: Sequence[float]) -> float:
+    """The slope :func:`fit_exponent` gives for exact n log n over ``sizes`` (about 1.1)."""
+    n = np.asarray(sizes, float)
+    return fit_exponent(n, n * np.log(n))
+
+
+def peak_rss_bytes() -> int:
+    """Peak resident set size of this process so far (bytes; Linux reports KiB)."""
+    return int(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss) * 1024
+
+
+def _cpu_model() -> str:
+    try:
+        with open("/proc/cpuinfo", encoding="utf-8") as info:
+            for line in info:
+                if line.startswith("model name"):
+                    return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or platform.machine()
+
+
+def _version(package: str) -> str:
+    try:
+        return metadata.version(package)
+    except metadata.PackageNotFoundError:
+        return "absent"
+
+
+def machine_info() -> dict[str, Any]:
+    """CPU model, core counts, load, memory and the versions that matter for the figures."""
+    try:
+        pages = os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    except (ValueError, OSError):
+        pages = 0
+    return {
+        "cpu": _cpu_model(), "cores": os.cpu_count(),
+        "cores_usable": len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else None,
+        "load_avg_1_5_15": [round(v, 2) for v in os.getloadavg()],
+        "memory_gib": round(pages / 2**30, 1), "platform": platform.platform(),
+        "python": platform.python_version(),
+        **{name: _version(name) for name in ("numpy", "scipy", "numba", "open3d", "pyoctomap")},
+    }

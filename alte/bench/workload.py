@@ -1,0 +1,86 @@
+"""Benchmark inputs: the simulated terrains, registered once per process, and tiled clouds.
+
+A :class:`Workload` is what the thesis' experiments feed the mappers: per kept frame
+the registered, grid-averaged points and the sensor origin, and the merged cloud
+(set A of the Hausdorff metrics). Full mode reads the whole mission from
+``data/NAME`` (simulated on first use); quick mode simulates a few scans into
+``data/bench_quick/NAME`` so the real terrain folders are never replaced.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from alte.errors import ParameterError
+
+__all__ = ["QUICK_FRAMES", "Workload", "load_workload", "tile_points", "workload_dir"]
+
+#: Scans simulated per terrain in quick mode.
+QUICK_FRAMES = 6
+
+
+@dataclass(frozen=True, eq=False)
+class Workload:
+    """One terrain ready for mapping: frames ``(points, origin)``, merged cloud, control box."""
+
+    name: str
+    frames: list[tuple[np.ndarray, np.ndarray]]
+    cloud: np.ndarray
+    bounds: np.ndarray
+    voxel: float
+
+    @property
+    def frame_points(self) -> int:
+        """Points over all frames (what incremental mappers insert)."""
+        return int(sum(len(p) for p, _ in self.frames))
+
+    def stacked(self) -> tuple[np.ndarray, np.ndarray]:
+        """All frame points (P, 3) and each point's sensor origin (P, 3), frame order kept."""
+        pts = np.vstack([p for p, _ in self.frames])
+        origins = np.repeat(np.array([o for _, o in self.frames]),
+                            [len(p) for p, _ in self.frames], axis=0)
+        return pts, origins
+
+
+def workload_dir(data_dir: str | Path, quick: bool) -> Path:
+    """Where the terrains of this mode live."""
+    return Path(data_dir) / "bench_quick" if quick else Path(data_dir)
+
+
+def load_workload(terrain: str, data_dir: str | Path, *, quick: bool = False,
+                  frames: int | None = None, progress: bool = False) -> Workload:
+    """Simulate ``terrain`` if missing, register it; ``frames`` keeps that many scans evenly."""
+    from alte.analysis.experiments import load_dataset
+    from alte.sim import ensure_terrain
+
+    folder = ensure_terrain(terrain, workload_dir(data_dir, quick),
+                            frames=QUICK_FRAMES if quick else None, progress=progress)
+    data = load_dataset(folder, frames=frames, progress=progress)
+    return Workload(terrain, data.frames, data.cloud, np.asarray(data.bounds, float),
+                    float(data.info["voxel_m"]))
+
+
+def tile_points(points: np.ndarray, count: int, *extra: np.ndarray) -> list[np.ndarray]:
+    """``count`` rows of ``points`` (N, 3): evenly subsampled, or tiled side by side in x/y.
+
+    Copies are shifted by whole multiples of the cloud's x/y extent (plus 1 m), so
+    tiles never overlap and every copy has the terrain's own density. ``extra``
+    arrays (N, 3), e.g. per-point sensor origins, get the same shifts and selection.
+    Rows keep their order, so runs of equal origins (scans) stay contiguous.
+    """
+    pts = np.asarray(points, dtype=np.float64)
+    if count < 1 or len(pts) == 0:
+        raise ParameterError(f"tile_points: need count >= 1 and points, got {count}, {len(pts)}")
+    copies = math.ceil(count / len(pts))
+    side = math.ceil(math.sqrt(copies))
+    step = np.ptp(pts[:, :2], axis=0) + 1.0
+    shift = np.zeros((copies, 3))
+    shift[:, 0] = np.arange(copies) % side * step[0]
+    shift[:, 1] = np.arange(copies) // side * step[1]
+    keep = np.round(np.linspace(0, copies * len(pts) - 1, count)).astype(np.int64)
+    tile, row = np.divmod(keep, len(pts))
+    return [np.asarray(arr, dtype=np.float64)[row] + shift[tile] for arr in (pts, *extra)]
