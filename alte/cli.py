@@ -24,6 +24,7 @@ COMMANDS: dict[str, str] = {
     "report": "alte.commands.report",
     "register": "alte.commands.register",
     "simulate": "alte.commands.simulate",
+    "bench": "alte.commands.bench",
 }
 
 

@@ -65,7 +65,7 @@ def interleave(names: Sequence[str], rounds: int) -> Iterable[tuple[int, str]]:
 
 def measure(funcs: Mapping[str, Callable[[], object]], repeats: int = 5,
             warmup: int = 1) -> dict[str, Sample]:
-    """Time every callable ``warmup + repeats`` times, interleaved; medians of the last ``repeats``."""
+    """Time every callable ``warmup + repeats`` times, interleaved; keep the last ``repeats``."""
     check_counts(repeats, warmup)
     times: dict[str, list[float]] = {name: [] for name in funcs}
     for r, name in interleave(list(funcs), warmup + repeats):

@@ -172,6 +172,11 @@ class QuadMap:
         return self.stats.nbytes
 
     def corners(self) -> np.ndarray:
-        """Corners of the occupied leaves at their height (M, 3), de-duplicated."""
+        """Corners of every known leaf at its height (M, 3), de-duplicated: set B of fig. 5.1.
+
+        A 2D map's basis functions are heights: a free leaf is ground at its mean
+        height, so it belongs to set B as much as an occupied one (the thesis builds B
+        from "the corners of each basis function"); unknown leaves have no height.
+        """
         cells = self.cells()
-        return rectangle_corners(cells, cells.occupied)
+        return rectangle_corners(cells, np.isfinite(cells.centers[:, 2]))

@@ -26,7 +26,7 @@ points (siblings of split cells) are *unknown*: NaN height and value, not occupi
 Cells: ``centers[:, 2]`` is the leaf's mean z, ``value`` the thresholded statistic
 (mean or max height above the plane). ``basis_functions`` counts every leaf (free,
 occupied and unknown: the variable-size occupancy grid a planner walks);
-``corners()`` gives the 4 corners of the occupied leaves at their mean z. Memory
+``corners()`` gives the 4 corners of every known leaf at its mean z. Memory
 holds per-level statistics down to ``max_depth`` (needed to split a leaf later).
 """
 

@@ -1,0 +1,199 @@
+"""Rows 1, 2, 3 and 5: mapper speed, memory and latency against their peers.
+
+Row 1/2: our Octomap (``backend=native``) and the C++ OctoMap through ``pyoctomap``
+insert the same scans (same origins, max range and sensor model), interleaved pass
+by pass; the last map of each gives the Jaccard index and the memory figures.
+Row 3: batch builds at the chapter 4 parameters against ``numpy.argsort`` of as many
+float64 keys (the floor of any sort-based build). Row 5: per-frame ``insert``
+latency of every incremental mapper against one VLP-16 rotation (100 ms).
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from tqdm.auto import tqdm
+
+from alte.bench.core import LIMITS, Context, Result
+from alte.bench.timing import interleave, measure
+from alte.thesis import mapper_params
+
+__all__ = [
+    "JACCARD_MIN",
+    "ROTATION_S",
+    "Passes",
+    "batch_builds",
+    "insert_latencies",
+    "insert_latency",
+    "interleaved_passes",
+    "mapper_setup",
+    "octomap_memory",
+    "octomap_passes",
+    "octomap_speed",
+]
+
+#: One VLP-16 rotation at 10 Hz: a mapper keeping up with the sensor inserts faster.
+ROTATION_S = 0.1
+#: Row 1's agreement bar between the backends (the mappers issue's).
+JACCARD_MIN = 0.999
+NAV, LAN = "sim_nav_1", "sim_lan_2"
+#: Terrain each mapper is benchmarked on (its thesis case, chapter 4).
+TERRAIN_OF = {"octomap": NAV, "alte3d": NAV, "quadtree": LAN, "alte2d": LAN}
+
+
+@dataclass(frozen=True, eq=False)
+class Passes:
+    """Per-frame insert seconds of every timed pass, and the last map, per contender."""
+
+    latencies: dict[str, list[np.ndarray]]
+    maps: dict[str, Any]
+
+    def totals(self, name: str) -> list[float]:
+        """Seconds of each timed pass of ``name`` (sum of its frame latencies)."""
+        return [float(t.sum()) for t in self.latencies[name]]
+
+
+def insert_latencies(mapper: Any, scans: Sequence[tuple[np.ndarray, np.ndarray]]) -> np.ndarray:
+    """Insert every scan in order; seconds spent in each ``insert`` call."""
+    out = np.empty(len(scans))
+    for i, (points, origin) in enumerate(scans):
+        start = time.perf_counter()
+        mapper.insert(points, origin)
+        out[i] = time.perf_counter() - start
+    return out
+
+
+def interleaved_passes(makers: Mapping[str, Callable[[], Any]],
+                       scans: Sequence[tuple[np.ndarray, np.ndarray]], *, repeats: int,
+                       warmup: int, progress: bool = False, desc: str = "passes") -> Passes:
+    """Fresh map per pass; contenders alternate pass by pass; warm-up passes discarded."""
+    latencies: dict[str, list[np.ndarray]] = {name: [] for name in makers}
+    maps: dict[str, Any] = {}
+    rounds = list(interleave(list(makers), warmup + repeats))
+    for r, name in tqdm(rounds, desc=desc, unit="pass", disable=not progress, leave=False):
+        mapper = makers[name]()
+        seconds = insert_latencies(mapper, scans)
+        if r >= warmup:
+            latencies[name].append(seconds)
+        maps[name] = mapper
+    return Passes(latencies, maps)
+
+
+def mapper_setup(ctx: Context, name: str) -> dict[str, Any]:
+    """Chapter 4 parameters of ``name`` on its terrain, with the fixed domain ``insert`` needs."""
+    from alte.mappers.timelapse import cube_domain, square_domain
+
+    terrain = TERRAIN_OF[name]
+    params = mapper_params(terrain)[name]
+    bounds = ctx.workload(terrain).bounds
+    if name == "alte3d":
+        params["domain"] = cube_domain(bounds)
+    elif name in {"quadtree", "alte2d"}:
+        params["domain"] = square_domain(bounds)
+    return params
+
+
+def octomap_passes(ctx: Context) -> Passes:
+    """Native and reference Octomap over the same scans (memoised: rows 1, 2, 4, 5 share it)."""
+    from alte.mappers import make_mapper
+
+    def run() -> Passes:
+        params = mapper_setup(ctx, "octomap")
+        makers = {b: (lambda b=b: make_mapper("octomap", **params, backend=b))
+                  for b in ("native", "reference")}
+        cfg = ctx.config
+        return interleaved_passes(makers, ctx.scans(NAV), repeats=cfg.repeats,
+                                  warmup=cfg.warmup, progress=cfg.progress, desc="octomap")
+
+    return ctx.memo("octomap-passes", run)
+
+
+def _jaccard(a: np.ndarray, b: np.ndarray) -> float:
+    union = np.union1d(a, b).size
+    return np.intersect1d(a, b, assume_unique=True).size / union if union else 1.0
+
+
+def octomap_speed(ctx: Context) -> list[Result]:
+    """Row 1: native vs pyoctomap insertPointCloud, whole scan sequence; Jaccard of voxels."""
+    passes = octomap_passes(ctx)
+    native, reference = passes.maps["native"], passes.maps["reference"]
+    jac = ctx.memo("octomap-jaccard", lambda: _jaccard(native.occupied_voxels(),
+                                                       reference.occupied_voxels()))
+    ours, peer = np.median(passes.totals("native")), np.median(passes.totals("reference"))
+    scans = ctx.scans(NAV)
+    detail = {"jaccard": jac, "frames": len(scans), "points": int(sum(len(p) for p, _ in scans)),
+              "params": native.params, "native_s": passes.totals("native"),
+              "reference_s": passes.totals("reference")}
+    met = bool(ours / peer <= LIMITS[1] and jac >= JACCARD_MIN)
+    target = f"ratio <= {LIMITS[1]:.3f}, Jaccard >= {JACCARD_MIN}"
+    return [Result(1, f"Octomap native vs pyoctomap, {NAV} ({len(scans)} frames)", float(ours),
+                   float(peer), "s", target, met, detail)]
+
+
+def octomap_memory(ctx: Context) -> list[Result]:
+    """Row 2: bytes of the native map's arrays vs the reference's ``memoryUsage()``."""
+    passes = octomap_passes(ctx)
+    native, reference = passes.maps["native"], passes.maps["reference"]
+    ours, peer = native.memory_bytes, reference.memory_bytes
+    detail = {"leaves_native": native.basis_functions,
+              "leaves_reference": reference.basis_functions}
+    return [Result(2, f"Octomap native memory, {NAV}", float(ours), float(peer), "B",
+                   "ratio <= 1", bool(ours <= LIMITS[2] * peer), detail)]
+
+
+def batch_builds(ctx: Context) -> list[Result]:
+    """Row 3: Quadtree and 2D-ALTE on sim_lan_2, 3D-ALTE on sim_nav_1 vs argsort floor."""
+    from alte.mappers import make_mapper
+
+    out = []
+    for name in ("quadtree", "alte2d", "alte3d"):
+        terrain = TERRAIN_OF[name]
+        cloud = ctx.workload(terrain).cloud
+        params = mapper_params(terrain)[name]
+        keys = np.random.default_rng(0).random(len(cloud))
+        times = measure({"ours": lambda n=name, p=params, c=cloud: make_mapper(n, **p).build(c),
+                         "peer": lambda k=keys: np.argsort(k)},
+                        ctx.config.repeats, ctx.config.warmup)
+        ratio = times["ours"].median / times["peer"].median
+        out.append(Result(3, f"{name} build, {terrain} ({len(cloud)} pts)",
+                          times["ours"].median, times["peer"].median, "s", "ratio <= 10",
+                          bool(ratio <= LIMITS[3]), {"params": params, "points": len(cloud),
+                                              **{k: s.as_dict() for k, s in times.items()}}))
+    return out
+
+
+def _latency_result(name: str, terrain: str, lat: list[np.ndarray]) -> Result:
+    p99 = [float(np.percentile(t, 99)) for t in lat]
+    ours = float(np.median(p99)) * 1e3
+    detail = {"p99_ms_per_pass": [v * 1e3 for v in p99], "frames": len(lat[0]),
+              "median_ms": float(np.median(np.concatenate(lat))) * 1e3,
+              "max_ms": float(np.max(np.concatenate(lat))) * 1e3}
+    return Result(5, f"{name} insert p99, {terrain}", ours, ROTATION_S * 1e3, "ms",
+                  "p99 < 100 ms", bool(ours < ROTATION_S * 1e3), detail)
+
+
+def insert_latency(ctx: Context) -> list[Result]:
+    """Row 5: p99 per-frame insert latency of each incremental mapper over EVERY frame
+    (``--frames`` does not apply: later frames meet a bigger map), median over passes."""
+    from alte.mappers import MAPPERS, make_mapper
+
+    cfg = ctx.config
+    out = []
+    for name, cls in MAPPERS.items():
+        if not getattr(cls, "incremental", False) or name not in TERRAIN_OF:
+            continue
+        terrain = TERRAIN_OF[name]
+        if name == "octomap" and cfg.frames is None and ctx.has("octomap-passes"):
+            lat = octomap_passes(ctx).latencies["native"]  # row 1 already inserted every frame
+        else:
+            params = mapper_setup(ctx, name)
+            passes = interleaved_passes({name: lambda n=name, p=params: make_mapper(n, **p)},
+                                        ctx.workload(terrain).frames, repeats=cfg.repeats,
+                                        warmup=cfg.warmup, progress=cfg.progress, desc=name)
+            lat = passes.latencies[name]
+        out.append(_latency_result(name, terrain, lat))
+    return out

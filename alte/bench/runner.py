@@ -1,0 +1,96 @@
+"""The benchmark suite: the rows of issue 6 by number, run in one process.
+
+:data:`ROWS` maps a row number to its title and function; :func:`run_bench` runs
+the selected rows in order (sharing loaded terrains and the Octomap passes) and
+returns a :class:`Bench` with the machine description. A row that fails is recorded
+with its error and the others still run, so one broken stage never hides the rest.
+"""
+
+from __future__ import annotations
+
+import time
+import traceback
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass, field
+from datetime import UTC, datetime
+from typing import Any
+
+from tqdm.auto import tqdm
+
+from alte.bench.clouds import cloud_stages, hausdorff_speed
+from alte.bench.core import BenchConfig, Context, Result
+from alte.bench.maps import batch_builds, insert_latency, octomap_memory, octomap_speed
+from alte.bench.scaling import scaling
+from alte.bench.timing import machine_info, peak_rss_bytes
+from alte.bench.wall import report_wall_time
+from alte.errors import ParameterError
+
+__all__ = ["ROWS", "Bench", "run_bench", "select_rows"]
+
+Row = Callable[[Context], list[Result]]
+
+#: Row number -> (what it compares, the function measuring it).
+ROWS: dict[int, tuple[str, Row]] = {
+    1: ("Octomap native vs pyoctomap insertPointCloud", octomap_speed),
+    2: ("Octomap native memory vs memoryUsage()", octomap_memory),
+    3: ("batch builds vs numpy.argsort floor", batch_builds),
+    4: ("HD/MHD vs open3d compute_point_cloud_distance", hausdorff_speed),
+    5: ("per-frame insert latency vs one 10 Hz rotation", insert_latency),
+    6: ("grid average / MSAC / clustering vs open3d", cloud_stages),
+    7: ("scaling 10^4..10^7 points", scaling),
+    8: ("make report wall time vs thesis MATLAB", report_wall_time),
+}
+
+
+@dataclass
+class Bench:
+    """Results of one run, the rows that failed, the machine and the settings."""
+
+    config: BenchConfig
+    results: list[Result]
+    errors: dict[int, str]
+    machine: dict[str, Any]
+    started: str
+    seconds: float = 0.0
+    row_seconds: dict[int, float] = field(default_factory=dict)
+
+    def as_dict(self) -> dict[str, Any]:
+        """JSON-ready record."""
+        cfg = self.config
+        return {"started": self.started, "seconds": self.seconds, "machine": self.machine,
+                "config": {"quick": cfg.quick, "repeats": cfg.repeats, "warmup": cfg.warmup,
+                           "frames": cfg.frames, "sizes": list(cfg.scaling_sizes),
+                           "budget_s": cfg.budget_s},
+                "row_seconds": self.row_seconds, "errors": self.errors,
+                "results": [r.as_dict() for r in self.results]}
+
+
+def select_rows(only: Iterable[int] | None) -> list[int]:
+    """The row numbers to run (all by default); unknown numbers raise ParameterError."""
+    chosen = sorted(set(only)) if only else sorted(ROWS)
+    bad = [n for n in chosen if n not in ROWS]
+    if bad:
+        raise ParameterError(f"bench: unknown row(s) {bad}; rows are {sorted(ROWS)}")
+    return chosen
+
+
+def run_bench(config: BenchConfig, only: Iterable[int] | None = None) -> Bench:
+    """Run the chosen rows with ``config``; failures are recorded per row, not raised."""
+    rows = select_rows(only)
+    ctx = Context(config)
+    bench = Bench(config, [], {}, machine_info(),
+                  datetime.now(UTC).isoformat(timespec="seconds"))
+    t0 = time.perf_counter()
+    for number in tqdm(rows, desc="bench", unit="row", disable=not config.progress):
+        start = time.perf_counter()
+        try:
+            bench.results.extend(ROWS[number][1](ctx))
+        except Exception as err:  # a broken row is reported, the others still run
+            last = traceback.extract_tb(err.__traceback__)[-1]
+            bench.errors[number] = (f"{type(err).__name__}: {err} "
+                                    f"({last.filename}:{last.lineno})")
+        bench.row_seconds[number] = time.perf_counter() - start
+    bench.seconds = time.perf_counter() - t0
+    bench.machine["peak_rss_gib"] = round(peak_rss_bytes() / 2**30, 2)
+    bench.machine["load_avg_end"] = machine_info()["load_avg_1_5_15"]
+    return bench

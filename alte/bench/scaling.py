@@ -1,0 +1,95 @@
+"""Row 7: how each mapper and the Hausdorff metrics scale from 10^4 to 10^7 points.
+
+Inputs are the terrains' own clouds, evenly subsampled below their size and tiled
+side by side above it (:func:`alte.bench.workload.tile_points`), so density and
+structure stay those of the terrain. Octomap gets the raw frame points with their
+sensor origins (runs of equal origin = one scan each, as ``build`` defines), so its
+rays keep their real length. The exponent is the slope of a log-log fit; exact
+n log n over the same sizes gives the bar (plus 0.1 for timing noise). A size whose
+run is predicted to exceed ``budget_s`` (from the last size and the slope so far)
+is skipped and reported as such.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+from tqdm.auto import tqdm
+
+from alte.bench.core import Context, Result
+from alte.bench.maps import NAV, TERRAIN_OF
+from alte.bench.timing import fit_exponent, measure, nlogn_exponent, peak_rss_bytes
+from alte.bench.workload import tile_points
+from alte.thesis import mapper_params
+
+__all__ = ["EXPONENT_SLACK", "predicted_seconds", "scaling", "scaling_cases"]
+
+#: Allowed excess of the fitted exponent over n log n's (timing noise on a shared machine).
+EXPONENT_SLACK = 0.1
+
+Case = Callable[[int], Callable[[], object]]
+
+
+def scaling_cases(ctx: Context) -> dict[str, Case]:
+    """Name -> (size -> the timed call on an input of that size); inputs built untimed."""
+    from alte.mappers import make_mapper
+    from alte.metrics import hausdorff
+
+    def cloud_build(name: str) -> Case:
+        def make(n: int) -> Callable[[], object]:
+            (pts,) = tile_points(ctx.workload(TERRAIN_OF[name]).cloud, n)
+            params = mapper_params(TERRAIN_OF[name])[name]
+            return lambda: make_mapper(name, **params).build(pts)
+        return make
+
+    def octomap(n: int) -> Callable[[], object]:
+        raw, per_point = ctx.workload(NAV).stacked()
+        pts, origins = tile_points(raw, n, per_point)
+        params = mapper_params(NAV)["octomap"]
+        return lambda: make_mapper("octomap", **params).build(pts, origins)
+
+    def metrics(n: int) -> Callable[[], object]:
+        (pts,) = tile_points(ctx.workload(NAV).cloud, n)
+        return lambda: hausdorff(pts, pts[::4])
+
+    return {"octomap": octomap, **{m: cloud_build(m) for m in ("quadtree", "alte2d", "alte3d")},
+            "hausdorff": metrics}
+
+
+def predicted_seconds(sizes: list[int], seconds: list[float], n: int) -> float:
+    """Seconds expected at ``n`` from the last timing and the slope so far (>= 1)."""
+    slope = max(1.0, fit_exponent(sizes, seconds)) if len(sizes) >= 2 else 1.0
+    return seconds[-1] * (n / sizes[-1]) ** slope
+
+
+def _one_case(ctx: Context, name: str, make: Case) -> Result:
+    cfg = ctx.config
+    sizes: list[int] = []
+    seconds: list[float] = []
+    skipped: dict[int, float] = {}
+    rss: dict[int, int] = {}
+    for n in cfg.scaling_sizes:
+        if sizes and (guess := predicted_seconds(sizes, seconds, n)) > cfg.budget_s:
+            skipped[n] = guess
+            continue
+        sample = measure({name: make(n)}, cfg.repeats, cfg.warmup)[name]
+        sizes.append(n)
+        seconds.append(sample.median)
+        rss[n] = peak_rss_bytes()
+    exponent = fit_exponent(sizes, seconds) if len(sizes) >= 2 else float("nan")
+    bar = nlogn_exponent(sizes) if len(sizes) >= 2 else float("nan")
+    detail: dict[str, Any] = {"sizes": sizes, "seconds": seconds, "peak_rss_bytes": rss,
+                              "skipped_predicted_s": skipped}
+    met = bool(exponent <= bar + EXPONENT_SLACK) if len(sizes) >= 2 else None
+    span = f"{sizes[0]:.0e}..{sizes[-1]:.0e}" if sizes else "none"
+    return Result(7, f"{name} scaling, n = {span}", exponent, bar, "exponent",
+                  f"exponent <= n log n's + {EXPONENT_SLACK}", met, detail)
+
+
+def scaling(ctx: Context) -> list[Result]:
+    """Row 7: fitted exponents of every mapper's build and of HD/MHD."""
+    cases = scaling_cases(ctx)
+    return [_one_case(ctx, name, make)
+            for name, make in tqdm(cases.items(), desc="scaling", unit="case",
+                                   disable=not ctx.config.progress, leave=False)]

@@ -1,0 +1,53 @@
+"""Row 8: the wall time of ``make report`` and each stage's share, read, never re-run.
+
+The report runner records its total and every notebook's seconds in
+``reports/latest/run.json``; the bench reads that record. The peer is the thesis'
+MATLAB mapping time summed over tables 5.7-5.12 (informative only: different
+machine, and the thesis times the mappers alone).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from alte.bench.core import Context, Result
+from alte.thesis import COMPARISONS, SWEEPS
+
+__all__ = ["report_wall_time", "stage_shares", "thesis_total_s"]
+
+
+def thesis_total_s() -> float:
+    """Seconds summed over tables 5.7, 5.8, 5.9, 5.12 and the rows 5.10-5.11 repeat."""
+    sweeps = sum(row[1] for spec in SWEEPS.values() for row in spec["rows"])
+    repeated = sum(SWEEPS[table]["rows"][row][1]
+                   for chosen in COMPARISONS.values() for table, row in chosen.values())
+    return float(sweeps + repeated)
+
+
+def stage_shares(record: dict) -> dict[str, float]:
+    """Each notebook run's share of the report's wall time; the rest is simulation/publishing."""
+    total = float(record.get("seconds") or 0.0)
+    runs = {r["name"]: float(r.get("seconds") or 0.0) for r in record.get("runs", [])}
+    if total <= 0:
+        return {}
+    shares = {name: sec / total for name, sec in runs.items()}
+    shares["other (terrains, publishing)"] = max(0.0, 1.0 - sum(shares.values()))
+    return shares
+
+
+def report_wall_time(ctx: Context) -> list[Result]:
+    """Row 8 from the latest finished report run, or 'not run' when there is none."""
+    from alte.report.runs import read_record
+
+    latest = Path(ctx.config.reports_dir) / "latest"
+    record = read_record(latest) if latest.is_dir() else None
+    peer = thesis_total_s()
+    if record is None:
+        return [Result(8, "make report (not run: no reports/latest/run.json)", float("nan"),
+                       peer, "s", "informative", None, {"status": "not run"})]
+    detail = {"status": "read", "run": str(latest.resolve()), "mode": record.get("mode"),
+              "started": record.get("started"), "shares": stage_shares(record),
+              "run_status": {r["name"]: r.get("status") for r in record.get("runs", [])}}
+    return [Result(8, f"make report ({record.get('mode')} mode, {record.get('started')})",
+                   float(record.get("seconds") or float("nan")), peer, "s", "informative",
+                   None, detail)]

@@ -1,0 +1,160 @@
+"""The benchmark code itself, on tiny inputs (nothing here asserts a speed)."""
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from alte.bench import ROWS, BenchConfig, Context, Result, run_bench, select_rows, write_outputs
+from alte.bench.output import format_value, miss_note, render_markdown
+from alte.bench.scaling import predicted_seconds
+from alte.bench.timing import fit_exponent, interleave, machine_info, measure, nlogn_exponent
+from alte.bench.wall import report_wall_time, stage_shares, thesis_total_s
+from alte.bench.workload import tile_points
+from alte.cli import main
+from alte.errors import ParameterError
+from alte.report.runs import point_latest, write_record
+
+
+def test_measure_interleaves_alternating_and_drops_the_warmup():
+    log = []
+    samples = measure({"a": lambda: log.append("a"), "b": lambda: log.append("b")},
+                      repeats=3, warmup=1)
+    assert log == ["a", "b", "b", "a", "a", "b", "b", "a"]
+    assert [len(s.times) for s in samples.values()] == [3, 3]
+    assert samples["a"].median >= 0 and samples["a"].as_dict()["repeats"] == 3
+    assert list(interleave(["x", "y"], 2)) == [(0, "x"), (0, "y"), (1, "y"), (1, "x")]
+
+
+@pytest.mark.parametrize(("repeats", "warmup", "match"),
+                         [(0, 1, "repeats=0"), (3, -1, "warmup=-1")])
+def test_measure_rejects_bad_counts(repeats, warmup, match):
+    with pytest.raises(ParameterError, match=match):
+        measure({"a": lambda: None}, repeats=repeats, warmup=warmup)
+
+
+def test_fit_exponent_recovers_power_laws_and_nlogn_bar():
+    n = np.array([1e4, 1e5, 1e6, 1e7])
+    assert fit_exponent(n, 3e-9 * n**2) == pytest.approx(2.0)
+    assert fit_exponent(n, 5e-7 * n) == pytest.approx(1.0)
+    assert 1.05 < nlogn_exponent(n) < 1.15
+    with pytest.raises(ParameterError, match="need >= 2"):
+        fit_exponent([10], [1.0])
+
+
+def test_predicted_seconds_extrapolates_at_least_linearly():
+    assert predicted_seconds([10], [1.0], 100) == pytest.approx(10.0)
+    assert predicted_seconds([10, 100], [1.0, 100.0], 1000) == pytest.approx(10000.0)
+    assert predicted_seconds([10, 100], [1.0, 1.0], 1000) == pytest.approx(10.0)
+
+
+def test_tile_points_subsamples_and_tiles_without_overlap():
+    rng = np.random.default_rng(1)
+    pts = rng.random((100, 3)) * [10, 5, 1]
+    origins = np.repeat(np.arange(10.0), 10)[:, None] * [1, 0, 0]
+    (small,) = tile_points(pts, 30)
+    assert small.shape == (30, 3) and np.isin(small[:, 0], pts[:, 0]).all()
+    big, big_origins = tile_points(pts, 450, origins)
+    assert big.shape == (450, 3) and big_origins.shape == (450, 3)
+    shift = big - big_origins  # points keep their offset from their own origin
+    assert np.isin(np.round(shift, 9), np.round(pts - origins, 9)).all()
+    assert np.unique(np.round(big, 9), axis=0).shape[0] == 450
+    with pytest.raises(ParameterError, match="count >= 1"):
+        tile_points(pts, 0)
+
+
+def test_config_and_row_selection_errors():
+    with pytest.raises(ParameterError, match="frames=0"):
+        BenchConfig(frames=0)
+    with pytest.raises(ParameterError, match="sizes"):
+        BenchConfig(sizes=(1, 10))
+    with pytest.raises(ParameterError, match="budget_s"):
+        BenchConfig(budget_s=0)
+    with pytest.raises(ParameterError, match=r"unknown row\(s\) \[9\]"):
+        select_rows([1, 9])
+    assert select_rows(None) == sorted(ROWS) == list(range(1, 9))
+    assert BenchConfig(quick=True).scaling_sizes == (500, 1000, 2000)
+    assert BenchConfig().scaling_sizes[-1] == 10**7
+
+
+def test_thesis_total_and_stage_shares():
+    assert thesis_total_s() == pytest.approx(321.86, abs=0.01)
+    shares = stage_shares({"seconds": 10.0, "runs": [{"name": "a", "seconds": 6.0},
+                                                     {"name": "b", "seconds": 3.0}]})
+    assert shares["a"] == pytest.approx(0.6)
+    assert sum(shares.values()) == pytest.approx(1.0)
+    assert stage_shares({"seconds": 0}) == {}
+
+
+def test_row8_reads_the_latest_report_record_or_says_not_run(tmp_path):
+    ctx = Context(BenchConfig(reports_dir=tmp_path))
+    (missing,) = report_wall_time(ctx)
+    assert missing.detail["status"] == "not run" and math.isnan(missing.ours)
+    run_dir = tmp_path / "runs" / "20240101T000000Z"
+    run_dir.mkdir(parents=True)
+    write_record(run_dir, {"mode": "quick", "started": "2024-01-01", "seconds": 20.0,
+                           "runs": [{"name": "ch5", "status": "ok", "seconds": 15.0}]})
+    point_latest(tmp_path, run_dir)
+    (row,) = report_wall_time(ctx)
+    assert row.ours == 20.0 and row.peer == pytest.approx(thesis_total_s())
+    assert row.detail["shares"]["ch5"] == pytest.approx(0.75)
+
+
+def test_a_failing_row_is_recorded_and_the_others_still_run(monkeypatch, tmp_path):
+    def broken(ctx):
+        raise ValueError("boom")
+
+    monkeypatch.setitem(ROWS, 99, ("broken", broken))
+    bench = run_bench(BenchConfig(reports_dir=tmp_path, progress=False), [8, 99])
+    assert "ValueError: boom" in bench.errors[99]
+    assert [r.row for r in bench.results] == [8]
+    assert "Rows that failed" in render_markdown(bench)
+
+
+def test_formatting_and_miss_notes():
+    assert format_value(3 * 2**20, "B") == "3.0 MiB"
+    assert format_value(2e-5, "s") == "20 us"
+    assert format_value(float("nan"), "s") == "n/a"
+    slow = Result(3, "quadtree build", 30.0, 2.0, "s", "ratio <= 10", False)
+    assert "missed by 1.50x" in miss_note(slow)
+    assert miss_note(Result(3, "ok", 1.0, 1.0, "s", "ratio <= 10", True)) == ""
+    assert machine_info()["cores"] >= 1
+
+
+@pytest.fixture(scope="module")
+def quick_bench(tmp_path_factory):
+    """Every row on a few simulated scans, one repeat, no warm-up."""
+    root = tmp_path_factory.mktemp("bench")
+    config = BenchConfig(quick=True, repeats=1, warmup=0, frames=3, sizes=(200, 400),
+                         data_dir=root / "data", reports_dir=root / "reports", progress=False)
+    return run_bench(config)
+
+
+def test_quick_bench_runs_every_row_and_writes_its_outputs(quick_bench):
+    assert quick_bench.errors == {}
+    assert {r.row for r in quick_bench.results} == set(range(1, 9))
+    for r in quick_bench.results:
+        if r.row != 8:
+            assert math.isfinite(r.ours) and r.peer > 0, r.case
+    row1 = next(r for r in quick_bench.results if r.row == 1)
+    assert row1.detail["jaccard"] >= 0.999 and row1.detail["frames"] == 3
+    hd = [r for r in quick_bench.results if r.row == 4]
+    assert all(r.detail["hd_m"] == pytest.approx(r.detail["hd_open3d_m"]) for r in hd)
+    assert len([r for r in quick_bench.results if r.row == 5]) == 4
+    paths = write_outputs(quick_bench, quick_bench.config.reports_dir)
+    record = json.loads(paths["json"].read_text())
+    assert record["machine"]["cpu"] and len(record["results"]) == len(quick_bench.results)
+    text = paths["md"].read_text()
+    assert "| # | case | ours | peer | ratio ours/peer | target | met |" in text
+    assert paths["png"].stat().st_size > 0
+
+
+def test_cli_bench_quick_only_cheap_rows(tmp_path, capsys):
+    code = main(["bench", "--quick", "--only", "8", "--repeats", "1", "--warmup", "0",
+                 "--reports", str(tmp_path), "--no-progress"])
+    assert code == 0
+    assert "make report (not run" in capsys.readouterr().out
+    assert (tmp_path / "bench.md").is_file() and (tmp_path / "bench.json").is_file()
+    with pytest.raises(SystemExit):
+        main(["bench", "--only", "x"])
