@@ -1,19 +1,38 @@
-"""Determinism of the real report: same inputs and seeds give byte-identical tables."""
+"""Determinism of the real report: same inputs and seeds give identical tables.
+
+Wall-clock columns (``elapsed_s``) are measurements of the machine, not of the
+inputs, so they are removed before comparing. The tables whose *chosen row* depends on
+measured time through the thesis' comparison rule (5.1-5.4, 5.10, 5.11) are not
+compared: their rule is a pure function of its inputs (tested in tests/test_analysis.py).
+"""
 
 from __future__ import annotations
 
+import io
 from pathlib import Path
 
+import pandas as pd
 import pytest
 
 from alte.report.plan import PLAN, build_plan
 from alte.report.runner import run_report
 
 ROOT = Path(__file__).resolve().parents[2]
+#: Tables whose content does not depend on which row a timing-based rule picked.
+TIMING_FREE = {"table_5_5.csv", "table_5_6.csv", "table_5_7.csv", "table_5_8.csv",
+               "table_5_9.csv", "table_5_12.csv"}
+
+
+def _without_timing(path: Path) -> bytes:
+    frame = pd.read_csv(path)
+    timing = [c for c in frame.columns if "elapsed" in c and not c.startswith("thesis_")]
+    out = io.StringIO()
+    frame.drop(columns=timing).to_csv(out, index=False)
+    return out.getvalue().encode()
 
 
 @pytest.mark.slow
-def test_ch5_tables_byte_identical_across_runs(tmp_path: Path) -> None:
+def test_ch5_tables_identical_across_runs_but_for_timing(tmp_path: Path) -> None:
     if not (ROOT / "notebooks" / "ch5_analysis.ipynb").exists():
         pytest.skip("notebooks/ch5_analysis.ipynb absent")
     runs = build_plan(PLAN, quick=True, notebooks_dir=ROOT / "notebooks", only=["ch5_analysis"],
@@ -23,6 +42,7 @@ def test_ch5_tables_byte_identical_across_runs(tmp_path: Path) -> None:
     assert all(not r.failed for r in reports), [r.error for r in reports[0].results]
     first, second = ([t.name for t in r.tables] for r in reports)
     assert first and first == second
+    assert set(first) >= TIMING_FREE
     differ = [t.name for t, u in zip(reports[0].tables, reports[1].tables, strict=True)
-              if t.read_bytes() != u.read_bytes()]
+              if t.name in TIMING_FREE and _without_timing(t) != _without_timing(u)]
     assert not differ, f"tables differ between two identical runs: {differ}"
