@@ -25,6 +25,7 @@ COMMANDS: dict[str, str] = {
     "register": "alte.commands.register",
     "simulate": "alte.commands.simulate",
     "bench": "alte.commands.bench",
+    "sweep": "alte.commands.sweep",
 }
 
 

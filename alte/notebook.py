@@ -2,25 +2,37 @@
 
 ``setup()`` chooses the rendering mode once: static off-screen images when no
 browser or display is attached (papermill, nbval, CI), pyvista's interactive trame
-backend in a JupyterLab session. ``save_results`` writes the notebook's named
-results to JSON atomically (the report runner collects them).
+backend in a JupyterLab session (``JPY_SESSION_NAME`` set) or with
+``ALTE_RENDER=interactive``. Interactive mode needs ``pyvista[jupyter]`` (trame,
+trame-pyvista, ipywidgets); without them ``setup`` warns and renders statically. In
+interactive mode :func:`alte.plot.render.show` displays an ipywidget whose iframe
+is served by a trame server the kernel starts on 127.0.0.1: a browser on the same
+machine reaches it directly; for a remote JupyterLab set
+``PYVISTA_TRAME_SERVER_PROXY_PREFIX=/proxy/`` so the iframe goes through
+jupyter-server-proxy. ``save_results`` writes the notebook's named results to JSON
+atomically (the report runner collects them).
 """
 
 from __future__ import annotations
 
+import importlib.util
 import json
 import os
+import warnings
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from alte.errors import ParameterError
 from alte.fsutil import atomic_path
 
-__all__ = ["interactive", "save_figure", "save_results", "setup"]
+__all__ = ["INTERACTIVE_MODULES", "interactive", "save_figure", "save_results", "setup"]
 
 _STATE = {"interactive": False}
+#: What pyvista's trame backend needs in the kernel (``pip install 'pyvista[jupyter]'``).
+INTERACTIVE_MODULES = ("trame", "trame_pyvista", "trame_vtk", "ipywidgets", "nest_asyncio2")
 
 
 def interactive() -> bool:
@@ -33,6 +45,7 @@ def setup(mode: str | None = None) -> str:
 
     ``mode`` overrides the ``ALTE_RENDER`` environment variable; without either,
     a kernel started by papermill/nbval (no ``JPY_SESSION_NAME``) renders statically.
+    Interactive falls back to static, with a warning, when trame is not installed.
     """
     import matplotlib
     import pyvista as pv
@@ -41,7 +54,12 @@ def setup(mode: str | None = None) -> str:
         "interactive" if os.environ.get("JPY_SESSION_NAME") else "static"
     )
     if chosen not in {"static", "interactive"}:
-        raise ValueError(f"render mode {chosen!r}: expected 'static' or 'interactive'")
+        raise ParameterError(f"render mode {chosen!r}: expected 'static' or 'interactive'")
+    missing = [m for m in INTERACTIVE_MODULES if importlib.util.find_spec(m) is None]
+    if chosen == "interactive" and missing:
+        warnings.warn(f"interactive 3D views need {', '.join(missing)} (pip install "
+                      "'pyvista[jupyter]'); rendering static images instead", stacklevel=2)
+        chosen = "static"
     _STATE["interactive"] = chosen == "interactive"
     if chosen == "static":
         matplotlib.use("Agg")

@@ -74,7 +74,7 @@ def parse_origin(text: str) -> np.ndarray:
 def _is_point_file(path: Path) -> bool:
     from alte.io.pointfiles import READ_SUFFIXES
 
-    return path.is_file() and path.name.lower().endswith(READ_SUFFIXES)
+    return not path.is_dir() and path.name.lower().endswith(READ_SUFFIXES)
 
 
 def _local_origin(mapper: Any, points: np.ndarray) -> np.ndarray:
@@ -92,17 +92,18 @@ def _local_origin(mapper: Any, points: np.ndarray) -> np.ndarray:
 
 
 def _map_points(mapper: Any, path: Path, voxel: float | None, origin: np.ndarray) -> dict:
-    from alte.io.pointfiles import read_points
+    from alte.io.pointfiles import read_points_info
     from alte.registration import grid_average
 
-    points = read_points(path)
+    info = read_points_info(path)
+    points = info.points
     if voxel is not None:
         points = grid_average(points, voxel)
     shift = _local_origin(mapper, points)
     start = time.perf_counter()
     mapper.build(points - shift, origin - shift)
     return {"frames": 1, "points": len(points), "elapsed_s": time.perf_counter() - start,
-            "local_origin": shift.tolist()}
+            "local_origin": shift.tolist(), "points_dropped_nonfinite": info.nonfinite}
 
 
 def _map_bag(mapper: Any, path: Path, voxel: float | None, mount_text: str | None) -> dict:
@@ -125,7 +126,8 @@ def _map_bag(mapper: Any, path: Path, voxel: float | None, mount_text: str | Non
         points += len(pts)
     shift = np.zeros(3) if shift is None else shift
     return {"frames": frames, "points": points, "elapsed_s": elapsed,
-            "local_origin": shift.tolist()}
+            "local_origin": shift.tolist(),
+            "points_dropped_nonfinite": int(frameset.counts["points_nonfinite"])}
 
 
 def check_export(path: Path, mapper: Any, overwrite: bool) -> None:
@@ -194,8 +196,9 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps(summary, sort_keys=True))
     else:
-        for key in ("mapper", "params", "input", "frames", "points", "elapsed_s",
-                    "basis_functions", "occupied_cells", "memory_bytes", "export"):
+        for key in ("mapper", "params", "input", "frames", "points", "points_dropped_nonfinite",
+                    "points_outside", "local_origin", "elapsed_s", "basis_functions",
+                    "occupied_cells", "memory_bytes", "export"):
             if key in summary:
                 print(f"{key}: {summary[key]}")
     return 0

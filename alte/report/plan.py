@@ -87,6 +87,14 @@ PLAN: tuple[Entry, ...] = (
     Entry("ch5_analysis", "ch5_analysis.ipynb", {"FRAMES": QUICK_FRAMES},
           {"FRAMES": None, "ROWS": None},
           terrains=("sim_nav_1", "sim_lan_2", "sim_nav_2")),
+    Entry("ch7_sensitivity", "ch7_sensitivity.ipynb", {"FRAMES": QUICK_FRAMES},
+          {"FRAMES": None, "SPEC": "notebooks/sweeps/thesis.yaml", "SCHEDULER": "local"},
+          terrains=("sim_lan_2", "sim_nav_1")),
+    Entry("ch6_real_data", "ch6_real_data.ipynb", {"FRAMES": QUICK_FRAMES}, {"FRAMES": None}),
+    Entry("ch7_landing", "ch7_landing.ipynb", {"FRAMES": QUICK_FRAMES}, {"FRAMES": None},
+          terrains=("sim_lan_1", "sim_lan_2", "exp_lan_1", "exp_lan_2")),
+    Entry("ch7_planning", "ch7_planning.ipynb", {"FRAMES": QUICK_FRAMES}, {"FRAMES": None},
+          terrains=("sim_nav_1", "sim_nav_2", "exp_nav_1", "exp_nav_2")),
 )
 
 

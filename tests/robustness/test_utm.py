@@ -16,8 +16,6 @@ import pytest
 
 from alte.io.pointfiles import local_origin, read_points, write_points
 
-pytestmark = pytest.mark.realdata
-
 SETS = {
     "quadtree": ["--set", "max_points=50", "--set", "ground=300"],
     "alte2d": ["--set", "kappa=0.5", "--set", "max_res=8"],
@@ -34,6 +32,7 @@ def _map(bags, capsys, cloud: Path, mapper: str, *, origin: np.ndarray, out: Pat
     return json.loads(text)
 
 
+@pytest.mark.realdata
 @pytest.mark.parametrize("mapper", sorted(SETS))
 @pytest.mark.parametrize("sample", ["samp11", "samp31"])
 def test_utm_cloud_maps_like_the_same_cloud_near_zero(bags, capsys, tmp_path, mapper, sample):
@@ -60,3 +59,31 @@ def test_utm_cloud_maps_like_the_same_cloud_near_zero(bags, capsys, tmp_path, ma
         assert far["local_origin"] == shift.tolist()
     else:
         assert far["local_origin"] == [0.0, 0.0, 0.0]
+
+
+@pytest.mark.parametrize("mapper", ["octomap", "alte2d"])
+def test_utm_bag_maps_like_the_same_bag_near_zero(bags, capsys, tmp_path, mapper):
+    """Poses at UTM scale (x 513 km, y 5404 km): frame-by-frame mapping as near the origin."""
+    from alte.io.writer import write_frames
+    from alte.types import Frame, Mount
+
+    rng = np.random.default_rng(3)
+    below = np.array([0.0, 0.0, -4.0])
+    scans = [rng.uniform(-3.0, 3.0, (150, 3)) + below for _ in range(4)]
+    summaries, cells = [], []
+    for name, offset in (("near", np.zeros(3)), ("utm", np.array([513_000.0, 5_404_000.0, 0.0]))):
+        frames = [Frame(10**10 + k * 10**8, pts, offset + np.array([0.5 * k, 0.0, 5.0]),
+                        np.array([0.0, 0.0, 0.0, 1.0])) for k, pts in enumerate(scans)]
+        bag = write_frames(tmp_path / name, frames, Mount(), dtype=np.float64)
+        code, text, err = bags.run_cli(capsys, "map", bag, "--mapper", mapper, "--json",
+                                       "--export", tmp_path / f"{name}.npz")
+        assert code == 0, err
+        summaries.append(json.loads(text))
+        with np.load(tmp_path / f"{name}.npz") as data:
+            cells.append({k: data[k] for k in data.files})
+    near, utm = summaries
+    assert near["occupied_cells"] == utm["occupied_cells"] > 0
+    assert near["basis_functions"] == utm["basis_functions"]
+    np.testing.assert_array_equal(cells[0]["occupied"], cells[1]["occupied"])
+    np.testing.assert_allclose(cells[1]["centers"] - (513_000.0, 5_404_000.0, 0.0),
+                               cells[0]["centers"], rtol=0, atol=1e-6)

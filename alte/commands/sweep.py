@@ -1,0 +1,51 @@
+"""``alte sweep SPEC.yaml``: run a parameter grid (serial or Dask), append Parquet rows."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import Any
+
+__all__ = ["add_parser", "run"]
+
+
+def add_parser(subparsers: Any) -> None:
+    """Register ``sweep``."""
+    parser = subparsers.add_parser(
+        "sweep", help="run a grid of terrains x mappers x parameters (resumable, Dask)",
+        description="Run every run of a YAML sweep spec that its Parquet output folder does not "
+                    "hold yet (finished runs are skipped, so an interrupted sweep resumes), one "
+                    "row of metrics per run. Default: a local Dask cluster.")
+    parser.add_argument("spec", type=Path, help="sweep spec (YAML), e.g. notebooks/sweeps/"
+                        "small.yaml")
+    parser.add_argument("--scheduler", default="local", metavar="ADDRESS",
+                        help="'local' (a LocalCluster, default), 'serial'/'none' (in-process) "
+                             "or a running scheduler's address, e.g. tcp://host:8786")
+    parser.add_argument("--workers", type=int, default=2,
+                        help="worker processes of the local cluster (default 2)")
+    parser.add_argument("--out", type=Path, default=None,
+                        help="Parquet dataset folder (default: the spec's output)")
+    parser.add_argument("--frames", type=int, default=None,
+                        help="scans per terrain, overriding the spec's frames")
+    parser.add_argument("--data", type=Path, default=None,
+                        help="terrain folder, overriding the spec's data_dir")
+    parser.add_argument("--no-progress", action="store_true", help="hide progress bars")
+    parser.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run the sweep and print a summary; 1 when a run failed (rerun to retry it)."""
+    from alte.sweep import load_spec, override, run_sweep
+
+    spec = load_spec(args.spec)
+    if args.frames is not None:
+        spec = override(spec, frames=args.frames)
+    if args.data is not None:
+        spec = override(spec, data_dir=str(args.data))
+    result = run_sweep(spec, scheduler=args.scheduler, workers=args.workers, output=args.out,
+                       progress=not args.no_progress)
+    for failed, message in result.failed:
+        print(f"failed: {failed.terrain} {failed.mapper} {dict(failed.params)}: {message}")
+    print(f"sweep {spec.name}: {result.ran} run, {result.skipped} already done, "
+          f"{len(result.failed)} failed; {len(result.table)} rows in {result.output}")
+    return 1 if result.failed else 0

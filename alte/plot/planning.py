@@ -1,0 +1,106 @@
+"""Planning figures: paths over each map's occupied cells (top view) and in 3D over the mesh.
+
+Top view: one panel per terrain x mapper; the occupied cells are one
+``PolyCollection`` of footprints coloured by cell top (higher cells drawn last), each
+policy's path a line, path samples that collide with the true mesh red dots.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from alte.planning.experiment import TerrainPlans
+from alte.planning.score import densify
+
+__all__ = ["POLICY_COLORS", "add_plans_3d", "plot_plans"]
+
+#: Line colour per unknown-space policy.
+POLICY_COLORS = {"free": "tab:orange", "occupied": "tab:blue"}
+_SIGNS = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]], dtype=np.float64)
+
+
+def _footprints(ax: Any, centers: np.ndarray, sizes: np.ndarray, vmax: float) -> Any:
+    from matplotlib.collections import PolyCollection
+
+    top = centers[:, 2] + sizes[:, 2] / 2
+    order = np.argsort(top)
+    verts = centers[order, None, :2] + _SIGNS[None] * sizes[order, None, :2] / 2
+    coll = PolyCollection(verts, array=top[order], cmap="Greys", clim=(0.0, vmax),
+                          edgecolors="none")
+    ax.add_collection(coll)
+    return coll
+
+
+def _collisions(plans: TerrainPlans, path: np.ndarray) -> np.ndarray:
+    if plans.surface is None or len(path) < 2:
+        return np.empty((0, 3))
+    samples, _ = densify(path, max(plans.case.clearance / 4, 1e-3))
+    bad = plans.surface.inside(samples) | (plans.surface.distance(samples)
+                                           < plans.case.clearance)
+    return samples[bad]
+
+
+def _panel(ax: Any, plans: TerrainPlans, mapper: str) -> None:
+    box = plans.case.box
+    centers, sizes = plans.occupied[mapper]
+    _footprints(ax, centers, sizes, float(box[1, 2]))
+    notes = []
+    for (name, policy), res in plans.results.items():
+        if name != mapper:
+            continue
+        notes.append(f"{policy}: {res.status}")
+        if res.found:
+            ax.plot(res.path[:, 0], res.path[:, 1], color=POLICY_COLORS.get(policy, "k"),
+                    lw=1.6, label=f"unknown={policy} ({res.length_m:.1f} m)")
+            hits = _collisions(plans, res.path)
+            ax.plot(hits[:, 0], hits[:, 1], "r.", ms=3)
+    ax.plot(*plans.case.start[:2], "g^", ms=8)
+    ax.plot(*plans.case.goal[:2], "r*", ms=10)
+    ax.set_xlim(box[0, 0], box[1, 0])
+    ax.set_ylim(box[0, 1], box[1, 1])
+    ax.set_aspect("equal")
+    ax.set_title(f"{plans.terrain} / {mapper}\n" + ", ".join(notes), fontsize=8)
+    if any(line.get_label()[:1] != "_" for line in ax.get_lines()):
+        ax.legend(fontsize=7, loc="lower right")
+
+
+def plot_plans(plans: Sequence[TerrainPlans], panel_size: float = 4.0) -> Any:
+    """Top views: one row per terrain, one column per mapper; returns the figure."""
+    import matplotlib.pyplot as plt
+
+    mappers = list(dict.fromkeys(m for p in plans for m in p.occupied))
+    fig, axes = plt.subplots(len(plans), max(len(mappers), 1), squeeze=False,
+                             figsize=(panel_size * max(len(mappers), 1),
+                                      panel_size * 0.85 * len(plans)))
+    for row, terrain_plans in zip(axes, plans, strict=True):
+        for ax, mapper in zip(row, mappers, strict=True):
+            if mapper in terrain_plans.occupied:
+                _panel(ax, terrain_plans, mapper)
+            else:
+                ax.set_visible(False)
+    fig.tight_layout()
+    return fig
+
+
+def add_plans_3d(plotter: Any, plans: TerrainPlans, mapper: str, opacity: float = 0.5) -> Any:
+    """The true mesh (clipped to the planning domain) and ``mapper``'s paths, start and goal."""
+    import pyvista as pv
+
+    if plans.surface is not None:
+        surface = plans.surface
+        faces = np.hstack([np.full((len(surface.triangles), 1), 3),
+                           surface.triangles]).reshape(-1)
+        mesh = pv.PolyData(surface.vertices, faces).clip_box(
+            plans.case.box.T.reshape(-1).tolist(), invert=False)
+        plotter.add_mesh(mesh, color="lightgrey", opacity=opacity)
+    for (name, policy), res in plans.results.items():
+        if name == mapper and res.found:
+            plotter.add_mesh(pv.lines_from_points(res.path), color=POLICY_COLORS.get(policy, "k"),
+                             line_width=4, label=f"unknown={policy}")
+    radius = 2 * plans.case.step
+    plotter.add_mesh(pv.Sphere(radius, plans.case.start), color="green")
+    plotter.add_mesh(pv.Sphere(radius, plans.case.goal), color="red")
+    return plotter
