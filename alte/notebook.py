@@ -62,6 +62,8 @@ def setup(mode: str | None = None) -> str:
         chosen = "static"
     _STATE["interactive"] = chosen == "interactive"
     if chosen == "static":
+        if not os.environ.get("DISPLAY"):  # skip VTK's failing X attempt: render with EGL
+            os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
         matplotlib.use("Agg")
         pv.OFF_SCREEN = True
         pv.set_jupyter_backend("static")
