@@ -61,15 +61,29 @@ def setup(mode: str | None = None) -> str:
                       "'pyvista[jupyter]'); rendering static images instead", stacklevel=2)
         chosen = "static"
     _STATE["interactive"] = chosen == "interactive"
+    if not os.environ.get("DISPLAY"):  # skip VTK's failing X attempt: render with EGL
+        os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
     if chosen == "static":
-        if not os.environ.get("DISPLAY"):  # skip VTK's failing X attempt: render with EGL
-            os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
         matplotlib.use("Agg")
         pv.OFF_SCREEN = True
         pv.set_jupyter_backend("static")
     else:
         pv.set_jupyter_backend("trame")
+    _show_figures_as_png()
     return chosen
+
+
+def _show_figures_as_png() -> None:
+    """In an IPython kernel, display matplotlib ``Figure`` objects as PNG images (the
+    Agg back-end registers no display formatter, so a figure would show as text)."""
+    try:
+        from IPython import get_ipython
+        from IPython.core.pylabtools import select_figure_formats
+    except ImportError:  # pragma: no cover - IPython is a dependency of the notebooks
+        return
+    shell = get_ipython()
+    if shell is not None:
+        select_figure_formats(shell, {"png"}, bbox_inches="tight")
 
 
 def _jsonable(value: Any) -> Any:

@@ -31,7 +31,13 @@ import pyvista as pv
 import alte.notebook
 from alte.plot.render import new_plotter, show
 
+from IPython.display import display
+from matplotlib.figure import Figure
+
 mode = alte.notebook.setup()
+figure = Figure()
+figure.add_subplot().plot([0, 1], [1, 0])
+display(figure)  # a 2D figure: always a PNG
 plotter = new_plotter(window_size=(320, 240))
 plotter.add_mesh(pv.Sphere())
 path = show(plotter, {out!r}, "sphere")
@@ -90,8 +96,9 @@ def test_interactive_kernel_shows_a_live_trame_widget(tmp_path: Path) -> None:
     ((status, page),) = result["pages"]  # the kernel's trame server serves the view
     assert result["src"][0].startswith("http://localhost:")
     assert status == 200 and "Application built with trame" in page
-    assert [WIDGET in s for s in shown] == [True]
-    assert not any("image/png" in s for s in shown)
+    figure, view = shown
+    assert "image/png" in figure
+    assert WIDGET in view and "image/png" not in view
     assert (tmp_path / "figures" / "sphere.png").read_bytes()[:4] == b"\x89PNG"
 
 
@@ -99,7 +106,7 @@ def test_static_kernel_shows_a_png(tmp_path: Path) -> None:
     result, shown = _run_in_kernel("static", tmp_path)
     assert result["mode"] == "static"
     assert result["views"] == [] and result["pages"] == []
-    assert shown == [{"image/png", "text/plain"}]
+    assert shown == [{"image/png", "text/plain"}] * 2  # the 2D figure, then the 3D view
     assert (tmp_path / "figures" / "sphere.png").read_bytes()[:4] == b"\x89PNG"
 
 

@@ -197,8 +197,9 @@ def _auto_domain(name: str, params: Mapping[str, Any], data: Dataset) -> dict[st
     """``domain`` = the cube (xmin, ymin, zmin, edge) over the control volume, when needed."""
     if name not in CUBE_DOMAIN_MAPPERS or "domain" in params or data.bounds is None:
         return {}
-    lo, hi = data.bounds
-    return {"domain": f"{lo[0]:.6g},{lo[1]:.6g},{lo[2]:.6g},{float(np.max(hi - lo)):.6g}"}
+    lo, hi = (np.asarray(b, dtype=np.float64) for b in data.bounds)
+    edge = float(np.max(hi - lo)) * (1 + 1e-9) + 1e-9  # lo + edge must not round below hi
+    return {"domain": ",".join(repr(float(v)) for v in (*lo, edge))}
 
 
 def run_mapper(data: Dataset, name: str, params: Mapping[str, Any] | None = None, *,

@@ -77,18 +77,19 @@ def _is_point_file(path: Path) -> bool:
     return not path.is_dir() and path.name.lower().endswith(READ_SUFFIXES)
 
 
-def _local_origin(mapper: Any, points: np.ndarray) -> np.ndarray:
+def _local_origin(mapper: Any, anchor: np.ndarray) -> np.ndarray:
     """Shift for mappers with a fixed key space around 0 (no ``domain``: Octomap).
 
     UTM-scale clouds (1e6-1e7 m) fall outside such a key space and lose centimetres
-    in float32; they are mapped relative to a round local origin, added back on export.
+    in float32; they are mapped relative to ``anchor`` (a sensor origin or the median
+    point, so a far outlier cannot move it) rounded to 1 km, added back on export.
     Domain-anchored mappers are exact at any offset and keep their coordinates.
     """
     from alte.io.pointfiles import local_origin
 
-    if "domain" in mapper.params or not len(points):
+    if "domain" in mapper.params:
         return np.zeros(3)
-    return local_origin(points)
+    return local_origin(np.reshape(anchor, (1, 3)))
 
 
 def _map_points(mapper: Any, path: Path, voxel: float | None, origin: np.ndarray) -> dict:
@@ -99,7 +100,7 @@ def _map_points(mapper: Any, path: Path, voxel: float | None, origin: np.ndarray
     points = info.points
     if voxel is not None:
         points = grid_average(points, voxel)
-    shift = _local_origin(mapper, points)
+    shift = _local_origin(mapper, np.median(points, axis=0))
     start = time.perf_counter()
     mapper.build(points - shift, origin - shift)
     return {"frames": 1, "points": len(points), "elapsed_s": time.perf_counter() - start,
@@ -118,7 +119,7 @@ def _map_bag(mapper: Any, path: Path, voxel: float | None, mount_text: str | Non
     shift = None
     for _frame, pts, origin in register_frames(frameset.frames, frameset.mount, voxel=voxel,
                                                progress=True):
-        shift = _local_origin(mapper, pts) if shift is None else shift
+        shift = _local_origin(mapper, origin) if shift is None else shift
         start = time.perf_counter()
         mapper.insert(pts - shift, origin - shift)
         elapsed += time.perf_counter() - start

@@ -65,8 +65,52 @@ def _read_text(path: Path) -> np.ndarray:
     return table.iloc[:, :3].to_numpy(np.float64)
 
 
+_PLY_SIZES = {"char": 1, "int8": 1, "uchar": 1, "uint8": 1, "short": 2, "int16": 2,
+              "ushort": 2, "uint16": 2, "int": 4, "int32": 4, "uint": 4, "uint32": 4,
+              "float": 4, "float32": 4, "double": 8, "float64": 8}
+
+
+def _ply_layout(path: Path) -> tuple[str, int, int]:
+    """(format, header bytes, minimum body: bytes if binary, rows if ascii) of a PLY file."""
+    with open(path, "rb") as fh:
+        head = fh.read(65536)
+    end = head.find(b"end_header")
+    if not head.startswith(b"ply") or end < 0:
+        raise PointFileError(f"{path}: not a PLY file (no 'ply' ... 'end_header' header)")
+    fmt, rows, size, count = "", 0, 0, 0
+    for line in head[:end].decode("ascii", "replace").splitlines():
+        word = line.split()
+        if word[:1] == ["format"] and len(word) > 1:
+            fmt = word[1]
+        elif word[:1] == ["element"] and len(word) > 2:
+            count = int(word[2])
+            rows += count
+        elif word[:1] == ["property"] and len(word) > 2:  # a list counts its length field
+            size += count * _PLY_SIZES.get(word[2] if word[1] == "list" else word[1], 0)
+    body_start = head.index(b"\n", end) + 1
+    return fmt, body_start, rows if fmt == "ascii" else size
+
+
+def _check_ply_complete(path: Path) -> None:
+    """Raise when the body is shorter than the header announces (open3d only warns)."""
+    fmt, start, need = _ply_layout(path)
+    if fmt == "ascii":
+        with open(path, "rb") as fh:
+            fh.seek(start)
+            have = sum(1 for line in fh if line.strip())
+    else:
+        have = path.stat().st_size - start
+    if have < need:
+        unit = "rows" if fmt == "ascii" else "bytes"
+        raise PointFileError(
+            f"{path}: truncated PLY ({have} of {need} {unit} the header announces)"
+        )
+
+
 def _read_ply(path: Path) -> np.ndarray:
     import open3d as o3d
+
+    _check_ply_complete(path)
 
     with o3d.utility.VerbosityContextManager(o3d.utility.VerbosityLevel.Error):
         cloud = o3d.io.read_point_cloud(str(path), format="ply")

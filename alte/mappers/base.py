@@ -109,11 +109,14 @@ def _coerce(name: str, spec: Param, value: Any, owner: str) -> Any:
                 raise ParameterError(f"{owner}: {name}={value!r} is not a boolean")
             return lowered in {"true", "1", "yes"}
         try:
-            value = float(value) if spec.kind is int else spec.kind(value)
+            parsed = float(value) if spec.kind is int else spec.kind(value)
         except ValueError as err:
             raise ParameterError(
                 f"{owner}: {name}={value!r} is not a valid {spec.kind.__name__}"
             ) from err
+        if spec.kind is int and not parsed.is_integer():
+            raise ParameterError(f"{owner}: {name}={value!r} must be an integer")
+        value = parsed
     if spec.kind is int and isinstance(value, float) and not value.is_integer():
         raise ParameterError(f"{owner}: {name}={value!r} must be an integer")
     try:

@@ -248,7 +248,7 @@ def test_unknown_extension_lists_supported(tmp_path):
             pcd_header(1, "ascii") + b"1 2\n",
             "2 ascii columns",
         ),
-        ("p.ply", b"ply\ngarbage\n", "no points"),
+        ("p.ply", b"ply\ngarbage\n", "not a PLY file"),
         ("l.las", b"LASF" + b"\0" * 50, "unreadable"),
         ("t.xyz", b"1 2\n3 4\n", "2 column"),
         ("u.xyz", b"1 2 3\na b c\n", "unreadable"),

@@ -90,8 +90,6 @@ def test_unknown_mapper_name(bags, capsys, cloud):
     assert code == 2 and "unknown mapper 'octree'; valid: quadtree, octomap, alte2d, alte3d" in line
 
 
-@pytest.mark.xfail(strict=True, reason="alte.mappers.base._coerce truncates '2.5' to int 2 "
-                   "(int(float(value))) instead of rejecting it; fix belongs in base.py")
 def test_fractional_integer_parameter_is_rejected(bags, capsys, cloud):
     code, _, err = bags.run_cli(capsys, "map", cloud, "--mapper", "quadtree",
                                 "--set", "max_points=2.5")
@@ -139,14 +137,7 @@ def _assigned(notebook: Path) -> set[str]:
             if isinstance(t, ast.Name)}
 
 
-_UNPARSED = pytest.mark.xfail(strict=True, reason=(
-    "papermill cannot parse 'ALTE2D_HEIGHT_THRESHOLD = 0.5  # m above z = 0: ...' (the '=' in "
-    "the comment), so --param ALTE2D_HEIGHT_THRESHOLD is rejected; reword the comment"))
-
-
-@pytest.mark.parametrize("notebook", [
-    pytest.param(p, marks=_UNPARSED) if p.stem == "ch3_mapping_techniques" else p
-    for p in sorted(NOTEBOOKS.glob("*.ipynb"))], ids=lambda p: p.stem)
+@pytest.mark.parametrize("notebook", sorted(NOTEBOOKS.glob("*.ipynb")), ids=lambda p: p.stem)
 def test_every_notebook_parameter_can_be_set(notebook):
     """Each name of the ``parameters`` cell is seen by papermill, so ``--param`` accepts it."""
     assert set(notebook_parameters(notebook)) == _assigned(notebook)
