@@ -116,13 +116,17 @@ def load_dataset(folder: str | os.PathLike[str], frames: int | None = None,
     frame_set = read_frames(scen.bag, progress=progress)
     chosen = _subsample(list(frame_set.frames), frames)
     size = scen.registration_voxel if voxel is None else float(voxel)
-    per_frame = [(pts, origin) for _, pts, origin in register_frames(
-        chosen, frame_set.mount, voxel=size, crop_box=scen.crop_box, progress=progress)]
+    kept = list(register_frames(chosen, frame_set.mount, voxel=size, crop_box=scen.crop_box,
+                                progress=progress))
+    per_frame = [(pts, origin) for _, pts, origin in kept]
     reg = register(chosen, frame_set.mount, voxel=size, crop_box=scen.crop_box)
     info = {
         "folder": str(folder), "voxel_m": size, "frames_in_bag": len(frame_set.frames),
-        "frames": len(per_frame), "points": len(reg.points), "counts": reg.counts,
+        # frames used for registration (thesis tables 5.5/5.6) and those left with points
+        "frames_used": len(chosen), "frames": len(per_frame), "points": len(reg.points),
+        "counts": reg.counts,
         "time_s": np.array([f.time for f in chosen]) - chosen[0].time,
+        "kept_time_s": np.array([f.time for f, _, _ in kept]) - chosen[0].time,
         "positions": np.array([f.position for f in chosen]),
         "quaternions": np.array([f.quaternion for f in chosen]),
         "title": scen.metadata.get("title", scen.name),
