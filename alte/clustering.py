@@ -16,6 +16,7 @@ from scipy.spatial import cKDTree
 
 from alte.errors import ParameterError
 from alte.ground import PlaneFit, height_above
+from alte.types import as_points
 
 __all__ = ["OBSTACLE_COLUMNS", "euclidean_clusters", "obstacle_map"]
 
@@ -27,12 +28,7 @@ OBSTACLE_COLUMNS = (
 
 
 def _check(points: object, owner: str) -> np.ndarray:
-    arr = np.asarray(points, dtype=np.float64)
-    if arr.ndim != 2 or arr.shape[1] != 3:
-        raise ParameterError(f"{owner}: points must have shape (N, 3), got {arr.shape}")
-    if not np.isfinite(arr).all():
-        raise ParameterError(f"{owner}: points contain NaN or inf values")
-    return arr
+    return as_points(points, owner=owner, error=ParameterError, finite=True)
 
 
 def euclidean_clusters(

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from alte.errors import GroundError, ParameterError
+from alte.types import as_points
 
 __all__ = [
     "GroundError",
@@ -46,11 +47,7 @@ class PlaneFit:
 
 
 def _check_cloud(points: object, owner: str) -> np.ndarray:
-    arr = np.asarray(points, dtype=np.float64)
-    if arr.ndim != 2 or arr.shape[1] != 3:
-        raise ParameterError(f"{owner}: points must have shape (N, 3), got {arr.shape}")
-    if not np.isfinite(arr).all():
-        raise ParameterError(f"{owner}: points contain NaN or inf values")
+    arr = as_points(points, owner=owner, error=ParameterError, finite=True)
     if len(arr) < 3:
         raise GroundError(f"{owner}: a plane needs at least 3 points, got {len(arr)}")
     return arr

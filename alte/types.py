@@ -21,11 +21,19 @@ __all__ = ["Frame", "Mount", "as_points", "thesis_mount"]
 _NS = 1_000_000_000
 
 
-def as_points(points: object, name: str = "points") -> np.ndarray:
-    """Return ``points`` as a C-contiguous float64 (N, 3) array or raise ``ValueError``."""
+def as_points(points: object, name: str = "points", *, owner: str = "",
+              error: type[Exception] = ValueError, finite: bool = False) -> np.ndarray:
+    """Return ``points`` as a C-contiguous float64 (N, 3) array or raise ``error``.
+
+    ``owner`` prefixes the message (the function or mapper at the user's end);
+    ``finite`` also rejects NaN and inf values.
+    """
+    where = f"{owner}: " if owner else ""
     arr = np.ascontiguousarray(points, dtype=np.float64)
     if arr.ndim != 2 or arr.shape[1] != 3:
-        raise ValueError(f"{name} must have shape (N, 3), got {arr.shape}")
+        raise error(f"{where}{name} must have shape (N, 3), got {arr.shape}")
+    if finite and not np.isfinite(arr).all():
+        raise error(f"{where}{name} contain NaN or inf values")
     return arr
 
 

@@ -23,7 +23,7 @@ __all__ = ["LIMITS", "BenchConfig", "Context", "Result"]
 
 T = TypeVar("T")
 FULL_SIZES = (10**4, 10**5, 10**6, 10**7)
-QUICK_SIZES = (500, 1000, 2000)
+QUICK_SIZES = (3000, 6000, 12000)
 #: Largest ratio ours / peer meeting each row's target (rows 7 and 8 have none).
 LIMITS: dict[int, float] = {1: 1 / 3, 2: 1.0, 3: 10.0, 4: 1.0, 5: 1.0, 6: 2.0}
 
@@ -34,7 +34,7 @@ class BenchConfig:
 
     ``frames`` limits the scans of rows 1, 2 and 4 (None = every frame; row 5 always
     inserts every frame);
-    ``sizes`` are row 7's point counts (default 10^4..10^7, quick 500..2000);
+    ``sizes`` are row 7's point counts (default 10^4..10^7, quick 3000..12000);
     ``budget_s`` skips a row-7 size whose predicted single run exceeds it.
     """
 

@@ -2,9 +2,9 @@
 
 Inputs are the terrains' own clouds, evenly subsampled below their size and tiled
 side by side above it (:func:`alte.bench.workload.tile_points`), so density and
-structure stay those of the terrain. Octomap gets the raw frame points with their
-sensor origins (runs of equal origin = one scan each, as ``build`` defines), so its
-rays keep their real length. The exponent is the slope of a log-log fit; exact
+structure stay those of the terrain. Octomap gets whole scans with their sensor
+origins (runs of equal origin = one scan each, as ``build`` defines), so rays keep
+their real length and scans their real size. The exponent is the slope of a log-log fit; exact
 n log n over the same sizes gives the bar (plus 0.1 for timing noise). A size whose
 run is predicted to exceed ``budget_s`` (from the last size and the slope so far)
 is skipped and reported as such.
@@ -12,9 +12,11 @@ is skipped and reported as such.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+import math
+from collections.abc import Callable, Sequence
 from typing import Any
 
+import numpy as np
 from tqdm.auto import tqdm
 
 from alte.bench.core import Context, Result
@@ -23,35 +25,55 @@ from alte.bench.timing import fit_exponent, measure, nlogn_exponent, peak_rss_by
 from alte.bench.workload import tile_points
 from alte.thesis import mapper_params
 
-__all__ = ["EXPONENT_SLACK", "predicted_seconds", "scaling", "scaling_cases"]
+__all__ = ["EXPONENT_SLACK", "predicted_seconds", "scaling", "scaling_cases", "whole_scans"]
 
 #: Allowed excess of the fitted exponent over n log n's (timing noise on a shared machine).
 EXPONENT_SLACK = 0.1
 
-Case = Callable[[int], Callable[[], object]]
+Case = Callable[[int], tuple[int, Callable[[], object]]]
+
+
+def whole_scans(frames: Sequence[tuple[np.ndarray, np.ndarray]],
+                n: int) -> tuple[np.ndarray, np.ndarray]:
+    """About ``n`` points as whole scans with per-point origins: evenly spaced scans of the
+    mission below its size, the whole mission tiled side by side above it."""
+    sizes = np.array([len(p) for p, _ in frames])
+    total = int(sizes.sum())
+    if n > total:
+        pts = np.vstack([p for p, _ in frames])
+        origins = np.repeat(np.array([o for _, o in frames]), sizes, axis=0)
+        return tuple(tile_points(pts, math.ceil(n / total) * total, origins))
+    k = max(1, round(len(frames) * n / total))
+    pick = np.unique(np.round(np.linspace(0, len(frames) - 1, k)).astype(int))
+    chosen = [frames[i] for i in pick]
+    return (np.vstack([p for p, _ in chosen]),
+            np.repeat(np.array([o for _, o in chosen]), [len(p) for p, _ in chosen], axis=0))
 
 
 def scaling_cases(ctx: Context) -> dict[str, Case]:
-    """Name -> (size -> the timed call on an input of that size); inputs built untimed."""
+    """Name -> (size -> actual size, the timed call); inputs are built untimed.
+
+    Octomap gets whole scans (:func:`whole_scans`): thinning every scan instead would
+    keep the 569 per-scan costs fixed and hide how the map's growth costs.
+    """
     from alte.mappers import make_mapper
     from alte.metrics import hausdorff
 
     def cloud_build(name: str) -> Case:
-        def make(n: int) -> Callable[[], object]:
+        def make(n: int) -> tuple[int, Callable[[], object]]:
             (pts,) = tile_points(ctx.workload(TERRAIN_OF[name]).cloud, n)
             params = mapper_params(TERRAIN_OF[name])[name]
-            return lambda: make_mapper(name, **params).build(pts)
+            return len(pts), lambda: make_mapper(name, **params).build(pts)
         return make
 
-    def octomap(n: int) -> Callable[[], object]:
-        raw, per_point = ctx.workload(NAV).stacked()
-        pts, origins = tile_points(raw, n, per_point)
+    def octomap(n: int) -> tuple[int, Callable[[], object]]:
+        pts, origins = whole_scans(ctx.workload(NAV).frames, n)
         params = mapper_params(NAV)["octomap"]
-        return lambda: make_mapper("octomap", **params).build(pts, origins)
+        return len(pts), lambda: make_mapper("octomap", **params).build(pts, origins)
 
-    def metrics(n: int) -> Callable[[], object]:
+    def metrics(n: int) -> tuple[int, Callable[[], object]]:
         (pts,) = tile_points(ctx.workload(NAV).cloud, n)
-        return lambda: hausdorff(pts, pts[::4])
+        return len(pts), lambda: hausdorff(pts, pts[::4])
 
     return {"octomap": octomap, **{m: cloud_build(m) for m in ("quadtree", "alte2d", "alte3d")},
             "hausdorff": metrics}
@@ -73,8 +95,11 @@ def _one_case(ctx: Context, name: str, make: Case) -> Result:
         if sizes and (guess := predicted_seconds(sizes, seconds, n)) > cfg.budget_s:
             skipped[n] = guess
             continue
-        sample = measure({name: make(n)}, cfg.repeats, cfg.warmup)[name]
-        sizes.append(n)
+        size, call = make(n)
+        if sizes and size <= sizes[-1]:
+            continue  # whole scans can round two sizes to the same input
+        sample = measure({name: call}, cfg.repeats, cfg.warmup)[name]
+        sizes.append(size)
         seconds.append(sample.median)
         rss[n] = peak_rss_bytes()
     exponent = fit_exponent(sizes, seconds) if len(sizes) >= 2 else float("nan")

@@ -80,8 +80,9 @@ def measure(funcs: Mapping[str, Callable[[], object]], repeats: int = 5,
 def fit_exponent(sizes: Sequence[float], seconds: Sequence[float]) -> float:
     """Slope of log(seconds) against log(size): the empirical complexity exponent."""
     x, y = np.log(np.asarray(sizes, float)), np.log(np.asarray(seconds, float))
-    if x.size < 2 or not np.isfinite(y).all():
-        raise ParameterError(f"fit_exponent: need >= 2 finite timings, got {list(seconds)}")
+    if np.unique(x).size < 2 or not np.isfinite(y).all():
+        raise ParameterError(f"fit_exponent: need >= 2 distinct sizes and finite timings, "
+                             f"got {list(sizes)}, {list(seconds)}")
     return float(np.polyfit(x, y, 1)[0])
 
 

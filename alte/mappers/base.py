@@ -14,6 +14,7 @@ from typing import Any, ClassVar, Protocol, runtime_checkable
 import numpy as np
 
 from alte.errors import MapperError, ParameterError
+from alte.types import as_points
 
 __all__ = ["Cells", "Mapper", "Param", "check_points", "parse_params"]
 
@@ -148,9 +149,4 @@ def parse_params(
 
 def check_points(points: object, owner: str, name: str = "points") -> np.ndarray:
     """Return finite float64 (N, 3) points or raise :class:`MapperError` naming the problem."""
-    arr = np.ascontiguousarray(points, dtype=np.float64)
-    if arr.ndim != 2 or arr.shape[1] != 3:
-        raise MapperError(f"{owner}: {name} must have shape (N, 3), got {arr.shape}")
-    if not np.isfinite(arr).all():
-        raise MapperError(f"{owner}: {name} contain NaN or inf values")
-    return arr
+    return as_points(points, name, owner=owner, error=MapperError, finite=True)

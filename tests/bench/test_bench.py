@@ -8,7 +8,7 @@ import pytest
 
 from alte.bench import ROWS, BenchConfig, Context, Result, run_bench, select_rows, write_outputs
 from alte.bench.output import format_value, miss_note, render_markdown
-from alte.bench.scaling import predicted_seconds
+from alte.bench.scaling import predicted_seconds, whole_scans
 from alte.bench.timing import fit_exponent, interleave, machine_info, measure, nlogn_exponent
 from alte.bench.wall import report_wall_time, stage_shares, thesis_total_s
 from alte.bench.workload import tile_points
@@ -41,6 +41,8 @@ def test_fit_exponent_recovers_power_laws_and_nlogn_bar():
     assert 1.05 < nlogn_exponent(n) < 1.15
     with pytest.raises(ParameterError, match="need >= 2"):
         fit_exponent([10], [1.0])
+    with pytest.raises(ParameterError, match="need >= 2"):
+        fit_exponent([10, 10], [1.0, 2.0])
 
 
 def test_predicted_seconds_extrapolates_at_least_linearly():
@@ -64,6 +66,15 @@ def test_tile_points_subsamples_and_tiles_without_overlap():
         tile_points(pts, 0)
 
 
+def test_whole_scans_keeps_scans_whole_and_tiles_the_mission():
+    frames = [(np.full((10, 3), float(i)), np.array([float(i), 0.0, 5.0])) for i in range(8)]
+    pts, origins = whole_scans(frames, 40)
+    assert len(pts) == 40 and len(np.unique(origins[:, 0])) == 4  # 4 of the 8 scans, whole
+    assert (pts[:, 0] == origins[:, 0]).all()
+    pts, origins = whole_scans(frames, 150)
+    assert len(pts) == 160 and len(np.unique(origins, axis=0)) == 16  # two copies of 8 scans
+
+
 def test_config_and_row_selection_errors():
     with pytest.raises(ParameterError, match="frames=0"):
         BenchConfig(frames=0)
@@ -74,7 +85,7 @@ def test_config_and_row_selection_errors():
     with pytest.raises(ParameterError, match=r"unknown row\(s\) \[9\]"):
         select_rows([1, 9])
     assert select_rows(None) == sorted(ROWS) == list(range(1, 9))
-    assert BenchConfig(quick=True).scaling_sizes == (500, 1000, 2000)
+    assert BenchConfig(quick=True).scaling_sizes == (3000, 6000, 12000)
     assert BenchConfig().scaling_sizes[-1] == 10**7
 
 
@@ -126,7 +137,7 @@ def test_formatting_and_miss_notes():
 def quick_bench(tmp_path_factory):
     """Every row on a few simulated scans, one repeat, no warm-up."""
     root = tmp_path_factory.mktemp("bench")
-    config = BenchConfig(quick=True, repeats=1, warmup=0, frames=3, sizes=(200, 400),
+    config = BenchConfig(quick=True, repeats=1, warmup=0, frames=3, sizes=(3000, 12000),
                          data_dir=root / "data", reports_dir=root / "reports", progress=False)
     return run_bench(config)
 
