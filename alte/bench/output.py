@@ -12,6 +12,7 @@ import numpy as np
 
 from alte.bench.core import LIMITS, Result
 from alte.bench.runner import ROWS, Bench
+from alte.bench.timing import nlogn_exponent
 from alte.fsutil import atomic_path
 
 __all__ = ["format_value", "miss_note", "plot_scaling", "render_markdown", "write_outputs"]
@@ -117,7 +118,7 @@ def plot_scaling(results: list[Result], path: Path) -> Path | None:
                   label=f"{r.case.split()[0]} (exponent {r.ours:.2f})")
     n = np.asarray(sorted({s for r in cases for s in r.detail["sizes"]}), float)
     ref = n * np.log(n) / (n[0] * np.log(n[0])) * min(r.detail["seconds"][0] for r in cases)
-    ax.loglog(n, ref, "k--", label=f"n log n (exponent {cases[0].peer:.2f})")
+    ax.loglog(n, ref, "k--", label=f"n log n (exponent {nlogn_exponent(n):.2f})")
     ax.set(xlabel="points", ylabel="seconds (median)", title="Row 7: scaling")
     ax.legend(fontsize=8)
     ax.grid(True, which="both", alpha=0.3)
