@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from alte.mappers._octree import Leaves, apply_update, prune, write_bt
+from alte.mappers._octree import Leaves, VoxelStore, prune, write_bt
 from alte.mappers._raycast import (
     TREE_DEPTH,
     TREE_MAX_VAL,
@@ -43,14 +43,13 @@ class SensorModel:
 
 
 class NativeTree:
-    """Per-voxel float32 log-odds in sorted Morton-key arrays (see ``_octree``)."""
+    """Per-voxel float32 log-odds in sorted Morton-key runs (see ``_octree.VoxelStore``)."""
 
     def __init__(self, params: dict[str, Any]) -> None:
         self.voxel = 1.0 / params["resolution"]
         self.max_range = params["max_range"]
         self.model = SensorModel(params)
-        self.keys = np.empty(0, dtype=np.uint64)
-        self.log_odds = np.empty(0, dtype=np.float32)
+        self.store = VoxelStore()
         self._leaves: Leaves | None = None
 
     def insert_scan(self, points: np.ndarray, origin: np.ndarray) -> None:
@@ -72,16 +71,25 @@ class NativeTree:
         if keys.size == 0:
             return
         updates = np.full(keys.size, value, dtype=np.float32)
-        self.keys, self.log_odds = apply_update(
-            self.keys, self.log_odds, keys, updates, self.model.clamp
-        )
+        self.store.update(keys, updates, self.model.clamp)
         self._leaves = None
+
+    @property
+    def keys(self) -> np.ndarray:
+        """Sorted Morton keys of every observed depth-16 voxel."""
+        return self.store.fold()[0]
+
+    @property
+    def log_odds(self) -> np.ndarray:
+        """Float32 log-odds of the voxels in :attr:`keys`."""
+        return self.store.fold()[1]
 
     def leaves(self) -> Leaves:
         """Pruned leaves (cached until the next update)."""
         if self._leaves is None:
-            depth = np.full(self.keys.size, TREE_DEPTH, dtype=np.int64)
-            self._leaves = prune(Leaves(self.keys, depth, self.log_odds))
+            keys, log_odds = self.store.fold()
+            depth = np.full(keys.size, TREE_DEPTH, dtype=np.int64)
+            self._leaves = prune(Leaves(keys, depth, log_odds))
         return self._leaves
 
     @property
@@ -90,7 +98,8 @@ class NativeTree:
 
     @property
     def memory_bytes(self) -> int:
-        return int(self.keys.nbytes + self.log_odds.nbytes)
+        keys, log_odds = self.store.fold()
+        return int(keys.nbytes + log_odds.nbytes)
 
     def write_bt(self, path: Path) -> None:
         leaves = self.leaves()

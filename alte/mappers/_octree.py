@@ -1,7 +1,7 @@
 """Sparse voxel storage, pruning and the ``.bt`` format for the native Octomap.
 
-The map is two parallel arrays sorted by 48-bit Morton key: ``keys`` (uint64) of
-the finest (depth-16) voxels ever observed and their float32 ``log_odds``. Memory
+The map is, per finest (depth-16) voxel ever observed, a 48-bit Morton key
+(uint64) and a float32 log-odds, kept in a few sorted runs (:class:`VoxelStore`). Memory
 therefore grows with the observed volume, never with the bounding box. OctoMap's
 pruned tree is a lossless compression of exactly this per-voxel state (a node
 collapses when its 8 children are leaves with bit-identical log-odds, and expands
@@ -14,14 +14,17 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
+import numba
 import numpy as np
 
 from alte.errors import MapperError
 from alte.mappers._raycast import TREE_DEPTH, TREE_MAX_VAL, morton_decode
 
-__all__ = ["Leaves", "apply_update", "check_origin", "leaf_geometry", "prune", "write_bt"]
+__all__ = ["Leaves", "VoxelStore", "check_origin", "leaf_geometry", "prune", "write_bt"]
 
 _THREE = np.uint64(3)
+#: A run is merged into the run below it once it holds at least 1/_RATIO of its voxels.
+_RATIO = 2
 
 
 @dataclass(frozen=True)
@@ -46,31 +49,108 @@ def check_origin(origin: object, owner: str) -> np.ndarray:
     return arr
 
 
-def apply_update(
-    keys: np.ndarray,
-    log_odds: np.ndarray,
-    update_keys: np.ndarray,
-    updates: np.ndarray,
-    clamp: tuple[np.float32, np.float32],
-) -> tuple[np.ndarray, np.ndarray]:
-    """Add float32 ``updates`` at sorted unique ``update_keys``, clamped like ``updateNodeLogOdds``.
+class VoxelStore:
+    """Per-voxel float32 log-odds as a stack of sorted, disjoint Morton-key runs.
 
-    New voxels start at log-odds 0 (OctoMap's new node). Returns the new sorted arrays;
-    cost is a binary search per update plus one merge copy for the new voxels.
+    One sorted array would copy the whole map to insert each scan's new voxels.
+    Instead every scan's new voxels become a small run on top of the stack, and a
+    run is merged into the one below it while it holds at least 1/``_RATIO`` as
+    many voxels (like Timsort's run stack): run sizes fall geometrically, so there
+    are O(log n) runs and each voxel is merged O(log n) times. Existing voxels are
+    found by a galloping search and updated in place, so the state is exactly that of
+    one sorted array, which :meth:`fold` returns.
     """
-    lo, hi = clamp
-    pos = np.searchsorted(keys, update_keys)
-    found = pos < keys.size
-    found[found] = keys[pos[found]] == update_keys[found]
-    hit = pos[found]
-    log_odds[hit] = np.clip(log_odds[hit] + updates[found], lo, hi)
-    fresh = ~found
-    if not fresh.any():
-        return keys, log_odds
-    new_values = np.clip(np.float32(0.0) + updates[fresh], lo, hi).astype(np.float32)
-    keys = np.insert(keys, pos[fresh], update_keys[fresh])
-    log_odds = np.insert(log_odds, pos[fresh], new_values)
-    return keys, log_odds
+
+    def __init__(self) -> None:
+        self._runs: list[tuple[np.ndarray, np.ndarray]] = []
+
+    def __len__(self) -> int:
+        return sum(int(keys.size) for keys, _ in self._runs)
+
+    def update(
+        self, update_keys: np.ndarray, updates: np.ndarray, clamp: tuple[np.float32, np.float32]
+    ) -> None:
+        """Add float32 ``updates`` at sorted unique ``update_keys``, clamped like
+        ``updateNodeLogOdds``; new voxels start at log-odds 0 (OctoMap's new node)."""
+        lo, hi = clamp
+        todo = np.arange(update_keys.size)
+        for keys, values in self._runs:
+            if todo.size == 0:
+                return
+            found = _update_run(keys, values, update_keys[todo], updates[todo], clamp)
+            todo = todo[~found]
+        if todo.size == 0:
+            return
+        fresh = np.clip(np.float32(0.0) + updates[todo], lo, hi).astype(np.float32)
+        self._runs.append((update_keys[todo], fresh))
+        while len(self._runs) > 1 and self._runs[-1][0].size * _RATIO >= self._runs[-2][0].size:
+            upper = self._runs.pop()
+            self._runs.append(_merge(*self._runs.pop(), *upper))
+
+    def fold(self) -> tuple[np.ndarray, np.ndarray]:
+        """Merge all runs into one; return its sorted keys and log-odds (live arrays)."""
+        while len(self._runs) > 1:
+            upper = self._runs.pop()
+            self._runs.append(_merge(*self._runs.pop(), *upper))
+        if not self._runs:
+            return np.empty(0, dtype=np.uint64), np.empty(0, dtype=np.float32)
+        return self._runs[0]
+
+
+@numba.njit(cache=True, inline="always")
+def _gallop(keys: np.ndarray, key: np.uint64, start: int) -> int:
+    """First index >= ``start`` with ``keys[index] >= key``: doubling steps, then bisection.
+
+    Sorted, clustered queries searched from the previous answer cost O(log gap) each.
+    """
+    step = 1
+    while start + step < keys.size and keys[start + step] < key:
+        step *= 2
+    low, high = start + step // 2, min(start + step, keys.size)
+    while low < high:
+        mid = (low + high) // 2
+        if keys[mid] < key:
+            low = mid + 1
+        else:
+            high = mid
+    return low
+
+
+@numba.njit(cache=True)
+def _update_run(
+    keys: np.ndarray, values: np.ndarray, query: np.ndarray, updates: np.ndarray,
+    clamp: tuple[np.float32, np.float32],
+) -> np.ndarray:
+    """Clamped in-place add of ``updates`` at the sorted ``query`` keys present in ``keys``;
+    returns which queries were found."""
+    found = np.zeros(query.size, dtype=np.bool_)
+    at = 0
+    for j in range(query.size):
+        at = _gallop(keys, query[j], at)
+        if at < keys.size and keys[at] == query[j]:
+            found[j] = True
+            value = values[at] + updates[j]
+            values[at] = min(max(value, clamp[0]), clamp[1])
+    return found
+
+
+@numba.njit(cache=True)
+def _merge(
+    keys_a: np.ndarray, values_a: np.ndarray, keys_b: np.ndarray, values_b: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Linear merge of two sorted, disjoint key runs with their values."""
+    size_a, size_b = keys_a.size, keys_b.size
+    keys = np.empty(size_a + size_b, dtype=np.uint64)
+    values = np.empty(size_a + size_b, dtype=np.float32)
+    i = j = 0
+    for k in range(size_a + size_b):
+        if j == size_b or (i < size_a and keys_a[i] < keys_b[j]):
+            keys[k], values[k] = keys_a[i], values_a[i]
+            i += 1
+        else:
+            keys[k], values[k] = keys_b[j], values_b[j]
+            j += 1
+    return keys, values
 
 
 def prune(leaves: Leaves) -> Leaves:

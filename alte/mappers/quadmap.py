@@ -64,10 +64,14 @@ class QuadMap:
         raise NotImplementedError
 
     def _update_splits(self, touched: list[np.ndarray] | None) -> None:
-        """Recompute the split flags of the ``touched`` rows per level (None: all rows)."""
-        for level in range(self.depth + 1):
-            rows = np.arange(len(self.stats.keys[level])) if touched is None else touched[level]
-            self.stats.split[level][rows] = self._split(level, rows)
+        """Recompute the split flags of the ``touched`` rows per level (None: all rows).
+
+        Deferred: ``touched`` are storage rows that a fold of pending cells would move.
+        """
+        with self.stats.deferred():
+            for level in range(self.depth + 1):
+                rows = np.arange(self.stats.size(level)) if touched is None else touched[level]
+                self.stats.split[level][rows] = self._split(level, rows)
 
     def _leaf_values(self, level: np.ndarray, rows: np.ndarray, centers: np.ndarray,
                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

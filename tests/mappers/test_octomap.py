@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 
 from alte.errors import AlteError, MapperError, ParameterError
 from alte.mappers._octomap_backends import logodds
-from alte.mappers._octree import Leaves, prune
+from alte.mappers._octree import Leaves, VoxelStore, prune
 from alte.mappers._raycast import morton_encode
 from alte.mappers.octomap import Octomap, compare_backends, read_bt
 
@@ -250,3 +250,43 @@ def test_bad_arrays_raise(points, origin, match):
 def test_build_rejects_mismatched_origins():
     with pytest.raises(MapperError, match="origins must be"):
         Octomap().build(np.zeros((4, 3)), np.zeros((3, 3)))
+
+
+def _one_array_update(keys, values, new_keys, updates, clamp):
+    """The plain single-sorted-array update that VoxelStore must reproduce bit for bit."""
+    pos = np.searchsorted(keys, new_keys)
+    found = pos < keys.size
+    found[found] = keys[pos[found]] == new_keys[found]
+    values[pos[found]] = np.clip(values[pos[found]] + updates[found], *clamp)
+    fresh = np.clip(np.float32(0) + updates[~found], *clamp).astype(np.float32)
+    return np.insert(keys, pos[~found], new_keys[~found]), np.insert(values, pos[~found], fresh)
+
+
+@settings(max_examples=25, deadline=None)
+@given(st.integers(0, 2**31), st.integers(1, 60))
+def test_voxel_store_equals_one_sorted_array(seed, batches):
+    rng = np.random.default_rng(seed)
+    clamp = (logodds(0.12), logodds(0.97))
+    store, keys, values = VoxelStore(), np.empty(0, np.uint64), np.empty(0, np.float32)
+    for _ in range(batches):  # overlapping batches of mixed hits/misses, some clamping
+        batch = np.unique(rng.integers(0, 3000, rng.integers(1, 400)).astype(np.uint64))
+        updates = np.where(rng.random(batch.size) < 0.5, logodds(0.7), logodds(0.4))
+        store.update(batch, updates.astype(np.float32), clamp)
+        keys, values = _one_array_update(keys, values, batch, updates.astype(np.float32), clamp)
+        assert len(store) == keys.size
+    folded_keys, folded_values = store.fold()
+    np.testing.assert_array_equal(folded_keys, keys)
+    assert folded_values.dtype == np.float32
+    assert folded_values.tobytes() == values.tobytes()
+    assert np.all(np.diff(folded_keys.astype(np.int64)) > 0)
+
+
+def test_voxel_store_keeps_runs_few_and_folds_on_read():
+    store = VoxelStore()
+    clamp = (logodds(0.12), logodds(0.97))
+    for start in range(0, 20000, 100):  # 200 batches of brand-new voxels
+        batch = np.arange(start, start + 100, dtype=np.uint64)
+        store.update(batch, np.full(100, logodds(0.7)), clamp)
+        assert len(store._runs) <= 20  # geometric run sizes: O(log n) runs
+    assert store.fold()[0].size == 20000 and len(store._runs) == 1
+    assert VoxelStore().fold()[0].size == 0

@@ -9,7 +9,8 @@ from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
 from alte.errors import MapperError, ParameterError
-from alte.mappers.quadgrid import morton_decode, morton_encode
+from alte.mappers import quadgrid
+from alte.mappers.quadgrid import LevelStats, Square, morton_decode, morton_encode
 from alte.mappers.quadtree import Quadtree
 
 DOMAIN = "0,0,16"
@@ -188,3 +189,51 @@ def test_bad_origin_and_fit_on_insert() -> None:
         Quadtree(ground="fit").insert(np.zeros((1, 3)), np.zeros(3))
     with pytest.raises(MapperError, match="ground=fit"):
         Quadtree(ground="fit").build(np.zeros((2, 3)))
+
+
+@pytest.mark.parametrize("pending_min", [0, 50, 10**9])
+def test_pending_cells_fold_to_the_same_statistics(monkeypatch, pending_min) -> None:
+    """Whenever pending cells are folded, the map equals one folded after every frame."""
+    pts = box_terrain(3000, seed=3)
+    frames = np.array_split(pts[np.argsort(pts[:, 0])], 15)  # new cells on every frame
+    eager = Quadtree(max_points=10, max_depth=7, domain=DOMAIN)
+    monkeypatch.setattr(quadgrid, "_PENDING_MIN", 0)
+    monkeypatch.setattr(quadgrid, "_PENDING_FRACTION", 0.0)
+    for frame in frames:
+        eager.insert(frame, np.zeros(3))
+    monkeypatch.setattr(quadgrid, "_PENDING_MIN", pending_min)
+    monkeypatch.setattr(quadgrid, "_PENDING_FRACTION", 0.25)
+    lazy = Quadtree(max_points=10, max_depth=7, domain=DOMAIN)
+    for frame in frames:
+        lazy.insert(frame, np.zeros(3))
+    assert same_cells(eager.cells(), lazy.cells())
+    assert lazy.memory_bytes == eager.memory_bytes
+    for level in range(8):  # bit-identical statistics, flags and order
+        assert np.array_equal(eager.stats.keys[level], lazy.stats.keys[level])
+        assert np.array_equal(eager.stats.rows[level], lazy.stats.rows[level])
+        assert np.array_equal(eager.stats.split[level], lazy.stats.split[level])
+        assert (np.diff(lazy.stats.keys[level]) > 0).all()
+
+
+def test_deferred_rows_are_the_ones_add_returned() -> None:
+    stats = LevelStats(3, 1)
+    sq = Square(0.0, 0.0, 16.0)
+    first = box_terrain(500, seed=1)
+    stats.add(sq.keys(first[:, :2], 3), first[:, 2:])
+    frame = box_terrain(200, seed=2)
+    keys = sq.keys(frame[:, :2], 3)
+    with stats.deferred():
+        touched = stats.add(keys, frame[:, 2:])
+        assert np.array_equal(stats.keys[3][touched[3]], np.unique(keys))
+        assert np.array_equal(stats.keys[1][touched[1]], np.unique(keys >> 4))
+    assert (np.diff(stats.keys[3]) > 0).all()  # folded once read outside
+    assert stats.column(0, "n")[0] == 700
+
+
+def test_split_flags_need_one_per_cell() -> None:
+    stats = LevelStats(2, 1)
+    stats.add(np.array([0, 5, 9]), np.zeros((3, 1)))
+    stats.split[2] = np.array([True, False, True])
+    assert stats.split[2].tolist() == [True, False, True]
+    with pytest.raises(MapperError, match=r"level 2: .* for 3 cells"):
+        stats.split[2] = np.zeros(2, bool)
