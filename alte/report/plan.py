@@ -88,7 +88,7 @@ PLAN: tuple[Entry, ...] = (
           {"FRAMES": None, "ROWS": None},
           terrains=("sim_nav_1", "sim_lan_2", "sim_nav_2")),
     Entry("ch7_sensitivity", "ch7_sensitivity.ipynb", {"FRAMES": QUICK_FRAMES},
-          {"FRAMES": None, "SPEC": "notebooks/sweeps/thesis.yaml", "SCHEDULER": "local"},
+          {"FRAMES": None, "SPEC": "notebooks/sweeps/report.yaml", "SCHEDULER": "local"},
           terrains=("sim_lan_2", "sim_nav_1")),
     Entry("ch6_real_data", "ch6_real_data.ipynb", {"FRAMES": QUICK_FRAMES}, {"FRAMES": None}),
     Entry("ch7_landing", "ch7_landing.ipynb", {"FRAMES": QUICK_FRAMES}, {"FRAMES": None},
