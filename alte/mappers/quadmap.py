@@ -22,7 +22,8 @@ from typing import Any, ClassVar
 import numpy as np
 
 from alte.mappers.base import Cells, Param, check_points, parse_params
-from alte.mappers.quadgrid import LevelStats, Square, parse_domain
+from alte.mappers.levelstats import LevelStats
+from alte.mappers.quadgrid import Square, parse_domain
 
 __all__ = ["QuadMap", "rectangle_corners"]
 

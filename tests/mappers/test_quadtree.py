@@ -9,8 +9,9 @@ from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
 from alte.errors import MapperError, ParameterError
-from alte.mappers import quadgrid
-from alte.mappers.quadgrid import LevelStats, Square, morton_decode, morton_encode
+from alte.mappers import levelstats
+from alte.mappers.levelstats import LevelStats
+from alte.mappers.quadgrid import Square, morton_decode, morton_encode
 from alte.mappers.quadtree import Quadtree
 
 DOMAIN = "0,0,16"
@@ -197,12 +198,12 @@ def test_pending_cells_fold_to_the_same_statistics(monkeypatch, pending_min) -> 
     pts = box_terrain(3000, seed=3)
     frames = np.array_split(pts[np.argsort(pts[:, 0])], 15)  # new cells on every frame
     eager = Quadtree(max_points=10, max_depth=7, domain=DOMAIN)
-    monkeypatch.setattr(quadgrid, "_PENDING_MIN", 0)
-    monkeypatch.setattr(quadgrid, "_PENDING_FRACTION", 0.0)
+    monkeypatch.setattr(levelstats, "_PENDING_MIN", 0)
+    monkeypatch.setattr(levelstats, "_PENDING_FRACTION", 0.0)
     for frame in frames:
         eager.insert(frame, np.zeros(3))
-    monkeypatch.setattr(quadgrid, "_PENDING_MIN", pending_min)
-    monkeypatch.setattr(quadgrid, "_PENDING_FRACTION", 0.25)
+    monkeypatch.setattr(levelstats, "_PENDING_MIN", pending_min)
+    monkeypatch.setattr(levelstats, "_PENDING_FRACTION", 0.25)
     lazy = Quadtree(max_points=10, max_depth=7, domain=DOMAIN)
     for frame in frames:
         lazy.insert(frame, np.zeros(3))
