@@ -28,7 +28,7 @@ from alte.thesis import COMPARISONS, POINT_CLOUDS, SWEEPS, sweep_table
 
 __all__ = ["COMPARISON_TRENDS", "SWEEP_TRENDS", "THESIS_CRITERIA", "best_row",
            "comparison_scores", "comparison_table", "point_cloud_table", "thesis_metrics",
-           "trend_table", "write_table"]
+           "trend_table", "write_csv", "write_table"]
 
 #: The criteria of the comparison rule, all lower-is-better, equally weighted.
 THESIS_CRITERIA: tuple[str, ...] = ("elapsed_s", "basis_functions", "mhd_m", "hd_minus_mhd_m")
@@ -184,10 +184,19 @@ def trend_table(number: int, table: pd.DataFrame) -> pd.DataFrame:
     raise ParameterError(f"table 5.{number} states no trends; those are 7-12")
 
 
-def write_table(table: pd.DataFrame, out_dir: str | os.PathLike[str], number: int,
-                overwrite: bool = False) -> Path:
-    """Write ``out_dir/table_5_<number>.csv`` atomically (refuses to overwrite by default)."""
-    path = Path(out_dir) / f"table_5_{number}.csv"
+def write_csv(table: pd.DataFrame, out_dir: str | os.PathLike[str], name: str,
+              overwrite: bool = False) -> Path:
+    """Write a report table as ``out_dir/<name>.csv``: atomic, 6 significant digits.
+
+    Refuses to overwrite unless asked. The one writer of every table in the report.
+    """
+    path = Path(out_dir) / f"{name}.csv"
     with atomic_path(path, overwrite=overwrite) as tmp:
         table.to_csv(tmp, index=False, float_format="%.6g")
     return path
+
+
+def write_table(table: pd.DataFrame, out_dir: str | os.PathLike[str], number: int,
+                overwrite: bool = False) -> Path:
+    """Write ``out_dir/table_5_<number>.csv`` (see :func:`write_csv`)."""
+    return write_csv(table, out_dir, f"table_5_{number}", overwrite)

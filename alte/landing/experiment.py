@@ -20,8 +20,8 @@ import pandas as pd
 from tqdm.auto import tqdm
 
 from alte.analysis.experiments import Dataset, MapRun, load_dataset, run_mapper
+from alte.analysis.tables import write_csv
 from alte.errors import MetricsError, ParameterError
-from alte.fsutil import atomic_path
 from alte.landing.detect import Centres, Detection, detect_sites
 from alte.landing.params import LandingParams, landing_params
 from alte.landing.raster import Grid, rasterise
@@ -162,8 +162,5 @@ def landing_summary(table: pd.DataFrame) -> pd.DataFrame:
 
 def write_landing_table(table: pd.DataFrame, out_dir: str | os.PathLike[str],
                         overwrite: bool = False) -> Path:
-    """Write ``out_dir/table_landing.csv`` atomically (refuses to overwrite by default)."""
-    path = Path(out_dir) / "table_landing.csv"
-    with atomic_path(path, overwrite=overwrite) as tmp:
-        table.to_csv(tmp, index=False, float_format="%.6g")
-    return path
+    """Write ``out_dir/table_landing.csv`` (atomic; refuses to overwrite by default)."""
+    return write_csv(table, out_dir, "table_landing", overwrite)

@@ -20,8 +20,8 @@ import pandas as pd
 from tqdm.auto import tqdm
 
 from alte.analysis.experiments import Dataset, load_dataset, run_mapper
+from alte.analysis.tables import write_csv
 from alte.errors import ParameterError
-from alte.fsutil import atomic_path
 from alte.planning.lattice import POLICIES, PlanningMap, planning_map
 from alte.planning.score import PathScore, score_path
 from alte.planning.search import PlanResult, plan_path
@@ -157,8 +157,5 @@ def planning_experiment(terrains: Sequence[str], data_dir: str | os.PathLike[str
 
 def write_planning_table(table: pd.DataFrame, out_dir: str | os.PathLike[str],
                          overwrite: bool = False) -> Path:
-    """Write ``out_dir/table_planning.csv`` atomically (refuses to overwrite by default)."""
-    path = Path(out_dir) / "table_planning.csv"
-    with atomic_path(path, overwrite=overwrite) as tmp:
-        table.to_csv(tmp, index=False, float_format="%.6g")
-    return path
+    """Write ``out_dir/table_planning.csv`` (atomic; refuses to overwrite by default)."""
+    return write_csv(table, out_dir, "table_planning", overwrite)

@@ -24,8 +24,8 @@ import pandas as pd
 from tqdm.auto import tqdm
 
 from alte.analysis.experiments import Dataset, MapRun, run_mapper
+from alte.analysis.tables import write_csv as write_tables_csv
 from alte.errors import ParameterError
-from alte.fsutil import atomic_path
 from alte.io import read_frames, read_points
 from alte.io.pointfiles import local_origin
 from alte.mappers import make_mapper
@@ -240,12 +240,7 @@ def map_table(runs: Sequence[MapRun]) -> pd.DataFrame:
 
 def write_csv(table: pd.DataFrame, out_dir: str | os.PathLike[str], name: str) -> Path | None:
     """Write ``out_dir/name.csv`` atomically (replaces it); nothing for an empty table."""
-    if table.empty:
-        return None
-    path = Path(out_dir) / f"{name}.csv"
-    with atomic_path(path, overwrite=True) as tmp:
-        table.to_csv(tmp, index=False, float_format="%.6g")
-    return path
+    return None if table.empty else write_tables_csv(table, out_dir, name, overwrite=True)
 
 
 def results(data: RealData, **parts: Any) -> dict[str, Any]:
