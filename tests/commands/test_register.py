@@ -2,12 +2,12 @@
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
 import pytest
+from synthetic import make_frame, scene
 
 from alte.cli import main
 from alte.commands import register as command
@@ -17,9 +17,6 @@ from alte.io import read_frames, write_frames
 from alte.io.pointfiles import read_points
 from alte.registration import crop, grid_average, register_frame
 from alte.types import Mount
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from test_registration import make_frame, scene
 
 BOX = (-4.0, -4.0, -4.0, 4.0, 4.0, 4.0)
 
