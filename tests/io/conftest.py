@@ -9,12 +9,10 @@ from typing import Any
 
 import numpy as np
 import pytest
+from bagtools import TS, Message, write_ros2  # noqa: F401 (exported through globals())
 from rosbags.rosbag1 import Writer as Writer1
-from rosbags.rosbag2 import StoragePlugin, Writer
-from rosbags.typesys import Stores, get_typestore
 from scipy.spatial.transform import Rotation
 
-TS = get_typestore(Stores.ROS2_HUMBLE)
 NS = 1_000_000_000
 REALDATA = Path(__file__).resolve().parents[2] / ".." / "shared" / "realdata"
 
@@ -24,7 +22,6 @@ ODOM = "nav_msgs/msg/Odometry"
 TF = "tf2_msgs/msg/TFMessage"
 
 #: (topic, msgtype, log_time_ns, message)
-Message = tuple[str, str, int, Any]
 
 
 def header(stamp_ns: int, frame_id: str) -> Any:
@@ -86,17 +83,6 @@ def tf_msg(stamp_ns: int, transforms: list[tuple[str, str, Any, Any]]) -> Any:
     ])
 
 
-def write_ros2(path: Path, messages: list[Message], storage: str = "sqlite3") -> Path:
-    """Write ``messages`` (in the given order) as a ROS 2 bag folder."""
-    plugin = StoragePlugin.MCAP if storage == "mcap" else StoragePlugin.SQLITE3
-    with Writer(path, version=9, storage_plugin=plugin) as writer:
-        conns: dict[str, Any] = {}
-        for topic, msgtype, _, _ in messages:
-            if topic not in conns:
-                conns[topic] = writer.add_connection(topic, msgtype, typestore=TS)
-        for topic, msgtype, log_time, msg in messages:
-            writer.write(conns[topic], log_time, TS.serialize_cdr(msg, msgtype))
-    return path
 
 
 def write_ros1(path: Path, messages: list[Message]) -> Path:

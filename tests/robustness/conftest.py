@@ -15,12 +15,10 @@ from typing import Any
 
 import numpy as np
 import pytest
-from rosbags.rosbag2 import StoragePlugin, Writer
-from rosbags.typesys import Stores, get_typestore
+from bagtools import TS, Message, write_ros2  # noqa: F401 (exported through globals())
 
 from alte.cli import main
 
-TS = get_typestore(Stores.ROS2_HUMBLE)
 NS = 1_000_000_000
 REALDATA = Path(__file__).resolve().parents[2] / ".." / "shared" / "realdata"
 PC2 = "sensor_msgs/msg/PointCloud2"
@@ -28,7 +26,6 @@ POSE = "geometry_msgs/msg/PoseStamped"
 IDENTITY = (0.0, 0.0, 0.0, 1.0)
 
 #: (topic, msgtype, log_time_ns, message)
-Message = tuple[str, str, int, Any]
 
 
 def header(stamp_ns: int, frame_id: str) -> Any:
@@ -59,17 +56,6 @@ def pose_msg(stamp_ns: int, pos: Sequence[float], quat: Sequence[float]) -> Any:
     return t[POSE](header(stamp_ns, "map"), pose)
 
 
-def write_ros2(path: Path, messages: Sequence[Message], storage: str = "sqlite3") -> Path:
-    """Write ``messages`` in the given order as a ROS 2 bag folder (no checks at all)."""
-    plugin = StoragePlugin.MCAP if storage == "mcap" else StoragePlugin.SQLITE3
-    with Writer(path, version=9, storage_plugin=plugin) as writer:
-        conns: dict[str, Any] = {}
-        for topic, msgtype, _, _ in messages:
-            if topic not in conns:
-                conns[topic] = writer.add_connection(topic, msgtype, typestore=TS)
-        for topic, msgtype, log_time, msg in messages:
-            writer.write(conns[topic], int(log_time), TS.serialize_cdr(msg, msgtype))
-    return path
 
 
 def scan_points(k: int, n: int = 40) -> np.ndarray:
