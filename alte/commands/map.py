@@ -107,28 +107,43 @@ def _map_points(mapper: Any, path: Path, voxel: float | None, origin: np.ndarray
             "local_origin": shift.tolist(), "points_dropped_nonfinite": info.nonfinite}
 
 
-def _map_bag(mapper: Any, path: Path, voxel: float | None, mount_text: str | None) -> dict:
+def _with_domain(mapper: Any, clouds: list[np.ndarray]) -> Any:
+    """``mapper`` with its unset ``domain`` fixed to the bounding cube of all ``clouds``.
+
+    Frame-by-frame insertion needs the root cell fixed before the first frame (3D-ALTE
+    refuses without one; the 2D mappers would grow a power-of-two root instead). All
+    registered frames are known here, so the cube over them is the thesis' "overall
+    domain"; a ``--set domain=...`` of the user's is kept.
+    """
+    if mapper.params.get("domain", None) != "" or not clouds:
+        return mapper
+    points = np.concatenate(clouds)
+    lo, hi = points.min(axis=0), points.max(axis=0)
+    edge = float(np.max(hi - lo)) * (1 + 1e-9) + 1e-6  # lo + edge must not round below hi
+    domain = ",".join(repr(float(v)) for v in (*lo, edge))
+    return type(mapper)(**{**mapper.params, "domain": domain})
+
+
+def _map_bag(mapper: Any, path: Path, voxel: float | None,
+             mount_text: str | None) -> tuple[Any, dict]:
     from alte.io.bag import read_frames
     from alte.registration import register_frames
     from alte.types import Mount
 
     mount = Mount.from_string(mount_text) if mount_text else None
     frameset = read_frames(path, mount=mount, progress=True)
-    frames = points = 0
+    kept = [(pts, origin) for _f, pts, origin in register_frames(
+        frameset.frames, frameset.mount, voxel=voxel, progress=True)]
+    mapper = _with_domain(mapper, [pts for pts, _ in kept])
+    shift = _local_origin(mapper, kept[0][1]) if kept else np.zeros(3)
     elapsed = 0.0
-    shift = None
-    for _frame, pts, origin in register_frames(frameset.frames, frameset.mount, voxel=voxel,
-                                               progress=True):
-        shift = _local_origin(mapper, origin) if shift is None else shift
+    for pts, origin in kept:
         start = time.perf_counter()
         mapper.insert(pts - shift, origin - shift)
         elapsed += time.perf_counter() - start
-        frames += 1
-        points += len(pts)
-    shift = np.zeros(3) if shift is None else shift
-    return {"frames": frames, "points": points, "elapsed_s": elapsed,
-            "local_origin": shift.tolist(),
-            "points_dropped_nonfinite": int(frameset.counts["points_nonfinite"])}
+    return mapper, {"frames": len(kept), "points": sum(len(p) for p, _ in kept),
+                    "elapsed_s": elapsed, "local_origin": shift.tolist(),
+                    "points_dropped_nonfinite": int(frameset.counts["points_nonfinite"])}
 
 
 def check_export(path: Path, mapper: Any, overwrite: bool) -> None:
@@ -162,17 +177,21 @@ def export_cells(mapper: Any, path: Path, overwrite: bool = False,
 
 
 def run_map(mapper: Any, path: Path, voxel: float | None = None,
-            origin: np.ndarray | None = None, mount: str | None = None) -> dict[str, Any]:
-    """Feed ``path`` (bag or point file) to ``mapper``; return the summary dict."""
+            origin: np.ndarray | None = None,
+            mount: str | None = None) -> tuple[Any, dict[str, Any]]:
+    """Feed ``path`` (bag or point file) to ``mapper``; return the mapper used and a summary.
+
+    For a bag the mapper may be a copy with its ``domain`` fixed (see :func:`_with_domain`).
+    """
     if voxel is not None and not (np.isfinite(voxel) and voxel > 0):
         raise ParameterError(f"--voxel {voxel!r}: must be > 0")
     if _is_point_file(path):
         origin = np.zeros(3) if origin is None else origin
         counts = _map_points(mapper, path, voxel, origin)
     else:
-        counts = _map_bag(mapper, path, voxel, mount)
+        mapper, counts = _map_bag(mapper, path, voxel, mount)
     cells = mapper.cells()
-    return {
+    return mapper, {
         "mapper": mapper.name, "params": mapper.params, "input": str(path), **counts,
         "basis_functions": int(mapper.basis_functions), "cells": len(cells),
         "occupied_cells": int(np.count_nonzero(cells.occupied)),
@@ -190,7 +209,7 @@ def run(args: argparse.Namespace) -> int:
     mapper = make_mapper(args.mapper, **params)
     if args.export is not None:
         check_export(args.export, mapper, args.force)  # fail before the long work
-    summary = run_map(mapper, args.input, args.voxel, origin, args.mount)
+    mapper, summary = run_map(mapper, args.input, args.voxel, origin, args.mount)
     if args.export is not None:
         export_cells(mapper, args.export, args.force, np.asarray(summary["local_origin"]))
         summary["export"] = str(args.export)
