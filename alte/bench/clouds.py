@@ -17,7 +17,7 @@ import numpy as np
 from alte.bench.core import LIMITS, Context, Result
 from alte.bench.maps import NAV, mapper_setup, octomap_passes
 from alte.bench.timing import measure
-from alte.thesis import mapper_params
+from alte.studies.thesis import mapper_params
 
 __all__ = ["CLUSTER_TOLERANCE", "OBSTACLE_HEIGHT", "PLANE_THRESHOLD", "cloud_stages",
            "corner_sets", "hausdorff_speed", "open3d_hausdorff"]
@@ -95,9 +95,9 @@ def cloud_stages(ctx: Context) -> list[Result]:
     """Row 6: grid average, MSAC plane, Euclidean clusters vs their Open3D counterparts."""
     import open3d as o3d
 
-    from alte.clustering import euclidean_clusters
-    from alte.grid import grid_average
     from alte.ground import fit_plane_msac, obstacle_mask
+    from alte.ground.clustering import euclidean_clusters
+    from alte.registration.grid import grid_average
 
     work, cfg = ctx.workload(NAV), ctx.config
     raw, _ = work.stacked()

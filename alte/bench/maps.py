@@ -20,7 +20,7 @@ from tqdm.auto import tqdm
 
 from alte.bench.core import LIMITS, Context, Result
 from alte.bench.timing import interleave, measure
-from alte.thesis import mapper_params
+from alte.studies.thesis import mapper_params
 
 __all__ = [
     "JACCARD_MIN",
@@ -85,7 +85,7 @@ def interleaved_passes(makers: Mapping[str, Callable[[], Any]],
 
 def mapper_setup(ctx: Context, name: str) -> dict[str, Any]:
     """Chapter 4 parameters of ``name`` on its terrain, with the fixed domain ``insert`` needs."""
-    from alte.mappers.timelapse import cube_domain, square_domain
+    from alte.pipeline.timelapse import cube_domain, square_domain
 
     terrain = TERRAIN_OF[name]
     params = mapper_params(terrain)[name]

@@ -23,7 +23,7 @@ from alte.bench.core import Context, Result
 from alte.bench.maps import NAV, TERRAIN_OF
 from alte.bench.timing import fit_exponent, measure, nlogn_exponent, peak_rss_bytes
 from alte.bench.workload import tile_points
-from alte.thesis import mapper_params
+from alte.studies.thesis import mapper_params
 
 __all__ = ["EXPONENT_SLACK", "predicted_seconds", "scaling", "scaling_cases", "whole_scans"]
 

@@ -54,8 +54,8 @@ def workload_dir(data_dir: str | Path, quick: bool) -> Path:
 def load_workload(terrain: str, data_dir: str | Path, *, quick: bool = False,
                   frames: int | None = None, progress: bool = False) -> Workload:
     """Simulate ``terrain`` if missing, register it; ``frames`` keeps that many scans evenly."""
-    from alte.analysis.experiments import load_dataset
     from alte.sim import ensure_terrain
+    from alte.studies.experiments import load_dataset
 
     folder = ensure_terrain(terrain, workload_dir(data_dir, quick),
                             frames=QUICK_FRAMES if quick else None, progress=progress)

@@ -6,6 +6,7 @@ import argparse
 from pathlib import Path
 
 from alte.errors import ParameterError
+from alte.paths import REPO_ROOT
 from alte.report import PLAN, build_plan, load_plan, parse_param, run_report
 
 __all__ = ["add_parser", "run"]
@@ -27,8 +28,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
                    help="override a notebook parameter in every notebook declaring it")
     p.add_argument("--jobs", type=int, default=1, help="notebooks executed in parallel")
-    p.add_argument("--notebooks", type=Path, default=Path(__file__).resolve().parents[2] /
-                   "notebooks", help="notebook folder (default: the repository's)")
+    p.add_argument("--notebooks", type=Path, default=REPO_ROOT / "notebooks",
+                   help="notebook folder (default: the repository's)")
     p.add_argument("--plan", type=Path, default=None,
                    help="JSON plan replacing the built-in one (list of Entry objects)")
     p.set_defaults(func=run)

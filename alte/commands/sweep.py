@@ -35,7 +35,7 @@ def add_parser(subparsers: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run the sweep and print a summary; 1 when a run failed (rerun to retry it)."""
-    from alte.sweep import load_spec, override, run_sweep
+    from alte.studies.sweep import load_spec, override, run_sweep
 
     spec = load_spec(args.spec)
     if args.frames is not None:

@@ -1,6 +1,6 @@
 """Map quality metrics: the thesis' (5.2.1) and ground-truth ones from the simulator.
 
-Thesis metrics: elapsed mapping time (measured by :mod:`alte.analysis` around the
+Thesis metrics: elapsed mapping time (measured by :mod:`alte.studies.analysis` around the
 mapper calls only), number of basis functions (``Mapper.basis_functions``), and the
 Hausdorff / modified Hausdorff distances between the registered cloud and the corners
 of the occupied cells (:func:`hausdorff`). Ground-truth metrics (accuracy,

@@ -15,9 +15,9 @@ from typing import Any
 import numpy as np
 
 from alte.errors import ParameterError
-from alte.landing.detect import Centres, Detection
-from alte.landing.experiment import LandingRun
-from alte.landing.params import LandingParams
+from alte.studies.landing.detect import Centres, Detection
+from alte.studies.landing.experiment import LandingRun
+from alte.studies.landing.params import LandingParams
 
 __all__ = ["plot_landing", "plot_landing_runs"]
 

@@ -12,8 +12,8 @@ from typing import Any
 
 import numpy as np
 
-from alte.planning.experiment import TerrainPlans
-from alte.planning.score import densify
+from alte.studies.planning.experiment import TerrainPlans
+from alte.studies.planning.score import densify
 
 __all__ = ["POLICY_COLORS", "add_plans_3d", "plot_plans"]
 

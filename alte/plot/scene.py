@@ -115,7 +115,7 @@ def plot_obstacle_map(points: np.ndarray, obstacles: Any, ground: np.ndarray | N
                       max_points: int = 50_000) -> Any:
     """Top view: points, obstacle centroids and radius circles (thesis fig. 3.13).
 
-    ``obstacles`` has columns ``x``, ``y``, ``radius`` (``alte.clustering.obstacle_map``).
+    ``obstacles`` has columns ``x``, ``y``, ``radius`` (``alte.ground.clustering.obstacle_map``).
     """
     import matplotlib.pyplot as plt
     from matplotlib.collections import PatchCollection

@@ -13,7 +13,7 @@ import numpy as np
 import pandas as pd
 
 from alte.errors import ParameterError
-from alte.sweep.analysis import main_effects, mapper_rows, param_columns, sensitivity_table
+from alte.studies.sweep.analysis import main_effects, mapper_rows, param_columns, sensitivity_table
 
 __all__ = ["effects_figure", "sensitivity_figure"]
 

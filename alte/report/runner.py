@@ -21,6 +21,7 @@ from typing import Any
 from tqdm.auto import tqdm
 
 from alte.errors import AlteError, ReportError
+from alte.paths import REPO_ROOT
 from alte.report.html import notebook_to_html, run_index_html, top_index_html, write_html
 from alte.report.plan import Run
 from alte.report.runs import list_runs, new_run_dir, point_latest, publish_tables, write_record
@@ -29,7 +30,6 @@ __all__ = ["Report", "RunResult", "ensure_terrains", "execute_run", "run_report"
 
 #: ``ensure(name, out_dir=..., seed=..., frames=...)`` makes a terrain's data exist.
 EnsureTerrain = Callable[..., Any]
-REPO_ROOT = Path(__file__).resolve().parents[2]
 
 
 @dataclass

@@ -15,6 +15,7 @@ from alte.commands.register import format_counts, parse_box
 from alte.errors import ParameterError
 from alte.io import read_frames, write_frames
 from alte.io.pointfiles import read_points
+from alte.paths import realdata_dir
 from alte.registration import crop, grid_average, register_frame
 from alte.types import Mount
 
@@ -131,7 +132,7 @@ def test_parse_box_and_format_counts():
     assert "7 (outside crop box)" in lines[1]
 
 
-REALDATA = Path(__file__).resolve().parents[2] / ".." / "shared" / "realdata"
+REALDATA = realdata_dir()
 
 
 @pytest.mark.realdata

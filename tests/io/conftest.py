@@ -13,8 +13,10 @@ from bagtools import TS, Message, write_ros2  # noqa: F401 (exported through glo
 from rosbags.rosbag1 import Writer as Writer1
 from scipy.spatial.transform import Rotation
 
+from alte.paths import realdata_dir
+
 NS = 1_000_000_000
-REALDATA = Path(__file__).resolve().parents[2] / ".." / "shared" / "realdata"
+REALDATA = realdata_dir()
 
 PC2 = "sensor_msgs/msg/PointCloud2"
 POSE = "geometry_msgs/msg/PoseStamped"

@@ -18,8 +18,9 @@ from alte.io.pointfiles import (
     read_points_info,
     write_points,
 )
+from alte.paths import realdata_dir
 
-REALDATA = Path(__file__).resolve().parents[2] / ".." / "shared" / "realdata"
+REALDATA = realdata_dir()
 UTM = np.array([513_456.789, 5_403_210.123, 287.5])
 
 

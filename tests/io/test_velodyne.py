@@ -18,8 +18,9 @@ from alte.io.velodyne import (
     decode_velodyne_scan,
     register_velodyne_types,
 )
+from alte.paths import realdata_dir
 
-REALDATA = Path(__file__).resolve().parents[2] / ".." / "shared" / "realdata"
+REALDATA = realdata_dir()
 VLP_DIR = REALDATA / "vlp16_packets"
 MODE = {"strongest": 0x37, "last": 0x38, "dual": 0x39}
 

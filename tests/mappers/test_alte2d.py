@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -12,6 +10,7 @@ from hypothesis.extra.numpy import arrays
 
 from alte.errors import MapperError, ParameterError
 from alte.mappers.alte2d import Alte2D, plane_height
+from alte.paths import realdata_dir
 
 DOMAIN = "0,0,16"
 coords = st.floats(0.0, 16.0, allow_nan=False, width=32)
@@ -224,7 +223,7 @@ def test_bad_points(points, match) -> None:
         Alte2D().insert(np.zeros((2, 3)), np.zeros(2))
 
 
-REALDATA = Path(__file__).resolve().parents[2] / ".." / "shared" / "realdata"
+REALDATA = realdata_dir()
 
 
 @pytest.mark.realdata

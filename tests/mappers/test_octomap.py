@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import bz2
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -15,8 +14,9 @@ from alte.mappers._octomap_backends import logodds
 from alte.mappers._octree import Leaves, VoxelStore, prune
 from alte.mappers._raycast import morton_encode
 from alte.mappers.octomap import Octomap, compare_backends, read_bt
+from alte.paths import realdata_dir
 
-REALDATA = Path(__file__).resolve().parents[2] / ".." / "shared" / "realdata" / "octomap_scan"
+REALDATA = realdata_dir() / "octomap_scan"
 BACKENDS = ["native", "reference"]
 
 

@@ -9,9 +9,9 @@ from __future__ import annotations
 
 import pytest
 
-from alte.analysis.experiments import load_dataset
 from alte.mappers.octomap import compare_backends
 from alte.sim import ensure_terrain
+from alte.studies.experiments import load_dataset
 
 
 @pytest.mark.slow

@@ -14,11 +14,12 @@ from pathlib import Path
 import pytest
 
 from alte.cli import main
+from alte.paths import REPO_ROOT
 from alte.report.runs import list_runs
 
 from .conftest import write_plan
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = REPO_ROOT
 
 
 def _args(tmp_path: Path, notebooks: Path, *extra: str) -> list[str]:

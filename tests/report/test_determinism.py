@@ -14,10 +14,11 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
+from alte.paths import REPO_ROOT
 from alte.report.plan import PLAN, build_plan
 from alte.report.runner import run_report
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = REPO_ROOT
 #: Tables whose content does not depend on which row a timing-based rule picked.
 TIMING_FREE = {"table_5_5.csv", "table_5_6.csv", "table_5_7.csv", "table_5_8.csv",
                "table_5_9.csv", "table_5_12.csv"}

@@ -7,6 +7,7 @@ from pathlib import Path
 import pytest
 
 from alte.errors import ParameterError, ReportError
+from alte.paths import REPO_ROOT
 from alte.report.plan import (
     PLAN,
     QUICK_FRAMES,
@@ -20,7 +21,7 @@ from alte.report.plan import (
 
 from .conftest import make_notebook, write_plan
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = REPO_ROOT
 ENTRIES = (Entry("good", "good.ipynb", {"ROWS": 1}, {"ROWS": 5}),
            Entry("bad", "bad.ipynb", None, {}),
            Entry("slow", "slow.ipynb", {}, None, terrains=("sim_nav_1",)))

@@ -18,9 +18,10 @@ import pytest
 from bagtools import TS, Message, write_ros2  # noqa: F401 (exported through globals())
 
 from alte.cli import main
+from alte.paths import realdata_dir
 
 NS = 1_000_000_000
-REALDATA = Path(__file__).resolve().parents[2] / ".." / "shared" / "realdata"
+REALDATA = realdata_dir()
 PC2 = "sensor_msgs/msg/PointCloud2"
 POSE = "geometry_msgs/msg/PoseStamped"
 IDENTITY = (0.0, 0.0, 0.0, 1.0)

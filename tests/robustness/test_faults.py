@@ -16,9 +16,10 @@ from pathlib import Path
 
 import pytest
 
+from alte.paths import REPO_ROOT
 from alte.sim.scenario import load_scenario
 
-REPO = Path(__file__).resolve().parents[2]
+REPO = REPO_ROOT
 TERRAIN = "sim_lan_1"
 
 

@@ -14,9 +14,10 @@ import numpy as np
 import pytest
 
 from alte.io.pointfiles import write_points
+from alte.paths import REPO_ROOT
 from alte.report.plan import notebook_parameters
 
-NOTEBOOKS = Path(__file__).resolve().parents[2] / "notebooks"
+NOTEBOOKS = REPO_ROOT / "notebooks"
 
 #: (mapper, --set value, what the error line must say)
 OUT_OF_RANGE = [

@@ -1,0 +1,1 @@
+"""The pipeline: an input and a map specification -> a map run."""

@@ -1,0 +1,87 @@
+"""Chapter-6 figures; each accepts the empty runs of a skipped chapter and then draws nothing.
+
+:func:`ground_figure` shows every ISPRS sample x filter from above, each point
+coloured by its outcome against the reference (ground kept, object removed, type I,
+type II); :func:`show_maps` puts 3D maps side by side in one pyvista plotter, shown
+through :func:`alte.plot.render.show` (a PNG headless, trame in JupyterLab).
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from matplotlib.colors import ListedColormap
+from matplotlib.figure import Figure
+
+from alte.notebook import save_figure as _save_figure
+from alte.studies.experiments import MapRun
+from alte.studies.realdata.data import GroundRun
+
+__all__ = ["OUTCOMES", "ground_figure", "outcomes", "save_figure", "show_maps"]
+
+#: Outcome classes of a ground filter, in the order of :func:`outcomes`' codes.
+OUTCOMES = ("ground kept", "object removed", "type I (ground removed)",
+            "type II (object kept)")
+_COLORS = ListedColormap(["#c8b28a", "#9aa7b1", "#1f5fd6", "#e0241b"])
+_MAX_DOTS = 40_000
+
+
+def outcomes(ground: np.ndarray, reference: np.ndarray) -> np.ndarray:
+    """Per point: 0 ground kept, 1 object removed, 2 type I error, 3 type II error."""
+    ground, reference = np.asarray(ground, bool), np.asarray(reference, bool)
+    return np.select([reference & ground, ~reference & ~ground, reference & ~ground],
+                     [0, 1, 2], default=3)
+
+
+def ground_figure(runs: Sequence[GroundRun]) -> Figure | None:
+    """Top views, one row per sample, one column per filter (None for no runs)."""
+    if not runs:
+        return None
+    samples = list(dict.fromkeys(r.sample for r in runs))
+    filters = list(dict.fromkeys(r.mapper_name for r in runs))
+    fig = Figure(figsize=(3.6 * len(filters), 3.4 * len(samples)), layout="constrained")
+    axes = np.asarray(fig.subplots(len(samples), len(filters), squeeze=False))
+    for run in runs:
+        ax = axes[samples.index(run.sample), filters.index(run.mapper_name)]
+        step = max(1, len(run.points) // _MAX_DOTS)
+        code = outcomes(run.ground, run.reference)[::step]
+        xy = run.points[::step, :2]
+        order = np.argsort(code, kind="stable")  # errors drawn on top
+        ax.scatter(xy[order, 0], xy[order, 1], c=code[order], cmap=_COLORS, vmin=0, vmax=3,
+                   s=0.4, rasterized=True)
+        ax.set_aspect("equal")
+        ax.set_title(f"{run.sample} {run.mapper_name}: total {run.metrics['total_pct']:.1f}%",
+                     fontsize=9)
+        ax.tick_params(labelsize=7)
+    handles = [ax.scatter([], [], color=_COLORS(i), label=name)
+               for i, name in enumerate(OUTCOMES)]
+    fig.legend(handles=handles, loc="outside lower center", ncol=4, fontsize=8)
+    return fig
+
+
+def save_figure(fig: Figure | None, out_dir: str | os.PathLike[str], name: str) -> Path | None:
+    """:func:`alte.notebook.save_figure`, or nothing for a skipped figure (None)."""
+    return None if fig is None else _save_figure(fig, out_dir, name)
+
+
+def show_maps(runs: Sequence[MapRun], out_dir: str | os.PathLike[str] | None = None,
+              name: str | None = None, title: str = "") -> Path | None:
+    """Occupied cells of each map side by side (linked cameras); nothing for no runs."""
+    if not runs:
+        return None
+    from alte.plot.maps import add_cells_3d
+    from alte.plot.render import new_plotter, show
+
+    plotter: Any = new_plotter(shape=(1, len(runs)), window_size=(480 * len(runs), 480))
+    for i, run in enumerate(runs):
+        plotter.subplot(0, i)
+        add_cells_3d(plotter, run.mapper.cells(), show_edges=False,
+                     scalar_bar_args={"title": f"height {i} [m]"})
+        plotter.add_text(f"{title} {run.mapper_name}: {run.metrics['occupied_cells']} occupied",
+                         font_size=9)
+    plotter.link_views()
+    return show(plotter, out_dir, name)

@@ -1,0 +1,78 @@
+"""Landing-zone detection on 2D maps (Quadtree, 2D-ALTE), scored against ground truth.
+
+Thesis 1.2 defines a landing zone as "any planar site, free of obstacles, with a clear
+approach path, and with an area big enough for the vehicle to land". Here a 2D map is
+rasterised (:mod:`alte.studies.landing.raster`), every pixel is tested as a site centre and
+connected feasible centres become ranked sites (:mod:`alte.studies.landing.detect`); the same
+tests on the simulator's true surface, plus "no object other than ground", give the
+truly safe centres the detection is scored against (:mod:`alte.studies.landing.truth`), per
+terrain, mapper and parameter set (:mod:`alte.studies.landing.experiment`).
+"""
+
+from alte.studies.landing.detect import (
+    SITE_COLUMNS,
+    Centres,
+    Detection,
+    detect_sites,
+    feasible_centres,
+    map_obstacles,
+    rank_sites,
+)
+from alte.studies.landing.experiment import (
+    LANDING_MAPPERS,
+    SWEEP_ROWS,
+    LandingRun,
+    evaluate_landing,
+    landing_grid,
+    landing_param_sets,
+    landing_summary,
+    landing_table,
+    landing_truth,
+    load_terrains,
+    score_landing,
+    write_landing_table,
+)
+from alte.studies.landing.params import LAB, QUADROTOR, LandingParams, landing_params
+from alte.studies.landing.raster import Grid, PlaneFeatures, plane_features, rasterise
+from alte.studies.landing.truth import (
+    GROUND_CLASSES,
+    object_footprints,
+    score_detection,
+    top_surface,
+    truth_centres,
+)
+
+__all__ = [
+    "GROUND_CLASSES",
+    "LAB",
+    "LANDING_MAPPERS",
+    "QUADROTOR",
+    "SITE_COLUMNS",
+    "SWEEP_ROWS",
+    "Centres",
+    "Detection",
+    "Grid",
+    "LandingParams",
+    "LandingRun",
+    "PlaneFeatures",
+    "detect_sites",
+    "evaluate_landing",
+    "feasible_centres",
+    "landing_grid",
+    "landing_param_sets",
+    "landing_params",
+    "landing_summary",
+    "landing_table",
+    "landing_truth",
+    "load_terrains",
+    "map_obstacles",
+    "object_footprints",
+    "plane_features",
+    "rank_sites",
+    "rasterise",
+    "score_detection",
+    "score_landing",
+    "top_surface",
+    "truth_centres",
+    "write_landing_table",
+]

@@ -1,0 +1,58 @@
+"""Chapter 6: the pipeline on real recordings nobody here made (``../shared/realdata``).
+
+:mod:`~alte.studies.realdata.data` locates the folder (skipping cleanly when it is absent),
+loads the ISPRS airborne samples, the OctoMap scan and the VLP-16 packet bag, runs
+the mappers and tabulates them; :mod:`~alte.studies.realdata.ground` is the map-based ground
+filter and its Sithole & Vosselman (2004) scores; :mod:`~alte.plot.realdata`
+draws them.
+"""
+
+from alte.studies.realdata.data import (
+    BASELINE,
+    SAMPLES,
+    GroundRun,
+    IsprsSample,
+    RealData,
+    default_dir,
+    ground_runs,
+    ground_table,
+    isprs_sample,
+    locate,
+    map_runs,
+    map_table,
+    results,
+    scan_dataset,
+    vlp16_dataset,
+    write_csv,
+)
+from alte.studies.realdata.ground import (
+    classify_ground,
+    ground_errors,
+    map_heights,
+    opened_surface,
+    reference_labels,
+)
+
+__all__ = [
+    "BASELINE",
+    "SAMPLES",
+    "GroundRun",
+    "IsprsSample",
+    "RealData",
+    "classify_ground",
+    "default_dir",
+    "ground_errors",
+    "ground_runs",
+    "ground_table",
+    "isprs_sample",
+    "locate",
+    "map_heights",
+    "map_runs",
+    "map_table",
+    "opened_surface",
+    "reference_labels",
+    "results",
+    "scan_dataset",
+    "vlp16_dataset",
+    "write_csv",
+]

@@ -1,0 +1,261 @@
+"""Locate and load the real recordings, run the chapter-6 experiments, tabulate them.
+
+:func:`locate` finds the folder (``<repo>/../shared/realdata`` unless given); when it
+is absent the returned :class:`RealData` says why and every function here takes that
+in its stride (empty runs, empty tables, None datasets), so the notebook runs
+through and records ``{"skipped": reason}``. Reference ground labels of the ISPRS
+samples are membership in the ``*-ground.pcd`` subset (same offset, KD-tree match
+within 1e-3 m); float32 storage makes a few points coincide, so a point sharing a
+ground point's coordinates counts as ground (samp11: 21,793 points match its 21,786
+ground points).
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+from tqdm.auto import tqdm
+
+from alte.errors import ParameterError
+from alte.io import read_frames, read_points
+from alte.io.pointfiles import local_origin
+from alte.mappers import make_mapper
+from alte.paths import realdata_dir
+from alte.registration import register, register_frames
+from alte.studies.experiments import Dataset, MapRun, run_mapper
+from alte.studies.realdata.ground import (
+    classify_ground,
+    ground_errors,
+    map_heights,
+    opened_surface,
+    reference_labels,
+)
+from alte.studies.tables import write_csv as write_tables_csv
+from alte.types import Mount
+
+__all__ = [
+    "BASELINE",
+    "SAMPLES",
+    "GroundRun",
+    "IsprsSample",
+    "RealData",
+    "default_dir",
+    "ground_runs",
+    "ground_table",
+    "isprs_sample",
+    "locate",
+    "map_runs",
+    "map_table",
+    "results",
+    "scan_dataset",
+    "vlp16_dataset",
+    "write_csv",
+]
+
+#: The ISPRS filter-test samples stored in ``isprs_terrain/``.
+SAMPLES: tuple[str, ...] = ("samp11", "samp21", "samp31")
+#: Name of the map-free filter (raw point heights) in the ground runs and table.
+BASELINE = "points"
+
+
+@dataclass(frozen=True)
+class RealData:
+    """The real-data folder, or ``root=None`` and the ``reason`` it is unusable."""
+
+    root: Path | None
+    reason: str = ""
+
+    @property
+    def available(self) -> bool:
+        """True when the folder exists."""
+        return self.root is not None
+
+    def file(self, *parts: str) -> Path:
+        """A path inside the folder (readers name it when it is missing)."""
+        if self.root is None:
+            raise ParameterError(f"real data unavailable: {self.reason}")
+        return self.root.joinpath(*parts)
+
+    def describe(self) -> str:
+        """One line for the notebook: where the data are, or why the chapter is skipped."""
+        return f"real data: {self.root}" if self.root else f"SKIPPED: {self.reason}"
+
+
+def default_dir() -> Path:
+    """``<repo>/../shared/realdata`` (:func:`alte.paths.realdata_dir`)."""
+    return realdata_dir()
+
+
+def locate(path: str | os.PathLike[str] | None = None) -> RealData:
+    """The real-data folder ``path`` (empty/None: :func:`default_dir`), or why it is absent."""
+    folder = default_dir() if path is None or str(path) == "" else Path(path)
+    if not folder.is_dir():
+        return RealData(None, f"real-data folder {folder} is absent; chapter 6 is skipped "
+                              "(see ../shared/realdata/SOURCES.md for the recordings)")
+    return RealData(folder.resolve())
+
+
+# ---------------------------------------------------------------------- data sets
+
+
+@dataclass(eq=False)
+class IsprsSample:
+    """An ISPRS sample in local coordinates (``origin`` subtracted) and its labels."""
+
+    name: str
+    points: np.ndarray
+    reference: np.ndarray
+    origin: np.ndarray
+
+
+def isprs_sample(data: RealData, name: str) -> IsprsSample:
+    """Read ``isprs_terrain/<name>-utm.pcd`` and label it with ``<name>-utm-ground.pcd``."""
+    points = read_points(data.file("isprs_terrain", f"{name}-utm.pcd"))
+    ground = read_points(data.file("isprs_terrain", f"{name}-utm-ground.pcd"))
+    origin = local_origin(points)
+    return IsprsSample(name, points - origin, reference_labels(points - origin, ground - origin),
+                       origin)
+
+
+@dataclass(eq=False)
+class GroundRun:
+    """One sample filtered with one surface source: the mask, the labels and the scores."""
+
+    sample: str
+    mapper_name: str
+    params: dict[str, Any]
+    points: np.ndarray
+    ground: np.ndarray
+    reference: np.ndarray
+    metrics: dict[str, Any] = field(default_factory=dict)
+
+
+def _ground_run(sample: IsprsSample, name: str, params: Mapping[str, Any],
+                options: Mapping[str, float]) -> GroundRun:
+    pts, extra = sample.points, {"basis_functions": 0, "map_s": 0.0}
+    if name == BASELINE:
+        heights = pts[:, 2]
+    else:
+        mapper = make_mapper(name, **params)
+        start = time.perf_counter()
+        mapper.build(pts)
+        extra = {"basis_functions": int(mapper.basis_functions),
+                 "map_s": time.perf_counter() - start}
+        heights = map_heights(mapper.cells(), pts)
+    surface = opened_surface(pts, heights, options["step"], options["window"])
+    ground = classify_ground(pts, surface, options["tolerance"])
+    metrics = {**extra, "points": len(pts), **ground_errors(ground, sample.reference)}
+    return GroundRun(sample.name, name, dict(params), pts, ground, sample.reference, metrics)
+
+
+def ground_runs(data: RealData, samples: Sequence[str], mappers: Mapping[str, Mapping[str, Any]],
+                *, step: float = 1.0, window: float = 20.0, tolerance: float = 1.0,
+                baseline: bool = True, progress: bool = True) -> list[GroundRun]:
+    """Filter every sample with every 2D mapper (and the map-free baseline); [] if absent."""
+    if not data.available:
+        return []
+    bad = sorted(set(samples) - set(SAMPLES))
+    if bad:
+        raise ParameterError(f"ISPRS samples {bad} unknown; stored samples: {list(SAMPLES)}")
+    options = {"step": step, "window": window, "tolerance": tolerance}
+    sources = {**({BASELINE: {}} if baseline else {}), **mappers}
+    runs = []
+    for name in tqdm(samples, desc="ISPRS samples", disable=not progress):
+        sample = isprs_sample(data, name)
+        runs += [_ground_run(sample, m, p, options) for m, p in sources.items()]
+    return runs
+
+
+def ground_table(runs: Sequence[GroundRun]) -> pd.DataFrame:
+    """One row per sample x surface source: map size and time, type I/II/total errors."""
+    return pd.DataFrame([{"sample": r.sample, "filter": r.mapper_name,
+                          "params": ", ".join(f"{k}={v}" for k, v in r.params.items()),
+                          **r.metrics} for r in runs])
+
+
+def scan_dataset(data: RealData) -> Dataset | None:
+    """``octomap_scan/scan.dat.bz2``: one scan, sensor at the origin (None when absent)."""
+    if not data.available:
+        return None
+    pts = read_points(data.file("octomap_scan", "scan.dat.bz2"))
+    return _dataset("octomap_scan", [(pts, np.zeros(3))], pts, {"points": len(pts)})
+
+
+def vlp16_dataset(data: RealData, voxel: float | None = None,
+                  frames: int | None = None) -> Dataset | None:
+    """The VLP-16 packet bag decoded and registered with the identity pose (stationary
+    sensor, no pose topic, identity mount); ``voxel`` grid-averages each frame and
+    ``frames`` keeps at most that many rotations, evenly spaced (None: all)."""
+    if not data.available:
+        return None
+    if frames is not None and (isinstance(frames, bool) or not isinstance(frames, int)
+                               or frames < 1):
+        raise ParameterError(f"frames={frames!r}: expected a positive integer or None")
+    scans = read_frames(data.file("vlp16_packets", "bag"), allow_no_pose=True).frames
+    if frames is not None and frames < len(scans):
+        scans = [scans[i] for i in np.round(np.linspace(0, len(scans) - 1, frames)).astype(int)]
+    per_frame = [(pts, origin) for _, pts, origin in register_frames(scans, Mount(),
+                                                                      voxel=voxel)]
+    cloud = register(scans, Mount(), voxel=voxel).points
+    info = {"frames": len(per_frame), "points": len(cloud),
+            "raw_points": int(sum(len(f.points) for f in scans))}
+    return _dataset("vlp16_packets", per_frame, cloud, info)
+
+
+def _dataset(name: str, frames: list[tuple[np.ndarray, np.ndarray]], cloud: np.ndarray,
+             info: dict[str, Any]) -> Dataset:
+    # a 1 cm margin, so that the mappers' domain does not sit exactly on the extreme points
+    lo, hi = cloud.min(axis=0), cloud.max(axis=0)
+    pad = 0.01 + 1e-5 * np.maximum(np.abs(lo), np.abs(hi))
+    bounds = np.array([lo - pad, hi + pad])
+    return Dataset(name, "nav", frames, cloud, np.array([o for _, o in frames]), None, bounds,
+                   info)
+
+
+def map_runs(dataset: Dataset | None, mappers: Mapping[str, Mapping[str, Any]],
+             progress: bool = True) -> list[MapRun]:
+    """Map ``dataset`` frame by frame with each mapper (timed, measured); [] when None."""
+    if dataset is None:
+        return []
+    return [run_mapper(dataset, name, params)
+            for name, params in tqdm(mappers.items(), desc=dataset.name, disable=not progress)]
+
+
+def map_table(runs: Sequence[MapRun]) -> pd.DataFrame:
+    """Basis functions, occupied cells, time, memory, HD/MHD (cloud vs corners) per map."""
+    keys = ("elapsed_s", "basis_functions", "occupied_cells", "memory_bytes", "hd_m", "mhd_m")
+    return pd.DataFrame([{"mapper": r.mapper_name,
+                          "params": ", ".join(f"{k}={v}" for k, v in r.params.items()),
+                          **{k: r.metrics[k] for k in keys}} for r in runs])
+
+
+# ---------------------------------------------------------------------- output
+
+
+def write_csv(table: pd.DataFrame, out_dir: str | os.PathLike[str], name: str) -> Path | None:
+    """Write ``out_dir/name.csv`` atomically (replaces it); nothing for an empty table."""
+    return None if table.empty else write_tables_csv(table, out_dir, name, overwrite=True)
+
+
+def results(data: RealData, **parts: Any) -> dict[str, Any]:
+    """The notebook's results (tables as rows, datasets as tallies), or ``{"skipped":
+    reason}`` alone when the data are absent."""
+    if not data.available:
+        return {"skipped": data.reason}
+    return {"realdata_dir": str(data.root), **{k: _records(v) for k, v in parts.items()}}
+
+
+def _records(value: Any) -> Any:
+    """Tables as lists of rows, datasets as their name and tallies, the rest as is."""
+    if isinstance(value, pd.DataFrame):
+        return value.to_dict(orient="records")
+    if isinstance(value, Dataset):
+        return {"name": value.name, **value.info}
+    return value

@@ -1,0 +1,56 @@
+"""Parameter sweeps at scale: a YAML grid of terrains x mappers x parameters, run
+serially or on Dask distributed, stored as a resumable Parquet dataset.
+
+``load_spec(path)`` -> :class:`SweepSpec`; ``run_sweep(spec, scheduler=...)`` runs
+the runs not yet stored and returns the table; ``load_results(folder)`` reads it
+back. Thesis 5.2.2 found the mappers "sensitive to tuning parameters"; the sweeps
+map that sensitivity over whole grids instead of six hand-picked rows.
+"""
+
+from alte.studies.sweep.analysis import (
+    main_effects,
+    mapper_rows,
+    param_columns,
+    sensitivity_ranking,
+    sensitivity_table,
+)
+from alte.studies.sweep.runner import SERIAL, SweepResult, override, run_one, run_sweep
+from alte.studies.sweep.spec import (
+    MapperGrid,
+    SweepRun,
+    SweepSpec,
+    load_spec,
+    parse_spec,
+    plan_runs,
+)
+from alte.studies.sweep.store import (
+    KEY_COLUMNS,
+    TIMING_COLUMNS,
+    finished_ids,
+    load_results,
+    write_row,
+)
+
+__all__ = [
+    "KEY_COLUMNS",
+    "SERIAL",
+    "TIMING_COLUMNS",
+    "MapperGrid",
+    "SweepResult",
+    "SweepRun",
+    "SweepSpec",
+    "finished_ids",
+    "load_results",
+    "load_spec",
+    "main_effects",
+    "mapper_rows",
+    "override",
+    "param_columns",
+    "parse_spec",
+    "plan_runs",
+    "run_one",
+    "run_sweep",
+    "sensitivity_ranking",
+    "sensitivity_table",
+    "write_row",
+]

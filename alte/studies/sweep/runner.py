@@ -1,0 +1,201 @@
+"""Run a sweep serially or on Dask distributed, appending rows to a Parquet dataset.
+
+Data flows one way: spec -> runs (minus those already stored) -> terrains ensured
+(one task per distinct terrain, so no two workers simulate the same folder) -> one
+task per run on the workers (:func:`run_one`: load dataset, map, measure, return a
+flat row) -> the client writes each finished row to its own Parquet file. The
+client is the only writer; workers only read terrain folders.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import functools
+import json
+import time
+from collections.abc import Callable, Iterator, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import pandas as pd
+from tqdm.auto import tqdm
+
+from alte.errors import ParameterError, SimulationError
+from alte.sim import ensure_terrain, terrain_folder
+from alte.studies.experiments import Dataset, flat_metrics, load_dataset, run_mapper
+from alte.studies.sweep.spec import SweepRun, SweepSpec, plan_runs
+from alte.studies.sweep.store import finished_ids, load_results, write_row
+
+__all__ = ["SERIAL", "SweepResult", "override", "run_one", "run_sweep"]
+
+#: How long to wait for a scheduler given by address.
+CONNECT_TIMEOUT = "10s"
+#: ``scheduler`` values that run everything in this process.
+SERIAL = frozenset({"serial", "none"})
+
+#: Outcome of one task: (index into the submitted items, result, error or None).
+Outcome = tuple[int, Any, BaseException | None]
+MapUnordered = Callable[..., Iterator[Outcome]]
+
+
+@dataclass(frozen=True)
+class SweepResult:
+    """What :func:`run_sweep` did: the spec's rows (grid order) and the run tallies."""
+
+    output: Path
+    table: pd.DataFrame
+    ran: int
+    skipped: int
+    failed: list[tuple[SweepRun, str]] = field(default_factory=list)
+
+    def summary(self) -> dict[str, Any]:
+        """Counts and failures, JSON-ready (for ``save_results``)."""
+        return {"output": str(self.output), "rows": len(self.table), "ran": self.ran,
+                "skipped": self.skipped,
+                "failed": [{"run_id": r.run_id, "terrain": r.terrain, "mapper": r.mapper,
+                            "params": dict(r.params), "error": msg} for r, msg in self.failed]}
+
+
+@functools.lru_cache(maxsize=2)
+def _dataset(folder: str, frames: int | None, voxel: float | None) -> Dataset:
+    """Per-process cache: consecutive runs on one terrain load it once."""
+    return load_dataset(folder, frames, voxel)
+
+
+def run_one(run: SweepRun, data_dir: str) -> dict[str, Any]:
+    """Map one run's terrain and return its flat row (keys, ``p_*`` params, metrics)."""
+    start = time.perf_counter()
+    folder = terrain_folder(data_dir, run.terrain, run.frames)
+    data = _dataset(str(folder), run.frames, run.voxel)
+    result = run_mapper(data, run.mapper, run.params, truth=run.truth)
+    metrics = flat_metrics(result.metrics)
+    return {
+        "run_id": run.run_id, "terrain": run.terrain, "frames_requested": run.frames or 0,
+        "seed": run.seed, "mapper": run.mapper,
+        "params_json": json.dumps(dict(run.params), sort_keys=True),
+        **{f"p_{k}": v for k, v in run.params.items()},
+        "frames": int(data.info["frames"]), "points": int(data.info["points"]),
+        **{k: v for k, v in metrics.items() if k != "elapsed_s"},
+        "elapsed_s": float(metrics["elapsed_s"]), "wall_s": time.perf_counter() - start,
+    }
+
+
+def _ensure(item: tuple[str, int | None, int], data_dir: str) -> str:
+    terrain, frames, seed = item
+    return str(ensure_terrain(terrain, data_dir, seed, frames))
+
+
+def _serial_map(fn: Callable[..., Any], items: Sequence[Any], *args: Any) -> Iterator[Outcome]:
+    for i, item in enumerate(items):
+        try:
+            yield i, fn(item, *args), None
+        except Exception as err:  # a failed run is reported, the sweep goes on
+            yield i, None, err
+
+
+def _dask_map(client: Any) -> MapUnordered:
+    from distributed import as_completed
+
+    def map_unordered(fn: Callable[..., Any], items: Sequence[Any],
+                      *args: Any) -> Iterator[Outcome]:
+        futures = [client.submit(fn, item, *args, pure=False) for item in items]
+        index = {f.key: i for i, f in enumerate(futures)}
+        for future in as_completed(futures):
+            try:
+                yield index[future.key], future.result(), None
+            except Exception as err:  # re-raised from the worker
+                yield index[future.key], None, err
+            finally:
+                future.release()
+    return map_unordered
+
+
+@contextlib.contextmanager
+def _executor(scheduler: str, workers: int) -> Iterator[MapUnordered]:
+    """``serial``/``none``: in-process; ``local``: a LocalCluster; else a scheduler address."""
+    if scheduler in SERIAL:
+        yield _serial_map
+        return
+    from distributed import Client, LocalCluster
+
+    if scheduler == "local":
+        if workers < 1:
+            raise ParameterError(f"--workers {workers}: must be at least 1")
+        with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                          dashboard_address=None) as cluster, Client(cluster) as client:
+            yield _dask_map(client)
+        return
+    if "://" not in scheduler:
+        raise ParameterError(f"--scheduler {scheduler!r}: expected serial, none, local or an "
+                             "address like tcp://host:8786")
+    try:
+        client = Client(scheduler, timeout=CONNECT_TIMEOUT)
+    except (OSError, TimeoutError) as err:
+        raise ParameterError(f"--scheduler {scheduler}: cannot connect ({err})") from err
+    with client:
+        yield _dask_map(client)
+
+
+def _ensure_all(pool: MapUnordered, runs: Sequence[SweepRun], data_dir: str,
+                progress: bool) -> None:
+    items = sorted({(r.terrain, r.frames, r.seed) for r in runs}, key=str)
+    bar = tqdm(total=len(items), desc="terrains", unit="terrain", disable=not progress)
+    with bar:
+        for i, _, err in pool(_ensure, items, data_dir):
+            if err is not None:
+                raise SimulationError(f"sweep: terrain {items[i][0]} (frames={items[i][1]}) "
+                                      f"could not be simulated: {err}") from err
+            bar.update()
+
+
+def _map_all(pool: MapUnordered, runs: Sequence[SweepRun], data_dir: str, out: Path,
+             progress: bool) -> list[tuple[SweepRun, str]]:
+    failed = []
+    with tqdm(total=len(runs), desc="runs", unit="run", disable=not progress) as bar:
+        for i, row, err in pool(run_one, runs, data_dir):
+            if err is None:
+                write_row(out, row)
+            else:
+                failed.append((runs[i], f"{type(err).__name__}: {err}"))
+            bar.update()
+    return failed
+
+
+def run_sweep(spec: SweepSpec, *, scheduler: str = "local", workers: int = 2,
+              output: str | Path | None = None, progress: bool = True) -> SweepResult:
+    """Run the spec's unfinished runs and return all its rows in grid order.
+
+    ``scheduler``: ``"serial"``/``"none"`` (in-process), ``"local"`` (a
+    ``LocalCluster`` of ``workers`` single-threaded processes) or the address of a
+    running scheduler (its workers must see the same ``data_dir`` and Python env).
+    ``output`` overrides ``spec.output``. Failed runs are listed, not written, so a
+    rerun retries them.
+    """
+    out = Path(output or spec.output).resolve()
+    data_dir = str(Path(spec.data_dir).resolve())
+    runs = plan_runs(spec)
+    done = finished_ids(out)
+    todo = [r for r in runs if r.run_id not in done]
+    failed: list[tuple[SweepRun, str]] = []
+    if todo:
+        with _executor(scheduler, workers) as pool:
+            _ensure_all(pool, todo, data_dir, progress)
+            failed = _map_all(pool, todo, data_dir, out, progress)
+    table = load_results(out, [r.run_id for r in runs])
+    return SweepResult(out, table, len(todo) - len(failed), len(runs) - len(todo), failed)
+
+
+def override(spec: SweepSpec, **changes: Any) -> SweepSpec:
+    """``spec`` with other ``frames``/``data_dir``/``output``/``seed`` (CLI and notebook)."""
+    allowed = ("frames", "data_dir", "output", "seed")
+    unknown = sorted(set(changes) - set(allowed))
+    if unknown:
+        raise ParameterError(f"sweep override {', '.join(unknown)}: valid: {', '.join(allowed)}")
+    frames = changes.get("frames")
+    if frames is not None and (isinstance(frames, bool) or not isinstance(frames, int)
+                               or frames < 1):
+        raise ParameterError(f"frames={frames!r}: expected a positive integer or None")
+    return dataclasses.replace(spec, **{k: v for k, v in changes.items()
+                                        if k == "frames" or v is not None})

@@ -1,0 +1,232 @@
+"""Sweep specifications: a YAML grid of terrains x mappers x parameters, validated.
+
+A spec names terrains, the scans kept per terrain (``frames``), the simulation
+``seed``, where results go (``output``) and, per mapper, a ``grid`` of parameter
+lists (their cartesian product) and/or explicit ``rows``. Every run is a
+:class:`SweepRun` with a stable :attr:`SweepRun.run_id`: the sha256 of its canonical
+JSON, so a resumed sweep recognises runs it has already finished.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import itertools
+import json
+import os
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from alte.errors import AlteError, ParameterError
+from alte.mappers import make_mapper
+from alte.sim import TERRAINS
+from alte.studies.experiments import TruthOptions
+
+__all__ = ["MapperGrid", "SweepRun", "SweepSpec", "load_spec", "parse_spec", "plan_runs"]
+
+_TOP_KEYS = ("name", "terrains", "frames", "seed", "voxel", "data_dir", "output", "truth",
+             "mappers")
+_MAPPER_KEYS = ("grid", "rows", "terrains")
+_SCALARS = (bool, int, float, str)
+
+
+@dataclass(frozen=True)
+class SweepRun:
+    """One map to make and measure; ``params`` are as the spec gives them (type-coerced)."""
+
+    terrain: str
+    frames: int | None
+    seed: int
+    mapper: str
+    params: Mapping[str, Any]
+    voxel: float | None = None
+    truth: TruthOptions = field(default_factory=TruthOptions)
+
+    def key(self) -> dict[str, Any]:
+        """Everything that determines the run's result, JSON-ready."""
+        return {"terrain": self.terrain, "frames": self.frames, "seed": self.seed,
+                "mapper": self.mapper, "params": dict(sorted(self.params.items())),
+                "voxel": self.voxel, "truth": dataclasses.asdict(self.truth)}
+
+    @property
+    def run_id(self) -> str:
+        """sha256 of the canonical JSON of :meth:`key` (stable across processes)."""
+        text = json.dumps(self.key(), sort_keys=True, separators=(",", ":"))
+        return hashlib.sha256(text.encode()).hexdigest()
+
+
+@dataclass(frozen=True)
+class MapperGrid:
+    """A mapper's parameter rows (grid product and explicit rows) and its terrains."""
+
+    mapper: str
+    rows: tuple[Mapping[str, Any], ...]
+    terrains: tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class SweepSpec:
+    """A validated sweep (see the module docstring); ``source`` names it in messages."""
+
+    name: str
+    terrains: tuple[str, ...]
+    mappers: tuple[MapperGrid, ...]
+    frames: int | None = None
+    seed: int = 0
+    voxel: float | None = None
+    data_dir: str = "data"
+    output: str = ""
+    truth: TruthOptions = field(default_factory=TruthOptions)
+    source: str = "spec"
+
+
+def _fail(source: str, key: str, message: str) -> ParameterError:
+    return ParameterError(f"{source}: {key}: {message}")
+
+
+def _check_keys(source: str, where: str, given: Mapping[str, Any], valid: Sequence[str]) -> None:
+    unknown = sorted(set(map(str, given)) - set(valid))
+    if unknown:
+        raise _fail(source, where, f"unknown key(s) {', '.join(unknown)}; valid: "
+                    f"{', '.join(valid)}")
+
+
+def _int(source: str, key: str, value: Any, minimum: int, optional: bool = False) -> int | None:
+    if value is None and optional:
+        return None
+    if isinstance(value, bool) or not isinstance(value, int) or value < minimum:
+        extra = " or null" if optional else ""
+        raise _fail(source, key, f"{value!r} must be an integer >= {minimum}{extra}")
+    return value
+
+
+def _terrains(source: str, key: str, value: Any) -> tuple[str, ...]:
+    names = [value] if isinstance(value, str) else value
+    if not isinstance(names, list) or not names:
+        raise _fail(source, key, f"{value!r} must be a terrain name or a non-empty list")
+    bad = [n for n in names if n not in TERRAINS]
+    if bad:
+        raise _fail(source, key, f"unknown terrain(s) {bad}; valid: {', '.join(TERRAINS)}")
+    return tuple(dict.fromkeys(names))
+
+
+def _truth(source: str, value: Any) -> TruthOptions:
+    if value is None:
+        return TruthOptions()
+    if not isinstance(value, Mapping):
+        raise _fail(source, "truth", f"{value!r} must be a mapping")
+    valid = [f.name for f in dataclasses.fields(TruthOptions)]
+    _check_keys(source, "truth", value, valid)
+    try:
+        opts = TruthOptions(**{k: type(getattr(TruthOptions(), k))(v) for k, v in value.items()})
+    except (TypeError, ValueError) as err:
+        raise _fail(source, "truth", str(err)) from err
+    if opts.tolerance <= 0 or opts.grid_step <= 0 or opts.n_samples < 1:
+        raise _fail(source, "truth", f"{value!r}: tolerance, grid_step and n_samples must be > 0")
+    return opts
+
+
+def _grid_rows(source: str, key: str, grid: Any) -> list[dict[str, Any]]:
+    if not isinstance(grid, Mapping) or not grid:
+        raise _fail(source, key, f"{grid!r} must map parameter names to lists of values")
+    lists = {}
+    for name, given in grid.items():
+        values = given if isinstance(given, list) else [given]
+        if not values:
+            raise _fail(source, f"{key}.{name}", "empty list of values")
+        lists[str(name)] = values
+    return [dict(zip(lists, combo, strict=True)) for combo in itertools.product(*lists.values())]
+
+
+def _coerce_row(source: str, key: str, mapper: str, row: Any) -> dict[str, Any]:
+    """Validate one parameter row by constructing the mapper; values come back coerced."""
+    if not isinstance(row, Mapping):
+        raise _fail(source, key, f"{row!r} must map parameter names to values")
+    for name, value in row.items():
+        if not isinstance(value, _SCALARS):
+            raise _fail(source, f"{key}.{name}", f"{value!r} must be a number, string or bool")
+    try:
+        resolved = make_mapper(mapper, **row).params
+    except AlteError as err:
+        raise _fail(source, key, str(err)) from err
+    return {str(name): resolved[name] for name in row}
+
+
+def _mapper(source: str, name: str, body: Any, terrains: tuple[str, ...]) -> MapperGrid:
+    key = f"mappers.{name}"
+    if not isinstance(body, Mapping) or not ({"grid", "rows"} & set(body)):
+        raise _fail(source, key, "needs a 'grid' of parameter lists and/or explicit 'rows'")
+    _check_keys(source, key, body, _MAPPER_KEYS)
+    rows = _grid_rows(source, f"{key}.grid", body["grid"]) if "grid" in body else []
+    explicit = body.get("rows", [])
+    if not isinstance(explicit, list):
+        raise _fail(source, f"{key}.rows", f"{explicit!r} must be a list of parameter mappings")
+    rows += explicit
+    coerced = [_coerce_row(source, key, name, row) for row in rows]
+    own = _terrains(source, f"{key}.terrains", body["terrains"]) if "terrains" in body else terrains
+    outside = sorted(set(own) - set(terrains))
+    if outside:
+        raise _fail(source, f"{key}.terrains", f"{outside} not in the top-level terrains")
+    return MapperGrid(name, tuple(coerced), own)
+
+
+def _optional_float(source: str, key: str, value: Any) -> float | None:
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, int | float) or not value > 0:
+        raise _fail(source, key, f"{value!r} must be a positive number or null")
+    return float(value)
+
+
+def parse_spec(raw: Any, source: str = "spec") -> SweepSpec:
+    """Validate a spec mapping (as read from YAML); errors name ``source`` and the key."""
+    if not isinstance(raw, Mapping):
+        raise ParameterError(f"{source}: expected a mapping of sweep settings, got {raw!r}")
+    _check_keys(source, "top level", raw, _TOP_KEYS)
+    for key in ("terrains", "mappers"):
+        if key not in raw:
+            raise _fail(source, key, "missing (required)")
+    terrains = _terrains(source, "terrains", raw["terrains"])
+    if not isinstance(raw["mappers"], Mapping) or not raw["mappers"]:
+        raise _fail(source, "mappers", "must map mapper names to their grids")
+    name = str(raw.get("name") or Path(source).stem)
+    return SweepSpec(
+        name=name, terrains=terrains,
+        mappers=tuple(_mapper(source, str(m), body, terrains)
+                      for m, body in raw["mappers"].items()),
+        frames=_int(source, "frames", raw.get("frames"), 1, optional=True),
+        seed=int(_int(source, "seed", raw.get("seed", 0), 0) or 0),
+        voxel=_optional_float(source, "voxel", raw.get("voxel")),
+        data_dir=str(raw.get("data_dir", "data")),
+        output=str(raw.get("output") or f"reports/sweeps/{name}"),
+        truth=_truth(source, raw.get("truth")), source=source)
+
+
+def load_spec(path: str | os.PathLike[str]) -> SweepSpec:
+    """Read and validate a YAML sweep spec."""
+    import yaml
+
+    path = Path(path)
+    try:
+        raw = yaml.safe_load(path.read_text())
+    except OSError as err:
+        raise ParameterError(f"sweep spec {path}: cannot read it ({err.strerror})") from err
+    except yaml.YAMLError as err:
+        raise ParameterError(f"sweep spec {path}: invalid YAML ({err})") from err
+    return parse_spec(raw, str(path))
+
+
+def plan_runs(spec: SweepSpec) -> list[SweepRun]:
+    """Every run of ``spec`` in grid order (terrain, mapper, row), duplicates dropped."""
+    runs: dict[str, SweepRun] = {}
+    for terrain in spec.terrains:
+        for grid in spec.mappers:
+            if terrain not in grid.terrains:
+                continue
+            for params in grid.rows:
+                run = SweepRun(terrain, spec.frames, spec.seed, grid.mapper, params,
+                               spec.voxel, spec.truth)
+                runs.setdefault(run.run_id, run)
+    return list(runs.values())

@@ -1,0 +1,202 @@
+"""Tables 5.1-5.12 from measurements, the thesis' comparison rule, and trend checks.
+
+The comparison rule (thesis 5.2.2, "Comparison") as code: every criterion counts the
+same except HD, which enters only as outlier rejection (HD - MHD, "the closer HD is to
+MHD, the better"). So the criteria are elapsed time, basis functions, MHD and HD - MHD,
+all lower-is-better; each is min-max normalised over the sweep (0 = best row, 1 =
+worst), the four are summed and the lowest sum wins (:func:`best_row`).
+Applied to the thesis' own numbers the rule reproduces its 3D-ALTE choice (table 5.11)
+but not the other three: the thesis' tables are not consistent with any one rule (its
+2D-ALTE pick, row 4 of table 5.9, is beaten by row 1 on time and basis functions at
+equal HD and MHD). :func:`comparison_table` prints both choices side by side.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+from scipy.stats import spearmanr
+
+from alte.errors import ParameterError
+from alte.fsutil import atomic_path
+from alte.studies.thesis import COMPARISONS, POINT_CLOUDS, SWEEPS, sweep_table
+
+__all__ = ["COMPARISON_TRENDS", "SWEEP_TRENDS", "THESIS_CRITERIA", "best_row",
+           "comparison_scores", "comparison_table", "point_cloud_table", "thesis_metrics",
+           "trend_table", "write_csv", "write_table"]
+
+#: The criteria of the comparison rule, all lower-is-better, equally weighted.
+THESIS_CRITERIA: tuple[str, ...] = ("elapsed_s", "basis_functions", "mhd_m", "hd_minus_mhd_m")
+
+_THESIS_COLS = {"elapsed_s": "thesis_elapsed_s", "basis_functions": "thesis_basis_functions",
+                "hd_m": "thesis_hd_m", "mhd_m": "thesis_mhd_m"}
+
+#: Trends the thesis states for each sweep: (statement, parameter, metric, expected sign).
+SWEEP_TRENDS: dict[int, list[tuple[str, str, str, int]]] = {
+    7: [("elapsed time falls as max points per cell rises", "max_points", "elapsed_s", -1),
+        ("basis functions fall as max points per cell rises", "max_points", "basis_functions",
+         -1),
+        ("MHD rises as the map gets coarser (more max points)", "max_points", "mhd_m", 1)],
+    8: [("elapsed time rises with resolution", "resolution", "elapsed_s", 1),
+        ("basis functions rise with resolution", "resolution", "basis_functions", 1),
+        ("HD falls as resolution rises", "resolution", "hd_m", -1),
+        ("MHD falls as resolution rises", "resolution", "mhd_m", -1)],
+    9: [("elapsed time rises with max_res", "max_res", "elapsed_s", 1),
+        ("basis functions rise with max_res", "max_res", "basis_functions", 1),
+        ("elapsed time rises with kappa", "kappa", "elapsed_s", 1)],
+    12: [("elapsed time rises with max_res", "max_res", "elapsed_s", 1),
+         ("basis functions rise with max_res", "max_res", "basis_functions", 1),
+         ("MHD falls as max_res rises", "max_res", "mhd_m", -1)],
+}
+
+#: Comparison claims of tables 5.10/5.11: (statement, lower mapper, higher mapper, metric).
+COMPARISON_TRENDS: dict[int, list[tuple[str, str, str, str]]] = {
+    10: [("2D-ALTE has fewer basis functions than Quadtree", "alte2d", "quadtree",
+          "basis_functions"),
+         ("2D-ALTE has a lower MHD than Quadtree", "alte2d", "quadtree", "mhd_m"),
+         ("Quadtree rejects outliers better (smaller HD - MHD)", "quadtree", "alte2d",
+          "hd_minus_mhd_m")],
+    11: [("Octomap maps faster than 3D-ALTE", "octomap", "alte3d", "elapsed_s"),
+         ("3D-ALTE has fewer basis functions than Octomap", "alte3d", "octomap",
+          "basis_functions"),
+         ("3D-ALTE has a lower MHD than Octomap", "alte3d", "octomap", "mhd_m"),
+         ("3D-ALTE rejects outliers better (smaller HD - MHD)", "alte3d", "octomap",
+          "hd_minus_mhd_m")],
+}
+
+
+def thesis_metrics(number: int) -> pd.DataFrame:
+    """Sweep table 5.``number`` of the thesis with our metric column names."""
+    table = sweep_table(number).rename(columns={v: k for k, v in _THESIS_COLS.items()})
+    table["hd_minus_mhd_m"] = table["hd_m"] - table["mhd_m"]
+    return table
+
+
+def comparison_scores(table: pd.DataFrame,
+                      criteria: Sequence[str] = THESIS_CRITERIA) -> np.ndarray:
+    """Equal-weight score per row: the sum of min-max normalised criteria (lower is better)."""
+    missing = [c for c in criteria if c not in table.columns]
+    if missing:
+        raise ParameterError(f"comparison rule: table lacks column(s) {', '.join(missing)}")
+    if len(table) == 0:
+        raise ParameterError("comparison rule: the table has no rows")
+    values = table[list(criteria)].to_numpy(dtype=np.float64)
+    valid = np.isfinite(values).all(axis=1)
+    if not valid.any():
+        raise ParameterError("comparison rule: no row has every criterion (empty maps?)")
+    lo, hi = values[valid].min(axis=0), values[valid].max(axis=0)
+    norm = (values - lo) / np.where(hi > lo, hi - lo, 1.0)
+    return np.where(valid, norm.sum(axis=1), np.inf)
+
+
+def best_row(table: pd.DataFrame, criteria: Sequence[str] = THESIS_CRITERIA) -> int:
+    """Position of the row the comparison rule picks (first on ties; rows with a missing
+    criterion, e.g. NaN HD of an empty map, never win)."""
+    return int(np.argmin(comparison_scores(table, criteria)))
+
+
+def _params_text(params: Mapping[str, Any]) -> str:
+    return ", ".join(f"{k}={v}" for k, v in params.items())
+
+
+def comparison_table(number: int, sweeps: Mapping[str, pd.DataFrame]) -> pd.DataFrame:
+    """Table 5.10 or 5.11: per mapper our best row (by the rule) beside the thesis' choice.
+
+    ``sweeps`` maps mapper name to its sweep table from :func:`alte.studies.analysis.sweep`.
+    ``rule_on_thesis`` is what the same rule picks from the thesis' own numbers.
+    """
+    if number not in COMPARISONS:
+        raise ParameterError(f"table 5.{number} is not a comparison; those are 10 and 11")
+    rows = []
+    for mapper, (table, thesis_row) in COMPARISONS[number].items():
+        if mapper not in sweeps:
+            raise ParameterError(f"table 5.{number} needs the {mapper} sweep (table 5.{table})")
+        ours = sweeps[mapper]
+        pick = ours.iloc[best_row(ours)]
+        theirs = thesis_metrics(table)
+        params = SWEEPS[table]["rows"]
+        row = {"mapper": mapper, "params": _params_text(params[int(pick["thesis_row"])][0]),
+               **{k: v for k, v in pick.items() if not str(k).startswith("thesis_")}}
+        chosen = theirs.iloc[thesis_row]
+        row.update({"thesis_params": _params_text(params[thesis_row][0]),
+                    **{v: chosen[k] for k, v in _THESIS_COLS.items()},
+                    "thesis_hd_minus_mhd_m": chosen["hd_minus_mhd_m"],
+                    "rule_on_thesis": _params_text(params[best_row(theirs)][0])})
+        rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def point_cloud_table(number: int, name: str, frames: int, points: int) -> pd.DataFrame:
+    """Table 5.5 or 5.6: frames and points of our registered cloud beside the thesis'."""
+    if number not in POINT_CLOUDS:
+        raise ParameterError(f"table 5.{number} is not a point-cloud table; those are 5 and 6")
+    ref = POINT_CLOUDS[number]
+    return pd.DataFrame([{"terrain": name, "frames": frames, "points": points,
+                          "thesis_terrain": ref["terrain"], "thesis_frames": ref["frames"],
+                          "thesis_points": ref["points"]}])
+
+
+def _rho(x: pd.Series, y: pd.Series) -> float:
+    if len(x) < 3 or x.nunique() < 2 or y.nunique() < 2:
+        return float("nan")
+    return float(spearmanr(x, y).statistic)
+
+
+def _sweep_trends(number: int, ours: pd.DataFrame) -> list[dict[str, Any]]:
+    theirs = thesis_metrics(number)
+    out = []
+    for text, param, metric, sign in SWEEP_TRENDS[number]:
+        r_t, r_o = _rho(theirs[param], theirs[metric]), _rho(ours[param], ours[metric])
+        out.append({"table": f"5.{number}", "trend": text, "thesis_rho": r_t, "ours_rho": r_o,
+                    "holds_in_thesis": bool(r_t * sign >= 0.5), "holds_on_ours":
+                    bool(r_o * sign >= 0.5)})
+    return out
+
+
+def _comparison_trends(number: int, table: pd.DataFrame) -> list[dict[str, Any]]:
+    by = table.set_index("mapper")
+    out = []
+    for text, low, high, metric in COMPARISON_TRENDS[number]:
+        tcol = "thesis_hd_minus_mhd_m" if metric == "hd_minus_mhd_m" else _THESIS_COLS[metric]
+        out.append({"table": f"5.{number}", "trend": text,
+                    "thesis_rho": np.nan, "ours_rho": np.nan,
+                    "holds_in_thesis": bool(by.at[low, tcol] < by.at[high, tcol]),
+                    "holds_on_ours": bool(by.at[low, metric] < by.at[high, metric])})
+    return out
+
+
+def trend_table(number: int, table: pd.DataFrame) -> pd.DataFrame:
+    """Which of the thesis' stated trends for table 5.``number`` hold, there and on ours.
+
+    Sweeps: a trend holds when the Spearman rank correlation between parameter and metric
+    has the stated sign and magnitude >= 0.5 (NaN with fewer than 3 rows). Comparisons:
+    the stated inequality between the two chosen maps.
+    """
+    if number in SWEEP_TRENDS:
+        return pd.DataFrame(_sweep_trends(number, table))
+    if number in COMPARISON_TRENDS:
+        return pd.DataFrame(_comparison_trends(number, table))
+    raise ParameterError(f"table 5.{number} states no trends; those are 7-12")
+
+
+def write_csv(table: pd.DataFrame, out_dir: str | os.PathLike[str], name: str,
+              overwrite: bool = False) -> Path:
+    """Write a report table as ``out_dir/<name>.csv``: atomic, 6 significant digits.
+
+    Refuses to overwrite unless asked. The one writer of every table in the report.
+    """
+    path = Path(out_dir) / f"{name}.csv"
+    with atomic_path(path, overwrite=overwrite) as tmp:
+        table.to_csv(tmp, index=False, float_format="%.6g")
+    return path
+
+
+def write_table(table: pd.DataFrame, out_dir: str | os.PathLike[str], number: int,
+                overwrite: bool = False) -> Path:
+    """Write ``out_dir/table_5_<number>.csv`` (see :func:`write_csv`)."""
+    return write_csv(table, out_dir, f"table_5_{number}", overwrite)
