@@ -7,7 +7,7 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
-from synthetic import make_frame, scene
+from support.synthetic import make_frame, scene
 
 from alte.cli import main
 from alte.commands import register as command

@@ -9,9 +9,9 @@ from typing import Any
 
 import numpy as np
 import pytest
-from bagtools import TS, Message, write_ros2  # noqa: F401 (exported through globals())
 from rosbags.rosbag1 import Writer as Writer1
 from scipy.spatial.transform import Rotation
+from support.bagtools import TS, Message, write_ros2  # noqa: F401 (exported through globals())
 
 from alte.paths import realdata_dir
 

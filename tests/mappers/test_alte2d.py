@@ -7,6 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
+from support.maps import assert_partition, same_cells
 
 from alte.errors import MapperError, ParameterError
 from alte.mappers.alte2d import Alte2D, plane_height
@@ -23,21 +24,6 @@ def step_terrain(n: int = 3000, seed: int = 0) -> np.ndarray:
     rng = np.random.default_rng(seed)
     xy = rng.uniform(0, 16, (n, 2))
     return np.column_stack([xy, np.where(xy[:, 0] > 8, 2.0, 0.0) + rng.normal(0, 0.01, n)])
-
-
-def assert_partition(cells, size: float = 16.0) -> None:
-    assert np.isclose((cells.sizes[:, 0] * cells.sizes[:, 1]).sum(), size * size)
-    probes = np.random.default_rng(1).uniform(0, size, (200, 2))
-    lo = cells.centers[:, :2] - cells.sizes[:, :2] / 2
-    hi = cells.centers[:, :2] + cells.sizes[:, :2] / 2
-    inside = ((probes[:, None] >= lo) & (probes[:, None] < hi)).all(axis=2)
-    assert (inside.sum(axis=1) == 1).all()
-
-
-def same_cells(a, b) -> bool:
-    return (len(a) == len(b) and np.array_equal(a.level, b.level)
-            and np.allclose(a.centers, b.centers, equal_nan=True)
-            and np.array_equal(a.occupied, b.occupied))
 
 
 @settings(max_examples=40, deadline=None)

@@ -7,6 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
+from support.maps import assert_partition, same_cells
 
 from alte.errors import MapperError, ParameterError
 from alte.mappers import levelstats
@@ -25,23 +26,6 @@ def box_terrain(n: int = 4000, seed: int = 0) -> np.ndarray:
     xy = rng.uniform(0, 16, (n, 2))
     box = (xy[:, 0] > 4) & (xy[:, 0] < 8) & (xy[:, 1] > 4) & (xy[:, 1] < 8)
     return np.column_stack([xy, np.where(box, 3.0, 0.0) + rng.normal(0, 0.02, n)])
-
-
-def assert_partition(cells, size: float = 16.0) -> None:
-    """Leaves cover the square exactly once: areas add up and probes hit one cell each."""
-    assert np.isclose((cells.sizes[:, 0] * cells.sizes[:, 1]).sum(), size * size)
-    probes = np.random.default_rng(1).uniform(0, size, (200, 2))
-    lo = cells.centers[:, :2] - cells.sizes[:, :2] / 2
-    hi = cells.centers[:, :2] + cells.sizes[:, :2] / 2
-    inside = ((probes[:, None] >= lo) & (probes[:, None] < hi)).all(axis=2)
-    assert (inside.sum(axis=1) == 1).all()
-
-
-def same_cells(a, b) -> bool:
-    return (len(a) == len(b) and np.array_equal(a.level, b.level)
-            and np.allclose(a.centers, b.centers, equal_nan=True)
-            and np.allclose(a.value, b.value, equal_nan=True)
-            and np.array_equal(a.occupied, b.occupied))
 
 
 def test_morton_round_trip() -> None:

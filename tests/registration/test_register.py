@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
-from synthetic import make_frame, scene
+from support.synthetic import make_frame, scene
 
 from alte.errors import ParameterError, RegistrationError
 from alte.registration import (

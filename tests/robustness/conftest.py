@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 import pytest
-from bagtools import TS, Message, write_ros2  # noqa: F401 (exported through globals())
+from support.bagtools import TS, Message, write_ros2  # noqa: F401 (exported through globals())
 
 from alte.cli import main
 from alte.paths import realdata_dir

@@ -1,0 +1,1 @@
+"""Helpers shared by the tests: synthetic frames, raw bag writers, map checks, a browser."""
