@@ -60,7 +60,7 @@ _CASE = {"quadtree": ("sim_lan_1", "sim_lan_2"), "alte2d": ("sim_lan_1", "sim_la
          "octomap": ("sim_nav_1", "sim_nav_2"), "alte3d": ("sim_nav_1", "sim_nav_2")}
 
 
-def _row(terrain: str, mapper: str, p: Mapping[str, float], seed: int, curve: Curve,
+def _row(terrain: str, mapper: str, p: Mapping[str, float], seed: int, *, curve: Curve,
          rng: np.random.Generator) -> dict[str, object]:
     size = _size(mapper, p)
     mhd = curve.scale * (size / 1000.0) ** -curve.slope * (1 + curve.noise * rng.normal())
@@ -85,7 +85,7 @@ def synthetic_tradeoff(curves: Mapping[str, Curve] | None = None, seeds: Sequenc
     terrains (``terrains`` overrides per mapper), every grid setting, every seed."""
     chosen = {**_DEFAULT, **(curves or {})}
     rng = np.random.default_rng(rng_seed)
-    rows = [_row(terrain, mapper, p, seed, curve, rng)
+    rows = [_row(terrain, mapper, p, seed, curve=curve, rng=rng)
             for mapper, curve in chosen.items()
             for terrain in (terrains or _CASE).get(mapper, _CASE[mapper])
             for seed in seeds for p in GRIDS[mapper]]
