@@ -204,7 +204,8 @@ def _front_reads(table: pd.DataFrame, mappers: Sequence[str], axes: tuple[str, s
         lo, hi = _span(list(curves.values()), by_size)
         if not by_size:
             lo, hi = sorted((sign * lo, sign * hi))
-        wanted = list(levels) if levels else _levels(lo, hi, log=by_size)
+        wanted = list(levels) if levels is not None and len(levels) else _levels(lo, hi,
+                                                                               log=by_size)
         at = np.asarray(wanted, dtype=np.float64)
         for (mapper, seed), (xs, ys, x_max) in curves.items():
             values = (sign * read_at_size(xs, ys, at, x_max) if by_size

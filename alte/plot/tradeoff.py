@@ -1,0 +1,185 @@
+"""Trade-off figures: size against error per mapper (the field's classic figure), and the
+mappers compared at equal size and at equal fidelity.
+
+:func:`tradeoff_figure` draws, per terrain panel, every map as a faint dot (one per
+setting and seed), each mapper's Pareto front as its mean over seeds (read at common
+sizes, see :mod:`alte.studies.tradeoff`) with a shaded 95 % bootstrap band over seeds,
+and a star at the thesis' chosen setting. Size is on a log axis.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from alte.errors import ParameterError
+from alte.studies.measures import NoDataError, thesis_setting
+from alte.studies.tradeoff import (
+    MAPPER_NAMES,
+    equal_fidelity,
+    equal_size,
+    fronts,
+    interval_table,
+    label,
+    prepare,
+)
+
+__all__ = ["COLORS", "equal_fidelity_figure", "equal_size_figure", "tradeoff_figure"]
+
+#: One colour per mapper, the same in every figure.
+COLORS = {"quadtree": "tab:blue", "alte2d": "tab:orange", "octomap": "tab:green",
+          "alte3d": "tab:red"}
+_GRID_POINTS = 25
+
+
+def _panels(count: int, width: float = 4.2, height: float = 3.4) -> tuple[Any, np.ndarray]:
+    import matplotlib.pyplot as plt
+
+    cols = min(count, 4)
+    rows = -(-count // cols)
+    fig, axes = plt.subplots(rows, cols, figsize=(width * cols, height * rows), squeeze=False,
+                             layout="constrained")
+    for ax in axes.ravel()[count:]:
+        ax.set_visible(False)
+    return fig, axes.ravel()
+
+
+def _legend(fig: Any) -> None:
+    """One legend below the panels with every label once."""
+    handles: dict[str, Any] = {}
+    for ax in fig.axes:
+        for handle, text in zip(*ax.get_legend_handles_labels(), strict=True):
+            handles.setdefault(text, handle)
+    if handles:
+        fig.legend(handles.values(), handles.keys(), loc="outside lower center",
+                   ncols=min(len(handles), 4), fontsize=8)
+
+
+def _select(table: pd.DataFrame, mappers: Sequence[str] | None,
+            terrains: Sequence[str] | None) -> tuple[pd.DataFrame, list[str], list[str]]:
+    names = list(dict.fromkeys(table["mapper"])) if mappers is None else list(mappers)
+    places = sorted(set(table["terrain"])) if terrains is None else list(terrains)
+    rows = table[table["mapper"].isin(names) & table["terrain"].isin(places)]
+    if rows.empty:
+        raise ParameterError(f"trade-off table: no rows of {names} on {places}")
+    present = set(rows["terrain"])
+    return rows, [m for m in names if m in set(rows["mapper"])], [t for t in places
+                                                                  if t in present]
+
+
+def _mean_front(ax: Any, rows: pd.DataFrame, mapper: str, axes: tuple[str, str],
+                higher_is_better: bool) -> None:
+    size, metric = axes
+    x = rows[size].to_numpy(float)
+    x = x[np.isfinite(x) & (x > 0)]
+    if x.size == 0:
+        return
+    grid = np.geomspace(x.min(), x.max(), _GRID_POINTS)
+    reads = equal_size(rows, (mapper,), metric, size=size, levels=grid,
+                       higher_is_better=higher_is_better)
+    band = interval_table(reads).sort_values("level")
+    color = COLORS.get(mapper)
+    ax.plot(band["level"], band["mean"], color=color, lw=2,
+            label=f"{MAPPER_NAMES.get(mapper, mapper)} front")
+    ax.fill_between(band["level"], band["low"], band["high"], color=color, alpha=0.2, lw=0)
+
+
+def _thesis_star(ax: Any, rows: pd.DataFrame, mapper: str, axes: tuple[str, str]) -> None:
+    try:
+        setting = thesis_setting(mapper)
+    except NoDataError:
+        return
+    match = np.ones(len(rows), dtype=bool)
+    for key, value in setting.items():
+        column = rows.get(f"p_{key}")
+        match &= (np.isclose(pd.to_numeric(column, errors="coerce"), float(value))
+                  if column is not None else False)
+    if match.any():
+        chosen = rows[match]
+        ax.plot(chosen[axes[0]].mean(), chosen[axes[1]].mean(), "*", ms=14, mec="k",
+                color=COLORS.get(mapper), label=f"{MAPPER_NAMES.get(mapper, mapper)}: "
+                "thesis' setting")
+
+
+def tradeoff_figure(table: pd.DataFrame, metric: str = "mhd_m", *,
+                    size: str = "basis_functions", mappers: Sequence[str] | None = None,
+                    terrains: Sequence[str] | None = None,
+                    higher_is_better: bool = False) -> Any:
+    """One panel per terrain: ``metric`` against ``size`` (log) for each mapper, every map
+    as a dot, the mean Pareto front over seeds with its bootstrap band, the thesis' setting
+    starred."""
+    rows, names, places = _select(prepare(table), mappers, terrains)
+    fig, axes = _panels(len(places))
+    for ax, terrain in zip(axes, places, strict=False):
+        here = rows[rows["terrain"] == terrain]
+        for mapper in names:
+            mine = here[here["mapper"] == mapper]
+            if mine.empty:
+                continue
+            dots = fronts(mine, size, metric, higher_is_better)
+            for on, alpha in ((False, 0.25), (True, 0.7)):
+                part = dots[dots["on_front"] == on]
+                ax.scatter(part["x"], part["y"], s=10, alpha=alpha, color=COLORS.get(mapper),
+                           lw=0)
+            _mean_front(ax, mine, mapper, (size, metric), higher_is_better)
+            _thesis_star(ax, mine, mapper, (size, metric))
+        ax.set_xscale("log")
+        ax.set(title=terrain, xlabel=label(size), ylabel=label(metric))
+        ax.grid(alpha=0.3, which="both")
+    _legend(fig)
+    seeds = rows["seed"].nunique()
+    fig.suptitle(f"{label(metric)} against {label(size)}: Pareto fronts, mean over {seeds} "
+                 f"seed{'s' if seeds != 1 else ''} with 95 % bootstrap band")
+    return fig
+
+
+def _level_panels(summary: pd.DataFrame, names: Sequence[str], ylabel: str, xlabel: str,
+                  title: str) -> Any:
+    places = sorted(set(summary["terrain"]))
+    if not places:
+        raise ParameterError("no terrain has every mapper over a common range to compare")
+    fig, axes = _panels(len(places), 4.0, 3.2)
+    for ax, terrain in zip(axes, places, strict=False):
+        part = summary[summary["terrain"] == terrain]
+        levels = sorted(set(part["level"]))
+        for k, mapper in enumerate(names):
+            mine = part[part["mapper"] == mapper].set_index("level").reindex(levels)
+            pos = np.arange(len(levels)) + (k - (len(names) - 1) / 2) * 0.15
+            err = np.vstack([mine["mean"] - mine["low"], mine["high"] - mine["mean"]])
+            ax.errorbar(pos, mine["mean"], yerr=err, fmt="o", capsize=3,
+                        color=COLORS.get(mapper), label=MAPPER_NAMES.get(mapper, mapper))
+        ax.set_xticks(range(len(levels)), [f"{v:,.0f}" if v >= 100 else f"{v:.3g}"
+                                           for v in levels])
+        ax.set(title=terrain, xlabel=xlabel, ylabel=ylabel)
+        ax.grid(alpha=0.3)
+    _legend(fig)
+    fig.suptitle(title)
+    return fig
+
+
+def equal_size_figure(table: pd.DataFrame, mappers: Sequence[str], metric: str = "mhd_m", *,
+                      size: str = "basis_functions", levels: Sequence[float] | None = None,
+                      higher_is_better: bool = False) -> Any:
+    """``metric`` of each mapper read off its front at equal ``size`` (mean over seeds,
+    95 % bootstrap interval), one panel per terrain."""
+    reads = equal_size(prepare(table), mappers, metric, size=size, levels=levels,
+                       higher_is_better=higher_is_better)
+    return _level_panels(interval_table(reads.dropna(subset=["value"])), mappers,
+                         label(metric), label(size),
+                         f"{label(metric)} at equal {label(size, False)}")
+
+
+def equal_fidelity_figure(table: pd.DataFrame, mappers: Sequence[str],
+                          metric: str = "basis_functions", *, fidelity: str = "mhd_m",
+                          levels: Sequence[float] | None = None) -> Any:
+    """The ``metric`` (size or time) each mapper needs for equal ``fidelity`` (log axis)."""
+    reads = equal_fidelity(prepare(table), mappers, metric, fidelity=fidelity, levels=levels)
+    fig = _level_panels(interval_table(reads.dropna(subset=["value"])), mappers,
+                        label(metric), label(fidelity),
+                        f"{label(metric)} needed for equal {label(fidelity)}")
+    for ax in fig.axes:
+        ax.set_yscale("log")
+    return fig
