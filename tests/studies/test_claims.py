@@ -65,7 +65,9 @@ def test_table_quotes_match_the_transcribed_tables():
         number = int(item.section.rsplit(".", 1)[1])
         criterion, cells = item.quote.split(": ", 1)
         key = criterion.lower().replace(" ", "_")
-        for name, label in re.findall(r'(Quadtree|2D ALTE|Octomap|3D ALTE) "(\w+)"', cells):
+        found = re.findall(r"(Quadtree|2D ALTE|Octomap|3D ALTE) (\w+)", cells)
+        assert len(found) == 2, item.id
+        for name, label in found:
             assert QUALITATIVE[number][names[name]][key] == label, item.id
 
 

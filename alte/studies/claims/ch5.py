@@ -45,50 +45,50 @@ _ROBUST = ("robustness read as a small coefficient of variation of MHD over the 
 
 _TABLES: tuple[Claim, ...] = (
     Claim("t5.1-adaptability", "5.1, table 5.1",
-          'Adaptability: Quadtree "Mid", 2D ALTE "High"',
+          "Adaptability: Quadtree Mid, 2D ALTE High",
           Summary("lan", "alte2d", "size_octaves", "median", "quadtree", higher_is_better=True),
           _ADAPT),
-    Claim("t5.1-robustness", "5.1, table 5.1", 'Robustness: Quadtree "Low", 2D ALTE "Mid"',
+    Claim("t5.1-robustness", "5.1, table 5.1", "Robustness: Quadtree Low, 2D ALTE Mid",
           Summary("lan", "alte2d", "mhd_m", "cv", "quadtree"), _ROBUST),
-    Claim("t5.1-development", "5.1, table 5.1", 'Development: Quadtree "Low", 2D ALTE "Mid"',
+    Claim("t5.1-development", "5.1, table 5.1", "Development: Quadtree Low, 2D ALTE Mid",
           NotMeasurable("the level of development is a judgement of code maturity, not a "
                         "property of a map")),
     Claim("t5.1-recursiveness", "5.1, table 5.1",
-          'Recursiveness: Quadtree "No", 2D ALTE "Yes"',
+          "Recursiveness: Quadtree No, 2D ALTE Yes",
           Property("incremental", ("alte2d",), ("quadtree",)),
           "checked on our implementations (the mappers' incremental attribute)"),
     Claim("t5.1-outliers", "5.1, table 5.1",
-          'Outlier Rejection: Quadtree "High", 2D ALTE "Mid"',
+          "Outlier Rejection: Quadtree High, 2D ALTE Mid",
           _fidelity("lan", "quadtree", "alte2d", "hd_minus_mhd_m"),
           "outlier rejection read as a smaller HD - MHD (thesis 5.2.2) at equal size"),
-    Claim("t5.2-adaptability", "5.1, table 5.2", 'Adaptability: Octomap "Low", 3D ALTE "High"',
+    Claim("t5.2-adaptability", "5.1, table 5.2", "Adaptability: Octomap Low, 3D ALTE High",
           Summary("nav", "alte3d", "size_octaves", "median", "octomap", higher_is_better=True),
           _ADAPT),
-    Claim("t5.2-robustness", "5.1, table 5.2", 'Robustness: Octomap "High", 3D ALTE "Low"',
+    Claim("t5.2-robustness", "5.1, table 5.2", "Robustness: Octomap High, 3D ALTE Low",
           Summary("nav", "octomap", "mhd_m", "cv", "alte3d"), _ROBUST),
-    Claim("t5.2-development", "5.1, table 5.2", 'Development: Octomap "High", 3D ALTE "Low"',
+    Claim("t5.2-development", "5.1, table 5.2", "Development: Octomap High, 3D ALTE Low",
           NotMeasurable("the level of development is a judgement of code maturity, not a "
                         "property of a map")),
     Claim("t5.2-outliers", "5.1, table 5.2",
-          'Outlier Rejection: Octomap "High", 3D ALTE "Mid"',
+          "Outlier Rejection: Octomap High, 3D ALTE Mid",
           _fidelity("nav", "octomap", "alte3d", "hd_minus_mhd_m"),
           "outlier rejection read as a smaller HD - MHD at equal size"),
     Claim("t5.3-obstacles", "5.1, table 5.3",
-          'Obstacle Identification: Quadtree "Mid", 2D ALTE "High"',
+          "Obstacle Identification: Quadtree Mid, 2D ALTE High",
           NotMeasurable("the trade-off table holds whole-map metrics; identifying obstacles "
                         "needs per-obstacle detection against the truth, which it lacks")),
-    Claim("t5.3-outliers", "5.1, table 5.3", 'Outlier rejection: Quadtree "High", 2D ALTE "Mid"',
+    Claim("t5.3-outliers", "5.1, table 5.3", "Outlier rejection: Quadtree High, 2D ALTE Mid",
           _fidelity("lan", "quadtree", "alte2d", "hd_minus_mhd_m"),
           "outlier rejection read as a smaller HD - MHD at equal size"),
-    Claim("t5.3-quality", "5.1, table 5.3", 'Map Quality: Quadtree "Mid", 2D ALTE "High"',
+    Claim("t5.3-quality", "5.1, table 5.3", "Map Quality: Quadtree Mid, 2D ALTE High",
           AllOf((_fidelity("lan", "alte2d", "quadtree", "height_rmse_m"),
                  _fidelity("lan", "alte2d", "quadtree", "completeness", higher=True))),
           "map quality read as the true height RMSE and completeness at equal size"),
-    Claim("t5.4-size", "5.1, table 5.4", 'Map Size: Octomap "High", 3D ALTE "Mid"',
+    Claim("t5.4-size", "5.1, table 5.4", "Map Size: Octomap High, 3D ALTE Mid",
           _size("nav", "alte3d", "octomap"),
           "map size read as basis functions needed for the same MHD"),
     Claim("t5.4-free-space", "5.1, table 5.4",
-          'Free Space Mapping: Octomap "Yes", 3D ALTE "No"',
+          "Free Space Mapping: Octomap Yes, 3D ALTE No",
           NotMeasurable("a design property: Octomap stores observed-free leaves, 3D-ALTE's "
                         "empty leaves mean not occupied, not observed free; whether the free "
                         "leaves are truly free is free_truly_free_share (Octomap only)")),
@@ -104,7 +104,7 @@ _REMARKS: tuple[Claim, ...] = (
           "The lack of adaptability in the mapping process also plays a considerable role as "
           "it highly contributes to the map's size.",
           _size("nav", "alte3d", "octomap"),
-          "read as: Octomap needs more basis functions than 3D-ALTE for the same MHD"),
+          "Octomap needs more basis functions than 3D-ALTE for the same MHD"),
     Claim("5.1.1-octomap-fidelity", "5.1.1 (Octomap)",
           "This algorithm outperforms every other mapping technique in all areas except for "
           "the already mentioned computational burden and adaptability (multiresolution).",
@@ -140,7 +140,7 @@ _REMARKS: tuple[Claim, ...] = (
           "on the algorithm's processing requirements.",
           Summary("nav", "octomap", "free_share", "median", higher_is_better=True,
                   threshold=0.5),
-          "read as: free cells are most (> 50 %) of Octomap's basis functions"),
+          "free cells are most (> 50 %) of Octomap's basis functions"),
 )
 
 _LAN, _NAV = "lan", "nav"
@@ -154,7 +154,7 @@ _RESULTS: tuple[Claim, ...] = (
     Claim("5.2.2-quadtree-optimum", "5.2.2 (Quadtree)",
           "The accuracy of the map increases with the resolution to a certain point.",
           Optimum(_LAN, "quadtree", "max_points", "mhd_m", "low"),
-          "read as: the finest setting (smallest max_points) has a higher MHD than the best "
+          "the finest setting (smallest max_points) has a higher MHD than the best "
           "coarser one"),
     Claim("5.2.2-quadtree-mhd", "5.2.2 (Quadtree)",
           "The MHD is inversely proportional to Max pts per cell, which means the mismatch "
@@ -165,7 +165,7 @@ _RESULTS: tuple[Claim, ...] = (
     Claim("5.2.2-quadtree-hd", "5.2.2 (Quadtree)",
           "The HD metric fails to deliver conclusive results due to the presence of outliers.",
           Agreement(_LAN, "quadtree", "mhd_m", "height_rmse_m", other="hd_m"),
-          "read as: over Quadtree's settings MHD tracks the true height RMSE better than HD"),
+          "over Quadtree's settings MHD tracks the true height RMSE better than HD"),
     Claim("5.2.2-octomap-cost", "5.2.2 (Octomap)",
           "Elapsed time and basis functions are inversely proportional to the size of the "
           "cell.",
@@ -181,7 +181,7 @@ _RESULTS: tuple[Claim, ...] = (
           "It means that the Hausdorff approaches, implemented as proposed in this thesis, "
           "become more unreliable as the number of basis functions increases.",
           Trend(_NAV, "octomap", "basis_functions", "mhd_m", +1, largest_half=True),
-          "read as: over the larger half of Octomap's maps MHD rises with basis functions"),
+          "over the larger half of Octomap's maps MHD rises with basis functions"),
     Claim("5.2.2-alte2d-time", "5.2.2 (2D-ALTE)",
           "Kappa seems to be closely related to the algorithm's execution time but Max Res is "
           "more heavily correlated.",
@@ -193,7 +193,7 @@ _RESULTS: tuple[Claim, ...] = (
     Claim("5.2.2-alte2d-unreliable", "5.2.2 (2D-ALTE)",
           "Again, HD and MHD results are unreliable for higher resolutions.",
           Trend(_LAN, "alte2d", "basis_functions", "mhd_m", +1, largest_half=True),
-          "read as: over the larger half of 2D-ALTE's maps MHD rises with basis functions"),
+          "over the larger half of 2D-ALTE's maps MHD rises with basis functions"),
     Claim("5.2.2-alte3d-drivers", "5.2.2 (3D-ALTE)",
           "MAX RES appears to be the driving factor in both execution time and number of basis "
           "functions. MIN PTS 2 also influences these metrics but to a lesser degree.",
@@ -209,12 +209,12 @@ _RESULTS: tuple[Claim, ...] = (
           "Resolutions of (4) produce an incomplete map due the occupancy criterion added to "
           "refine the mapping process.",
           Trend(_NAV, "alte3d", "max_res", "completeness", +1),
-          "read as: completeness rises with max_res"),
+          "completeness rises with max_res"),
     Claim("5.2.2-alte3d-insensitive", "5.2.2 (3D-ALTE)",
           "This implies that the Hausdorff metrics are not sensitive enough to missing "
           "information.",
           Agreement(_NAV, "alte3d", "mhd_m", "completeness", sign=-1),
-          "read as: over 3D-ALTE's settings MHD does not track (rho <= 0.5) the loss of "
+          "over 3D-ALTE's settings MHD does not track (rho <= 0.5) the loss of "
           "completeness"),
 )
 
@@ -255,7 +255,7 @@ _COMPARISON: tuple[Claim, ...] = (
           "counterparts.",
           AllOf((_fidelity(_LAN, "alte2d", "quadtree"), _size(_LAN, "alte2d", "quadtree"),
                  _fidelity(_NAV, "alte3d", "octomap"), _size(_NAV, "alte3d", "octomap"))),
-          "read as: ahead of the counterpart's curve, lower MHD at equal size and fewer basis "
+          "ahead of the counterpart's curve, lower MHD at equal size and fewer basis "
           "functions at equal MHD, in both cases"),
     Claim("5.2.2-2d-superior", "5.2.2 (Comparison)",
           "The 2D version is clearly superior in terms of efficiency and map accuracy",

@@ -78,7 +78,7 @@ CH6_CLAIMS: tuple[Claim, ...] = (
           "It was found that the Hausdorff Distance is inconsistent in the presence of "
           "outliers, so a modified version was used instead, the Modified Hausdorff Distance.",
           _HD_VS_MHD,
-          "read as: over each mapper's settings MHD tracks the true error (height RMSE in 2D, "
+          "over each mapper's settings MHD tracks the true error (height RMSE in 2D, "
           "mean accuracy in 3D) better than HD"),
     Claim("6-mhd-unreliable", _S,
           "However, the MHD became non-reliable when analyzing maps with a high number of "
@@ -86,7 +86,7 @@ CH6_CLAIMS: tuple[Claim, ...] = (
           AllOf(tuple(Trend(case, mapper, "basis_functions", "mhd_m", +1, largest_half=True)
                       for case, mapper in (("lan", "quadtree"), ("lan", "alte2d"),
                                            ("nav", "octomap"), ("nav", "alte3d")))),
-          "read as: over the larger half of each mapper's maps MHD rises with basis functions"),
+          "over the larger half of each mapper's maps MHD rises with basis functions"),
     Claim("6-quadtree-worse", _S,
           "The numbers show that Quadtree produces less reliable maps that are computationally "
           "heavier and take longer to produce than 2D-ALTE's maps.",
@@ -134,6 +134,6 @@ CH6_CLAIMS: tuple[Claim, ...] = (
           "Overall, the ALTE approaches compare favorably to powerful algorithms like Octomap "
           "and Quadtree, and should be considered for real-time applications.",
           _OVERALL,
-          "read as: ahead of the counterpart's curve, lower MHD at equal size and fewer "
+          "ahead of the counterpart's curve, lower MHD at equal size and fewer "
           "basis functions at equal MHD, in both cases; 'should be considered' is advice"),
 )

@@ -179,7 +179,11 @@ class AllOf:
 @dataclass(frozen=True)
 class Claim:
     """A comparative claim: verbatim ``quote``, thesis ``section``, its ``check`` and
-    ``reading`` (how the words were turned into the check, where that needed a choice)."""
+    ``reading`` (how the words were turned into the check, where that needed a choice).
+
+    Claims from tables 5.1-5.4 quote the two compared cells as "Criterion: Mapper
+    Label, Mapper Label"; every other quote is the thesis' text, verbatim.
+    """
 
     id: str
     section: str
