@@ -9,14 +9,15 @@ and a star at the thesis' chosen setting. Size is on a log axis.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import os
+from collections.abc import Iterator, Sequence
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pandas as pd
 
 from alte.errors import ParameterError
-from alte.studies.measures import NoDataError, thesis_setting
 from alte.studies.tradeoff import (
     MAPPER_NAMES,
     equal_fidelity,
@@ -24,10 +25,14 @@ from alte.studies.tradeoff import (
     fronts,
     interval_table,
     label,
+    matching,
     prepare,
+    thesis_setting,
 )
+from alte.studies.uncertainty import bootstrap_columns
 
-__all__ = ["COLORS", "equal_fidelity_figure", "equal_size_figure", "tradeoff_figure"]
+__all__ = ["COLORS", "equal_fidelity_figure", "equal_size_figure", "save_tradeoff_figures",
+           "tradeoff_figure"]
 
 #: One colour per mapper, the same in every figure.
 COLORS = {"quadtree": "tab:blue", "alte2d": "tab:orange", "octomap": "tab:green",
@@ -72,33 +77,30 @@ def _select(table: pd.DataFrame, mappers: Sequence[str] | None,
 
 def _mean_front(ax: Any, rows: pd.DataFrame, mapper: str, axes: tuple[str, str],
                 higher_is_better: bool) -> None:
+    """The mean front over seeds, read at sizes every seed's maps span, with its band."""
     size, metric = axes
     x = rows[size].to_numpy(float)
     x = x[np.isfinite(x) & (x > 0)]
     if x.size == 0:
         return
-    grid = np.geomspace(x.min(), x.max(), _GRID_POINTS)
-    reads = equal_size(rows, (mapper,), metric, size=size, levels=grid,
+    reads = equal_size(rows, (mapper,), metric, size=size,
+                       levels=np.geomspace(x.min(), x.max(), _GRID_POINTS),
                        higher_is_better=higher_is_better)
-    band = interval_table(reads).sort_values("level")
+    grid = reads.pivot_table(index="seed", columns="level", values="value", dropna=False)
+    grid = grid.loc[:, grid.notna().all(axis=0)]
+    if grid.empty:
+        return
+    mean, low, high = bootstrap_columns(grid.to_numpy())
     color = COLORS.get(mapper)
-    ax.plot(band["level"], band["mean"], color=color, lw=2,
+    ax.plot(grid.columns, mean, color=color, lw=2,
             label=f"{MAPPER_NAMES.get(mapper, mapper)} front")
-    ax.fill_between(band["level"], band["low"], band["high"], color=color, alpha=0.2, lw=0)
+    ax.fill_between(grid.columns, low, high, color=color, alpha=0.2, lw=0)
 
 
 def _thesis_star(ax: Any, rows: pd.DataFrame, mapper: str, axes: tuple[str, str]) -> None:
-    try:
-        setting = thesis_setting(mapper)
-    except NoDataError:
-        return
-    match = np.ones(len(rows), dtype=bool)
-    for key, value in setting.items():
-        column = rows.get(f"p_{key}")
-        match &= (np.isclose(pd.to_numeric(column, errors="coerce"), float(value))
-                  if column is not None else False)
-    if match.any():
-        chosen = rows[match]
+    setting = thesis_setting(mapper)
+    chosen = rows[matching(rows, setting)] if setting else rows.iloc[:0]
+    if not chosen.empty:
         ax.plot(chosen[axes[0]].mean(), chosen[axes[1]].mean(), "*", ms=14, mec="k",
                 color=COLORS.get(mapper), label=f"{MAPPER_NAMES.get(mapper, mapper)}: "
                 "thesis' setting")
@@ -183,3 +185,48 @@ def equal_fidelity_figure(table: pd.DataFrame, mappers: Sequence[str],
     for ax in fig.axes:
         ax.set_yscale("log")
     return fig
+
+
+#: The front page's trade-off figures: name -> (metric, size, higher is better).
+CURVES: dict[str, tuple[str, str, bool]] = {
+    "tradeoff_mhd": ("mhd_m", "basis_functions", False),
+    "tradeoff_accuracy": ("accuracy_mean_m", "basis_functions", False),
+    "tradeoff_completeness": ("completeness", "basis_functions", True),
+    "tradeoff_height_rmse": ("height_rmse_m", "basis_functions", False),
+    "tradeoff_time": ("elapsed_s", "basis_functions", False),
+    "tradeoff_memory": ("mhd_m", "memory_bytes", False),
+}
+#: Pairs compared at equal size / fidelity: figure suffix -> mappers.
+PAIRS = {"2d": ("quadtree", "alte2d"), "3d": ("octomap", "alte3d")}
+
+
+def _figures(table: pd.DataFrame) -> Iterator[tuple[str, Any]]:
+    for name, (metric, size, higher) in CURVES.items():
+        if metric in table and table[metric].notna().any():
+            rows = table[table[metric].notna()]
+            yield name, lambda r=rows, m=metric, s=size, h=higher: tradeoff_figure(
+                r, m, size=s, higher_is_better=h)
+    for suffix, pair in PAIRS.items():
+        yield f"equal_size_{suffix}", lambda p=pair: equal_size_figure(table, p)
+        yield f"equal_fidelity_{suffix}", lambda p=pair: equal_fidelity_figure(table, p)
+
+
+def save_tradeoff_figures(table: pd.DataFrame, out_dir: str | os.PathLike[str]
+                          ) -> dict[str, Path | str]:
+    """Draw and save every trade-off figure the front page shows (names as in
+    :mod:`alte.report.captions`) as ``out_dir/figures/<name>.png``; returns name -> path,
+    or the reason a figure could not be drawn (e.g. a mapper absent from the table)."""
+    import matplotlib.pyplot as plt
+
+    from alte.notebook import save_figure
+
+    out: dict[str, Path | str] = {}
+    for name, draw in _figures(table):
+        try:
+            fig = draw()
+        except ParameterError as err:
+            out[name] = f"not drawn: {err}"
+            continue
+        out[name] = save_figure(fig, out_dir, name)
+        plt.close(fig)
+    return out

@@ -166,6 +166,7 @@ class KeyTable:
     name: str
     title: str
     text: str
+    key: bool = True
 
 
 #: The key tables, in the order the front page shows them.
@@ -182,6 +183,10 @@ KEY_TABLES: tuple[KeyTable, ...] = (
     KeyTable("equal_fidelity", "Size at equal fidelity",
              "The size each mapper needs for the same MHD; mean over seeds with 95 % "
              "bootstrap interval."),
+    KeyTable("ablation", "Ablations: what moves the verdicts",
+             "Each claim's verdict with one thing changed (domain and cell size, set B, the "
+             "occupancy rule, min_pts semantics, counting Octomap's free cells or not).",
+             key=False),
     KeyTable("table_5_7", "Table 5.7: Quadtree sweep", "Our maps beside the thesis' rows."),
     KeyTable("table_5_8", "Table 5.8: Octomap sweep", "Our maps beside the thesis' rows."),
     KeyTable("table_5_9", "Table 5.9: 2D-ALTE sweep", "Our maps beside the thesis' rows."),

@@ -217,7 +217,7 @@ def run_page(record: Mapping[str, Any], run_dir: str | Path,
         page.sections.append(RunSection(**{**section.__dict__, "figures": [
             f for f in section.figures if not _is_tradeoff(f)]}))
     by_name = {t.stem: t for t in tables}
-    page.key_tables = [_table(by_name[k.name], run_dir, k.title, k.text, key=True)
+    page.key_tables = [_table(by_name[k.name], run_dir, k.title, k.text, key=k.key)
                        for k in KEY_TABLES if k.name in by_name]
     keyed = {k.name for k in KEY_TABLES} | {Path(CLAIMS_CSV).stem}
     page.tables = [_table(t, run_dir, t.name, "", key=False) for t in tables

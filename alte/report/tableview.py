@@ -22,7 +22,8 @@ from alte.studies.tradeoff import MAPPER_NAMES, METRICS
 __all__ = ["TableView", "cell_text", "header", "table_view"]
 
 #: Columns that identify a row (shown first, in this order, when present).
-IDENTITY = ("terrain", "mapper", "params", "level", "thesis_params", "rule_on_thesis")
+IDENTITY = ("case", "terrain", "metric", "mapper", "params", "level", "thesis_params",
+            "rule_on_thesis")
 _PARAMETERS = tuple(dict.fromkeys(k for spec in SWEEPS.values() for p, *_ in spec["rows"]
                                   for k in p))
 _UNITS = {"_m": "m", "_s": "s", "_bytes": "B"}
@@ -58,8 +59,9 @@ def cell_text(value: Any, column: str = "") -> str:
     """One value as text: mapper names spelled out, numbers to 4 significant digits."""
     if value is None or (isinstance(value, float) and math.isnan(value)):
         return "\u2013"  # an en dash
-    if column == "mapper" and value in MAPPER_NAMES:
-        return MAPPER_NAMES[value]
+    names = {"mapper": MAPPER_NAMES, "metric": {m: header(m) for m in METRICS}}.get(column, {})
+    if isinstance(value, str) and value in names:
+        return names[value]
     if isinstance(value, bool):
         return "yes" if value else "no"
     if isinstance(value, int) or (isinstance(value, float) and value.is_integer()

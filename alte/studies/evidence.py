@@ -16,7 +16,7 @@ Claims no map metric decides are ``not measurable``; checks the table cannot fee
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, fields, is_dataclass, replace
 from typing import Any
 
@@ -29,7 +29,7 @@ from alte.studies.tradeoff import MAPPER_NAMES, METRICS, prepare
 from alte.studies.uncertainty import CONFIDENCE, bootstrap_ci
 
 __all__ = ["CELL_COLUMNS", "CLAIM_COLUMNS", "VERDICTS", "EvidenceOptions", "Finding",
-           "ablation_table", "cells_table", "claims_table", "evaluate", "evaluate_all"]
+           "cells_table", "claims_table", "evaluate", "evaluate_all"]
 
 #: Every verdict a claim can get.
 VERDICTS = ("holds", "does not hold", "depends", "not measurable", "no data")
@@ -276,24 +276,3 @@ def cells_table(findings: Sequence[Finding]) -> pd.DataFrame:
     frames = [f.cells for f in findings if not f.cells.empty]
     return (pd.concat(frames, ignore_index=True) if frames
             else pd.DataFrame(columns=CELL_COLUMNS))
-
-
-def ablation_table(claims: Sequence[Claim],
-                   variants: Mapping[str, tuple[pd.DataFrame, EvidenceOptions]]
-                   ) -> pd.DataFrame:
-    """One row per claim, one verdict column per variant (a table and its options, e.g.
-    another domain or occupancy rule, or ``size="occupied_cells"``), and ``moves``: the
-    variants whose verdict differs from the first one's."""
-    verdicts = {name: evaluate_all(claims, table, options)
-                for name, (table, options) in variants.items()}
-    rows = []
-    for i, claim in enumerate(claims):
-        row: dict[str, Any] = {"id": claim.id, "section": claim.section, "claim": claim.quote}
-        for name, found in verdicts.items():
-            f = found[i]
-            row[name] = f.verdict + (f" ({f.depends_on})" if f.depends_on else "")
-        first = next(iter(verdicts.values()))[i].verdict if verdicts else ""
-        row["moves"] = ", ".join(n for n, found in verdicts.items()
-                                 if found[i].verdict != first)
-        rows.append(row)
-    return pd.DataFrame(rows)

@@ -30,10 +30,18 @@ from alte.studies.claims.types import (
     Trend,
 )
 from alte.studies.tables import THESIS_CRITERIA, best_row
-from alte.studies.thesis import COMPARISONS, SWEEPS, TERRAIN_CASE
-from alte.studies.tradeoff import MAPPER_NAMES, METRICS, equal_fidelity, equal_size, label
+from alte.studies.thesis import TERRAIN_CASE
+from alte.studies.tradeoff import (
+    MAPPER_NAMES,
+    METRICS,
+    equal_fidelity,
+    equal_size,
+    label,
+    matching,
+    thesis_setting,
+)
 
-__all__ = ["STAT_COLUMNS", "Measured", "NoDataError", "measure", "thesis_setting"]
+__all__ = ["STAT_COLUMNS", "Measured", "NoDataError", "measure"]
 
 #: Columns of :attr:`Measured.stats`.
 STAT_COLUMNS = ["terrain", "level", "seed", "value"]
@@ -87,25 +95,6 @@ def _case_rows(table: pd.DataFrame, case: str, mappers: Sequence[str],
     return rows
 
 
-def thesis_setting(mapper: str) -> dict[str, Any]:
-    """The parameters of ``mapper``'s map chosen by the thesis (tables 5.10-5.11)."""
-    for chosen in COMPARISONS.values():
-        if mapper in chosen:
-            number, row = chosen[mapper]
-            return dict(SWEEPS[number]["rows"][row][0])
-    raise NoDataError(f"the thesis chose no {mapper} map")
-
-
-def _matching(rows: pd.DataFrame, setting: dict[str, Any]) -> pd.Series:
-    match = pd.Series(True, index=rows.index)
-    for key, value in setting.items():
-        column = f"p_{key}"
-        if column not in rows:
-            return pd.Series(False, index=rows.index)
-        match &= np.isclose(pd.to_numeric(rows[column], errors="coerce"), float(value))
-    return match
-
-
 def _point_values(rows: pd.DataFrame, c: Compare) -> pd.DataFrame:
     """(terrain, level, seed, mapper, value) at the thesis' settings or the rule's pick."""
     out = []
@@ -113,7 +102,9 @@ def _point_values(rows: pd.DataFrame, c: Compare) -> pd.DataFrame:
         mine = rows[rows["mapper"] == mapper]
         if c.at == "thesis_point":
             setting = thesis_setting(mapper)
-            mine = mine[_matching(mine, setting)]
+            if setting is None:
+                raise NoDataError(f"the thesis chose no {mapper} map")
+            mine = mine[matching(mine, setting)]
             if mine.empty:
                 text = ", ".join(f"{k}={v}" for k, v in setting.items())
                 raise NoDataError(f"the table lacks the thesis' setting {mapper} {text}")
@@ -166,14 +157,10 @@ def _compare(c: Compare, table: pd.DataFrame) -> Measured:
                           "size range")
     ratio = c.metric in _RATIO_METRICS
     b, o = wide["value_b"].to_numpy(float), wide["value_o"].to_numpy(float)
+    sign = 1.0 if c.relation == "similar" or c.higher_is_better else -1.0
     with np.errstate(divide="ignore", invalid="ignore"):
-        if c.relation == "similar":
-            value = np.log(b / o) if ratio else b - o
-        elif ratio:
-            value = np.log(b / o) if c.higher_is_better else np.log(o / b)
-        else:
-            value = b - o if c.higher_is_better else o - b
-    stats = wide[["terrain", "level", "seed"]].assign(value=value)
+        value = sign * (np.log(b / o) if ratio else b - o)
+    stats = wide[keys].assign(value=value)
     what, level = _compare_what(c, ratio)
     band = float(np.log1p(c.tolerance)) if ratio else c.tolerance
     kind = {"equal_size": "size", "equal_fidelity": "fidelity"}.get(c.at, "")

@@ -24,11 +24,12 @@ import numpy as np
 import pandas as pd
 
 from alte.errors import ParameterError
+from alte.studies.thesis import COMPARISONS, SWEEPS
 from alte.studies.uncertainty import CONFIDENCE, bootstrap_ci
 
 __all__ = ["MAPPER_NAMES", "METRICS", "OPTIONAL_COLUMNS", "REQUIRED_COLUMNS", "equal_fidelity",
-           "equal_size", "fronts", "interval_table", "label", "pareto_front", "parse_params",
-           "prepare", "read_at_size", "size_for_fidelity"]
+           "equal_size", "fronts", "interval_table", "label", "matching", "pareto_front",
+           "parse_params", "prepare", "read_at_size", "size_for_fidelity", "thesis_setting"]
 
 #: Columns every trade-off table must have.
 REQUIRED_COLUMNS = ("terrain", "mapper", "params", "seed", "basis_functions", "occupied_cells",
@@ -95,6 +96,26 @@ def prepare(table: pd.DataFrame) -> pd.DataFrame:
     basis = out["basis_functions"].astype(float)
     out["free_share"] = 1.0 - out["occupied_cells"].astype(float) / basis.where(basis > 0)
     return out
+
+
+def thesis_setting(mapper: str) -> dict[str, Any] | None:
+    """The parameters of ``mapper``'s map the thesis chose (tables 5.10-5.11), if any."""
+    for chosen in COMPARISONS.values():
+        if mapper in chosen:
+            number, row = chosen[mapper]
+            return dict(SWEEPS[number]["rows"][row][0])
+    return None
+
+
+def matching(rows: pd.DataFrame, setting: dict[str, Any]) -> pd.Series:
+    """Which ``rows`` (with ``p_*`` columns) have every parameter of ``setting``."""
+    match = pd.Series(True, index=rows.index)
+    for key, value in setting.items():
+        column = f"p_{key}"
+        if column not in rows:
+            return pd.Series(False, index=rows.index)
+        match &= np.isclose(pd.to_numeric(rows[column], errors="coerce"), float(value))
+    return match
 
 
 def pareto_front(x: np.ndarray, y: np.ndarray) -> np.ndarray:

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.stats import bootstrap
 
-__all__ = ["CONFIDENCE", "Interval", "bootstrap_ci"]
+__all__ = ["CONFIDENCE", "Interval", "bootstrap_ci", "bootstrap_columns"]
 
 #: Confidence level of every interval in the report.
 CONFIDENCE = 0.95
@@ -49,3 +49,19 @@ def bootstrap_ci(values: np.ndarray | list[float], level: float = CONFIDENCE,
                        method="percentile", rng=np.random.default_rng(seed))
     ci = result.confidence_interval
     return Interval(mean, float(ci.low), float(ci.high), int(data.size), level)
+
+
+def bootstrap_columns(values: np.ndarray, level: float = CONFIDENCE, n_resamples: int = 2000,
+                      seed: int = 0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Mean and percentile-bootstrap interval of every column of ``values`` (seeds x
+    quantities, all finite) in one resampling: the seeds are resampled together, as for
+    a curve read at many sizes."""
+    data = np.asarray(values, dtype=np.float64)
+    mean = data.mean(axis=0)
+    if data.shape[0] < 2:
+        return mean, mean.copy(), mean.copy()
+    result = bootstrap((data,), np.mean, n_resamples=n_resamples, confidence_level=level,
+                       method="percentile", axis=0, rng=np.random.default_rng(seed))
+    ci = result.confidence_interval
+    flat = np.ptp(data, axis=0) == 0  # identical seeds: no spread, no interval
+    return mean, np.where(flat, mean, ci.low), np.where(flat, mean, ci.high)

@@ -16,6 +16,7 @@ from alte.plot.tradeoff import (
     COLORS,
     equal_fidelity_figure,
     equal_size_figure,
+    save_tradeoff_figures,
     tradeoff_figure,
 )
 
@@ -78,3 +79,19 @@ def test_equal_fidelity_figure_uses_a_log_size_axis(table):
     plt.close(fig)
     with pytest.raises(ParameterError, match="no terrain has every mapper"):
         equal_fidelity_figure(table, ("octomap", "quadtree"))
+
+
+@pytest.mark.slow
+def test_save_tradeoff_figures_writes_every_captioned_figure(tmp_path):
+    from alte.report.captions import FIGURES
+
+    small = synthetic_tradeoff({"alte2d": Curve(scale=0.5)}, seeds=(0, 1), terrains={
+        m: ("sim_lan_1",) for m in ("quadtree", "alte2d")} | {"octomap": ("sim_nav_1",)})
+    out = save_tradeoff_figures(small.query("mapper != 'alte3d'"), tmp_path)
+    drawn = {k for k, v in out.items() if not isinstance(v, str)}
+    assert drawn == {"tradeoff_mhd", "tradeoff_accuracy", "tradeoff_completeness",
+                     "tradeoff_height_rmse", "tradeoff_time", "tradeoff_memory",
+                     "equal_size_2d", "equal_fidelity_2d"}
+    assert out["equal_size_3d"].startswith("not drawn: no terrain has every mapper")
+    assert all((tmp_path / "figures" / f"{k}.png").stat().st_size > 1000 for k in drawn)
+    assert set(out) <= set(FIGURES["ch5_analysis"])

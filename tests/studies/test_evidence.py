@@ -13,13 +13,11 @@ from alte.studies.claims import (
     Compare,
     NotMeasurable,
     Property,
-    claim,
 )
 from alte.studies.evidence import (
     CELL_COLUMNS,
     VERDICTS,
     EvidenceOptions,
-    ablation_table,
     cells_table,
     claims_table,
     evaluate,
@@ -153,20 +151,6 @@ def test_the_whole_catalogue_gets_verdicts_and_a_table_with_the_report_schema():
     assert (out.loc[out["verdict"] == "depends", "depends_on"] != "").all()
     cells = cells_table(findings)
     assert list(cells.columns) == CELL_COLUMNS and set(cells["id"]) < set(out["id"])
-
-
-def test_ablation_shows_what_moves_when_free_space_is_not_counted():
-    # 3D-ALTE a bit better: Octomap needs ~2x the basis functions for the same MHD, but
-    # 70 % of Octomap's basis functions are free cells
-    table = synthetic_tradeoff({"alte3d": Curve(scale=0.8)})
-    size = claim("t5.4-size")
-    out = ablation_table([size, claim("5.2.2-3d-mhd")], {
-        "basis functions": (table, EvidenceOptions()),
-        "occupied cells": (table, EvidenceOptions(size="occupied_cells"))})
-    row = out.set_index("id").loc["t5.4-size"]
-    assert row["basis functions"] == "holds" and row["occupied cells"] == "does not hold"
-    assert row["moves"] == "occupied cells"
-    assert out.set_index("id").at["5.2.2-3d-mhd", "moves"] == ""
 
 
 @pytest.mark.parametrize("level", [0.5, 0.99])

@@ -19,8 +19,8 @@ from alte.studies.claims import (
     Summary,
     Trend,
 )
-from alte.studies.measures import NoDataError, measure, thesis_setting
-from alte.studies.tradeoff import prepare
+from alte.studies.measures import NoDataError, measure
+from alte.studies.tradeoff import prepare, thesis_setting
 
 
 def _table(mapper: str, xs: list[float], metric: dict[str, list[float]], *, param: str = "x",
@@ -104,6 +104,7 @@ def test_summary_medians_and_coefficients_of_variation():
 def test_compare_at_the_thesis_point_needs_the_thesis_setting():
     assert thesis_setting("quadtree") == {"max_points": 150}
     assert thesis_setting("alte3d") == {"min_pts": 5, "min_pts_split": 10, "max_res": 5}
+    assert thesis_setting("nope") is None
     table = prepare(synthetic_tradeoff())
     m = measure(Compare("lan", "alte2d", "quadtree", "basis_functions", "thesis_point"), table)
     assert m.ratio and m.unit == "x" and len(m.stats) == 2 * 3
