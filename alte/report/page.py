@@ -11,6 +11,7 @@ labelled scalars, tables through :mod:`alte.report.tableview`.
 from __future__ import annotations
 
 import json
+import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -200,7 +201,7 @@ def _counts(claims: Sequence[ClaimRow]) -> list[tuple[str, int, str]]:
     return [(v, n, _VERDICT_CSS.get(v, "untested")) for v, n in counts.items() if n]
 
 
-def run_page(record: Mapping[str, Any], run_dir: str | Path,
+def run_page(record: Mapping[str, Any], run_dir: str | os.PathLike[str],
              tables: Sequence[Path]) -> RunPage:
     """The page model of the run in ``run_dir`` (its record, files and ``tables``)."""
     run_dir = Path(run_dir)

@@ -17,7 +17,7 @@ Claims no map metric decides are ``not measurable``; checks the table cannot fee
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, fields, is_dataclass, replace
+from dataclasses import dataclass, fields, replace
 from typing import Any
 
 import numpy as np
@@ -137,12 +137,14 @@ def _check_text(m: Measured, cells: pd.DataFrame) -> str:
     seeds = int(cells["seeds"].max())
     unit = f" {m.unit}" if m.unit and not m.ratio else ""
     parts = []
-    for row in cells.itertuples():
-        span = (f" [{_number(row.low, m.ratio)}, {_number(row.high, m.ratio)}]"
-                if row.seeds > 1 else " (one seed, no interval)")
-        fewer = f" ({row.seeds} seeds)" if 1 < row.seeds < seeds else ""
-        parts.append(f"{row.terrain}{_level_text(row.level, m.level_name)}: "
-                     f"{_number(row.estimate, m.ratio)}{span}{unit}{fewer}")
+    columns = ("terrain", "level", "seeds", "estimate", "low", "high")
+    for terrain, level, n, est, low, high in zip(*(cells[c].tolist() for c in columns),
+                                                 strict=True):
+        span = (f" [{_number(low, m.ratio)}, {_number(high, m.ratio)}]"
+                if n > 1 else " (one seed, no interval)")
+        fewer = f" ({n} seeds)" if 1 < n < seeds else ""
+        parts.append(f"{terrain}{_level_text(level, m.level_name)}: "
+                     f"{_number(est, m.ratio)}{span}{unit}{fewer}")
     return (f"{m.what} ({seeds} seed{'s' if seeds != 1 else ''}; supports the claim where "
             f"{_criterion(m)}): " + "; ".join(parts))
 
@@ -209,13 +211,15 @@ def _combine(parts: Sequence[Any], results: Sequence[tuple[str, str, str, pd.Dat
     return _DEPENDS, ", ".join(dict.fromkeys(dims)) or "uncertainty"
 
 
-def _resized(check: Any, size: str | None) -> Any:
-    if size is None or not is_dataclass(check):
+def _resized(check: Check | AllOf, size: str | None) -> Check | AllOf:
+    """``check`` with every ``basis_functions`` column replaced by ``size``."""
+    if size is None:
         return check
     if isinstance(check, AllOf):
-        return AllOf(tuple(_resized(p, size) for p in check.parts))
-    return replace(check, **{f.name: size for f in fields(check)  # type: ignore[arg-type]
-                             if getattr(check, f.name) == "basis_functions"})
+        return AllOf(tuple(_resized(p, size) for p in check.parts))  # type: ignore[misc]
+    changes: dict[str, Any] = {f.name: size for f in fields(check)
+                               if getattr(check, f.name) == "basis_functions"}
+    return replace(check, **changes)
 
 
 Result = tuple[str, str, str, pd.DataFrame]

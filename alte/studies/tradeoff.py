@@ -31,6 +31,8 @@ __all__ = ["MAPPER_NAMES", "METRICS", "OPTIONAL_COLUMNS", "REQUIRED_COLUMNS", "e
            "equal_size", "fronts", "interval_table", "label", "matching", "pareto_front",
            "parse_params", "prepare", "read_at_size", "size_for_fidelity", "thesis_setting"]
 
+#: Sizes or fidelities to read fronts at.
+Levels = Sequence[float] | np.ndarray
 #: Columns every trade-off table must have.
 REQUIRED_COLUMNS = ("terrain", "mapper", "params", "seed", "basis_functions", "occupied_cells",
                     "memory_bytes", "elapsed_s", "mhd_m", "hd_m", "accuracy_mean_m",
@@ -135,7 +137,7 @@ def pareto_front(x: np.ndarray, y: np.ndarray) -> np.ndarray:
     return order[keep]
 
 
-def read_at_size(xs: np.ndarray, ys: np.ndarray, levels: Sequence[float],
+def read_at_size(xs: np.ndarray, ys: np.ndarray, levels: Levels,
                  x_max: float | None = None) -> np.ndarray:
     """The front's error at each size in ``levels``: linear in log10 size between front
     points, flat from the last front point up to ``x_max`` (the largest map made: a
@@ -144,11 +146,11 @@ def read_at_size(xs: np.ndarray, ys: np.ndarray, levels: Sequence[float],
         return np.full(len(levels), np.nan)
     if x_max is not None and x_max > xs[-1]:
         xs, ys = np.append(xs, x_max), np.append(ys, ys[-1])
-    return np.interp(np.log10(np.asarray(levels, dtype=np.float64)), np.log10(xs), ys,
-                     left=np.nan, right=np.nan)
+    return np.asarray(np.interp(np.log10(np.asarray(levels, dtype=np.float64)), np.log10(xs),
+                                ys, left=np.nan, right=np.nan), dtype=np.float64)
 
 
-def size_for_fidelity(xs: np.ndarray, ys: np.ndarray, levels: Sequence[float]) -> np.ndarray:
+def size_for_fidelity(xs: np.ndarray, ys: np.ndarray, levels: Levels) -> np.ndarray:
     """The size the front needs to reach each error in ``levels`` (linear in log10 size
     between front points); NaN outside the front's error range (a level its smallest map
     already beats is censored: a smaller map might too)."""
@@ -156,7 +158,7 @@ def size_for_fidelity(xs: np.ndarray, ys: np.ndarray, levels: Sequence[float]) -
         return np.full(len(levels), np.nan)
     logs = np.interp(np.asarray(levels, dtype=np.float64), ys[::-1], np.log10(xs)[::-1],
                      left=np.nan, right=np.nan)
-    return np.power(10.0, logs)
+    return np.asarray(np.power(10.0, logs), dtype=np.float64)
 
 
 def fronts(table: pd.DataFrame, size: str = "basis_functions", metric: str = "mhd_m",
@@ -216,7 +218,7 @@ def _span(curves: Sequence[Curve], by_size: bool) -> tuple[float, float]:
 
 
 def _front_reads(table: pd.DataFrame, mappers: Sequence[str], axes: tuple[str, str], *,
-                 sign: float, levels: Sequence[float] | None, by_size: bool) -> pd.DataFrame:
+                 sign: float, levels: Levels | None, by_size: bool) -> pd.DataFrame:
     rows = []
     for terrain, part in table[table["mapper"].isin(mappers)].groupby("terrain", sort=True):
         curves = _curves(part, *axes, sign)
@@ -237,7 +239,7 @@ def _front_reads(table: pd.DataFrame, mappers: Sequence[str], axes: tuple[str, s
 
 
 def equal_size(table: pd.DataFrame, mappers: Sequence[str], metric: str = "mhd_m", *,
-               size: str = "basis_functions", levels: Sequence[float] | None = None,
+               size: str = "basis_functions", levels: Levels | None = None,
                higher_is_better: bool = False) -> pd.DataFrame:
     """``metric`` read off each mapper's front at equal ``size`` levels, per terrain and seed.
 
@@ -250,7 +252,7 @@ def equal_size(table: pd.DataFrame, mappers: Sequence[str], metric: str = "mhd_m
 
 def equal_fidelity(table: pd.DataFrame, mappers: Sequence[str],
                    metric: str = "basis_functions", *, fidelity: str = "mhd_m",
-                   levels: Sequence[float] | None = None,
+                   levels: Levels | None = None,
                    higher_is_better: bool = False) -> pd.DataFrame:
     """The ``metric`` (a size or the time) each mapper needs to reach ``fidelity`` levels,
     read off its (metric, fidelity) front; same columns as :func:`equal_size`."""
