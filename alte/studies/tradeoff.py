@@ -84,7 +84,11 @@ def parse_params(text: Any) -> dict[str, Any]:
 
 def prepare(table: pd.DataFrame) -> pd.DataFrame:
     """Check the trade-off schema; add ``p_*`` parameter columns (parsed from ``params``
-    when absent), ``hd_minus_mhd_m`` and ``free_share`` (1 - occupied/basis functions)."""
+    when absent), ``hd_minus_mhd_m`` and ``free_share`` (1 - occupied/basis functions).
+    Rows of ``alte sweep`` (:func:`alte.studies.sweep.load_results`) name the setting
+    ``params_json``; it serves as ``params``."""
+    if "params" not in table.columns and "params_json" in table.columns:  # `alte sweep` rows
+        table = table.assign(params=table["params_json"])
     missing = [c for c in REQUIRED_COLUMNS if c not in table.columns]
     if missing:
         raise ParameterError(f"trade-off table lacks column(s) {', '.join(missing)}; it needs "

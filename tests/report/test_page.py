@@ -27,3 +27,11 @@ def test_run_page_model(tmp_path: Path) -> None:
     assert set(others) == {"extra.csv", "tradeoff.csv"}
     assert others["tradeoff.csv"].view is None and "rows" in others["tradeoff.csv"].caption
     assert others["extra.csv"].view is not None
+
+
+def test_an_unreadable_table_is_named_not_fatal(tmp_path: Path) -> None:
+    record = make_front_run(tmp_path)
+    (tmp_path / "tables" / "broken.csv").write_text("")
+    page = run_page(record, tmp_path, sorted((tmp_path / "tables").glob("*.csv")))
+    broken = next(t for t in page.tables if t.title == "broken.csv")
+    assert broken.view is None and broken.caption.startswith("unreadable: ")

@@ -66,6 +66,8 @@ def test_prepare_checks_the_schema_and_derives_columns():
     with pytest.raises(ParameterError, match=r"lacks column.*mhd_m, hd_m; it needs terrain"):
         prepare(table.drop(columns=["mhd_m", "hd_m"]))
     assert len(REQUIRED_COLUMNS) == 12
+    swept = prepare(table.rename(columns={"params": "params_json"}))
+    assert swept["params"].equals(swept["params_json"])
 
 
 def test_fronts_flag_each_seeds_front():
