@@ -31,10 +31,8 @@ def new_plotter(shape: tuple[int, int] = (1, 1), window_size: tuple[int, int] = 
 
 
 def _png(plotter: Any) -> bytes:
-    from PIL import Image
-
     buffer = io.BytesIO()
-    Image.fromarray(plotter.screenshot(None, return_img=True)).save(buffer, format="png")
+    plotter.screenshot(buffer, return_img=False)  # pyvista writes a PNG into a BytesIO
     return buffer.getvalue()
 
 
