@@ -2,8 +2,8 @@
 
 Headless (papermill, nbval, CI) a plotter renders off-screen to a PNG that is
 displayed inline; in JupyterLab (:func:`alte.notebook.interactive`) it is a live
-trame view, displayed with the same PNG beside it so that a notebook saved
-without widget state (JupyterLab's default), and its HTML, still show the figure.
+trame view, displayed with the same PNG beside it so that the HTML of a notebook
+saved without widget state (JupyterLab's default) still shows the figure.
 Notebooks never choose: they call :func:`new_plotter` and :func:`show`.
 """
 
