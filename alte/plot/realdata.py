@@ -69,10 +69,10 @@ def save_figure(fig: Figure | None, out_dir: str | os.PathLike[str], name: str) 
 
 
 def show_maps(runs: Sequence[Measured], out_dir: str | os.PathLike[str] | None = None,
-              name: str | None = None, title: str = "") -> Path | None:
+              name: str | None = None, title: str = "") -> None:
     """Occupied cells of each map side by side (linked cameras); nothing for no runs."""
     if not runs:
-        return None
+        return
     from alte.plot.maps import add_cells_3d
     from alte.plot.render import new_plotter, show
 
@@ -84,4 +84,4 @@ def show_maps(runs: Sequence[Measured], out_dir: str | os.PathLike[str] | None =
         plotter.add_text(f"{title} {run.name}: {run.metrics.occupied_cells} occupied",
                          font_size=9)
     plotter.link_views()
-    return show(plotter, out_dir, name)
+    show(plotter, out_dir, name)
