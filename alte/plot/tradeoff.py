@@ -31,8 +31,8 @@ from alte.studies.tradeoff import (
 )
 from alte.studies.uncertainty import bootstrap_columns
 
-__all__ = ["COLORS", "equal_fidelity_figure", "equal_size_figure", "save_tradeoff_figures",
-           "tradeoff_figure"]
+__all__ = ["COLORS", "ablation_figure", "equal_fidelity_figure", "equal_size_figure",
+           "save_ablation_figures", "save_tradeoff_figures", "tradeoff_figure"]
 
 #: One colour per mapper, the same in every figure.
 COLORS = {"quadtree": "tab:blue", "alte2d": "tab:orange", "octomap": "tab:green",
@@ -211,22 +211,83 @@ def _figures(table: pd.DataFrame) -> Iterator[tuple[str, Any]]:
         yield f"equal_fidelity_{suffix}", lambda p=pair: equal_fidelity_figure(table, p)
 
 
-def save_tradeoff_figures(table: pd.DataFrame, out_dir: str | os.PathLike[str]
-                          ) -> dict[str, Path | str]:
-    """Draw and save every trade-off figure the front page shows (names as in
-    :mod:`alte.report.captions`) as ``out_dir/figures/<name>.png``; returns name -> path,
-    or the reason a figure could not be drawn (e.g. a mapper absent from the table)."""
+def _panel(ax: Any, rows: pd.DataFrame, mappers: Sequence[str], axes: tuple[str, str],
+           title: str) -> None:
+    size, metric = axes
+    for mapper in mappers:
+        mine = rows[rows["mapper"] == mapper]
+        if mine.empty:
+            continue
+        dots = fronts(mine, size, metric)
+        ax.scatter(dots["x"], dots["y"], s=8, alpha=0.25, color=COLORS.get(mapper), lw=0)
+        _mean_front(ax, mine, mapper, (size, metric), False)
+    ax.set_xscale("log")
+    ax.set(title=title, xlabel=label(size), ylabel=label(metric))
+    ax.grid(alpha=0.3, which="both")
+
+
+def ablation_figure(variants: pd.DataFrame, mappers: Sequence[str], terrain: str,
+                    metric: str = "mhd_m") -> Any:
+    """``metric`` against basis functions of ``mappers`` on ``terrain``, one panel per
+    ablation variant (rows of :func:`alte.studies.grid.Grid.variants`, column
+    ``variant``), plus the base grid with size counted as occupied cells."""
+    rows = prepare(variants[variants["terrain"] == terrain])
+    rows = rows[rows["mapper"].isin(mappers) & rows[metric].notna()]
+    names = list(dict.fromkeys(rows["variant"]))
+    if rows.empty or len(names) < 2:
+        raise ParameterError(f"no ablation variants of {list(mappers)} on {terrain}")
+    fig, axes = _panels(len(names) + 1, 3.6, 3.0)
+    for ax, name in zip(axes, names, strict=False):
+        _panel(ax, rows[rows["variant"] == name], mappers, ("basis_functions", metric), name)
+    _panel(axes[len(names)], rows[rows["variant"] == names[0]], mappers,
+           ("occupied_cells", metric), f"{names[0]}, size = occupied cells")
+    _legend(fig)
+    fig.suptitle(f"{terrain}: {label(metric)} against map size with one thing changed")
+    return fig
+
+
+def _save_all(figures: Iterator[tuple[str, Any]], out_dir: str | os.PathLike[str],
+              close: bool) -> dict[str, Path | str]:
     import matplotlib.pyplot as plt
 
     from alte.notebook import save_figure
 
     out: dict[str, Path | str] = {}
-    for name, draw in _figures(table):
+    for name, draw in figures:
         try:
             fig = draw()
         except ParameterError as err:
             out[name] = f"not drawn: {err}"
             continue
         out[name] = save_figure(fig, out_dir, name)
-        plt.close(fig)
+        if close:
+            plt.close(fig)
     return out
+
+
+def save_tradeoff_figures(table: pd.DataFrame, out_dir: str | os.PathLike[str], *,
+                          close: bool = True) -> dict[str, Path | str]:
+    """Draw and save every trade-off figure the front page shows (names as in
+    :mod:`alte.report.captions`) as ``out_dir/figures/<name>.png``; returns name -> path,
+    or the reason a figure could not be drawn (e.g. a mapper absent from the table).
+    ``close=False`` leaves the figures open (a notebook then shows them)."""
+    return _save_all(_figures(table), out_dir, close)
+
+
+def save_ablation_figures(variants: pd.DataFrame, out_dir: str | os.PathLike[str], *,
+                          close: bool = True) -> dict[str, Path | str]:
+    """:func:`ablation_figure` for each pair of mappers on the first ablated terrain of
+    its case, saved as ``tradeoff_ablation_2d``/``_3d`` (see :func:`save_tradeoff_figures`)."""
+    from alte.studies.thesis import TERRAIN_CASE
+
+    changed = variants[variants["variant"] != variants["variant"].iloc[0]] \
+        if len(variants) else variants
+    places = sorted(set(changed["terrain"]))
+    cases = {"2d": "lan", "3d": "nav"}
+
+    def figures() -> Iterator[tuple[str, Any]]:
+        for suffix, pair in PAIRS.items():
+            where = [t for t in places if TERRAIN_CASE.get(t) == cases[suffix]]
+            yield f"tradeoff_ablation_{suffix}", lambda p=pair, w=where: ablation_figure(
+                variants, p, w[0] if w else "(no terrain)")
+    return _save_all(figures(), out_dir, close)

@@ -113,6 +113,19 @@ FIGURES: dict[str, dict[str, Caption]] = {
         "tradeoff_time": Caption("Mapping time against map size",
                                  "Time spent in the mapper calls only. " + _FRONT),
         "tradeoff_memory": Caption("MHD against memory", _FRONT),
+        "tradeoff_ablation_2d": Caption(
+            "2D maps with one thing changed",
+            "MHD against basis functions of Quadtree and 2D-ALTE on a landing terrain, one "
+            "panel per ablation (base: the grid as specified; domain_data: root cell over "
+            "the data; set_b_centers / set_b_occupied: another set B; occupancy_max: "
+            "Quadtree's occupancy rule; min_pts_per_leaf: 3D-ALTE only), and the base grid "
+            "against occupied cells. Fronts averaged over seeds with 95 % bootstrap bands."),
+        "tradeoff_ablation_3d": Caption(
+            "3D maps with one thing changed",
+            "MHD against basis functions of Octomap and 3D-ALTE on a navigation terrain, one "
+            "panel per ablation (see the 2D figure), and the base grid against occupied "
+            "cells: Octomap's free leaves and 3D-ALTE's empty ones not counted. Fronts "
+            "averaged over seeds with 95 % bootstrap bands."),
         "equal_size_2d": Caption("2D maps at equal size",
                                  "MHD each 2D mapper reaches at the same number of basis "
                                  "functions, read off its front; mean over seeds with 95 % "

@@ -31,6 +31,7 @@ from alte.studies.thesis import CASE_MAPPERS, TERRAIN_CASE
 from alte.studies.tradeoff import equal_fidelity, equal_size, interval_table, prepare
 
 __all__ = ["EQUAL_FIDELITY", "EQUAL_SIZE", "SIZES", "EvidenceFiles", "ablation_table",
+           "ablation_verdicts",
            "comparison_tables", "write_evidence"]
 
 #: Sizes (basis functions) fidelity is compared at.
@@ -116,8 +117,14 @@ def ablation_table(claims: Sequence[Claim],
     """One row per claim, one verdict column per variant (a table and its options, e.g.
     another domain or occupancy rule, or ``size="occupied_cells"``), and ``moves``: the
     variants whose verdict differs from the first one's."""
-    verdicts = {name: evaluate_all(claims, table, options)
-                for name, (table, options) in variants.items()}
+    return ablation_verdicts(claims, {name: evaluate_all(claims, table, options)
+                                      for name, (table, options) in variants.items()})
+
+
+def ablation_verdicts(claims: Sequence[Claim],
+                      verdicts: Mapping[str, Sequence[Finding]]) -> pd.DataFrame:
+    """:func:`ablation_table` from findings already evaluated (variant -> one finding per
+    claim, in the order of ``claims``)."""
     rows = []
     for i, claim in enumerate(claims):
         row: dict[str, Any] = {"id": claim.id, "section": claim.section, "claim": claim.quote}

@@ -92,7 +92,8 @@ def test_checks_name_known_mappers_columns_and_parameters():
             assert {values[k] for k in _COLUMN_FIELDS if values.get(k)} <= columns, item.id
             for key in _PARAM_FIELDS:
                 if values.get(key) and values[key] not in columns:
-                    assert values[key] in make_mapper(mappers[0]).params, (item.id, values[key])
+                    assert values[key] in make_mapper(mappers[0]).params.as_dict(), (item.id,
+                                                                          values[key])
 
 
 def test_compare_checks_are_consistent():
