@@ -23,6 +23,7 @@ from alte.report.captions import (
     FIGURES,
     KEY_TABLES,
     TRADEOFF_PREFIXES,
+    KeyTable,
     caption,
     chapter_title,
 )
@@ -184,15 +185,17 @@ def _claims(tables_dir: Path) -> list[ClaimRow]:
                      str(r.get("reading", ""))) for r in frame.to_dict(orient="records")]
 
 
-def _table(csv: Path, run_dir: Path, title: str, text: str, key: bool) -> TableItem:
+def _table(csv: Path, run_dir: Path, shown: KeyTable) -> TableItem:
+    """A CSV as a page table, as ``shown`` says (title, text, columns hidden, row limit)."""
     href = csv.relative_to(run_dir).as_posix()
     try:
         frame = pd.read_csv(csv)
     except (OSError, ValueError, pd.errors.EmptyDataError) as err:
-        return TableItem(title, f"unreadable: {err}", href, None)
-    view = table_view(frame, key=key) if len(frame) <= INLINE_ROWS else None
+        return TableItem(shown.title, f"unreadable: {err}", href, None)
+    visible = frame.drop(columns=[c for c in shown.hide if c in frame])
+    view = table_view(visible, key=shown.key) if len(frame) <= shown.rows else None
     shape = f"{len(frame):,} rows, {len(frame.columns)} columns"
-    return TableItem(title, f"{text} ({shape})".lstrip(), href, view)
+    return TableItem(shown.title, f"{shown.text} ({shape})".lstrip(), href, view)
 
 
 def _counts(claims: Sequence[ClaimRow]) -> list[tuple[str, int, str]]:
@@ -218,9 +221,9 @@ def run_page(record: Mapping[str, Any], run_dir: str | os.PathLike[str],
         page.sections.append(RunSection(**{**section.__dict__, "figures": [
             f for f in section.figures if not _is_tradeoff(f)]}))
     by_name = {t.stem: t for t in tables}
-    page.key_tables = [_table(by_name[k.name], run_dir, k.title, k.text, key=k.key)
-                       for k in KEY_TABLES if k.name in by_name]
+    page.key_tables = [_table(by_name[k.name], run_dir, k) for k in KEY_TABLES
+                       if k.name in by_name]
     keyed = {k.name for k in KEY_TABLES} | {Path(CLAIMS_CSV).stem}
-    page.tables = [_table(t, run_dir, t.name, "", key=False) for t in tables
-                   if t.stem not in keyed]
+    page.tables = [_table(t, run_dir, KeyTable(t.stem, t.name, "", key=False, rows=INLINE_ROWS))
+                   for t in tables if t.stem not in keyed]
     return page

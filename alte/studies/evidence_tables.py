@@ -5,7 +5,9 @@ fidelity, and ablations (what moves a verdict when one thing changes).
 claim on the trade-off table and writes ``claims.csv`` (the front page's claims table),
 ``claims_cells.csv`` (every number behind the verdicts), ``equal_size.csv`` and
 ``equal_fidelity.csv`` (each case's two mappers read off their fronts; mean over seeds
-with bootstrap intervals) into the run's tables folder.
+with bootstrap intervals) and their headline rows with units in the headers
+(``key_equal_size.csv``: MHD at 1k/5k/20k basis functions; ``key_equal_fidelity.csv``:
+basis functions for equal MHD) into the run's tables folder.
 """
 
 from __future__ import annotations
@@ -30,9 +32,17 @@ from alte.studies.tables import write_csv
 from alte.studies.thesis import CASE_MAPPERS, TERRAIN_CASE
 from alte.studies.tradeoff import equal_fidelity, equal_size, interval_table, prepare
 
-__all__ = ["EQUAL_FIDELITY", "EQUAL_SIZE", "SIZES", "EvidenceFiles", "ablation_table",
-           "ablation_verdicts",
-           "comparison_tables", "write_evidence"]
+__all__ = [
+    "EQUAL_FIDELITY",
+    "EQUAL_SIZE",
+    "SIZES",
+    "EvidenceFiles",
+    "ablation_table",
+    "ablation_verdicts",
+    "comparison_tables",
+    "key_table",
+    "write_evidence",
+]
 
 #: Sizes (basis functions) fidelity is compared at.
 SIZES = (1_000.0, 5_000.0, 20_000.0)
@@ -53,6 +63,8 @@ class EvidenceFiles:
     cells: Path
     equal_size: Path
     equal_fidelity: Path
+    key_equal_size: Path
+    key_equal_fidelity: Path
 
 
 def _case_table(table: pd.DataFrame, case: str) -> pd.DataFrame:
@@ -98,6 +110,18 @@ def _concat(parts: list[pd.DataFrame]) -> pd.DataFrame:
     return pd.concat(frames, ignore_index=True)[_SUMMARY]
 
 
+def key_table(summary: pd.DataFrame, metric: str, level: str, value: str) -> pd.DataFrame:
+    """The rows of ``metric`` of a comparison table (:func:`comparison_tables`) with named
+    columns: ``level`` for the level read at, ``value`` for the mean and ``ci_low``/
+    ``ci_high`` carrying the value's unit suffix (``_m``), so each header shows a unit."""
+    part = summary[summary["metric"] == metric]
+    unit = next((u for u in ("_m", "_s", "_bytes") if value.endswith(u)), "")
+    return pd.DataFrame({"case": part["case"], "terrain": part["terrain"],
+                         level: part["level"], "mapper": part["mapper"], value: part["mean"],
+                         f"ci_low{unit}": part["low"], f"ci_high{unit}": part["high"],
+                         "seeds": part["seeds"]}).reset_index(drop=True)
+
+
 def write_evidence(table: pd.DataFrame, tables_dir: str | os.PathLike[str], *,
                    claims: Sequence[Claim] = CLAIMS, options: EvidenceOptions | None = None,
                    overwrite: bool = True) -> EvidenceFiles:
@@ -107,7 +131,10 @@ def write_evidence(table: pd.DataFrame, tables_dir: str | os.PathLike[str], *,
     at_size, at_fidelity = comparison_tables(table, options=options)
     paths = [write_csv(frame, tables_dir, name, overwrite=overwrite) for frame, name in (
         (claims_table(findings), "claims"), (cells_table(findings), "claims_cells"),
-        (at_size, "equal_size"), (at_fidelity, "equal_fidelity"))]
+        (at_size, "equal_size"), (at_fidelity, "equal_fidelity"),
+        (key_table(at_size, "mhd_m", "basis_functions", "mhd_m"), "key_equal_size"),
+        (key_table(at_fidelity, "basis_functions", "mhd_m", "basis_functions"),
+         "key_equal_fidelity"))]
     return EvidenceFiles(findings, *paths)
 
 

@@ -26,14 +26,14 @@ import pandas as pd
 from alte.errors import ParameterError
 from alte.studies.claims import CLAIMS, Claim
 from alte.studies.evidence import EvidenceOptions, cells_table, evaluate_all
-from alte.studies.evidence_tables import ablation_verdicts
+from alte.studies.evidence_tables import EQUAL_SIZE, SIZES, ablation_verdicts
 from alte.studies.sweep import BASE, SweepSpec, load_spec, override, run_sweep, variant_table
 from alte.studies.tables import write_csv
-from alte.studies.thesis import SWEEPS, TERRAIN_CASE
-from alte.studies.tradeoff import matching, prepare
+from alte.studies.thesis import CASE_MAPPERS, SWEEPS, TERRAIN_CASE
+from alte.studies.tradeoff import equal_size, matching, prepare
 
 __all__ = ["OCCUPIED_SIZE", "THESIS_ROWS", "TRADEOFF_COLUMNS", "Grid", "GridTables", "ablations",
-           "run_grid",
+           "front_order", "run_grid",
            "thesis_rows", "tradeoff_table", "write_grid"]
 
 #: The columns tradeoff.csv starts with (then the parameters as ``p_*`` and the rest).
@@ -160,3 +160,44 @@ def write_grid(grid: Grid, tables_dir: str | os.PathLike[str], *,
         paths += [write_csv(verdicts, tables_dir, "ablation", overwrite),
                   write_csv(cells, tables_dir, "ablation_cells", overwrite)]
     return GridTables(paths, verdicts, cells)
+
+
+def _means_at_size(table: pd.DataFrame, pair: tuple[str, str], metric: str,
+                   higher: bool, sizes: Sequence[float]) -> pd.DataFrame | None:
+    """Mean over seeds of each mapper's ``metric`` read at ``sizes`` (terrain, level rows)."""
+    if metric not in table or table[metric].isna().all() or set(pair) - set(table["mapper"]):
+        return None
+    reads = equal_size(table, pair, metric, levels=sizes, higher_is_better=higher)
+    return reads.groupby(["terrain", "level", "mapper"])["value"].mean().unstack("mapper")
+
+
+def _lead(first: float, second: float, higher: bool, names: tuple[str, str]) -> str:
+    if not (pd.notna(first) and pd.notna(second)) or first == second:
+        return ""
+    return names[0] if (first > second) == higher else names[1]
+
+
+def front_order(short: pd.DataFrame, whole: pd.DataFrame, *,
+                sizes: Sequence[float] = SIZES) -> pd.DataFrame:
+    """Which mapper of each pair the thesis compares leads at equal size (the fidelity
+    metrics of :data:`~alte.studies.evidence_tables.EQUAL_SIZE`, means over seeds), in two
+    trade-off tables (e.g. short and whole missions), on the terrains and sizes both
+    reach: one row per (terrain, metric, size) with both reads and ``same`` order."""
+    rows = []
+    for case, pair in CASE_MAPPERS.items():
+        parts = [prepare(t[t["terrain"].map(TERRAIN_CASE) == case]) for t in (short, whole)]
+        for metric, higher in EQUAL_SIZE:
+            means = [_means_at_size(p, pair, metric, higher, sizes) for p in parts]
+            if means[0] is None or means[1] is None:
+                continue
+            both = means[0].add_suffix("_short").join(means[1].add_suffix("_whole"), how="inner")
+            for (terrain, level), r in both.iterrows():
+                lead = [_lead(r[f"{pair[0]}_{k}"], r[f"{pair[1]}_{k}"], higher, pair)
+                        for k in ("short", "whole")]
+                if all(lead):
+                    rows.append({"terrain": terrain, "metric": metric, "level": level,
+                                 **{f"{m}_{k}": r[f"{m}_{k}"] for k in ("short", "whole")
+                                    for m in pair},
+                                 "lead_short": lead[0], "lead_whole": lead[1],
+                                 "same": lead[0] == lead[1]})
+    return pd.DataFrame(rows)

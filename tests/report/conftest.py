@@ -107,6 +107,15 @@ def make_front_run(run_dir: Path) -> dict:
                   "basis_functions": [1435, 232], "thesis_basis_functions": [4399, 220],
                   "memory_bytes": [123, 456]}).to_csv(tables / "table_5_10.csv", index=False)
     pd.DataFrame({"a": [1, 2], "b_m": [0.5, 0.25]}).to_csv(tables / "extra.csv", index=False)
+    pd.DataFrame({"case": ["lan", "lan"], "terrain": ["sim_lan_2"] * 2,
+                  "basis_functions": [1000, 1000], "mapper": ["quadtree", "alte2d"],
+                  "mhd_m": [0.61, 0.66], "ci_low_m": [0.6, 0.64], "ci_high_m": [0.62, 0.7],
+                  "seeds": [3, 3]}).to_csv(tables / "key_equal_size.csv", index=False)
+    pd.DataFrame({"id": [c.id for c in CLAIMS[:3]], "section": ["5.1"] * 3,
+                  "claim": [c.quote for c in CLAIMS[:3]], "base": ["holds"] * 3,
+                  "set_b_centers": ["holds", "does not hold", "holds"],
+                  "moves": ["", "set_b_centers", ""]}).to_csv(tables / "ablation.csv",
+                                                              index=False)
     for name in ("terrain", "cloud", "mystery"):
         _png(run_dir / "ch4_sim_lan_1", name)
     for name in ("fig_5_2", "tradeoff_mhd", "equal_size_2d"):

@@ -37,6 +37,17 @@ def test_front_page_renders_with_every_figure_and_the_claims_table(tmp_path: Pat
             "return Array.from(document.querySelectorAll('#claims-table .verdict'))"
             ".map(b => getComputedStyle(b).backgroundColor)")
         assert len(set(badges)) >= 2  # verdicts are coloured
+        keyed = driver.execute_script(
+            "return Array.from(document.querySelectorAll('#key-tables h3'))"
+            ".map(h => h.textContent)")
+        assert keyed[:3] == ["Table 5.10: best 2D maps by the thesis' rule", "MHD at equal size",
+                             "Ablations: what moves the verdicts"]
+        headers = driver.execute_script(
+            "return Array.from(document.querySelectorAll('#key-tables th'))"
+            ".map(h => h.textContent)")
+        assert {"MHD [m]", "ci low [m]", "ours", "thesis", "set b centers"} <= set(headers)
+        text = driver.execute_script("return document.body.innerText")
+        assert "{'" not in text and '{"' not in text  # no raw dicts or JSON
         assert browser_logs(driver) == []
         height = driver.execute_script("return document.body.scrollHeight")
         driver.set_window_size(1400, min(height, 8000))

@@ -49,7 +49,7 @@ def test_comparison_tables_skip_a_case_without_both_mappers():
     assert empty.empty and "mean" in empty.columns
 
 
-def test_write_evidence_writes_the_four_tables(tmp_path):
+def test_write_evidence_writes_the_six_tables(tmp_path):
     table = synthetic_tradeoff({"alte2d": Curve(scale=0.5)})
     files = write_evidence(table, tmp_path, claims=CLAIMS[:5])
     claims = pd.read_csv(files.claims)
@@ -57,5 +57,13 @@ def test_write_evidence_writes_the_four_tables(tmp_path):
     assert list(pd.read_csv(files.cells).columns) == CELL_COLUMNS
     assert files.equal_size.name == "equal_size.csv" and files.equal_fidelity.exists()
     assert len(files.findings) == 5
+    key = pd.read_csv(files.key_equal_size)
+    assert list(key.columns) == ["case", "terrain", "basis_functions", "mapper", "mhd_m",
+                                 "ci_low_m", "ci_high_m", "seeds"]
+    assert set(key["basis_functions"]) <= {1000, 5000, 20000} and (key["seeds"] == 3).all()
+    assert (key["ci_low_m"] <= key["mhd_m"]).all() and (key["mhd_m"] <= key["ci_high_m"]).all()
+    fid = pd.read_csv(files.key_equal_fidelity)
+    assert list(fid.columns[2:5]) == ["mhd_m", "mapper", "basis_functions"]
+    assert "ci_low" in fid.columns and fid["basis_functions"].gt(0).all()
     again = write_evidence(table, tmp_path, claims=CLAIMS[:5], options=EvidenceOptions(seed=1))
     assert again.claims == files.claims

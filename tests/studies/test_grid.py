@@ -17,6 +17,7 @@ from alte.studies.grid import (
     TRADEOFF_COLUMNS,
     Grid,
     ablations,
+    front_order,
     run_grid,
     thesis_rows,
     tradeoff_table,
@@ -132,3 +133,20 @@ def test_run_grid_end_to_end(tmp_path):
     again = run_grid(spec, scheduler="serial", data_dir=str(tmp_path / "data"),
                      output=tmp_path / "runs", progress=False, frames=2, seeds=[3, 4])
     assert again.ran == 0 and again.runs == 16
+
+
+def test_front_order_compares_who_leads_at_equal_size():
+    where = {m: ("sim_lan_2",) if m in ("quadtree", "alte2d") else ("sim_nav_1",)
+             for m in ("quadtree", "alte2d", "octomap", "alte3d")}
+    short = synthetic_tradeoff({"alte2d": Curve(scale=0.5), "alte3d": Curve(scale=0.5)},
+                               terrains=where)
+    whole = synthetic_tradeoff({"alte2d": Curve(scale=0.5), "alte3d": Curve(scale=2.0)},
+                               terrains=where, seeds=(0,), rng_seed=3)
+    order = front_order(short, whole)
+    assert set(order["terrain"]) == {"sim_lan_2", "sim_nav_1"}
+    lan = order[(order["terrain"] == "sim_lan_2") & (order["metric"] == "mhd_m")]
+    assert list(lan["level"]) == [1000.0, 5000.0, 20000.0]
+    assert (lan["lead_short"] == "alte2d").all() and lan["same"].all()
+    nav = order[(order["terrain"] == "sim_nav_1") & (order["metric"] == "mhd_m")]
+    assert (nav["lead_whole"] == "octomap").all() and not nav["same"].any()
+    assert {"alte2d_short", "quadtree_whole", "octomap_whole"} <= set(order.columns)
