@@ -97,6 +97,11 @@ def _mean_front(ax: Any, rows: pd.DataFrame, mapper: str, axes: tuple[str, str],
     ax.fill_between(grid.columns, low, high, color=color, alpha=0.2, lw=0)
 
 
+def _log_axis(metric: str) -> bool:
+    """Errors (m) and times (s) span decades over a grid: log axis; shares stay linear."""
+    return metric.endswith(("_m", "_s"))
+
+
 def _thesis_star(ax: Any, rows: pd.DataFrame, mapper: str, axes: tuple[str, str]) -> None:
     setting = thesis_setting(mapper)
     chosen = rows[matching(rows, setting)] if setting else rows.iloc[:0]
@@ -129,6 +134,7 @@ def tradeoff_figure(table: pd.DataFrame, metric: str = "mhd_m", *,
             _mean_front(ax, mine, mapper, (size, metric), higher_is_better)
             _thesis_star(ax, mine, mapper, (size, metric))
         ax.set_xscale("log")
+        ax.set_yscale("log" if _log_axis(metric) else "linear")
         ax.set(title=terrain, xlabel=label(size), ylabel=label(metric))
         ax.grid(alpha=0.3, which="both")
     _legend(fig)
@@ -222,18 +228,29 @@ def _panel(ax: Any, rows: pd.DataFrame, mappers: Sequence[str], axes: tuple[str,
         ax.scatter(dots["x"], dots["y"], s=8, alpha=0.25, color=COLORS.get(mapper), lw=0)
         _mean_front(ax, mine, mapper, (size, metric), False)
     ax.set_xscale("log")
+    ax.set_yscale("log" if _log_axis(metric) else "linear")
     ax.set(title=title, xlabel=label(size), ylabel=label(metric))
     ax.grid(alpha=0.3, which="both")
+
+
+def _same_maps(rows: pd.DataFrame, first: str, other: str, metric: str) -> bool:
+    """Whether variant ``other`` gave the same maps as ``first`` (it changed nothing here)."""
+    values = [np.sort(rows.loc[rows["variant"] == n, ["basis_functions", metric]].to_numpy(
+        float), axis=0) for n in (first, other)]
+    return values[0].shape == values[1].shape and bool(np.allclose(values[0], values[1],
+                                                                  equal_nan=True))
 
 
 def ablation_figure(variants: pd.DataFrame, mappers: Sequence[str], terrain: str,
                     metric: str = "mhd_m") -> Any:
     """``metric`` against basis functions of ``mappers`` on ``terrain``, one panel per
     ablation variant (rows of :func:`alte.studies.grid.Grid.variants`, column
-    ``variant``), plus the base grid with size counted as occupied cells."""
+    ``variant``) that changes them, plus the base grid with size counted as occupied
+    cells."""
     rows = prepare(variants[variants["terrain"] == terrain])
     rows = rows[rows["mapper"].isin(mappers) & rows[metric].notna()]
-    names = list(dict.fromkeys(rows["variant"]))
+    names = [n for n in dict.fromkeys(rows["variant"]) if n == rows["variant"].iloc[0]
+             or not _same_maps(rows, rows["variant"].iloc[0], n, metric)]
     if rows.empty or len(names) < 2:
         raise ParameterError(f"no ablation variants of {list(mappers)} on {terrain}")
     fig, axes = _panels(len(names) + 1, 3.6, 3.0)

@@ -38,7 +38,7 @@ def test_tradeoff_figure_has_a_log_panel_per_terrain_and_a_front_per_mapper(tabl
     axes = _visible(fig)
     assert [ax.get_title() for ax in axes] == ["sim_lan_1", "sim_lan_2", "sim_nav_1",
                                                "sim_nav_2"]
-    assert all(ax.get_xscale() == "log" for ax in axes)
+    assert all(ax.get_xscale() == ax.get_yscale() == "log" for ax in axes)  # errors: log-log
     assert axes[0].get_ylabel() == "MHD [m]" and axes[0].get_xlabel() == "basis functions"
     lan = axes[0]
     fronts = [line for line in lan.get_lines() if line.get_label().endswith(" front")]
@@ -60,6 +60,7 @@ def test_tradeoff_figure_selects_and_reports_empty_selections(table):
                           higher_is_better=True)
     (ax,) = _visible(fig)
     assert ax.get_title() == "sim_nav_1" and ax.get_ylabel() == "completeness"
+    assert ax.get_yscale() == "linear"  # a share, not an error spanning decades
     plt.close(fig)
     with pytest.raises(ParameterError, match="no rows of"):
         tradeoff_figure(table, mappers=["octomap"], terrains=["sim_lan_1"])
@@ -112,6 +113,10 @@ def test_ablation_figure(tmp_path):
     fig = ablation_figure(variants, ("quadtree", "alte2d"), "sim_lan_2")
     titles = [ax.get_title() for ax in _visible(fig)]
     assert titles == ["base", "centres", "base, size = occupied cells"]
+    same = pd.concat([variants, base.assign(variant="no change")], ignore_index=True)
+    titles = [ax.get_title() for ax in _visible(ablation_figure(same, ("quadtree", "alte2d"),
+                                                                "sim_lan_2"))]
+    assert "no change" not in titles  # a variant that changed nothing here gets no panel
     assert _visible(fig)[2].get_xlabel() == "occupied cells"
     plt.close(fig)
     with pytest.raises(ParameterError, match=r"no ablation variants of \['quadtree', 'alte2d'\] "
@@ -123,6 +128,6 @@ def test_ablation_figure(tmp_path):
     assert set(out) == {"tradeoff_ablation_2d", "tradeoff_ablation_3d"} <= set(
         FIGURES["ch5_analysis"])
     assert (tmp_path / "figures" / "tradeoff_ablation_2d.png").stat().st_size > 1000
-    assert (tmp_path / "figures" / "tradeoff_ablation_3d.png").is_file()
+    assert str(out["tradeoff_ablation_3d"]).startswith("not drawn")  # 3D maps unchanged
     lone = save_ablation_figures(base, tmp_path / "lone")
     assert all(str(v).startswith("not drawn: no ablation variants") for v in lone.values())
