@@ -105,7 +105,8 @@ def run_grid(spec_path: str | os.PathLike[str], *, scheduler: str = "local", wor
               for r, msg in result.failed]
     variants = tradeoff_table(variant_table(spec, result.table))
     base = variants[variants["variant"] == BASE].drop(columns="variant")
-    cpu = result.table["cpu_s"].astype(float).sum() if "cpu_s" in result.table else np.nan
+    cpu = (result.table["cpu_s"].astype(float).sum(min_count=len(result.table))  # all or NaN
+           if "cpu_s" in result.table else np.nan)
     return Grid(spec, base.reset_index(drop=True), variants, len(result.table), result.ran,
                 seconds, failed, float(cpu))
 
