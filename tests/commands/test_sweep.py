@@ -53,7 +53,7 @@ def test_failed_runs_exit_1(spec_file, capsys, monkeypatch):
     def broken(*args, **kwargs):
         raise RuntimeError("mapper crashed")
 
-    monkeypatch.setattr(sweep_runner, "run_mapper", broken)
+    monkeypatch.setattr(sweep_runner, "measure", broken)
     assert main(["sweep", str(spec_file), "--scheduler", "serial", "--no-progress"]) == 1
     out = capsys.readouterr().out
     assert "failed: sim_lan_1 quadtree {'max_points': 300}: RuntimeError: mapper crashed" in out

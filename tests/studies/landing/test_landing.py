@@ -16,6 +16,7 @@ from matplotlib.collections import EllipseCollection
 from alte.errors import AlteError, MetricsError, ParameterError
 from alte.mappers.base import Cells
 from alte.metrics import TrueSurface
+from alte.pipeline import InputKind
 from alte.plot.landing import plot_landing_runs
 from alte.sim import SceneBuilder
 from alte.studies.landing import (
@@ -276,7 +277,8 @@ def test_ground_truth_scoring_on_a_tiny_simulated_terrain(tiny_lan):
 
 def test_without_ground_truth_only_detection_is_reported(tiny_lan):
     params = landing_params("sim_lan_1", step=0.5)
-    real = dataclasses.replace(tiny_lan, surface=None)
+    real = dataclasses.replace(tiny_lan, source=dataclasses.replace(tiny_lan.source,
+                                                               kind=InputKind.BAG))
     run = evaluate_landing(real, "quadtree", {"max_points": 200}, params)
     assert run.truth is None and set(run.scores) == {"sites", "chosen"}
     assert run.scores["sites"] >= 1

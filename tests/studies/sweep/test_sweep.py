@@ -190,19 +190,19 @@ def test_serial_sweep_writes_rows_and_resumes(spec, tmp_path):
 
 
 def test_failed_runs_are_reported_not_written_and_retried(spec, tmp_path, monkeypatch):
-    real = sweep_runner.run_mapper
+    real = sweep_runner.measure
 
     def flaky(data, name, params, **kw):
         if name == "quadtree":
             raise MemoryError("boom")
         return real(data, name, params, **kw)
 
-    monkeypatch.setattr(sweep_runner, "run_mapper", flaky)
+    monkeypatch.setattr(sweep_runner, "measure", flaky)
     result = run_sweep(spec, scheduler="serial", output=tmp_path, progress=False)
     assert result.ran == 4 and len(result.table) == 4
     assert [(r.mapper, msg) for r, msg in result.failed] == [("quadtree", "MemoryError: boom")] * 2
     assert result.summary()["failed"][0]["params"] == {"max_points": 100}
-    monkeypatch.setattr(sweep_runner, "run_mapper", real)
+    monkeypatch.setattr(sweep_runner, "measure", real)
     retry = run_sweep(spec, scheduler="serial", output=tmp_path, progress=False)
     assert (retry.ran, retry.skipped, retry.failed) == (2, 4, [])
 
