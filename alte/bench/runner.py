@@ -19,8 +19,8 @@ from tqdm.auto import tqdm
 
 from alte.bench.clouds import cloud_stages, hausdorff_speed
 from alte.bench.core import BenchConfig, Context, Result
-from alte.bench.memory import map_memory
 from alte.bench.maps import batch_builds, insert_latency, octomap_memory, octomap_speed
+from alte.bench.memory import map_memory
 from alte.bench.scaling import scaling
 from alte.bench.timing import machine_info, peak_rss_bytes
 from alte.bench.wall import report_wall_time
