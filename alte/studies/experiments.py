@@ -94,14 +94,15 @@ def ground_truth(data: Registered) -> GroundTruth | None:
 
 def measure(data: Registered, mapper: str, params: Mapping[str, object] | None = None, *,
             truth: TruthOptions | None = None, spec: MapSpec | None = None,
-            progress: bool = False) -> Measured:
+            set_b: str = "corners", progress: bool = False) -> Measured:
     """Map ``data`` with ``mapper`` and ``params`` and measure it (``truth``: also against
-    the true surface). ``spec`` replaces the default map specification when given."""
+    the true surface; ``set_b``: the map's points of HD/MHD, see
+    :data:`alte.metrics.maps.SET_B`). ``spec`` replaces the default map specification."""
     chosen = spec or MapSpec(mapper, dict(params or {}))
     result = run(data, chosen, progress=progress)
     metrics = measure_map(result.mapper, data.cloud, elapsed_s=result.elapsed_s,
                           truth=ground_truth(data) if truth is not None else None,
-                          options=truth)
+                          options=truth, set_b=set_b)
     return Measured(result, metrics)
 
 
