@@ -15,15 +15,15 @@ import pytest
 from alte.mappers import _scan
 from alte.mappers._blockset import WORDS
 from alte.mappers.octomap import compare_backends
+from alte.pipeline import open_input, prepare
 from alte.sim import ensure_terrain
-from alte.studies.experiments import load_dataset
 
 
 @pytest.mark.slow
 def test_native_agrees_with_reference_on_sim_nav_1(tmp_path_factory):
     folder = ensure_terrain("sim_nav_1", tmp_path_factory.mktemp("data"), frames=12)
-    data = load_dataset(folder)
-    result = compare_backends(data.frames, resolution=5.0, max_range=100.0)
+    scans = [(np.array(f.points), f.origin) for f in prepare(open_input(folder)).frames()]
+    result = compare_backends(scans, resolution=5.0, max_range=100.0)
     assert result["jaccard"] == 1.0, result
     assert result["leaf_count_native"] == result["leaf_count_reference"] > 0, result
 
@@ -36,7 +36,8 @@ def _sorted(blocks: np.ndarray, bits: np.ndarray) -> tuple[np.ndarray, np.ndarra
 @pytest.mark.slow
 def test_dense_hashed_and_threaded_scans_give_the_same_keys(tmp_path_factory, monkeypatch):
     folder = ensure_terrain("sim_nav_1", tmp_path_factory.mktemp("data"), frames=6)
-    for points, origin in load_dataset(folder).frames:
+    for frame in prepare(open_input(folder)).frames():
+        points, origin = np.array(frame.points), frame.origin
         args = (points.astype(np.float32), origin.astype(np.float32), 0.2, 100.0)
         dense = _sorted(*_scan.scan_blocks(*args))
         assert dense[0].size > 100 and (dense[1][:, :WORDS] & dense[1][:, WORDS:] == 0).all()
