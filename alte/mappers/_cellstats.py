@@ -7,8 +7,10 @@ which kernel computed it: :func:`aggregate_points` sums every run of points as
 former numpy code: Chan's parallel mean and ``M2`` update.
 
 A level's *index* finds a cell's storage row from its key without keeping the keys
-sorted: an open-addressing table of int32 ``row + 1`` (0 = empty slot) whose key is
-checked against the level's key array; it is rebuilt after rows move.
+sorted. Where the level has few enough cells (``4**level``) it is *dense*: int32
+``row + 1`` at the key itself (0 = absent), one memory access per lookup, and the
+sorted keys of a frame read it in address order; deeper levels use an open-addressing
+table of ``key, row`` pairs (int64, key -1 = empty), key and row in one cache line.
 """
 
 from __future__ import annotations
@@ -16,7 +18,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-__all__ = ["aggregate_points", "build_index", "combine", "merge_cells", "stable_order"]
+__all__ = ["aggregate_points", "combine", "fill_index", "merge_cells", "stable_order"]
 
 _GOLDEN = np.uint64(0x9E3779B97F4A7C15)
 #: Below this many keys numba's merge sort beats the radix passes' fixed cost.
@@ -139,42 +141,62 @@ def combine(keys: np.ndarray, rows: np.ndarray, nv: int):
 
 
 @numba.njit(cache=True, inline="always")
-def _slot(index: np.ndarray, keys: np.ndarray, key: int) -> int:
-    """Slot of ``key`` in ``index``, or of the empty slot where it belongs."""
-    mask = np.uint64(index.size - 1)
-    j = ((np.uint64(key) * _GOLDEN) >> np.uint64(32)) & mask
-    while index[j] != 0 and keys[index[j] - 1] != key:
-        j = (j + np.uint64(1)) & mask
-    return int(j)
+def _locate(index: np.ndarray, key: int, dense: bool) -> int:
+    """Position of ``key`` in ``index``: the key itself (dense), else the slot holding it
+    or the empty slot where it belongs (hashed: pairs ``key, row``; key -1 = empty)."""
+    if dense:
+        return np.int64(key)
+    mask = np.int64(index.size // 2 - 1)
+    j = np.int64((np.uint64(key) * _GOLDEN) >> np.uint64(32)) & mask
+    while index[2 * j] != -1 and index[2 * j] != key:
+        j = (j + 1) & mask
+    return j
+
+
+@numba.njit(cache=True, inline="always")
+def _row(index: np.ndarray, j: int, key: int, dense: bool) -> int:
+    """Row stored at position ``j`` for ``key``; -1 when the key is absent."""
+    if dense:
+        return int(index[j]) - 1
+    return int(index[2 * j + 1]) if index[2 * j] == key else -1
+
+
+@numba.njit(cache=True, inline="always")
+def _set(index: np.ndarray, j: int, key: int, row: int, dense: bool) -> None:
+    if dense:
+        index[j] = row + 1
+    else:
+        index[2 * j], index[2 * j + 1] = key, row
 
 
 @numba.njit(cache=True)
-def build_index(keys: np.ndarray, n: int, size: int) -> np.ndarray:
-    """Index (``size`` slots, a power of two above 2n) of the first ``n`` keys."""
-    index = np.zeros(size, dtype=np.int32)
+def fill_index(index: np.ndarray, keys: np.ndarray, n: int, dense: bool) -> None:
+    """Point ``index`` at the rows of the first ``n`` keys (an empty index, or one already
+    holding exactly these keys at other rows: the rows are rewritten in place)."""
     for row in range(n):
-        index[_slot(index, keys, keys[row])] = row + 1
-    return index
+        _set(index, _locate(index, keys[row], dense), keys[row], row, dense)
 
 
 @numba.njit(cache=True)
-def merge_cells(store, n: int, keys: np.ndarray, agg: np.ndarray, nv: int):
-    """Merge cells (``keys``, rows ``agg``) into a level's ``store`` = (keys, rows, split,
-    index) holding ``n`` cells, capacity reserved; returns their rows and the new n.
+def merge_cells(store, n: int, cells, nv: int, dense: bool):
+    """Merge ``cells`` = (keys, rows) into a level's ``store`` = (keys, rows, split, index)
+    holding ``n`` cells, capacity reserved; returns their rows and the new n.
 
     Known cells get Chan's pairwise update in place; new ones are appended."""
     skeys, srows, split, index = store
+    keys, agg = cells
     touched = np.empty(keys.size, dtype=np.int64)
     for i in range(keys.size):
-        j = _slot(index, skeys, keys[i])
-        if index[j] == 0:
+        j = _locate(index, keys[i], dense)
+        row = _row(index, j, keys[i], dense)
+        if row < 0:
             skeys[n], split[n] = keys[i], False
             srows[n] = agg[i]
-            index[j] = n + 1
+            _set(index, j, keys[i], n, dense)
             touched[i] = n
             n += 1
             continue
-        row = touched[i] = index[j] - 1
+        touched[i] = row
         na, nb = srows[row, 0], agg[i, 0]
         total = na + nb
         for v in range(nv):

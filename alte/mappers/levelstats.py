@@ -8,12 +8,13 @@ and aggregated once at the finest level and merged upwards; at each level a hash
 index finds known cells, which are updated in place, and new cells are appended
 after the others (*pending*). Pending cells are sorted in only when a reader needs
 the sorted arrays, so an insertion costs O(frame x depth) whatever the map's size,
-with no copying of the map (storage grows rarely: doubling, from a generous lazily
-allocated first size).
+with no copying of the map (storage grows rarely: doubling, from a generous first
+size that the OS pages in only as it is used).
 """
 
 from __future__ import annotations
 
+import mmap
 from collections.abc import Iterator
 from contextlib import contextmanager
 
@@ -22,8 +23,8 @@ import numpy as np
 from alte.errors import MapperError
 from alte.mappers._cellstats import (
     aggregate_points,
-    build_index,
     combine,
+    fill_index,
     merge_cells,
     stable_order,
 )
@@ -35,8 +36,22 @@ MAX_DEPTH = 24
 
 
 #: Rows a level's storage first grows to when an insertion meets it (allocated lazily by
-#: the OS: untouched rows cost no memory); deeper levels double from there.
-_FIRST_CAPACITY = 1 << 20
+#: the OS: untouched rows cost no memory); it doubles from there.
+_FIRST_CAPACITY = 1 << 22
+#: Levels of at most this many cells (``4**level``) index their rows densely (4 bytes a
+#: cell, paged in by the OS only where data lie); deeper levels hash.
+_DENSE_CELLS = 1 << 24
+
+
+def _lazy_zeros(shape: tuple[int, ...], dtype: type) -> np.ndarray:
+    """A zeroed array in anonymous memory that the OS maps 4 KiB at a time on first touch.
+
+    numpy advises transparent huge pages for big arrays; then the first touch of every
+    2 MiB zeroes (and may compact memory for) a whole huge page, a stall of milliseconds
+    in whichever insertion meets it. Small pages spread that cost evenly."""
+    count = int(np.prod(shape))
+    buffer = mmap.mmap(-1, max(count * np.dtype(dtype).itemsize, 1))
+    return np.frombuffer(buffer, dtype, count).reshape(shape)
 
 
 class _PerLevel:
@@ -67,11 +82,12 @@ class LevelStats:
     """Per level: sorted Morton keys, aggregate rows ``n, mean, m2, max`` and a split flag.
 
     Each level stores its cells in arrays with growth slack: a prefix sorted by key,
-    then *pending* cells in arrival order; a hash index over all of them (built when
-    an insertion first needs it) finds a key's row. Readers (``keys[l]``, ``rows[l]``,
-    ``split[l]``, :meth:`column`, :meth:`leaves`) fold the pending cells in first, so
-    they always see sorted arrays; :meth:`add` never folds, and inside :meth:`deferred`
-    nothing does, so row numbers stay the ones :meth:`add` returned.
+    then *pending* cells in arrival order; an index over all of them (dense or hashed,
+    see ``_cellstats``; built when an insertion first needs it) finds a key's row.
+    Readers (``keys[l]``, ``rows[l]``, ``split[l]``, :meth:`column`, :meth:`leaves`)
+    fold the pending cells in first, so they always see sorted arrays; :meth:`add`
+    never folds, and inside :meth:`deferred` nothing does, so row numbers stay the ones
+    :meth:`add` returned.
     """
 
     def __init__(self, depth: int, nvalues: int) -> None:
@@ -130,22 +146,32 @@ class LevelStats:
             return np.arange(len(keys))
         self._reserve(level, len(keys))
         store = (self._k[level], self._r[level], self._s[level], self._index[level])
-        touched, self._n[level] = merge_cells(store, self._n[level], keys, agg, self.nv)
+        touched, self._n[level] = merge_cells(store, self._n[level], (keys, agg), self.nv,
+                                              self._dense(level))
         return touched
 
+    def _dense(self, level: int) -> bool:
+        return bool(4**level <= _DENSE_CELLS)
+
     def _reserve(self, level: int, k: int) -> None:
-        """Room for ``k`` more cells at ``level`` and a current index with a free half."""
+        """Room for ``k`` more cells at ``level`` and an index of its rows (a hashed one
+        kept at most half full)."""
         n = self._n[level]
         if n + k > len(self._k[level]):
             cap = max(n + k, 2 * len(self._k[level]), min(4**level, _FIRST_CAPACITY))
             for store in (self._k, self._r, self._s):
-                grown = np.empty((cap, *store[level].shape[1:]), store[level].dtype)
+                grown = _lazy_zeros((cap, *store[level].shape[1:]), store[level].dtype)
                 grown[:n] = store[level][:n]
                 store[level] = grown
-            self._index[level] = None
+            if not self._dense(level):
+                self._index[level] = None
         if self._index[level] is None:
-            size = 1 << int(2 * len(self._k[level])).bit_length()
-            self._index[level] = build_index(self._k[level], n, size)
+            if self._dense(level):
+                index = _lazy_zeros((4**level,), np.int32)
+            else:
+                index = np.full(2 << int(2 * len(self._k[level])).bit_length(), -1, np.int64)
+            fill_index(index, self._k[level], n, self._dense(level))
+            self._index[level] = index
 
     def fold(self, level: int) -> None:
         """Sort ``level``'s pending cells into its sorted prefix (not while deferred)."""
@@ -165,7 +191,9 @@ class LevelStats:
         for store in (self._k, self._r, self._s):
             store[level][first:n] = store[level][order]
         self._sorted[level] = n
-        self._index[level] = None  # rows moved
+        index = self._index[level]
+        if index is not None:  # same keys, new rows
+            fill_index(index, self._k[level], n, self._dense(level))
 
     def shift_up(self, quadrant: int) -> None:
         """Re-key for a root twice as large holding the old root in ``quadrant`` (0-3).
@@ -188,7 +216,8 @@ class LevelStats:
 
     @property
     def nbytes(self) -> int:
-        """Bytes of the cells' keys, rows and flags (not counting storage growth slack)."""
+        """Bytes of the cells' keys, rows and flags: the map itself, not the insertion's
+        growth slack or row index (up to 4 bytes per cell of a level's touched area)."""
         row = 8 * (1 + 3 * self.nv)
         return sum(n * (8 + row + 1) for n in self._n)
 

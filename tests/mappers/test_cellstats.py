@@ -7,8 +7,8 @@ import pytest
 
 from alte.mappers._cellstats import (
     aggregate_points,
-    build_index,
     combine,
+    fill_index,
     merge_cells,
     stable_order,
 )
@@ -71,7 +71,8 @@ def test_combine_groups_children_by_parent() -> None:
         assert row[0] == kids[:, 0].sum()
 
 
-def test_merge_cells_updates_known_and_appends_new() -> None:
+@pytest.mark.parametrize("dense", [True, False])
+def test_merge_cells_updates_known_and_appends_new(dense) -> None:
     rng = np.random.default_rng(9)
     old_keys = np.unique(rng.integers(0, 1000, 300))
     _, old_rows = aggregate_points(old_keys, rng.normal(0, 1, (len(old_keys), 2)))
@@ -82,8 +83,10 @@ def test_merge_cells_updates_known_and_appends_new() -> None:
     srows = np.zeros((cap, old_rows.shape[1]))
     split = np.ones(cap, bool)
     skeys[: len(old_keys)], srows[: len(old_keys)] = old_keys, old_rows
-    index = build_index(skeys, len(old_keys), 2048)
-    touched, n = merge_cells((skeys, srows, split, index), len(old_keys), new_keys, new_rows, 2)
+    index = np.zeros(1024, np.int32) if dense else np.full(2 * 2048, -1, np.int64)
+    fill_index(index, skeys, len(old_keys), dense)
+    store = (skeys, srows, split, index)
+    touched, n = merge_cells(store, len(old_keys), (new_keys, new_rows), 2, dense)
     assert n == len(np.union1d(old_keys, new_keys))
     assert np.array_equal(skeys[touched], new_keys)
     known = np.isin(new_keys, old_keys)

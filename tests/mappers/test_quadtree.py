@@ -175,12 +175,15 @@ def test_bad_origin_and_fit_on_insert() -> None:
         Quadtree(ground="fit").build(np.zeros((2, 3)))
 
 
-@pytest.mark.parametrize("first_capacity", [1, 50, 1 << 20])
-def test_pending_cells_fold_to_the_same_statistics(monkeypatch, first_capacity) -> None:
-    """Folded after every frame or only at the end, whatever the storage growth: same map."""
+@pytest.mark.parametrize(("first_capacity", "dense_cells"), [(1, 0), (50, 64), (1 << 22, 1 << 24)])
+def test_pending_cells_fold_to_the_same_statistics(monkeypatch, first_capacity,
+                                                   dense_cells) -> None:
+    """Folded after every frame or only at the end, whatever the storage growth and the
+    index (hashed, dense on coarse levels only, dense): same map."""
     pts = box_terrain(3000, seed=3)
     frames = np.array_split(pts[np.argsort(pts[:, 0])], 15)  # new cells on every frame
     monkeypatch.setattr(levelstats, "_FIRST_CAPACITY", first_capacity)
+    monkeypatch.setattr(levelstats, "_DENSE_CELLS", dense_cells)
     eager = Quadtree(max_points=10, max_depth=7, domain=DOMAIN)
     lazy = Quadtree(max_points=10, max_depth=7, domain=DOMAIN)
     for frame in frames:
