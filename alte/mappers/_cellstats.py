@@ -18,7 +18,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-__all__ = ["aggregate_points", "combine", "fill_index", "merge_cells", "stable_order"]
+__all__ = ["aggregate_points", "combine", "fill_index", "merge_cells", "sort_keys"]
 
 _GOLDEN = np.uint64(0x9E3779B97F4A7C15)
 #: Below this many keys numba's merge sort beats the radix passes' fixed cost.
@@ -26,27 +26,33 @@ _RADIX_MIN = 1 << 14
 
 
 @numba.njit(cache=True)
-def stable_order(keys: np.ndarray, bits: int) -> np.ndarray:
-    """Stable argsort of non-negative int64 ``keys`` below ``2**bits`` (LSD radix, 8 bits
-    a pass; a merge sort for short arrays)."""
+def sort_keys(keys: np.ndarray, bits: int):
+    """Stably sorted non-negative int64 ``keys`` below ``2**bits`` and their order (LSD
+    radix sort of key and index together, digits of at most 12 bits counted in one
+    pass; numba's merge sort for short arrays)."""
     n = keys.size
     if n < _RADIX_MIN:
-        return np.argsort(keys, kind="mergesort")
-    order = np.arange(n)
-    spare = np.empty(n, dtype=np.int64)
-    count = np.empty(257, dtype=np.int64)
-    for shift in range(0, max(bits, 1), 8):
-        count[:] = 0
+        order = np.argsort(keys, kind="mergesort")
+        return keys[order], order
+    passes = max(1, -(-bits // 12))
+    width = -(-max(bits, 1) // passes)
+    mask = (1 << width) - 1
+    count = np.zeros((passes, (1 << width) + 1), dtype=np.int64)
+    for i in range(n):
+        for p in range(passes):
+            count[p, ((keys[i] >> (p * width)) & mask) + 1] += 1
+    src_k, src_o = keys.copy(), np.arange(n)
+    dst_k, dst_o = np.empty(n, dtype=np.int64), np.empty(n, dtype=np.int64)
+    for p in range(passes):
+        at = count[p]
+        for d in range(1 << width):
+            at[d + 1] += at[d]
         for i in range(n):
-            count[((keys[i] >> shift) & 255) + 1] += 1
-        for d in range(256):
-            count[d + 1] += count[d]
-        for i in range(n):
-            d = (keys[order[i]] >> shift) & 255
-            spare[count[d]] = order[i]
-            count[d] += 1
-        order, spare = spare, order
-    return order
+            d = (src_k[i] >> (p * width)) & mask
+            dst_k[at[d]], dst_o[at[d]] = src_k[i], src_o[i]
+            at[d] += 1
+        src_k, dst_k, src_o, dst_o = dst_k, src_k, dst_o, src_o
+    return src_k, src_o
 
 
 @numba.njit(cache=True)
@@ -79,65 +85,106 @@ def _run_total(x: np.ndarray, j: int, a: int, b: int) -> float:
 
 
 @numba.njit(cache=True)
-def aggregate_points(keys: np.ndarray, values: np.ndarray):
-    """Cells of sorted point ``keys`` and their rows ``n, mean.., m2.., max..``."""
-    n, nv = values.shape
-    starts = np.flatnonzero(np.diff(keys)) + 1
-    starts = np.concatenate((np.zeros(min(n, 1), np.int64), starts))
-    out = np.empty((starts.size, 1 + 3 * nv))
-    dev = np.empty((n, nv))
-    for s in range(starts.size):
-        a, b = starts[s], starts[s + 1] if s + 1 < starts.size else n
-        out[s, 0] = count = np.float64(b - a)
-        for j in range(nv):
-            mean = _run_total(values, j, a, b) / count
-            top = values[a, j]
-            for i in range(a, b):
-                d = values[i, j] - mean
-                dev[i, j] = d * d
-                top = max(top, values[i, j])
-            out[s, 1 + j], out[s, 1 + 2 * nv + j] = mean, top
-            out[s, 1 + nv + j] = _run_total(dev, j, a, b)
-    return keys[starts], out
+def _run_starts(keys: np.ndarray, shift: int) -> np.ndarray:
+    """Start index of every run of equal ``keys >> shift`` in sorted ``keys``, then ``n``."""
+    n = keys.size
+    runs = 0
+    for i in range(n):
+        runs += i == 0 or (keys[i] >> shift) != (keys[i - 1] >> shift)
+    starts = np.empty(runs + 1, dtype=np.int64)
+    s = 0
+    for i in range(n):
+        if i == 0 or (keys[i] >> shift) != (keys[i - 1] >> shift):
+            starts[s] = i
+            s += 1
+    starts[runs] = n
+    return starts
 
 
 @numba.njit(cache=True, inline="always")
-def _run_sum(x: np.ndarray, a: int, b: int) -> float:
-    """``x[a] + (x[a+1] + ... + x[b-1])``: the order of ``np.add.reduceat`` on short runs."""
-    if b - a == 1:
-        return x[a]
-    rest = x[a + 1]
-    for i in range(a + 2, b):
+def _cell_row(values: np.ndarray, run: tuple[int, int], out: np.ndarray, s: int,
+              dev: np.ndarray) -> None:
+    """Row ``s`` of ``out``: ``n, mean.., m2.., max..`` of the points ``values[a:b]``,
+    ``run = (a, b)`` (``np.add.reduceat``'s sums; ``dev``: scratch of the values' shape)."""
+    a, b = run
+    nv = values.shape[1]
+    out[s, 0] = count = np.float64(b - a)
+    for j in range(nv):
+        if b - a == 1:  # one point: the general formulas reduce to these
+            mean = values[a, j] / count
+            d = values[a, j] - mean
+            out[s, 1 + j], out[s, 1 + nv + j] = mean, d * d
+            out[s, 1 + 2 * nv + j] = values[a, j]
+            continue
+        mean = _run_total(values, j, a, b) / count
+        top = values[a, j]
+        for i in range(a, b):
+            d = values[i, j] - mean
+            dev[i, j] = d * d
+            top = max(top, values[i, j])
+        out[s, 1 + j], out[s, 1 + 2 * nv + j] = mean, top
+        out[s, 1 + nv + j] = _run_total(dev, j, a, b)
+
+
+@numba.njit(cache=True)
+def aggregate_points(keys: np.ndarray, values: np.ndarray):
+    """Cells of sorted point ``keys`` and their rows ``n, mean.., m2.., max..``."""
+    starts = _run_starts(keys, 0)
+    out = np.empty((starts.size - 1, 1 + 3 * values.shape[1]))
+    cells = np.empty(starts.size - 1, dtype=np.int64)
+    dev = np.empty(values.shape)
+    for s in range(starts.size - 1):
+        cells[s] = keys[starts[s]]
+        _cell_row(values, (starts[s], starts[s + 1]), out, s, dev)
+    return cells, out
+
+
+@numba.njit(cache=True, inline="always")
+def _run_sum(x: np.ndarray, m: int) -> float:
+    """``x[0] + (x[1] + ... + x[m-1])``: the order of ``np.add.reduceat`` on short runs."""
+    if m == 1:
+        return x[0]
+    rest = x[1]
+    for i in range(2, m):
         rest += x[i]
-    return x[a] + rest
+    return x[0] + rest
+
+
+@numba.njit(cache=True, inline="always")
+def _parent_row(rows: np.ndarray, run: tuple[int, int], out: np.ndarray, s: int,
+                term: np.ndarray) -> None:
+    """Row ``s`` of ``out``: Chan's merge of the (at most 4) child rows ``rows[a:b]``,
+    ``run = (a, b)``; ``term`` is scratch of 4 values."""
+    a, b = run
+    nv = (rows.shape[1] - 1) // 3
+    m = b - a
+    for i in range(m):
+        term[i] = rows[a + i, 0]
+    out[s, 0] = count = _run_sum(term, m)
+    for j in range(nv):
+        for i in range(m):
+            term[i] = rows[a + i, 0] * rows[a + i, 1 + j]
+        out[s, 1 + j] = mean = _run_sum(term, m) / count
+        top = rows[a, 1 + 2 * nv + j]
+        for i in range(m):
+            dev = rows[a + i, 1 + j] - mean
+            term[i] = rows[a + i, 1 + nv + j] + rows[a + i, 0] * dev * dev
+            top = max(top, rows[a + i, 1 + 2 * nv + j])
+        out[s, 1 + nv + j] = _run_sum(term, m)
+        out[s, 1 + 2 * nv + j] = top
 
 
 @numba.njit(cache=True)
 def combine(keys: np.ndarray, rows: np.ndarray, nv: int):
     """Parent cells (key >> 2) of sorted child ``keys`` with Chan's merge of their rows."""
-    parents = keys >> 2
-    starts = np.flatnonzero(np.diff(parents)) + 1
-    starts = np.concatenate((np.zeros(min(keys.size, 1), np.int64), starts))
-    out = np.empty((starts.size, rows.shape[1]))
+    starts = _run_starts(keys, 2)
+    out = np.empty((starts.size - 1, rows.shape[1]))
+    parents = np.empty(starts.size - 1, dtype=np.int64)
     term = np.empty(4)
-    col = np.empty(4)
-    for s in range(starts.size):
-        a, b = starts[s], starts[s + 1] if s + 1 < starts.size else keys.size
-        for i in range(a, b):
-            col[i - a] = rows[i, 0]
-        out[s, 0] = count = _run_sum(col, 0, b - a)
-        for j in range(nv):
-            for i in range(a, b):
-                term[i - a] = rows[i, 0] * rows[i, 1 + j]
-            out[s, 1 + j] = mean = _run_sum(term, 0, b - a) / count
-            top = rows[a, 1 + 2 * nv + j]
-            for i in range(a, b):
-                dev = rows[i, 1 + j] - mean
-                term[i - a] = rows[i, 1 + nv + j] + rows[i, 0] * dev * dev
-                top = max(top, rows[i, 1 + 2 * nv + j])
-            out[s, 1 + nv + j] = _run_sum(term, 0, b - a)
-            out[s, 1 + 2 * nv + j] = top
-    return parents[starts], out
+    for s in range(starts.size - 1):
+        parents[s] = keys[starts[s]] >> 2
+        _parent_row(rows, (starts[s], starts[s + 1]), out, s, term)
+    return parents, out
 
 
 @numba.njit(cache=True, inline="always")
@@ -191,7 +238,8 @@ def merge_cells(store, n: int, cells, nv: int, dense: bool):
         row = _row(index, j, keys[i], dense)
         if row < 0:
             skeys[n], split[n] = keys[i], False
-            srows[n] = agg[i]
+            for c in range(agg.shape[1]):
+                srows[n, c] = agg[i, c]
             _set(index, j, keys[i], n, dense)
             touched[i] = n
             n += 1

@@ -26,7 +26,7 @@ from alte.mappers._cellstats import (
     combine,
     fill_index,
     merge_cells,
-    stable_order,
+    sort_keys,
 )
 
 __all__ = ["MAX_DEPTH", "LevelStats"]
@@ -126,16 +126,18 @@ class LevelStats:
         finally:
             self._defer -= 1
 
-    def add(self, fine_keys: np.ndarray, values: np.ndarray) -> list[np.ndarray]:
-        """Add points given by finest-level keys and (N, nv) values; rows touched per level."""
-        order = stable_order(np.asarray(fine_keys, np.int64), 2 * self.depth)
-        keys, agg = aggregate_points(fine_keys[order], np.ascontiguousarray(values[order], float))
+    def add(self, fine_keys: np.ndarray, values: np.ndarray) -> list[np.ndarray] | None:
+        """Add points given by finest-level keys and (N, nv) values; the rows touched per
+        level, or None when the map was empty (every row is new)."""
+        was_empty = not any(self._n)
+        keys, order = sort_keys(np.asarray(fine_keys, np.int64), 2 * self.depth)
+        keys, agg = aggregate_points(keys, np.ascontiguousarray(values[order], float))
         touched: list[np.ndarray] = [np.empty(0, np.int64)] * (self.depth + 1)
         for level in range(self.depth, -1, -1):
             if level < self.depth:
                 keys, agg = combine(keys, agg, self.nv)
             touched[level] = self._merge(level, keys, agg)
-        return touched
+        return None if was_empty else touched
 
     def _merge(self, level: int, keys: np.ndarray, agg: np.ndarray) -> np.ndarray:
         if not self._n[level]:  # empty level (a build): take the arrays as they are

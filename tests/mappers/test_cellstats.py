@@ -10,7 +10,7 @@ from alte.mappers._cellstats import (
     combine,
     fill_index,
     merge_cells,
-    stable_order,
+    sort_keys,
 )
 
 
@@ -37,11 +37,14 @@ def _numpy_pair(a: np.ndarray, b: np.ndarray, nv: int) -> np.ndarray:
     return np.column_stack([n, mean, m2, np.maximum(a[:, 1 + 2 * nv:], b[:, 1 + 2 * nv:])])
 
 
-@pytest.mark.parametrize("n", [0, 1, 100, 40_000])
-def test_stable_order_is_numpys_stable_argsort(n) -> None:
-    keys = np.random.default_rng(n).integers(0, 1 << 20, n)
+@pytest.mark.parametrize(("n", "bits"), [(0, 20), (1, 20), (100, 20), (40_000, 0),
+                                         (40_000, 7), (40_000, 20), (40_000, 24), (40_000, 48)])
+def test_sort_keys_is_numpys_stable_argsort(n, bits) -> None:
+    keys = np.random.default_rng(n).integers(0, 1 << bits, n)
     keys[: n // 3] = keys[0] if n else 0  # long runs of ties
-    assert np.array_equal(stable_order(keys, 20), np.argsort(keys, kind="stable"))
+    got, order = sort_keys(keys, bits)
+    assert np.array_equal(order, np.argsort(keys, kind="stable"))
+    assert np.array_equal(got, np.sort(keys, kind="stable"))
 
 
 @pytest.mark.parametrize("per_cell", [1, 7, 9, 130, 300])
