@@ -87,7 +87,7 @@ class Alte2D(QuadMap):
     def _values(self, points: np.ndarray) -> np.ndarray:
         return points[:, 2:3]
 
-    def _split(self, level: int, rows: np.ndarray) -> np.ndarray:
+    def _split(self, level: int, rows: np.ndarray | slice) -> np.ndarray:
         """Thesis rule (eq. 3.2): ``M2 > kappa`` with enough points, below ``max_res``."""
         n = self.stats.column(level, "n")[rows]
         m2 = self.stats.column(level, "m2")[rows]

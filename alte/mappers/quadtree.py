@@ -129,7 +129,7 @@ class Quadtree(QuadMap):
         above = points[:, 2] - plane_height(self.plane, points[:, :2])
         return np.column_stack([points[:, 2], above])
 
-    def _split(self, level: int, rows: np.ndarray) -> np.ndarray:
+    def _split(self, level: int, rows: np.ndarray | slice) -> np.ndarray:
         n = self.stats.column(level, "n")[rows]
         return (n > self._params["max_points"]) & (level < self.depth)
 
