@@ -23,7 +23,6 @@ __all__ = [
     "POINT_CLOUDS",
     "QUALITATIVE",
     "SWEEPS",
-    "TERRAIN_CASE",
     "MapperParams",
     "PointCloudRef",
     "Sweep",
@@ -55,12 +54,6 @@ class PointCloudRef(TypedDict):
     frames: int
     points: int
 
-
-#: Case of every terrain of chapter 4: "nav" (urban navigation, 3D) or "lan" (landing, 2D).
-TERRAIN_CASE: dict[str, str] = {
-    "sim_nav_1": "nav", "sim_nav_2": "nav", "sim_lan_1": "lan", "sim_lan_2": "lan",
-    "exp_nav_1": "nav", "exp_nav_2": "nav", "exp_lan_1": "lan", "exp_lan_2": "lan",
-}
 
 #: Mappers the thesis applied per case (chapter 4 and tables 5.1-5.4).
 CASE_MAPPERS: dict[str, tuple[str, str]] = {"nav": ("octomap", "alte3d"),

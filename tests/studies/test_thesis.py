@@ -5,12 +5,13 @@ from __future__ import annotations
 import pytest
 
 from alte.errors import ParameterError
+from alte.sim import TERRAINS
+from alte.sim.scenario import get_terrain
 from alte.studies.thesis import (
     CASE_MAPPERS,
     CH4_PARAMS,
     COMPARISONS,
     SWEEPS,
-    TERRAIN_CASE,
     mapper_params,
     qualitative_table,
     sweep_table,
@@ -18,7 +19,8 @@ from alte.studies.thesis import (
 
 
 def test_every_terrain_has_the_parameters_of_its_case():
-    for terrain, case in TERRAIN_CASE.items():
+    for terrain in TERRAINS:
+        case = get_terrain(terrain).spec.case
         assert set(CH4_PARAMS[terrain]) == set(CASE_MAPPERS[case])
     assert mapper_params("sim_lan_2")["quadtree"] == {"max_points": 25}
     assert mapper_params("exp_nav_1")["alte3d"] == {"max_res": 5, "min_pts": 5,
