@@ -26,7 +26,8 @@ def register_frame(frame: Frame, mount: Mount) -> np.ndarray:
     """Eq. 2.2: R_P^I = R_B^I + DCM_B^I R_S/B^B + DCM_B^I DCM_S^B R_P/S^S for every point."""
     matrix, origin = sensor_pose(frame, mount)
     points = np.asarray(frame.points, dtype=np.float64).reshape(-1, 3)
-    return points @ matrix.T + origin
+    registered: np.ndarray = points @ matrix.T + origin
+    return registered
 
 
 def sensor_origin(frame: Frame, mount: Mount) -> np.ndarray:
@@ -37,4 +38,5 @@ def sensor_origin(frame: Frame, mount: Mount) -> np.ndarray:
 def to_sensor(points: np.ndarray, frame: Frame, mount: Mount) -> np.ndarray:
     """Inverse of :func:`register_frame`: inertial points back into the sensor frame."""
     matrix, origin = sensor_pose(frame, mount)
-    return (np.asarray(points, dtype=np.float64).reshape(-1, 3) - origin) @ matrix
+    local: np.ndarray = (np.asarray(points, dtype=np.float64).reshape(-1, 3) - origin) @ matrix
+    return local
