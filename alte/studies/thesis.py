@@ -15,6 +15,7 @@ from typing import TypedDict
 import pandas as pd
 
 from alte.errors import ParameterError
+from alte.sim.terrains import TERRAINS
 
 __all__ = [
     "CASE_MAPPERS",
@@ -23,6 +24,7 @@ __all__ = [
     "POINT_CLOUDS",
     "QUALITATIVE",
     "SWEEPS",
+    "TERRAIN_CASE",
     "MapperParams",
     "PointCloudRef",
     "Sweep",
@@ -54,6 +56,10 @@ class PointCloudRef(TypedDict):
     frames: int
     points: int
 
+
+#: Case of every terrain of chapter 4: "nav" (urban navigation, 3D) or "lan" (landing, 2D),
+#: as its name says (``sim_nav_1``); a test checks it against each terrain's own spec.
+TERRAIN_CASE: dict[str, str] = {name: name.split("_")[1] for name in TERRAINS}
 
 #: Mappers the thesis applied per case (chapter 4 and tables 5.1-5.4).
 CASE_MAPPERS: dict[str, tuple[str, str]] = {"nav": ("octomap", "alte3d"),

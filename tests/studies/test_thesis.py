@@ -12,6 +12,7 @@ from alte.studies.thesis import (
     CH4_PARAMS,
     COMPARISONS,
     SWEEPS,
+    TERRAIN_CASE,
     mapper_params,
     qualitative_table,
     sweep_table,
@@ -19,8 +20,10 @@ from alte.studies.thesis import (
 
 
 def test_every_terrain_has_the_parameters_of_its_case():
+    assert list(TERRAIN_CASE) == list(TERRAINS)
     for terrain in TERRAINS:
         case = get_terrain(terrain).spec.case
+        assert TERRAIN_CASE[terrain] == case
         assert set(CH4_PARAMS[terrain]) == set(CASE_MAPPERS[case])
     assert mapper_params("sim_lan_2")["quadtree"] == {"max_points": 25}
     assert mapper_params("exp_nav_1")["alte3d"] == {"max_res": 5, "min_pts": 5,
