@@ -89,7 +89,7 @@ def distance_to_boxes(points: np.ndarray, centers: np.ndarray, sizes: np.ndarray
 def _lattice_keys(ij: np.ndarray) -> np.ndarray:
     """One int64 per (i, j) lattice index pair (each shifted into 32 bits)."""
     shifted = np.clip(ij, -(1 << 30), (1 << 30) - 1) + (1 << 30)
-    return (shifted[:, 0] << 32) | shifted[:, 1]
+    return np.asarray((shifted[:, 0] << 32) | shifted[:, 1], dtype=np.int64)
 
 
 def cell_at_xy(xy: np.ndarray, centers: np.ndarray, sizes: np.ndarray) -> np.ndarray:

@@ -31,8 +31,8 @@ from alte.studies.tradeoff import (
 )
 from alte.studies.uncertainty import bootstrap_columns
 
-__all__ = ["COLORS", "ablation_figure", "equal_fidelity_figure", "equal_size_figure",
-           "save_ablation_figures", "save_tradeoff_figures", "tradeoff_figure"]
+__all__ = ["COLORS", "CURVES", "PAIRS", "equal_fidelity_figure", "equal_size_figure",
+           "save_figures", "save_tradeoff_figures", "tradeoff_figure"]
 
 #: One colour per mapper, the same in every figure.
 COLORS = {"quadtree": "tab:blue", "alte2d": "tab:orange", "octomap": "tab:green",
@@ -40,7 +40,7 @@ COLORS = {"quadtree": "tab:blue", "alte2d": "tab:orange", "octomap": "tab:green"
 _GRID_POINTS = 25
 
 
-def _panels(count: int, width: float = 4.2, height: float = 3.4) -> tuple[Any, np.ndarray]:
+def panels(count: int, width: float = 4.2, height: float = 3.4) -> tuple[Any, np.ndarray]:
     import matplotlib.pyplot as plt
 
     cols = min(count, 4)
@@ -52,7 +52,7 @@ def _panels(count: int, width: float = 4.2, height: float = 3.4) -> tuple[Any, n
     return fig, axes.ravel()
 
 
-def _legend(fig: Any) -> None:
+def legend(fig: Any) -> None:
     """One legend below the panels with every label once."""
     handles: dict[str, Any] = {}
     for ax in fig.axes:
@@ -75,7 +75,7 @@ def _select(table: pd.DataFrame, mappers: Sequence[str] | None,
                                                                   if t in present]
 
 
-def _mean_front(ax: Any, rows: pd.DataFrame, mapper: str, axes: tuple[str, str],
+def mean_front(ax: Any, rows: pd.DataFrame, mapper: str, axes: tuple[str, str],
                 higher_is_better: bool) -> None:
     """The mean front over seeds, read at sizes every seed's maps span, with its band."""
     size, metric = axes
@@ -97,6 +97,11 @@ def _mean_front(ax: Any, rows: pd.DataFrame, mapper: str, axes: tuple[str, str],
     ax.fill_between(grid.columns, low, high, color=color, alpha=0.2, lw=0)
 
 
+def log_axis(metric: str) -> bool:
+    """Errors (m) and times (s) span decades over a grid: log axis; shares stay linear."""
+    return metric.endswith(("_m", "_s"))
+
+
 def _thesis_star(ax: Any, rows: pd.DataFrame, mapper: str, axes: tuple[str, str]) -> None:
     setting = thesis_setting(mapper)
     chosen = rows[matching(rows, setting)] if setting else rows.iloc[:0]
@@ -114,7 +119,7 @@ def tradeoff_figure(table: pd.DataFrame, metric: str = "mhd_m", *,
     as a dot, the mean Pareto front over seeds with its bootstrap band, the thesis' setting
     starred."""
     rows, names, places = _select(prepare(table), mappers, terrains)
-    fig, axes = _panels(len(places))
+    fig, axes = panels(len(places))
     for ax, terrain in zip(axes, places, strict=False):
         here = rows[rows["terrain"] == terrain]
         for mapper in names:
@@ -126,24 +131,25 @@ def tradeoff_figure(table: pd.DataFrame, metric: str = "mhd_m", *,
                 part = dots[dots["on_front"] == on]
                 ax.scatter(part["x"], part["y"], s=10, alpha=alpha, color=COLORS.get(mapper),
                            lw=0)
-            _mean_front(ax, mine, mapper, (size, metric), higher_is_better)
+            mean_front(ax, mine, mapper, (size, metric), higher_is_better)
             _thesis_star(ax, mine, mapper, (size, metric))
         ax.set_xscale("log")
+        ax.set_yscale("log" if log_axis(metric) else "linear")
         ax.set(title=terrain, xlabel=label(size), ylabel=label(metric))
         ax.grid(alpha=0.3, which="both")
-    _legend(fig)
+    legend(fig)
     seeds = rows["seed"].nunique()
     fig.suptitle(f"{label(metric)} against {label(size)}: Pareto fronts, mean over {seeds} "
                  f"seed{'s' if seeds != 1 else ''} with 95 % bootstrap band")
     return fig
 
 
-def _level_panels(summary: pd.DataFrame, names: Sequence[str], ylabel: str, xlabel: str,
+def _levelpanels(summary: pd.DataFrame, names: Sequence[str], ylabel: str, xlabel: str,
                   title: str) -> Any:
     places = sorted(set(summary["terrain"]))
     if not places:
         raise ParameterError("no terrain has every mapper over a common range to compare")
-    fig, axes = _panels(len(places), 4.0, 3.2)
+    fig, axes = panels(len(places), 4.0, 3.2)
     for ax, terrain in zip(axes, places, strict=False):
         part = summary[summary["terrain"] == terrain]
         levels = sorted(set(part["level"]))
@@ -157,7 +163,7 @@ def _level_panels(summary: pd.DataFrame, names: Sequence[str], ylabel: str, xlab
                                            for v in levels])
         ax.set(title=terrain, xlabel=xlabel, ylabel=ylabel)
         ax.grid(alpha=0.3)
-    _legend(fig)
+    legend(fig)
     fig.suptitle(title)
     return fig
 
@@ -169,7 +175,7 @@ def equal_size_figure(table: pd.DataFrame, mappers: Sequence[str], metric: str =
     95 % bootstrap interval), one panel per terrain."""
     reads = equal_size(prepare(table), mappers, metric, size=size, levels=levels,
                        higher_is_better=higher_is_better)
-    return _level_panels(interval_table(reads.dropna(subset=["value"])), mappers,
+    return _levelpanels(interval_table(reads.dropna(subset=["value"])), mappers,
                          label(metric), label(size),
                          f"{label(metric)} at equal {label(size, False)}")
 
@@ -179,7 +185,7 @@ def equal_fidelity_figure(table: pd.DataFrame, mappers: Sequence[str],
                           levels: Sequence[float] | None = None) -> Any:
     """The ``metric`` (size or time) each mapper needs for equal ``fidelity`` (log axis)."""
     reads = equal_fidelity(prepare(table), mappers, metric, fidelity=fidelity, levels=levels)
-    fig = _level_panels(interval_table(reads.dropna(subset=["value"])), mappers,
+    fig = _levelpanels(interval_table(reads.dropna(subset=["value"])), mappers,
                         label(metric), label(fidelity),
                         f"{label(metric)} needed for equal {label(fidelity)}")
     for ax in fig.axes:
@@ -211,43 +217,10 @@ def _figures(table: pd.DataFrame) -> Iterator[tuple[str, Any]]:
         yield f"equal_fidelity_{suffix}", lambda p=pair: equal_fidelity_figure(table, p)
 
 
-def _panel(ax: Any, rows: pd.DataFrame, mappers: Sequence[str], axes: tuple[str, str],
-           title: str) -> None:
-    size, metric = axes
-    for mapper in mappers:
-        mine = rows[rows["mapper"] == mapper]
-        if mine.empty:
-            continue
-        dots = fronts(mine, size, metric)
-        ax.scatter(dots["x"], dots["y"], s=8, alpha=0.25, color=COLORS.get(mapper), lw=0)
-        _mean_front(ax, mine, mapper, (size, metric), False)
-    ax.set_xscale("log")
-    ax.set(title=title, xlabel=label(size), ylabel=label(metric))
-    ax.grid(alpha=0.3, which="both")
-
-
-def ablation_figure(variants: pd.DataFrame, mappers: Sequence[str], terrain: str,
-                    metric: str = "mhd_m") -> Any:
-    """``metric`` against basis functions of ``mappers`` on ``terrain``, one panel per
-    ablation variant (rows of :func:`alte.studies.grid.Grid.variants`, column
-    ``variant``), plus the base grid with size counted as occupied cells."""
-    rows = prepare(variants[variants["terrain"] == terrain])
-    rows = rows[rows["mapper"].isin(mappers) & rows[metric].notna()]
-    names = list(dict.fromkeys(rows["variant"]))
-    if rows.empty or len(names) < 2:
-        raise ParameterError(f"no ablation variants of {list(mappers)} on {terrain}")
-    fig, axes = _panels(len(names) + 1, 3.6, 3.0)
-    for ax, name in zip(axes, names, strict=False):
-        _panel(ax, rows[rows["variant"] == name], mappers, ("basis_functions", metric), name)
-    _panel(axes[len(names)], rows[rows["variant"] == names[0]], mappers,
-           ("occupied_cells", metric), f"{names[0]}, size = occupied cells")
-    _legend(fig)
-    fig.suptitle(f"{terrain}: {label(metric)} against map size with one thing changed")
-    return fig
-
-
-def _save_all(figures: Iterator[tuple[str, Any]], out_dir: str | os.PathLike[str],
-              close: bool) -> dict[str, Path | str]:
+def save_figures(figures: Iterator[tuple[str, Any]], out_dir: str | os.PathLike[str],
+                 close: bool = True) -> dict[str, Path | str]:
+    """Draw each (name, draw) and save it as ``out_dir/figures/<name>.png``; a figure that
+    cannot be drawn (:class:`ParameterError`) is recorded as ``"not drawn: <reason>"``."""
     import matplotlib.pyplot as plt
 
     from alte.notebook import save_figure
@@ -271,23 +244,4 @@ def save_tradeoff_figures(table: pd.DataFrame, out_dir: str | os.PathLike[str], 
     :mod:`alte.report.captions`) as ``out_dir/figures/<name>.png``; returns name -> path,
     or the reason a figure could not be drawn (e.g. a mapper absent from the table).
     ``close=False`` leaves the figures open (a notebook then shows them)."""
-    return _save_all(_figures(table), out_dir, close)
-
-
-def save_ablation_figures(variants: pd.DataFrame, out_dir: str | os.PathLike[str], *,
-                          close: bool = True) -> dict[str, Path | str]:
-    """:func:`ablation_figure` for each pair of mappers on the first ablated terrain of
-    its case, saved as ``tradeoff_ablation_2d``/``_3d`` (see :func:`save_tradeoff_figures`)."""
-    from alte.studies.thesis import TERRAIN_CASE
-
-    changed = variants[variants["variant"] != variants["variant"].iloc[0]] \
-        if len(variants) else variants
-    places = sorted(set(changed["terrain"]))
-    cases = {"2d": "lan", "3d": "nav"}
-
-    def figures() -> Iterator[tuple[str, Any]]:
-        for suffix, pair in PAIRS.items():
-            where = [t for t in places if TERRAIN_CASE.get(t) == cases[suffix]]
-            yield f"tradeoff_ablation_{suffix}", lambda p=pair, w=where: ablation_figure(
-                variants, p, w[0] if w else "(no terrain)")
-    return _save_all(figures(), out_dir, close)
+    return save_figures(_figures(table), out_dir, close)

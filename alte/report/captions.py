@@ -52,7 +52,8 @@ CHAPTERS: dict[str, str] = {
 _FRONT = ("Each dot is one map (a parameter setting and seed); the line is the mapper's Pareto "
           "front (no other of its maps is both smaller and better) averaged over seeds, the "
           "band its 95 % bootstrap interval over seeds; the star marks the thesis' chosen "
-          "setting. Size on a log axis.")
+          "setting. Size on a log axis, and errors and times too (they span decades over a "
+          "grid); completeness on a linear one.")
 
 #: Captions per source notebook stem and figure name.
 FIGURES: dict[str, dict[str, Caption]] = {

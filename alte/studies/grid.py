@@ -94,8 +94,8 @@ def run_grid(spec_path: str | os.PathLike[str], *, scheduler: str = "local", wor
         changes["frames"] = frames
     spec = override(spec, **changes)
     start = time.perf_counter()
-    result = run_sweep(spec, scheduler=scheduler, workers=workers, output=output,
-                       progress=progress)
+    result = run_sweep(spec, scheduler=scheduler, workers=workers,
+                       output=Path(output) if output is not None else None, progress=progress)
     seconds = time.perf_counter() - start
     failed = [f"{r.terrain} seed {r.seed} {r.mapper} {dict(r.params)}: {msg}"
               for r, msg in result.failed]
@@ -191,7 +191,8 @@ def front_order(short: pd.DataFrame, whole: pd.DataFrame, *,
             if means[0] is None or means[1] is None:
                 continue
             both = means[0].add_suffix("_short").join(means[1].add_suffix("_whole"), how="inner")
-            for (terrain, level), r in both.iterrows():
+            for key, r in both.iterrows():
+                terrain, level = str(key[0]), float(key[1])  # type: ignore[index]
                 lead = [_lead(r[f"{pair[0]}_{k}"], r[f"{pair[1]}_{k}"], higher, pair)
                         for k in ("short", "whole")]
                 if all(lead):

@@ -227,9 +227,18 @@ def _optimum(c: Optimum, table: pd.DataFrame) -> Measured:
 
 
 def _spread(group: pd.DataFrame, x: str, metric: str) -> float:
-    means = _level_means(group, x, metric)
+    """How far ``x`` alone moves ``metric``: among settings equal in every other parameter,
+    the range of ``metric`` over the levels of ``x``, averaged over those sets, relative
+    to the mean of ``metric`` (so rows added off a balanced grid confound nothing)."""
+    others = [c for c in group.columns if c.startswith("p_") and c != x
+              and group[c].notna().all() and group[c].nunique() > 1]
+    sets = group.groupby(others, dropna=False) if others else [((), group)]
+    ranges = [float(means.max() - means.min()) for _, part in sets
+              if len(means := _level_means(part, x, metric)) > 1]
     overall = abs(float(group[metric].mean()))
-    return float((means.max() - means.min()) / overall) if overall > 0 else float("nan")
+    if not ranges or not overall > 0:
+        return float("nan")
+    return float(np.mean(ranges)) / overall
 
 
 def _effect(c: Effect, table: pd.DataFrame) -> Measured:

@@ -8,17 +8,14 @@ matplotlib.use("Agg")
 
 import matplotlib.pyplot as plt
 import numpy as np
-import pandas as pd
 import pytest
 from support.tradeoff import Curve, synthetic_tradeoff
 
 from alte.errors import ParameterError
 from alte.plot.tradeoff import (
     COLORS,
-    ablation_figure,
     equal_fidelity_figure,
     equal_size_figure,
-    save_ablation_figures,
     save_tradeoff_figures,
     tradeoff_figure,
 )
@@ -38,7 +35,7 @@ def test_tradeoff_figure_has_a_log_panel_per_terrain_and_a_front_per_mapper(tabl
     axes = _visible(fig)
     assert [ax.get_title() for ax in axes] == ["sim_lan_1", "sim_lan_2", "sim_nav_1",
                                                "sim_nav_2"]
-    assert all(ax.get_xscale() == "log" for ax in axes)
+    assert all(ax.get_xscale() == ax.get_yscale() == "log" for ax in axes)  # errors: log-log
     assert axes[0].get_ylabel() == "MHD [m]" and axes[0].get_xlabel() == "basis functions"
     lan = axes[0]
     fronts = [line for line in lan.get_lines() if line.get_label().endswith(" front")]
@@ -60,6 +57,7 @@ def test_tradeoff_figure_selects_and_reports_empty_selections(table):
                           higher_is_better=True)
     (ax,) = _visible(fig)
     assert ax.get_title() == "sim_nav_1" and ax.get_ylabel() == "completeness"
+    assert ax.get_yscale() == "linear"  # a share, not an error spanning decades
     plt.close(fig)
     with pytest.raises(ParameterError, match="no rows of"):
         tradeoff_figure(table, mappers=["octomap"], terrains=["sim_lan_1"])
@@ -98,31 +96,3 @@ def test_save_tradeoff_figures_writes_every_captioned_figure(tmp_path):
     assert out["equal_size_3d"].startswith("not drawn: no terrain has every mapper")
     assert all((tmp_path / "figures" / f"{k}.png").stat().st_size > 1000 for k in drawn)
     assert set(out) <= set(FIGURES["ch5_analysis"])
-
-
-def test_ablation_figure(tmp_path):
-    from alte.report.captions import FIGURES
-
-    where = {m: ("sim_lan_2",) for m in ("quadtree", "alte2d")} | {
-        m: ("sim_nav_1",) for m in ("octomap", "alte3d")}
-    base = synthetic_tradeoff(seeds=(0, 1), terrains=where).assign(variant="base")
-    other = synthetic_tradeoff({"alte2d": Curve(scale=0.3)}, seeds=(0, 1),
-                               terrains=where).assign(variant="centres")
-    variants = pd.concat([base, other], ignore_index=True)
-    fig = ablation_figure(variants, ("quadtree", "alte2d"), "sim_lan_2")
-    titles = [ax.get_title() for ax in _visible(fig)]
-    assert titles == ["base", "centres", "base, size = occupied cells"]
-    assert _visible(fig)[2].get_xlabel() == "occupied cells"
-    plt.close(fig)
-    with pytest.raises(ParameterError, match=r"no ablation variants of \['quadtree', 'alte2d'\] "
-                       "on sim_nav_1"):
-        ablation_figure(variants, ("quadtree", "alte2d"), "sim_nav_1")
-    with pytest.raises(ParameterError, match="no ablation variants"):
-        ablation_figure(base, ("octomap", "alte3d"), "sim_nav_1")
-    out = save_ablation_figures(variants, tmp_path)
-    assert set(out) == {"tradeoff_ablation_2d", "tradeoff_ablation_3d"} <= set(
-        FIGURES["ch5_analysis"])
-    assert (tmp_path / "figures" / "tradeoff_ablation_2d.png").stat().st_size > 1000
-    assert (tmp_path / "figures" / "tradeoff_ablation_3d.png").is_file()
-    lone = save_ablation_figures(base, tmp_path / "lone")
-    assert all(str(v).startswith("not drawn: no ablation variants") for v in lone.values())

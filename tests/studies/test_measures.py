@@ -78,6 +78,21 @@ def test_effect_compares_relative_spreads_of_two_parameters():
         measure(Effect("lan", "alte2d", "basis_functions", "nope"), table)
 
 
+def test_effect_holds_the_other_parameters_fixed():
+    """A parameter that changes nothing at fixed other settings has no effect, even when
+    rows off the balanced grid would make its level means differ (a confound)."""
+    rows = [{"terrain": "sim_lan_1", "seed": 0, "mapper": "alte3d", "p_max_res": r,
+             "p_min_pts": m, "basis_functions": 10.0 ** r}
+            for r in (4, 5, 6) for m in (5, 20)]
+    rows.append({"terrain": "sim_lan_1", "seed": 0, "mapper": "alte3d", "p_max_res": 5,
+                 "p_min_pts": 40, "basis_functions": 1e5})  # a thesis row at max_res 5 only
+    table = pd.DataFrame(rows).assign(case="lan")
+    m = measure(Effect("lan", "alte3d", "basis_functions", "min_pts", max_spread=0.1), table)
+    assert m.stats["value"].to_numpy() == pytest.approx([0.1])  # no spread at all
+    m = measure(Effect("lan", "alte3d", "basis_functions", "max_res", other="min_pts"), table)
+    assert m.stats["value"].iloc[0] > 1
+
+
 def test_agreement_with_the_ground_truth():
     table = _table("quadtree", [1, 2, 3, 4], {"mhd_m": [1.0, 2.0, 3.0, 4.0],
                                              "hd_m": [5.0, 3.0, 6.0, 4.0],

@@ -105,7 +105,8 @@ class Optimum:
 class Effect:
     """Parameter ``param`` moves ``metric`` more than parameter ``other`` does, or (with
     ``max_spread``) less than that relative spread. The spread of a parameter is the
-    range of the metric's means over its levels, relative to the metric's mean."""
+    range of the metric over its levels among settings equal in every other parameter,
+    averaged over those settings, relative to the metric's mean."""
 
     case: str
     mapper: str
