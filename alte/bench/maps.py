@@ -38,7 +38,7 @@ __all__ = [
 
 #: One VLP-16 rotation at 10 Hz: a mapper keeping up with the sensor inserts faster.
 ROTATION_S = 0.1
-#: Row 1's agreement bar between the backends (the mappers issue's).
+#: Row 1's agreement bar between the backends.
 JACCARD_MIN = 0.999
 NAV, LAN = "sim_nav_1", "sim_lan_2"
 #: Terrain each mapper is benchmarked on (its thesis case, chapter 4).

@@ -88,7 +88,7 @@ def _row7(results: list[Result]) -> list[str]:
 
 def render_markdown(bench: Bench) -> str:
     """The report: machine, the table, missed targets, failed rows, row 7/8 details."""
-    lines = ["# alte benchmark (issue 6)", "", *_machine(bench), "",
+    lines = ["# alte benchmark", "", *_machine(bench), "",
              "| # | case | ours | peer | ratio ours/peer | target | met |",
              "|---|---|---|---|---|---|---|"]
     lines += [_line(r) for r in bench.results]

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
-from typing import Any
 
 __all__ = ["add_parser", "run"]
 
@@ -23,7 +22,7 @@ def _sizes(text: str) -> tuple[int, ...]:
         raise argparse.ArgumentTypeError(f"--sizes {text!r}: expected counts like 1e4,1e5") from err
 
 
-def add_parser(subparsers: Any) -> None:
+def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Register ``bench``."""
     parser = subparsers.add_parser(
         "bench", help="run the performance benchmark (issue 6)",

@@ -186,12 +186,13 @@ class Feeder:
 
     def log(self, build_s: float = 0.0) -> FrameLog:
         arr = np.array(self.rows, dtype=np.float64).reshape(-1, 5)
-        insert = arr[:, 2].copy()
-        if self.feed is Feed.BATCH and len(insert):
+        insert, latency = arr[:, 2].copy(), arr[:, 3].copy()
+        if self.feed is Feed.BATCH and len(insert):  # the map exists after the build only
             insert[:] = 0.0
             insert[-1] = build_s
+            latency[-1] += build_s
         return FrameLog(arr[:, 0].astype(np.int64), arr[:, 1].astype(np.int64), insert,
-                        arr[:, 3], arr[:, 4].astype(np.int64))
+                        latency, arr[:, 4].astype(np.int64))
 
 
 def _snapshot_indices(total: int, snapshots: int) -> list[int]:

@@ -55,7 +55,8 @@ def crop_mask(points: np.ndarray, box: tuple[float, ...] | np.ndarray) -> np.nda
 def crop(points: np.ndarray, box: tuple[float, ...] | np.ndarray) -> np.ndarray:
     """Keep only the points inside the control volume (thesis 2.2.4)."""
     pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
-    return pts[crop_mask(pts, box)]
+    kept: np.ndarray = pts[crop_mask(pts, box)]
+    return kept
 
 
 def _check_limit(name: str, value: float | None) -> float | None:

@@ -31,7 +31,8 @@ def register_with_origin(frame: Frame, mount: Mount) -> tuple[np.ndarray, np.nda
     """:func:`register_frame` and :func:`sensor_origin` from one evaluation of the pose."""
     matrix, origin = sensor_pose(frame, mount)
     points = np.asarray(frame.points, dtype=np.float64).reshape(-1, 3)
-    return points @ matrix.T + origin, origin
+    registered: np.ndarray = points @ matrix.T + origin
+    return registered, origin
 
 
 def sensor_origin(frame: Frame, mount: Mount) -> np.ndarray:
@@ -42,4 +43,5 @@ def sensor_origin(frame: Frame, mount: Mount) -> np.ndarray:
 def to_sensor(points: np.ndarray, frame: Frame, mount: Mount) -> np.ndarray:
     """Inverse of :func:`register_frame`: inertial points back into the sensor frame."""
     matrix, origin = sensor_pose(frame, mount)
-    return (np.asarray(points, dtype=np.float64).reshape(-1, 3) - origin) @ matrix
+    local: np.ndarray = (np.asarray(points, dtype=np.float64).reshape(-1, 3) - origin) @ matrix
+    return local

@@ -113,6 +113,31 @@ def test_cell_at_xy_finds_containing_rectangle():
     np.testing.assert_array_equal(cell_at_xy(xy, centers, sizes), [0, 1, 2, -1])
 
 
+def test_cell_at_xy_matches_brute_force_on_a_quadtree():
+    """Leaves of a real 2D map (many sizes, edges shared) against a brute-force search."""
+    from alte.mappers import make_mapper
+
+    rng = np.random.default_rng(3)
+    pts = np.column_stack([rng.uniform(0, 32, 4000) ** 1.2 / 2, rng.uniform(0, 32, 4000),
+                           rng.normal(0, 1, 4000)])
+    tree = make_mapper("quadtree", {"max_points": 20})
+    tree.build(pts)
+    cells = tree.cells()
+    xy = np.vstack([rng.uniform(-2, 40, (3000, 2)),  # inside and outside the root
+                    cells.centers[:200, :2] + cells.sizes[:200, :2] / 2])  # on corners
+    lo = cells.centers[:, :2] - cells.sizes[:, :2] / 2
+    hi = cells.centers[:, :2] + cells.sizes[:, :2] / 2
+    inside = np.all((xy[:, None] >= lo[None] - 1e-9) & (xy[:, None] <= hi[None] + 1e-9), axis=2)
+    got = cell_at_xy(xy, cells.centers, cells.sizes)
+    assert np.array_equal(got >= 0, inside.any(axis=1))
+    assert inside[np.flatnonzero(got >= 0), got[got >= 0]].all()
+    # one cell alone: its four corners and edge midpoints are in it
+    box = np.array([[1.0, 1.0, 0.0]]), np.array([[2.0, 2.0, 0.0]])
+    rim = np.array([[0, 0], [2, 0], [0, 2], [2, 2], [1, 0], [2, 1], [1, 2], [0, 1]], float)
+    assert (cell_at_xy(rim, *box) == 0).all()
+    assert (cell_at_xy(rim + np.array([2.001, 0.0]), *box) == -1).all()
+
+
 def _scene() -> TrueSurface:
     """A 10 x 10 m ground plane (id 0) and a closed 2 x 2 x 2 m box on it (id 1)."""
     ground_v = np.array([[0, 0, 0], [10, 0, 0], [10, 10, 0], [0, 10, 0]], float)

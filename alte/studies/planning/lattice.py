@@ -80,7 +80,8 @@ class Lattice:
     def node_points(self, indices: np.ndarray) -> np.ndarray:
         """Coordinates of the nodes with flat ``indices`` (M, 3)."""
         ijk = np.stack(np.unravel_index(np.asarray(indices, dtype=np.int64), self.shape), axis=1)
-        return self.origin + self.step * ijk
+        points: np.ndarray = self.origin + self.step * ijk
+        return points
 
     def nearest(self, point: object, name: str = "point") -> int:
         """Index of the node nearest to ``point``; raises when it lies outside the lattice."""
