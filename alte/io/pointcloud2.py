@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 
 from alte.errors import BagError
+from alte.types import finite_rows
 
 __all__ = ["POINTFIELD_DTYPES", "decode_pointcloud2", "encode_pointcloud2", "make_header"]
 
@@ -102,11 +103,10 @@ def decode_pointcloud2(msg: Any, topic: str = "PointCloud2") -> tuple[np.ndarray
     points = np.empty((count, 3), dtype=np.float64)
     for axis, name in enumerate(_XYZ):
         points[:, axis] = records[name]
-    finite = np.isfinite(points).all(axis=1)
-    dropped = int(count - np.count_nonzero(finite))
-    if dropped:
-        points = points[finite]
-    return points, dropped
+    finite = finite_rows(points)
+    if finite is None:
+        return points, 0
+    return points[finite], int(count - np.count_nonzero(finite))
 
 
 def encode_pointcloud2(

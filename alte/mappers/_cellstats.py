@@ -26,7 +26,7 @@ _RADIX_MIN = 1 << 14
 
 
 @numba.njit(cache=True)
-def sort_keys(keys: np.ndarray, bits: int):
+def sort_keys(keys: np.ndarray, bits: int) -> tuple[np.ndarray, np.ndarray]:
     """Stably sorted non-negative int64 ``keys`` below ``2**bits`` and their order (LSD
     radix sort of key and index together, digits of at most 12 bits counted in one
     pass; numba's merge sort for short arrays)."""
@@ -62,7 +62,7 @@ def _pairwise(x: np.ndarray, j: int, a: int, n: int) -> float:
         res = -0.0
         for i in range(a, a + n):
             res += x[i, j]
-        return res
+        return float(res)
     if n <= 128:
         r = x[a:a + 8, j].copy()
         m = n - n % 8
@@ -72,7 +72,7 @@ def _pairwise(x: np.ndarray, j: int, a: int, n: int) -> float:
         res = ((r[0] + r[1]) + (r[2] + r[3])) + ((r[4] + r[5]) + (r[6] + r[7]))
         for i in range(m, n):
             res += x[a + i, j]
-        return res
+        return float(res)
     half = n // 2
     half -= half % 8
     return _pairwise(x, j, a, half) + _pairwise(x, j, a + half, n - half)
@@ -81,7 +81,7 @@ def _pairwise(x: np.ndarray, j: int, a: int, n: int) -> float:
 @numba.njit(cache=True, inline="always")
 def _run_total(x: np.ndarray, j: int, a: int, b: int) -> float:
     """``np.add.reduceat`` of the run ``x[a:b, j]``."""
-    return x[a, j] + _pairwise(x, j, a + 1, b - a - 1) if b - a > 1 else x[a, j]
+    return float(x[a, j] + _pairwise(x, j, a + 1, b - a - 1) if b - a > 1 else x[a, j])
 
 
 @numba.njit(cache=True)
@@ -127,7 +127,7 @@ def _cell_row(values: np.ndarray, run: tuple[int, int], out: np.ndarray, s: int,
 
 
 @numba.njit(cache=True)
-def aggregate_points(keys: np.ndarray, values: np.ndarray):
+def aggregate_points(keys: np.ndarray, values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Cells of sorted point ``keys`` and their rows ``n, mean.., m2.., max..``."""
     starts = _run_starts(keys, 0)
     out = np.empty((starts.size - 1, 1 + 3 * values.shape[1]))
@@ -143,11 +143,11 @@ def aggregate_points(keys: np.ndarray, values: np.ndarray):
 def _run_sum(x: np.ndarray, m: int) -> float:
     """``x[0] + (x[1] + ... + x[m-1])``: the order of ``np.add.reduceat`` on short runs."""
     if m == 1:
-        return x[0]
+        return float(x[0])
     rest = x[1]
     for i in range(2, m):
         rest += x[i]
-    return x[0] + rest
+    return float(x[0] + rest)
 
 
 @numba.njit(cache=True, inline="always")
@@ -175,7 +175,7 @@ def _parent_row(rows: np.ndarray, run: tuple[int, int], out: np.ndarray, s: int,
 
 
 @numba.njit(cache=True)
-def combine(keys: np.ndarray, rows: np.ndarray, nv: int):
+def combine(keys: np.ndarray, rows: np.ndarray, nv: int) -> tuple[np.ndarray, np.ndarray]:
     """Parent cells (key >> 2) of sorted child ``keys`` with Chan's merge of their rows."""
     starts = _run_starts(keys, 2)
     out = np.empty((starts.size - 1, rows.shape[1]))
@@ -192,12 +192,12 @@ def _locate(index: np.ndarray, key: int, dense: bool) -> int:
     """Position of ``key`` in ``index``: the key itself (dense), else the slot holding it
     or the empty slot where it belongs (hashed: pairs ``key, row``; key -1 = empty)."""
     if dense:
-        return np.int64(key)
+        return int(key)
     mask = np.int64(index.size // 2 - 1)
     j = np.int64((np.uint64(key) * _GOLDEN) >> np.uint64(32)) & mask
     while index[2 * j] != -1 and index[2 * j] != key:
         j = (j + 1) & mask
-    return j
+    return int(j)
 
 
 @numba.njit(cache=True, inline="always")
@@ -225,7 +225,9 @@ def fill_index(index: np.ndarray, keys: np.ndarray, n: int, dense: bool) -> None
 
 
 @numba.njit(cache=True)
-def merge_cells(store, n: int, cells, nv: int, dense: bool):
+def merge_cells(store: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray], n: int,
+                cells: tuple[np.ndarray, np.ndarray], nv: int,
+                dense: bool) -> tuple[np.ndarray, int]:
     """Merge ``cells`` = (keys, rows) into a level's ``store`` = (keys, rows, split, index)
     holding ``n`` cells, capacity reserved; returns their rows and the new n.
 

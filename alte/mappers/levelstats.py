@@ -19,6 +19,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 
 import numpy as np
+from numpy.typing import DTypeLike
 
 from alte.errors import MapperError
 from alte.mappers._cellstats import (
@@ -43,7 +44,7 @@ _FIRST_CAPACITY = 1 << 22
 _DENSE_CELLS = 1 << 24
 
 
-def _lazy_zeros(shape: tuple[int, ...], dtype: type) -> np.ndarray:
+def _lazy_zeros(shape: tuple[int, ...], dtype: DTypeLike) -> np.ndarray:
     """A zeroed array in anonymous memory that the OS maps 4 KiB at a time on first touch.
 
     numpy advises transparent huge pages for big arrays; then the first touch of every
@@ -146,8 +147,8 @@ class LevelStats:
             self._n[level] = self._sorted[level] = len(keys)
             self._index[level] = None
             return np.arange(len(keys))
-        self._reserve(level, len(keys))
-        store = (self._k[level], self._r[level], self._s[level], self._index[level])
+        index = self._reserve(level, len(keys))
+        store = (self._k[level], self._r[level], self._s[level], index)
         touched, self._n[level] = merge_cells(store, self._n[level], (keys, agg), self.nv,
                                               self._dense(level))
         return touched
@@ -155,8 +156,8 @@ class LevelStats:
     def _dense(self, level: int) -> bool:
         return bool(4**level <= _DENSE_CELLS)
 
-    def _reserve(self, level: int, k: int) -> None:
-        """Room for ``k`` more cells at ``level`` and an index of its rows (a hashed one
+    def _reserve(self, level: int, k: int) -> np.ndarray:
+        """Room for ``k`` more cells at ``level``; the index of its rows (a hashed one
         kept at most half full)."""
         n = self._n[level]
         if n + k > len(self._k[level]):
@@ -167,13 +168,15 @@ class LevelStats:
                 store[level] = grown
             if not self._dense(level):
                 self._index[level] = None
-        if self._index[level] is None:
+        index = self._index[level]
+        if index is None:
             if self._dense(level):
                 index = _lazy_zeros((4**level,), np.int32)
             else:
                 index = np.full(2 << int(2 * len(self._k[level])).bit_length(), -1, np.int64)
             fill_index(index, self._k[level], n, self._dense(level))
             self._index[level] = index
+        return index
 
     def fold(self, level: int) -> None:
         """Sort ``level``'s pending cells into its sorted prefix (not while deferred)."""

@@ -28,6 +28,7 @@ from alte.mappers._raycast import TREE_DEPTH, TREE_MAX_VAL
 from alte.mappers.base import Cells, Feed, check_points
 from alte.mappers.domain import Domain, DomainUse
 from alte.params import Record, param
+from alte.types import rows_all
 
 __all__ = ["SENSOR_MODELS", "Octomap", "OctomapParams", "compare_backends", "occupied_voxels",
            "read_bt"]
@@ -121,7 +122,7 @@ class Octomap:
     def _count_outside(self, pts: np.ndarray) -> np.ndarray:
         """Points inside the key space; the others are counted (their rays are skipped)."""
         half = TREE_MAX_VAL * self.voxel_size
-        inside = ((pts >= -half) & (pts < half)).all(axis=1)
+        inside = rows_all((pts >= -half) & (pts < half))
         self.points_outside += int(inside.size - np.count_nonzero(inside))
         return inside
 

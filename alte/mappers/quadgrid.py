@@ -22,6 +22,8 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
+from alte.types import rows_all
+
 __all__ = ["Square", "morton_decode", "morton_encode"]
 
 
@@ -56,7 +58,8 @@ def _spread(v: int) -> int:
 
 
 @numba.njit(cache=True)
-def _locate(xy: np.ndarray, corner: tuple[float, float], size: float, cells: int):
+def _locate(xy: np.ndarray, corner: tuple[float, float], size: float,
+            cells: int) -> tuple[np.ndarray, np.ndarray]:
     """Morton keys of ``xy``'s cells (clipped to the grid) and whether each point lies in
     the closed square: :meth:`Square.keys` and :meth:`Square.contains` in one pass."""
     keys = np.empty(xy.shape[0], dtype=np.int64)
@@ -72,7 +75,8 @@ def _locate(xy: np.ndarray, corner: tuple[float, float], size: float, cells: int
 
 def morton_encode(ix: np.ndarray, iy: np.ndarray) -> np.ndarray:
     """Interleave cell indices (x in the even bits) into int64 keys."""
-    return (_part1by1(ix) | (_part1by1(iy) << np.uint64(1))).astype(np.int64)
+    keys: np.ndarray = (_part1by1(ix) | (_part1by1(iy) << np.uint64(1))).astype(np.int64)
+    return keys
 
 
 def morton_decode(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -116,12 +120,14 @@ class Square:
         """Mask of the points inside the square; ``closed=False`` excludes the upper edges."""
         rel = (xy - (self.xmin, self.ymin)) / self.size
         upper = (rel <= 1.0) if closed else (rel < 1.0)
-        return ((rel >= 0.0) & upper).all(axis=1)
+        inside: np.ndarray = rows_all((rel >= 0.0) & upper)
+        return inside
 
     def locate(self, xy: np.ndarray, level: int) -> tuple[np.ndarray, np.ndarray]:
         """:meth:`keys` and :meth:`contains` (closed) of ``xy`` (N, 2), computed together."""
-        xy = np.asarray(xy, dtype=np.float64)
-        return _locate(xy, (self.xmin, self.ymin), self.size, 1 << level)
+        found: tuple[np.ndarray, np.ndarray] = _locate(
+            np.asarray(xy, dtype=np.float64), (self.xmin, self.ymin), self.size, 1 << level)
+        return found
 
     def keys(self, xy: np.ndarray, level: int) -> np.ndarray:
         """Morton keys of the level-``level`` cells holding ``xy`` (upper edge -> last cell)."""

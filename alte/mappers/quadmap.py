@@ -138,15 +138,21 @@ class QuadMap:
 
     def _grow(self, xy: np.ndarray) -> None:
         grown = False
-        while not self.square.contains(xy, closed=False).all():
-            self.square, quadrant = self.square.doubled(xy)
+        square = self._root()
+        while not square.contains(xy, closed=False).all():
+            square, quadrant = square.doubled(xy)
+            self.square = square
             self.stats.shift_up(quadrant)
             grown = True
         if grown:
             self._update_splits(None)
 
+    def _root(self) -> Square:
+        assert self.square is not None, "insert and build set the root before adding points"
+        return self.square
+
     def _add(self, pts: np.ndarray) -> None:
-        keys, inside = self.square.locate(pts[:, :2], self.depth)
+        keys, inside = self._root().locate(pts[:, :2], self.depth)
         kept = int(np.count_nonzero(inside))
         self.points_outside += len(pts) - kept
         if kept < len(pts):
@@ -180,7 +186,8 @@ class QuadMap:
         if self.square is None:
             return np.empty(0, np.int64)
         level, _keys, rows = self.stats.leaves()
-        return np.nan_to_num(self.leaf_stat(level, rows, "n")).astype(np.int64)
+        counts: np.ndarray = np.nan_to_num(self.leaf_stat(level, rows, "n")).astype(np.int64)
+        return counts
 
     def leaf_stat(self, level: np.ndarray, rows: np.ndarray, what: str, j: int = 0) -> np.ndarray:
         """Statistic ``what`` of value ``j`` for leaves (NaN for unknown leaves)."""
