@@ -27,6 +27,11 @@ TREE_DEPTH = 16
 TREE_MAX_VAL = 32768
 _KEY_LIMIT = 2 * TREE_MAX_VAL
 
+#: A ray's arrays: origin, origin key, end, end key, float and integer workspaces.
+_Ray = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+#: The block-bitmap key set: hash slots, slot rows, bit rows, row blocks.
+_Table = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+
 
 @numba.njit(cache=True, inline="always")
 def _spread(v: np.uint64) -> np.uint64:
@@ -90,11 +95,13 @@ def _key(coord: np.float32, factor: float) -> int:
 @numba.njit(cache=True, inline="always")
 def _norm(dx: np.float32, dy: np.float32, dz: np.float32) -> float:
     """``Vector3::norm``: float squares and sum, double square root."""
-    return np.sqrt(np.float64(dx * dx + dy * dy + dz * dz))
+    norm: float = np.sqrt(np.float64(dx * dx + dy * dy + dz * dz))
+    return norm
 
 
 @numba.njit(cache=True)
-def _ends(points: np.ndarray, origin: np.ndarray, max_range: float, factor: float):
+def _ends(points: np.ndarray, origin: np.ndarray, max_range: float, factor: float,
+          ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Ray ends (truncated at ``max_range``), their keys and whether each end is a hit."""
     n = points.shape[0]
     ends = np.empty((n, 3), dtype=np.float32)
@@ -140,7 +147,8 @@ def _find(slots: np.ndarray, block: np.uint64) -> int:
 
 
 @numba.njit(cache=True)
-def _rehash(slots, rows, blocks, n_blocks):
+def _rehash(slots: np.ndarray, rows: np.ndarray, blocks: np.ndarray, n_blocks: int,
+            ) -> tuple[np.ndarray, np.ndarray]:
     """Table twice as large holding the first ``n_blocks`` blocks."""
     new_slots = np.full(slots.size * 2, _EMPTY, dtype=np.uint64)
     new_rows = np.zeros(slots.size * 2, dtype=np.int64)
@@ -152,7 +160,7 @@ def _rehash(slots, rows, blocks, n_blocks):
 
 
 @numba.njit(cache=True)
-def _grow_rows(bits, blocks):
+def _grow_rows(bits: np.ndarray, blocks: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     new_bits = np.zeros((bits.shape[0] * 2, 8), dtype=np.uint64)
     new_bits[: bits.shape[0]] = bits
     new_blocks = np.zeros(blocks.size * 2, dtype=np.uint64)
@@ -180,7 +188,8 @@ def _collect(bits: np.ndarray, blocks: np.ndarray, n_blocks: int, count: int) ->
 
 
 @numba.njit(cache=True)
-def _row(slots, rows, blocks, block, n_blocks):
+def _row(slots: np.ndarray, rows: np.ndarray, blocks: np.ndarray, block: np.uint64,
+         n_blocks: int) -> tuple[int, int]:
     """Row of ``block`` in the bit array, adding the block if new; returns (row, n_blocks)."""
     j = _find(slots, block)
     if slots[j] == _EMPTY:
@@ -192,7 +201,7 @@ def _row(slots, rows, blocks, block, n_blocks):
 
 
 @numba.njit(cache=True)
-def _setup(ray, res):
+def _setup(ray: _Ray, res: float) -> float:
     """Amanatides & Woo initialisation exactly as OctoMap; returns the ray length.
 
     Fills the per-scan workspaces: ``work`` = (tMax, tDelta), ``iwork`` = (key, step).
@@ -216,7 +225,7 @@ def _setup(ray, res):
 
 
 @numba.njit(cache=True)
-def _walk(ray, res, limit, table, n_blocks):
+def _walk(ray: _Ray, res: float, limit: int, table: _Table, n_blocks: int) -> tuple[int, int]:
     """Add the keys of ``computeRayKeys(origin, end)`` to the set; return (new keys, n_blocks).
 
     A ray visits at most |dk| + 1 voxels; ``limit`` (|dk| + 4) only stops a ray
@@ -251,7 +260,7 @@ def _walk(ray, res, limit, table, n_blocks):
 
 
 @numba.njit(cache=True)
-def _reserve(table, n_blocks: int, need: int):
+def _reserve(table: _Table, n_blocks: int, need: int) -> _Table:
     """Grow ``table`` so ``need`` more blocks fit (rows and a half-empty hash table)."""
     slots, rows, bits, blocks = table
     while n_blocks + need > blocks.size:
@@ -262,7 +271,8 @@ def _reserve(table, n_blocks: int, need: int):
 
 
 @numba.njit(cache=True)
-def _free_keys(origin, okey, ends, ekeys, res):
+def _free_keys(origin: np.ndarray, okey: np.ndarray, ends: np.ndarray, ekeys: np.ndarray,
+               res: float) -> np.ndarray:
     """Sorted unique keys of every ray's free voxels (empty when the origin is off the tree)."""
     table = (
         np.full(1 << 12, _EMPTY, dtype=np.uint64),
@@ -289,7 +299,8 @@ def _free_keys(origin, okey, ends, ekeys, res):
 
 
 @numba.njit(cache=True)
-def scan_keys(points: np.ndarray, origin: np.ndarray, res: float, max_range: float):
+def scan_keys(points: np.ndarray, origin: np.ndarray, res: float, max_range: float,
+              ) -> tuple[np.ndarray, np.ndarray]:
     """Sorted unique free and occupied Morton keys of one scan (OctoMap ``computeUpdate``).
 
     ``points`` (N, 3) and ``origin`` (3,) are float32. Free keys that are also

@@ -41,12 +41,14 @@ def _aggregate_points(values: np.ndarray, starts: np.ndarray) -> np.ndarray:
 @numba.njit(cache=True)
 def _run_sum(x: np.ndarray, a: int, b: int) -> float:
     """``x[a] + (x[a+1] + ... + x[b-1])``: the order of ``np.add.reduceat`` on short runs."""
+    first: float = x[a]
     if b - a == 1:
-        return x[a]
+        return first
     rest = x[a + 1]
     for i in range(a + 2, b):
         rest += x[i]
-    return x[a] + rest
+    total: float = first + rest
+    return total
 
 
 @numba.njit(cache=True)

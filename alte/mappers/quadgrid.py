@@ -45,7 +45,8 @@ def _compact1by1(v: np.ndarray) -> np.ndarray:
 
 def morton_encode(ix: np.ndarray, iy: np.ndarray) -> np.ndarray:
     """Interleave cell indices (x in the even bits) into int64 keys."""
-    return (_part1by1(ix) | (_part1by1(iy) << np.uint64(1))).astype(np.int64)
+    keys: np.ndarray = (_part1by1(ix) | (_part1by1(iy) << np.uint64(1))).astype(np.int64)
+    return keys
 
 
 def morton_decode(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -82,7 +83,8 @@ class Square:
         """Mask of the points inside the square; ``closed=False`` excludes the upper edges."""
         rel = (xy - (self.xmin, self.ymin)) / self.size
         upper = (rel <= 1.0) if closed else (rel < 1.0)
-        return ((rel >= 0.0) & upper).all(axis=1)
+        inside: np.ndarray = np.all((rel >= 0.0) & upper, axis=1)
+        return inside
 
     def keys(self, xy: np.ndarray, level: int) -> np.ndarray:
         """Morton keys of the level-``level`` cells holding ``xy`` (upper edge -> last cell)."""

@@ -136,6 +136,7 @@ class QuadMap:
             self._add(pts)
 
     def _grow(self, xy: np.ndarray) -> None:
+        assert self.square is not None  # callers set the root square first
         grown = False
         while not self.square.contains(xy, closed=False).all():
             self.square, quadrant = self.square.doubled(xy)
@@ -145,6 +146,7 @@ class QuadMap:
             self._update_splits(None)
 
     def _add(self, pts: np.ndarray) -> None:
+        assert self.square is not None  # callers set the root square first
         inside = self.square.contains(pts[:, :2])
         self.points_outside += int((~inside).sum())
         pts = pts[inside]
@@ -178,7 +180,8 @@ class QuadMap:
         if self.square is None:
             return np.empty(0, np.int64)
         level, _keys, rows = self.stats.leaves()
-        return np.nan_to_num(self.leaf_stat(level, rows, "n")).astype(np.int64)
+        counts: np.ndarray = np.nan_to_num(self.leaf_stat(level, rows, "n")).astype(np.int64)
+        return counts
 
     def leaf_stat(self, level: np.ndarray, rows: np.ndarray, what: str, j: int = 0) -> np.ndarray:
         """Statistic ``what`` of value ``j`` for leaves (NaN for unknown leaves)."""
