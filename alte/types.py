@@ -105,6 +105,7 @@ class Box:
             return NotImplemented
         return bool(np.array_equal(self.lo, other.lo) and np.array_equal(self.hi, other.hi))
 
+    # Unhashable (array fields, value equality); typeshed types __hash__ as a method.
     __hash__ = None  # type: ignore[assignment]
 
 
@@ -146,6 +147,7 @@ class Frame:
             and np.array_equal(self.quaternion, other.quaternion)
         )
 
+    # Unhashable (array fields, value equality); typeshed types __hash__ as a method.
     __hash__ = None  # type: ignore[assignment]
 
 

@@ -90,7 +90,8 @@ class Context:
         """``make()`` once per process and key."""
         if key not in self._memo:
             self._memo[key] = make()
-        return self._memo[key]
+        value: T = self._memo[key]
+        return value
 
     def has(self, key: str) -> bool:
         """True when ``key`` is already memoised."""

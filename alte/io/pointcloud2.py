@@ -8,7 +8,7 @@ padding (``row_step > width * point_step``) are cut to their payload first.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 
@@ -34,7 +34,7 @@ _XYZ = ("x", "y", "z")
 
 def _xyz_dtype(msg: Any, topic: str) -> np.dtype:
     """Structured dtype holding x, y, z at their offsets, ``itemsize == point_step``."""
-    order = ">" if msg.is_bigendian else "<"
+    order: Literal[">", "<"] = ">" if msg.is_bigendian else "<"
     fields = {}
     needed = 0
     for field in msg.fields:
@@ -138,11 +138,13 @@ def encode_pointcloud2(
     table = np.empty(pts.shape[0], dtype=record)
     for name, values in columns.items():
         table[name] = values
+    layout = record.fields
+    assert layout is not None  # a structured dtype has fields
     types = typestore.types
     fields = [
         types["sensor_msgs/msg/PointField"](
             name=name,
-            offset=record.fields[name][1],
+            offset=layout[name][1],
             datatype=_CODES[fmt.newbyteorder("=")],
             count=1,
         )

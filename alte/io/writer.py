@@ -30,6 +30,8 @@ _POSE = "geometry_msgs/msg/PoseStamped"
 _PC2 = "sensor_msgs/msg/PointCloud2"
 _TF = "tf2_msgs/msg/TFMessage"
 _TYPESTORE = get_typestore(Stores.ROS2_HUMBLE)
+#: Poses to interleave with the clouds: stamps, positions, quaternions, write order.
+_Poses = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
 
 
 def _pose_arrays(
@@ -81,7 +83,7 @@ class _BagOut:
         data = _TYPESTORE.serialize_cdr(msg, self.conns[topic].msgtype)
         self.writer.write(self.conns[topic], int(stamp), data)
 
-    def poses_until(self, poses: tuple, until: int | None) -> None:
+    def poses_until(self, poses: _Poses, until: int | None) -> None:
         """Write the not yet written poses stamped at or before ``until`` (all for None)."""
         stamps, pos, quat, order = poses
         while self.next_pose < order.size and (
@@ -97,7 +99,7 @@ class _BagOut:
             self.next_pose += 1
 
     def clouds(
-        self, clouds: Iterable[tuple[int, np.ndarray]], poses: tuple, progress: bool
+        self, clouds: Iterable[tuple[int, np.ndarray]], poses: _Poses, progress: bool
     ) -> None:
         """Write every scan, each preceded by the poses up to its stamp."""
         topic = self.names["cloud"]

@@ -231,9 +231,10 @@ def _inner_nodes(leaves: Leaves) -> list[np.ndarray]:
     return inner
 
 
-def _child_codes(leaves: Leaves, occupied: np.ndarray, inner: list[np.ndarray]) -> list:
+def _child_codes(leaves: Leaves, occupied: np.ndarray,
+                 inner: list[np.ndarray]) -> list[np.ndarray]:
     """16-bit child descriptor of each inner node: 2 bits per child (1 free, 2 occ, 3 inner)."""
-    codes = []
+    codes: list[np.ndarray] = []
     for depth in range(TREE_DEPTH):
         parents = inner[depth]
         at = leaves.depth == depth + 1

@@ -34,6 +34,11 @@ TREE_DEPTH = 16
 TREE_MAX_VAL = 32768
 _KEY_LIMIT = 2 * TREE_MAX_VAL
 
+#: A ray's arrays: origin, origin key, end, end key, float and integer workspaces.
+_Ray = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+#: The block-bitmap key set: hash slots, slot rows, bit rows, row blocks.
+_Table = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+
 
 @numba.njit(cache=True, inline="always")
 def _spread(v: np.uint64) -> np.uint64:
@@ -97,11 +102,13 @@ def _key(coord: np.float32, factor: float) -> int:
 @numba.njit(cache=True, inline="always")
 def _norm(dx: np.float32, dy: np.float32, dz: np.float32) -> float:
     """``Vector3::norm``: float squares and sum, double square root."""
-    return np.sqrt(np.float64(dx * dx + dy * dy + dz * dz))
+    norm: float = np.sqrt(np.float64(dx * dx + dy * dy + dz * dz))
+    return norm
 
 
 @numba.njit(cache=True)
-def _ends(points: np.ndarray, origin: np.ndarray, max_range: float, factor: float):
+def _ends(points: np.ndarray, origin: np.ndarray, max_range: float, factor: float,
+          ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Ray ends (truncated at ``max_range``), their keys and whether each end is a hit."""
     n = points.shape[0]
     ends = np.empty((n, 3), dtype=np.float32)

@@ -56,7 +56,8 @@ class Domain:
         """The cube anchored at ``box.lo`` whose edge covers the box's longest side."""
         extent = float(np.max(box.hi - box.lo))
         size = extent * (1 + _REL) + _ABS if extent > 0 else 1.0
-        return cls(*(float(v) for v in box.lo), size)
+        xmin, ymin, zmin = (float(v) for v in box.lo)
+        return cls(xmin, ymin, zmin, size)
 
     @classmethod
     def parse(cls, text: str) -> Domain:

@@ -137,6 +137,7 @@ class QuadMap:
             self._add(pts)
 
     def _grow(self, xy: np.ndarray) -> None:
+        assert self.square is not None  # callers set the root square first
         grown = False
         square = self._root()
         while not square.contains(xy, closed=False).all():

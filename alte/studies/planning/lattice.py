@@ -55,12 +55,13 @@ class Lattice:
                                  f"got {box.tolist()}")
         if not (np.isfinite(step) and step > 0):
             raise ParameterError(f"planning step={step!r} must be a positive number (m)")
-        shape = tuple(int(n) for n in np.floor((box[1] - box[0]) / step + 1e-9).astype(int) + 1)
+        nx, ny, nz = (int(n) for n in np.floor((box[1] - box[0]) / step + 1e-9).astype(int) + 1)
+        shape = (nx, ny, nz)
         if int(np.prod(shape)) > MAX_NODES:
             raise ParameterError(f"planning step={step} m gives {int(np.prod(shape))} lattice "
                                  f"nodes over {box.tolist()} (limit {MAX_NODES}); use a larger "
                                  "step or smaller bounds")
-        return cls(box[0].copy(), float(step), shape)  # type: ignore[arg-type]
+        return cls(box[0].copy(), float(step), shape)
 
     @property
     def size(self) -> int:
