@@ -14,9 +14,9 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from alte.errors import PoseError
+from alte.errors import ParameterError, PoseError
 
-__all__ = ["Frame", "Mount", "as_points", "thesis_mount"]
+__all__ = ["Box", "Frame", "Mount", "RegisteredFrame", "Trajectory", "as_points", "thesis_mount"]
 
 _NS = 1_000_000_000
 
@@ -35,6 +35,60 @@ def as_points(points: object, name: str = "points", *, owner: str = "",
     if finite and not np.isfinite(arr).all():
         raise error(f"{where}{name} contain NaN or inf values")
     return arr
+
+
+@dataclass(frozen=True, eq=False)
+class Box:
+    """An axis-aligned box ``lo <= p <= hi`` (metres), e.g. a control volume (thesis 2.2.4)."""
+
+    lo: np.ndarray
+    hi: np.ndarray
+
+    def __post_init__(self) -> None:
+        lo = np.asarray(self.lo, dtype=np.float64).reshape(-1)
+        hi = np.asarray(self.hi, dtype=np.float64).reshape(-1)
+        if lo.shape != (3,) or hi.shape != (3,) or not (np.isfinite(lo).all()
+                                                        and np.isfinite(hi).all()):
+            raise ParameterError(f"box {lo.tolist()}..{hi.tolist()}: expected 3 finite "
+                                 "lower and 3 finite upper bounds")
+        if np.any(lo > hi):
+            raise ParameterError(f"box {lo.tolist()}..{hi.tolist()}: min must be <= max")
+        object.__setattr__(self, "lo", lo)
+        object.__setattr__(self, "hi", hi)
+
+    @classmethod
+    def of(cls, values: object) -> Box:
+        """From 6 numbers ``xmin,ymin,zmin,xmax,ymax,zmax`` (a sequence or (2, 3) array)."""
+        arr = np.asarray(values, dtype=np.float64).reshape(-1)
+        if arr.shape != (6,):
+            raise ParameterError(f"box {np.asarray(values).tolist()}: expected 6 numbers "
+                                 "xmin,ymin,zmin,xmax,ymax,zmax")
+        return cls(arr[:3], arr[3:])
+
+    @classmethod
+    def around(cls, points: np.ndarray) -> Box:
+        """The bounding box of (N, 3) points (N >= 1)."""
+        pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+        return cls(pts.min(axis=0), pts.max(axis=0))
+
+    def values(self) -> tuple[float, ...]:
+        """``(xmin, ymin, zmin, xmax, ymax, zmax)``."""
+        return tuple(float(v) for v in (*self.lo, *self.hi))
+
+    def array(self) -> np.ndarray:
+        """The (2, 3) array ``[lo, hi]``."""
+        return np.array([self.lo, self.hi])
+
+    def union(self, other: Box) -> Box:
+        """The smallest box holding both."""
+        return Box(np.minimum(self.lo, other.lo), np.maximum(self.hi, other.hi))
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Box):
+            return NotImplemented
+        return bool(np.array_equal(self.lo, other.lo) and np.array_equal(self.hi, other.hi))
+
+    __hash__ = None  # type: ignore[assignment]
 
 
 @dataclass(frozen=True, eq=False)
@@ -78,6 +132,52 @@ class Frame:
     __hash__ = None  # type: ignore[assignment]
 
 
+@dataclass(frozen=True, eq=False)
+class RegisteredFrame:
+    """One scan after registration: inertial ``points`` (N, 3) and the sensor ``origin`` (3,),
+    with the scan's stamp (ns) and the body pose it was registered with."""
+
+    stamp: int
+    points: np.ndarray
+    origin: np.ndarray
+    position: np.ndarray
+    quaternion: np.ndarray
+
+
+@dataclass(frozen=True, eq=False)
+class Trajectory:
+    """The poses scans were registered with: ``stamps`` (F,) int64 ns, body ``positions``
+    (F, 3) and ``quaternions`` (F, 4, x y z w), sensor ``origins`` (F, 3)."""
+
+    stamps: np.ndarray
+    positions: np.ndarray
+    quaternions: np.ndarray
+    origins: np.ndarray
+
+    def __len__(self) -> int:
+        return int(self.stamps.shape[0])
+
+    @property
+    def times(self) -> np.ndarray:
+        """Seconds since the first stamp (F,)."""
+        return (self.stamps - self.stamps[0]) / _NS if len(self) else np.empty(0)
+
+    @classmethod
+    def empty(cls) -> Trajectory:
+        """No poses."""
+        return cls(np.empty(0, np.int64), np.empty((0, 3)), np.empty((0, 4)), np.empty((0, 3)))
+
+    @classmethod
+    def of(cls, frames: list[RegisteredFrame]) -> Trajectory:
+        """The poses of ``frames`` in order."""
+        if not frames:
+            return cls.empty()
+        return cls(np.array([f.stamp for f in frames], np.int64),
+                   np.array([f.position for f in frames], np.float64),
+                   np.array([f.quaternion for f in frames], np.float64),
+                   np.array([f.origin for f in frames], np.float64))
+
+
 @dataclass(frozen=True)
 class Mount:
     """Fixed sensor pose on the body: offset ``R_S/B^B`` and rotation ``[DCM]_S^B``."""
@@ -103,7 +203,8 @@ class Mount:
 
     @classmethod
     def from_string(cls, text: str) -> Mount:
-        """Parse ``x,y,z,roll,pitch,yaw`` (metres, degrees; body axes, extrinsic xyz)."""
+        """Parse ``x,y,z,roll,pitch,yaw`` (metres, degrees; the angle convention of
+        :mod:`alte.plot.scene`: intrinsic z-y-x, equal to extrinsic x-y-z)."""
         try:
             values = [float(v) for v in text.split(",")]
         except ValueError as err:

@@ -6,7 +6,8 @@ off-screen, ``alte.notebook.setup`` in static mode) without a display. nbval sta
 kernels in the notebook's folder; the report runner (papermill) starts them in the
 repository root, where the notebooks' relative defaults (``DATA_DIR = "data"``,
 ``OUT_DIR = "reports/scratch/..."``) are meant to resolve, so nbval is made to do
-the same.
+the same. (``alte.notebook.setup()`` also moves a kernel to the repository root,
+which is what JupyterLab relies on; starting there covers code run before it.)
 """
 
 from __future__ import annotations

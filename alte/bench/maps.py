@@ -84,16 +84,16 @@ def interleaved_passes(makers: Mapping[str, Callable[[], Any]],
 
 
 def mapper_setup(ctx: Context, name: str) -> dict[str, Any]:
-    """Chapter 4 parameters of ``name`` on its terrain, with the fixed domain ``insert`` needs."""
-    from alte.pipeline.timelapse import cube_domain, square_domain
+    """Chapter 4 parameters of ``name`` on its terrain and, for mappers with a domain, the
+    control volume's cube (as the pipeline gives it), as keywords of ``make_mapper``."""
+    from alte.mappers import DomainUse, mapper_class
+    from alte.mappers.domain import Domain
+    from alte.types import Box
 
     terrain = TERRAIN_OF[name]
-    params = mapper_params(terrain)[name]
-    bounds = ctx.workload(terrain).bounds
-    if name == "alte3d":
-        params["domain"] = cube_domain(bounds)
-    elif name in {"quadtree", "alte2d"}:
-        params["domain"] = square_domain(bounds)
+    params: dict[str, Any] = mapper_params(terrain)[name]
+    if mapper_class(name).domain_use is not DomainUse.UNUSED:
+        params["domain"] = Domain.over(Box.of(ctx.workload(terrain).bounds))
     return params
 
 

@@ -1,4 +1,8 @@
-"""``alte info BAG``: topics, message counts, duration and the cloud/pose topics alte would use."""
+"""``alte info INPUT``: a bag's topics, counts, duration and the cloud/pose topics alte would use.
+
+For a terrain folder (``alte simulate``) it also shows what the pipeline takes from it:
+the control volume (crop and domain) and the registration voxel.
+"""
 
 from __future__ import annotations
 
@@ -6,7 +10,9 @@ import argparse
 import json
 from pathlib import Path
 
+from alte.errors import BagError
 from alte.io.bag import BagInfo, inspect_bag
+from alte.pipeline import InputKind, Source, open_input
 
 __all__ = ["add_parser", "format_info", "run"]
 
@@ -16,11 +22,12 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     p = subparsers.add_parser(
         "info",
         help="show a bag's topics and the cloud/pose topics alte detects",
-        description="List the topics of BAG (ROS 1 .bag file or ROS 2 bag folder) with their "
-        "types and message counts, the duration, the detected cloud and pose topics and the "
-        "/tf_static sensor mount.",
+        description="List the topics of INPUT (ROS 1 .bag file, ROS 2 bag folder, or a terrain "
+        "folder) with their types and message counts, the duration, the detected cloud and "
+        "pose topics and the /tf_static sensor mount.",
     )
-    p.add_argument("bag", type=Path, help="ROS 1 .bag file or ROS 2 bag folder")
+    p.add_argument("input", type=Path,
+                   help="ROS 1 .bag file, ROS 2 bag folder, or a terrain folder")
     p.add_argument("--json", action="store_true", help="print one JSON object instead of text")
     p.add_argument("--cloud-topic", default=None, help="PointCloud2 / VelodyneScan topic")
     p.add_argument("--pose-topic", default=None, help="pose / odometry / TF topic")
@@ -43,11 +50,34 @@ def format_info(info: BagInfo) -> list[str]:
     return lines
 
 
+def _terrain(source: Source) -> dict[str, object]:
+    if source.kind is not InputKind.TERRAIN:
+        return {}
+    crop = None if source.control is None else list(source.control.values())
+    return {"terrain": source.name, "title": source.title, "control_volume": crop,
+            "voxel": source.voxel}
+
+
+def format_terrain(terrain: dict[str, object]) -> list[str]:
+    """Lines for a terrain folder's settings."""
+    if not terrain:
+        return []
+    return [f"terrain:   {terrain['terrain']} ({terrain['title']})",
+            f"control:   {terrain['control_volume']} (xmin,ymin,zmin,xmax,ymax,zmax m: crop "
+            "and map domain)",
+            f"voxel:     {terrain['voxel']} m (registration grid)"]
+
+
 def run(args: argparse.Namespace) -> int:
-    """Inspect the bag and print the summary."""
-    info = inspect_bag(args.bag, cloud_topic=args.cloud_topic, pose_topic=args.pose_topic)
+    """Inspect the input and print the summary."""
+    source = open_input(args.input)
+    if source.bag is None:
+        raise BagError(f"{args.input}: a point file has no topics; `alte info` reads bags and "
+                       "terrain folders")
+    info = inspect_bag(source.bag, cloud_topic=args.cloud_topic, pose_topic=args.pose_topic)
+    terrain = _terrain(source)
     if args.json:
-        print(json.dumps(info.to_dict(), sort_keys=True))
+        print(json.dumps({**info.to_dict(), **terrain}, sort_keys=True))
     else:
-        print("\n".join(format_info(info)))
+        print("\n".join(format_info(info) + format_terrain(terrain)))
     return 0

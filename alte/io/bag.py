@@ -34,7 +34,8 @@ from alte.io.reader import (
 )
 from alte.types import Frame, Mount
 
-__all__ = ["BagInfo", "FrameSet", "inspect_bag", "read_frames"]
+__all__ = ["BagInfo", "FrameSet", "FrameStream", "ReadCounts", "ReadOptions", "evenly_spaced",
+           "inspect_bag", "read_frames"]
 
 _IDENTITY_Q = np.array([0.0, 0.0, 0.0, 1.0])
 
@@ -77,12 +78,32 @@ class BagInfo:
 
 
 @dataclass
+class ReadCounts:
+    """What reading a bag's scans kept and dropped, updated as frames stream through."""
+
+    scans_read: int = 0
+    scans_skipped: int = 0
+    scans_outside_poses: int = 0
+    scans_in_pose_gap: int = 0
+    scans_empty: int = 0
+    points_nonfinite: int = 0
+    pose_samples: int = 0
+    pose_duplicates: int = 0
+    pose_reordered: int = 0
+    frames: int = 0
+
+    def as_dict(self) -> dict[str, int]:
+        """Counts by name (JSON-ready)."""
+        return dict(vars(self))
+
+
+@dataclass
 class FrameSet:
     """The posed scans of a bag plus what was dropped on the way (``counts``, ``notes``)."""
 
     frames: list[Frame]
     mount: Mount
-    counts: dict[str, int]
+    counts: ReadCounts
     cloud_topic: str
     pose_topic: str | None
     path: Path
@@ -180,111 +201,157 @@ def _decode(msg: Any, msgtype: str, topic: str, return_mode: str) -> tuple[np.nd
     return decode_pointcloud2(msg, topic)
 
 
-def _pose_ok(samples: Any, counts: dict[str, int]) -> bool:
-    """Count a scan that gets no pose; True when it has one."""
+def evenly_spaced(total: int, limit: int | None) -> frozenset[int] | None:
+    """At most ``limit`` indices of ``range(total)`` evenly spaced over it (None: all)."""
+    if limit is None or limit >= total:
+        return None
+    if isinstance(limit, bool) or not isinstance(limit, int) or limit < 1:
+        raise ParameterError(f"frames={limit!r}: expected a positive integer or None")
+    return frozenset(np.unique(np.round(np.linspace(0, total - 1, limit))).astype(int).tolist())
+
+
+@dataclass(frozen=True)
+class ReadOptions:
+    """How scans are read: gap limit, Velodyne return mode, which scans (None: all)."""
+
+    max_gap_s: float = 0.5
+    return_mode: str = "strongest"
+    select: frozenset[int] | None = None
+    progress: bool = False
+
+
+class FrameStream:
+    """The posed scans of one bag, read lazily: each iteration streams the bag once.
+
+    Opening resolves the cloud and pose topics, the pose track and the mount (and
+    raises for a bad bag before any scan is read); iterating yields one
+    :class:`~alte.types.Frame` at a time, so memory holds a frame, never the bag.
+    ``counts`` describe the last (or current) iteration.
+    """
+
+    def __init__(self, path: str | Path, *, cloud_topic: str | None = None,
+                 pose_topic: str | None = None, mount: Mount | None = None,
+                 allow_no_pose: bool = False, body_frame: str | None = None,
+                 frames: int | None = None, max_gap_s: float = 0.5,
+                 return_mode: str = "strongest", progress: bool = False) -> None:
+        if not max_gap_s > 0:
+            raise ParameterError(f"max_gap_s={max_gap_s!r} must be > 0")
+        self.path = Path(path)
+        self.notes: list[str] = []
+        with open_bag(self.path) as reader:
+            self.cloud_topic, self.pose_topic, self.track, self.mount = _sources(
+                reader, self.path, (cloud_topic, pose_topic, body_frame), mount=mount,
+                allow_no_pose=allow_no_pose, notes=self.notes)
+            self.scans = int(reader.topics[self.cloud_topic].msgcount)
+        self.options = ReadOptions(max_gap_s, return_mode, evenly_spaced(self.scans, frames),
+                                   progress)
+        self.counts = self._new_counts()
+
+    def _new_counts(self) -> ReadCounts:
+        track = self.track
+        return ReadCounts(pose_samples=len(track) if track else 0,
+                          pose_duplicates=track.duplicates if track else 0,
+                          pose_reordered=track.reordered if track else 0)
+
+    @property
+    def selected(self) -> int:
+        """Scans this stream reads (after frame selection)."""
+        select = self.options.select
+        return self.scans if select is None else len(select)
+
+    def __iter__(self) -> Iterator[Frame]:
+        self.counts = counts = self._new_counts()
+        stamps = _StampRange()
+        with open_bag(self.path) as reader:
+            for frame in _scan_frames(reader, self, counts, stamps):
+                counts.frames += 1
+                yield frame
+        if counts.frames == 0:
+            _raise_empty(self, counts, stamps)
+
+
+@dataclass
+class _StampRange:
+    """First and last scan stamp seen (for the "different clocks?" message)."""
+
+    low: int | None = None
+    high: int | None = None
+
+    def add(self, stamp: int) -> None:
+        self.low = stamp if self.low is None else min(self.low, stamp)
+        self.high = stamp if self.high is None else max(self.high, stamp)
+
+
+def _pose_at(track: PoseTrack | None, stamp: int, max_gap_s: float,
+             counts: ReadCounts) -> tuple[np.ndarray, np.ndarray, float, float] | None:
+    """The body pose at ``stamp`` (identity without a track); None, counted, when none."""
+    if track is None:
+        return np.zeros(3), _IDENTITY_Q.copy(), 0.0, 0.0
+    samples = track.interpolate([stamp], max_gap_s)
     if samples.outside[0]:
-        counts["scans_outside_poses"] += 1
+        counts.scans_outside_poses += 1
     elif samples.in_gap[0]:
-        counts["scans_in_pose_gap"] += 1
-    return bool(samples.valid[0])
+        counts.scans_in_pose_gap += 1
+    if not samples.valid[0]:
+        return None
+    return (samples.positions[0], samples.quaternions[0], float(samples.offset_s[0]),
+            float(samples.angular_rate[0]))
 
 
-def _scan_frames(
-    reader: Any, topic: str, track: PoseTrack | None, counts: dict[str, int], opts: dict[str, Any]
-) -> Iterator[Frame]:
+def _scan_frames(reader: Any, stream: FrameStream, counts: ReadCounts,
+                 stamps: _StampRange) -> Iterator[Frame]:
     """Stream the cloud topic, yielding posed frames and counting what is dropped."""
-    messages = read_messages(reader, topic, opts["path"])
-    total = reader.topics[topic].msgcount
-    for log_time, msgtype, msg in tqdm(
-        messages, total=total, desc=topic, unit="scan", disable=not opts["progress"]
-    ):
-        counts["scans_read"] += 1
+    opts, topic = stream.options, stream.cloud_topic
+    messages = read_messages(reader, topic, stream.path, opts.select)
+    for log_time, msgtype, msg in tqdm(messages, total=stream.selected, desc=topic,
+                                       unit="scan", disable=not opts.progress):
+        if msg is None:
+            counts.scans_skipped += 1
+            continue
+        counts.scans_read += 1
         stamp = header_stamp(msg.header, log_time)
-        opts["stamps"].append(stamp)
-        pose = (np.zeros(3), _IDENTITY_Q.copy(), 0.0, 0.0)
-        if track is not None:
-            samples = track.interpolate([stamp], opts["max_gap_s"])
-            if not _pose_ok(samples, counts):
-                continue
-            pose = (
-                samples.positions[0],
-                samples.quaternions[0],
-                float(samples.offset_s[0]),
-                float(samples.angular_rate[0]),
-            )
-        points, dropped = _decode(msg, msgtype, topic, opts["return_mode"])
-        counts["points_nonfinite"] += dropped
+        stamps.add(stamp)
+        pose = _pose_at(stream.track, stamp, opts.max_gap_s, counts)
+        if pose is None:
+            continue
+        points, dropped = _decode(msg, msgtype, topic, opts.return_mode)
+        counts.points_nonfinite += dropped
         if points.shape[0] == 0:
-            counts["scans_empty"] += 1
+            counts.scans_empty += 1
             continue
         yield Frame(stamp, points, *pose, dropped_points=dropped)
 
 
-def _check_frames(frames: list[Frame], counts: dict[str, int], track: Any, opts: dict) -> None:
+def _raise_empty(stream: FrameStream, counts: ReadCounts, stamps: _StampRange) -> None:
     """Raise when no scan survived, saying why."""
-    if frames:
-        return
-    where = f"{opts['path']}:{opts['topic']}"
-    if counts["scans_empty"] == counts["scans_read"]:
-        raise BagError(f"{where}: all {counts['scans_read']} scans have no usable points")
-    stamps = opts["stamps"]
+    where = f"{stream.path}:{stream.cloud_topic}"
+    if counts.scans_empty == counts.scans_read or stream.track is None:
+        raise BagError(f"{where}: all {counts.scans_read} scans have no usable points")
+    track = stream.track
     raise PoseError(
-        f"{where}: no scan has a pose from {track.source}: scan stamps {min(stamps)}.."
-        f"{max(stamps)} ns, pose stamps {int(track.stamps[0])}..{int(track.stamps[-1])} ns "
-        f"({counts['scans_outside_poses']} outside the pose track, "
-        f"{counts['scans_in_pose_gap']} in gaps > {opts['max_gap_s']} s, "
-        f"{counts['scans_empty']} without points): different clocks?"
+        f"{where}: no scan has a pose from {track.source}: scan stamps {stamps.low}.."
+        f"{stamps.high} ns, pose stamps {int(track.stamps[0])}..{int(track.stamps[-1])} ns "
+        f"({counts.scans_outside_poses} outside the pose track, "
+        f"{counts.scans_in_pose_gap} in gaps > {stream.options.max_gap_s} s, "
+        f"{counts.scans_empty} without points): different clocks?"
     )
 
 
-def read_frames(
-    path: str | Path,
-    *,
-    cloud_topic: str | None = None,
-    pose_topic: str | None = None,
-    mount: Mount | None = None,
-    max_gap_s: float = 0.5,
-    return_mode: str = "strongest",
-    allow_no_pose: bool = False,
-    body_frame: str | None = None,
-    progress: bool = False,
-) -> FrameSet:
-    """Read every scan of a bag as a posed :class:`Frame` (see the module docstring).
+def read_frames(path: str | Path, **options: Any) -> FrameSet:
+    """Every posed scan of a bag in a list (see :class:`FrameStream` for ``options``).
 
     Topics are detected by message type unless given (``pose_topic=""`` forces
-    "no pose topic"). Without a pose topic, frames
-    get the identity pose only for raw ``VelodyneScan`` packets or with
-    ``allow_no_pose=True``. ``body_frame`` picks the child frame of a ``/tf``
-    pose topic when ``/tf_static`` does not tell it. ``mount`` overrides the bag's
-    ``/tf_static`` body -> sensor transform; with neither the mount is identity
-    (noted in ``notes``).
+    "no pose topic"). Without a pose topic, frames get the identity pose only for raw
+    ``VelodyneScan`` packets or with ``allow_no_pose=True``. ``body_frame`` picks the
+    child frame of a ``/tf`` pose topic when ``/tf_static`` does not tell it. ``mount``
+    overrides the bag's ``/tf_static`` body -> sensor transform; with neither the
+    mount is identity (noted in ``notes``). Holds the whole bag: the pipeline streams
+    a :class:`FrameStream` instead.
     """
-    bag = Path(path)
-    if not max_gap_s > 0:
-        raise ParameterError(f"max_gap_s={max_gap_s!r} must be > 0")
-    notes: list[str] = []
-    with open_bag(bag) as reader:
-        cloud, pose, track, used_mount = _sources(
-            reader,
-            bag,
-            (cloud_topic, pose_topic, body_frame),
-            mount=mount,
-            allow_no_pose=allow_no_pose,
-            notes=notes,
-        )
-        counts = _new_counts(track)
-        opts = {
-            "path": bag,
-            "topic": cloud,
-            "progress": progress,
-            "max_gap_s": max_gap_s,
-            "return_mode": return_mode,
-            "stamps": [],
-        }
-        frames = list(_scan_frames(reader, cloud, track, counts, opts))
-    _check_frames(frames, counts, track, opts)
-    counts["frames"] = len(frames)
-    return FrameSet(frames, used_mount, counts, cloud, pose, bag, notes)
+    stream = FrameStream(path, **options)
+    frames = list(stream)
+    return FrameSet(frames, stream.mount, stream.counts, stream.cloud_topic, stream.pose_topic,
+                    stream.path, stream.notes)
 
 
 def _sources(
@@ -319,20 +386,3 @@ def _sources(
         )
     notes.append("no pose topic: every frame has the identity pose")
     return cloud, None, None, used_mount
-
-
-def _new_counts(track: PoseTrack | None) -> dict[str, int]:
-    counts = dict.fromkeys(
-        (
-            "scans_read",
-            "scans_outside_poses",
-            "scans_in_pose_gap",
-            "scans_empty",
-            "points_nonfinite",
-        ),
-        0,
-    )
-    counts["pose_samples"] = len(track) if track is not None else 0
-    counts["pose_duplicates"] = track.duplicates if track is not None else 0
-    counts["pose_reordered"] = track.reordered if track is not None else 0
-    return counts

@@ -119,12 +119,19 @@ def _register_extra_types(reader: AnyReader) -> None:
 
 
 def read_messages(
-    reader: AnyReader, topic: str, path: str | Path
+    reader: AnyReader, topic: str, path: str | Path, select: frozenset[int] | None = None
 ) -> Iterator[tuple[int, str, Any]]:
-    """Yield ``(log_time_ns, msgtype, message)`` of one topic, errors as :class:`BagError`."""
+    """Yield ``(log_time_ns, msgtype, message)`` of one topic, errors as :class:`BagError`.
+
+    With ``select`` only messages at those indices (in log-time order) are decoded; the
+    others are yielded as ``None`` without the cost of deserializing them.
+    """
     conns = [c for c in reader.connections if c.topic == topic]
     try:
-        for conn, log_time, raw in reader.messages(connections=conns):
+        for i, (conn, log_time, raw) in enumerate(reader.messages(connections=conns)):
+            if select is not None and i not in select:
+                yield log_time, conn.msgtype, None
+                continue
             yield log_time, conn.msgtype, reader.deserialize(raw, conn.msgtype)
     except _READ_ERRORS as err:
         raise BagError(f"{path}: cannot read topic {topic} (truncated or corrupt?): {err}") from err

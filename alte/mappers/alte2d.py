@@ -33,15 +33,16 @@ in thesis ch. 6 (mean height above a ground plane over a threshold).
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import ClassVar
 
 import numpy as np
 
-from alte.mappers.base import Cells, Param
-from alte.mappers.quadgrid import domain_ok
+from alte.mappers.base import Cells
 from alte.mappers.quadmap import QuadMap
+from alte.params import Record, param
 
-__all__ = ["Alte2D", "plane_height"]
+__all__ = ["Alte2D", "Alte2DParams", "plane_height"]
 
 CRITERIA = ("thesis", "binev")
 
@@ -57,22 +58,26 @@ def plane_height(ground: float | np.ndarray, xy: np.ndarray) -> np.ndarray:
     return -(plane[0] * xy[:, 0] + plane[1] * xy[:, 1] + plane[3]) / plane[2]
 
 
+@dataclass(frozen=True)
+class Alte2DParams(Record):
+    """2D-ALTE parameters (module docstring)."""
+
+    OWNER: ClassVar[str] = "alte2d"
+    kappa: float = param(0.1, lambda v: v > 0, "kappa > 0",
+                         "refinement threshold (m^2; see criterion)")
+    max_res: int = param(6, lambda v: 0 <= v <= 20, "0 <= max_res <= 20",
+                         "deepest level a cell may reach (root = 0)")
+    min_pts: int = param(10, lambda v: v >= 1, "min_pts >= 1",
+                         "fewest points a cell needs to split")
+    criterion: str = param("thesis", lambda v: v in CRITERIA, "thesis or binev",
+                           "refinement criterion")
+
+
 class Alte2D(QuadMap):
     """2D Adaptive Learning Terrain Estimation (see the module docstring)."""
 
     name: ClassVar[str] = "alte2d"
-    SPECS: ClassVar[dict[str, Param]] = {
-        "kappa": Param(float, 0.1, lambda v: v > 0, "kappa > 0",
-                       "refinement threshold (m^2; see criterion)"),
-        "max_res": Param(int, 6, lambda v: 0 <= v <= 20, "0 <= max_res <= 20",
-                         "deepest level a cell may reach (root = 0)"),
-        "min_pts": Param(int, 10, lambda v: v >= 1, "min_pts >= 1",
-                         "fewest points a cell needs to split"),
-        "criterion": Param(str, "thesis", lambda v: v in CRITERIA, "thesis or binev",
-                           "refinement criterion"),
-        "domain": Param(str, "", domain_ok, "'' or xmin,ymin,size with size > 0",
-                        "fixed root square; '' = grow from the data"),
-    }
+    Params: ClassVar[type[Record]] = Alte2DParams
 
     @property
     def depth(self) -> int:

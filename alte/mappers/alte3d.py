@@ -22,31 +22,40 @@ z axis is cut into layers of ``cell_height`` metres from the domain's zmin.
 
 from __future__ import annotations
 
-from typing import Any, ClassVar
+from dataclasses import dataclass
+from pathlib import Path
+from typing import ClassVar
 
 import numpy as np
 
-from alte.errors import MapperError, ParameterError
+from alte.errors import MapperError
 from alte.mappers._octree import check_origin
-from alte.mappers.base import Cells, Param, check_points, parse_params
+from alte.mappers.base import Cells, Feed, check_points
+from alte.mappers.domain import Domain, DomainUse, check_domain
+from alte.params import Record, param
+from alte.types import Box
 
-__all__ = ["Alte3D"]
+__all__ = ["Alte3D", "Alte3DParams"]
 
 _BITS = 21
 _MASK = (1 << _BITS) - 1
 _Z_OFFSET = 1 << (_BITS - 1)
 
-_SPECS: dict[str, Param] = {
-    "max_res": Param(int, 6, lambda v: 0 <= v <= 16, "0 <= max_res <= 16", "maximum splits"),
-    "min_pts": Param(int, 10, lambda v: v >= 1, ">= 1", "points to be occupied (MIN PTS)"),
-    "min_pts_split": Param(int, 20, lambda v: v >= 1, ">= 1", "split above (MIN PTS 2)"),
-    "occupancy_level": Param(int, 6, lambda v: 0 <= v <= 16, "0 <= level <= 16",
-                             "level at which min_pts applies; coarser cells scale it"),
-    "variant": Param(str, "cube", lambda v: v in {"cube", "fixed_altitude"},
-                     "cube|fixed_altitude"),
-    "cell_height": Param(float, 1.0, lambda v: v > 0, "> 0", "layer height (fixed_altitude)"),
-    "domain": Param(str, "", rule="'xmin,ymin,zmin,size' (metres) or empty = data bounds"),
-}
+
+
+@dataclass(frozen=True)
+class Alte3DParams(Record):
+    """3D-ALTE parameters (module docstring)."""
+
+    OWNER: ClassVar[str] = "alte3d"
+    max_res: int = param(6, lambda v: 0 <= v <= 16, "0 <= max_res <= 16", "maximum splits")
+    min_pts: int = param(10, lambda v: v >= 1, ">= 1", "points to be occupied (MIN PTS)")
+    min_pts_split: int = param(20, lambda v: v >= 1, ">= 1", "split above (MIN PTS 2)")
+    occupancy_level: int = param(6, lambda v: 0 <= v <= 16, "0 <= level <= 16",
+                                 "level at which min_pts applies; coarser cells scale it")
+    variant: str = param("cube", lambda v: v in {"cube", "fixed_altitude"},
+                         "cube|fixed_altitude", "cubes, or x/y cells in cell_height layers")
+    cell_height: float = param(1.0, lambda v: v > 0, "> 0", "layer height (fixed_altitude)")
 
 
 def _pack(ix: np.ndarray, iy: np.ndarray, iz: np.ndarray) -> np.ndarray:
@@ -62,21 +71,27 @@ class Alte3D:
 
     Occupied and unoccupied leaves both count (including the empty children of a
     split): a planner walking the partition handles every cell, as Octomap's count
-    includes its free leaves. ``domain`` must be set for ``insert`` (the partition is
-    anchored on it); ``build`` uses the bounding cube of the data when it is empty.
+    includes its free leaves. ``domain`` must be given for ``insert`` (the partition is
+    anchored on it); ``build`` uses the bounding cube of the data when there is none.
+    Points outside the domain are dropped and counted (:attr:`points_outside`).
     """
 
     name: ClassVar[str] = "alte3d"
     dims: ClassVar[int] = 3
     incremental: ClassVar[bool] = True
+    domain_use: ClassVar[DomainUse] = DomainUse.REQUIRED
+    default_feed: ClassVar[Feed] = Feed.FRAMES
+    exports: ClassVar[frozenset[str]] = frozenset({".npz"})
+    free_space: ClassVar[bool] = False
+    Params: ClassVar[type[Record]] = Alte3DParams
 
-    def __init__(self, **params: Any) -> None:
-        if isinstance(params.get("domain"), tuple | list | np.ndarray):
-            params["domain"] = ",".join(str(float(v)) for v in params["domain"])
-        if params.get("domain") is None:
-            params.pop("domain", None)
-        self._params = parse_params("alte3d", _SPECS, params)
-        self._domain = _parse_domain(self._params["domain"]) if self._params["domain"] else None
+    def __init__(self, domain: Domain | None = None, **given: object) -> None:
+        domain = check_domain("alte3d", domain)
+        self._record = Alte3DParams.parse(given)
+        self._params = self._record.as_dict()
+        self._fixed = domain
+        self._domain = domain
+        self.points_outside = 0
         self._reset()
 
     def _reset(self) -> None:
@@ -85,13 +100,18 @@ class Alte3D:
         self._counts = [np.empty(0, dtype=np.int64) for _ in range(levels)]
 
     @property
-    def params(self) -> dict[str, Any]:
-        return dict(self._params)
+    def params(self) -> Record:
+        """The validated parameters, defaults filled in."""
+        return self._record
 
     @property
-    def domain(self) -> tuple[float, float, float, float] | None:
-        """(xmin, ymin, zmin, size) of the root cell, or None before the first build."""
+    def domain(self) -> Domain | None:
+        """The root cube, or None before the first build without a given domain."""
         return self._domain
+
+    def write_native(self, path: Path, overwrite: bool = False) -> Path:
+        """3D-ALTE has no format of its own: export ``.npz`` cells instead."""
+        raise MapperError("alte3d: no native map format; export .npz instead")
 
     @property
     def _branching(self) -> int:
@@ -102,20 +122,25 @@ class Alte3D:
         pts = check_points(points, "alte3d")
         check_origin(origin, "alte3d")
         if self._domain is None:
-            raise MapperError("alte3d: insert needs a fixed domain; pass domain='xmin,ymin,zmin,"
-                              "size' (or use build, which takes the data's bounding cube)")
+            raise MapperError("alte3d: insert needs a fixed domain (the partition is anchored "
+                              "on it); give one, or use build, which takes the data's cube")
         self._add(pts)
 
     def build(self, points: np.ndarray, origins: np.ndarray | None = None) -> None:
         """Rebuild from a whole cloud (``origins`` unused)."""
         pts = check_points(points, "alte3d")
-        if not self._params["domain"]:
-            self._domain = _bounding_cube(pts)
+        if self._fixed is None:
+            if pts.shape[0] == 0:
+                raise MapperError("alte3d: cannot build from an empty cloud without a domain")
+            self._domain = Domain.over(Box.around(pts))
         self._reset()
+        self.points_outside = 0
         self._add(pts)
 
     def _add(self, pts: np.ndarray) -> None:
         finest = self._finest_keys(pts)
+        if finest.size == 0:
+            return
         max_res = self._params["max_res"]
         for level in range(max_res + 1):
             keys, counts = np.unique(self._at_level(finest, max_res - level), return_counts=True)
@@ -124,20 +149,19 @@ class Alte3D:
             )
 
     def _finest_keys(self, pts: np.ndarray) -> np.ndarray:
-        """Packed cell keys at level max_res; points outside the domain raise."""
-        xmin, ymin, zmin, size = self._domain
+        """Packed cell keys at level max_res; points outside the domain are dropped, counted."""
+        dom = self._domain
         n = 1 << self._params["max_res"]
-        rel = (pts - np.array([xmin, ymin, zmin])) / size
         axes = 2 if self._params["variant"] == "fixed_altitude" else 3
-        outside = ((rel[:, :axes] < 0) | (rel[:, :axes] > 1)).any(axis=1)
-        if outside.any():
-            raise MapperError(f"alte3d: {int(outside.sum())} points lie outside the domain "
-                              f"{self._domain}; enlarge 'domain'")
-        idx = np.minimum((rel * n).astype(np.int64), n - 1)
+        inside = dom.inside(pts, axes)
         if axes == 2:
-            idx[:, 2] = np.floor((pts[:, 2] - zmin) / self._params["cell_height"]) + _Z_OFFSET
-            if ((idx[:, 2] < 0) | (idx[:, 2] > _MASK)).any():
-                raise MapperError("alte3d: points span too many cell_height layers")
+            layer = np.floor((pts[:, 2] - dom.zmin) / self._params["cell_height"]) + _Z_OFFSET
+            inside &= (layer >= 0) & (layer <= _MASK)
+        self.points_outside += int(inside.size - np.count_nonzero(inside))
+        pts = pts[inside]
+        idx = np.minimum(((pts - dom.lo) / dom.size * n).astype(np.int64), n - 1)
+        if axes == 2:
+            idx[:, 2] = layer[inside]
         return _pack(idx[:, 0], idx[:, 1], idx[:, 2])
 
     def _at_level(self, finest: np.ndarray, shift: int) -> np.ndarray:
@@ -182,7 +206,8 @@ class Alte3D:
         return Cells((lo + hi) / 2, hi - lo, value.astype(np.float64), value >= need, level)
 
     def _bounds(self, keys: np.ndarray, level: int) -> tuple[np.ndarray, np.ndarray]:
-        xmin, ymin, zmin, size = self._domain
+        xmin, ymin, zmin, size = (self._domain.xmin, self._domain.ymin, self._domain.zmin,
+                                  self._domain.size)
         edge = size / (1 << level)
         ix, iy, iz = _unpack(keys)
         lo = np.c_[xmin + ix * edge, ymin + iy * edge, zmin + iz * edge]
@@ -232,21 +257,3 @@ def _merge(keys, counts, new_keys, new_counts):
         keys = np.insert(keys, pos[fresh], new_keys[fresh])
         counts = np.insert(counts, pos[fresh], new_counts[fresh])
     return keys, counts
-
-
-def _parse_domain(text: str) -> tuple[float, float, float, float]:
-    try:
-        values = tuple(float(v) for v in text.split(","))
-    except ValueError as err:
-        raise ParameterError(f"alte3d: domain={text!r} is not 'xmin,ymin,zmin,size'") from err
-    if len(values) != 4 or not np.isfinite(values).all() or values[3] <= 0:
-        raise ParameterError(f"alte3d: domain={text!r} must be 4 finite numbers with size > 0")
-    return values  # type: ignore[return-value]
-
-
-def _bounding_cube(pts: np.ndarray) -> tuple[float, float, float, float]:
-    if pts.shape[0] == 0:
-        raise MapperError("alte3d: cannot build from an empty cloud without a domain")
-    lo, hi = pts.min(axis=0), pts.max(axis=0)
-    size = float(max((hi - lo).max(), 1e-9)) * (1 + 1e-9)
-    return float(lo[0]), float(lo[1]), float(lo[2]), size

@@ -7,16 +7,19 @@ real-time loop does) or a whole cloud at once with :meth:`Mapper.build`.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+import enum
 from dataclasses import dataclass
-from typing import Any, ClassVar, Protocol, runtime_checkable
+from pathlib import Path
+from typing import ClassVar, Protocol, runtime_checkable
 
 import numpy as np
 
-from alte.errors import MapperError, ParameterError
+from alte.errors import MapperError
+from alte.mappers.domain import Domain, DomainUse
+from alte.params import Record
 from alte.types import as_points
 
-__all__ = ["Cells", "Mapper", "Param", "check_points", "parse_params"]
+__all__ = ["Cells", "Feed", "Mapper", "check_points"]
 
 
 @dataclass(frozen=True)
@@ -49,19 +52,48 @@ class Cells:
         }
 
 
+class Feed(enum.Enum):
+    """How a map is fed: one registered frame at a time, or the merged cloud once."""
+
+    FRAMES = "frames"
+    BATCH = "batch"
+
+
 @runtime_checkable
 class Mapper(Protocol):
-    """What every mapper offers; see ``alte.mappers.MAPPERS`` for the registry."""
+    """What every mapper offers; see ``alte.mappers.MAPPERS`` for the registry.
+
+    Capabilities are class attributes the pipeline reads (never probed with hasattr):
+    ``dims``, ``incremental``, ``domain_use``, ``default_feed`` (the thesis' protocol:
+    Quadtree ran once on the final cloud), ``exports`` (file suffixes it writes) and
+    ``free_space`` (its unoccupied cells were observed free).
+    """
 
     name: ClassVar[str]
     #: 2 for height maps (Quadtree, 2D-ALTE), 3 for volumetric maps.
     dims: ClassVar[int]
     #: True when ``insert`` updates only what the new frame touches.
     incremental: ClassVar[bool]
+    domain_use: ClassVar[DomainUse]
+    default_feed: ClassVar[Feed]
+    #: Suffixes :func:`alte.mappers.export_map` can write for this mapper.
+    exports: ClassVar[frozenset[str]]
+    #: True when unoccupied cells are observed free space (ray casting), not just "not hit".
+    free_space: ClassVar[bool]
 
     @property
-    def params(self) -> dict[str, Any]:
+    def params(self) -> Record:
         """The validated parameters, defaults filled in."""
+        ...
+
+    @property
+    def domain(self) -> Domain | None:
+        """The root cell (None: grown from the data, or a key space of its own)."""
+        ...
+
+    @property
+    def points_outside(self) -> int:
+        """Points given to ``insert``/``build`` that fell outside the domain and were dropped."""
         ...
 
     def insert(self, points: np.ndarray, origin: np.ndarray) -> None:
@@ -90,61 +122,9 @@ class Mapper(Protocol):
         """Corners of the occupied basis functions (M, 3): set B of thesis fig. 5.1."""
         ...
 
-
-@dataclass(frozen=True)
-class Param:
-    """One mapper parameter: its type, default, a validity check and what it means."""
-
-    kind: type
-    default: Any
-    check: Callable[[Any], bool] = lambda _v: True
-    rule: str = ""
-    help: str = ""
-
-
-def _coerce(name: str, spec: Param, value: Any, owner: str) -> Any:
-    if isinstance(value, str) and spec.kind is not str:
-        if spec.kind is bool:
-            lowered = value.strip().lower()
-            if lowered not in {"true", "false", "1", "0", "yes", "no"}:
-                raise ParameterError(f"{owner}: {name}={value!r} is not a boolean")
-            return lowered in {"true", "1", "yes"}
-        try:
-            parsed = float(value) if spec.kind is int else spec.kind(value)
-        except ValueError as err:
-            raise ParameterError(
-                f"{owner}: {name}={value!r} is not a valid {spec.kind.__name__}"
-            ) from err
-        if spec.kind is int and not parsed.is_integer():
-            raise ParameterError(f"{owner}: {name}={value!r} must be an integer")
-        value = parsed
-    if spec.kind is int and isinstance(value, float) and not value.is_integer():
-        raise ParameterError(f"{owner}: {name}={value!r} must be an integer")
-    try:
-        return spec.kind(value)
-    except (TypeError, ValueError) as err:
-        kind = spec.kind.__name__
-        raise ParameterError(f"{owner}: {name}={value!r} is not a valid {kind}") from err
-
-
-def parse_params(
-    owner: str, specs: Mapping[str, Param], given: Mapping[str, Any]
-) -> dict[str, Any]:
-    """Validate ``given`` against ``specs``: unknown keys and out-of-range values raise."""
-    unknown = sorted(set(given) - set(specs))
-    if unknown:
-        raise ParameterError(
-            f"{owner}: unknown parameter(s) {', '.join(unknown)}; valid: {', '.join(sorted(specs))}"
-        )
-    out: dict[str, Any] = {}
-    for name, spec in specs.items():
-        value = _coerce(name, spec, given[name], owner) if name in given else spec.default
-        if spec.kind is float and not np.isfinite(value):
-            raise ParameterError(f"{owner}: {name}={value!r} must be finite")
-        if not spec.check(value):
-            raise ParameterError(f"{owner}: {name}={value!r} out of range ({spec.rule})")
-        out[name] = value
-    return out
+    def write_native(self, path: Path, overwrite: bool = False) -> Path:
+        """Write the map in its own format (the non-``.npz`` suffix of ``exports``)."""
+        ...
 
 
 def check_points(points: object, owner: str, name: str = "points") -> np.ndarray:

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Iterable
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, ClassVar
 
@@ -24,9 +25,12 @@ from alte.fsutil import atomic_path
 from alte.mappers._octomap_backends import NativeTree, ReferenceTree, tree_leaves
 from alte.mappers._octree import Leaves, check_origin, leaf_geometry
 from alte.mappers._raycast import TREE_DEPTH, TREE_MAX_VAL
-from alte.mappers.base import Cells, Param, check_points, parse_params
+from alte.mappers.base import Cells, Feed, check_points
+from alte.mappers.domain import Domain, DomainUse
+from alte.params import Record, param
 
-__all__ = ["SENSOR_MODELS", "Octomap", "compare_backends", "occupied_voxels", "read_bt"]
+__all__ = ["SENSOR_MODELS", "Octomap", "OctomapParams", "compare_backends", "occupied_voxels",
+           "read_bt"]
 
 #: Sensor models: MATLAB occupancyMap3D (its free threshold 0.2 only affects MATLAB's
 #: ``checkOccupancy`` queries, not the map) and OctoMap's library defaults.
@@ -39,23 +43,37 @@ SENSOR_MODELS: dict[str, dict[str, float]] = {
 _BACKENDS = {"native": NativeTree, "reference": ReferenceTree}
 
 
-def _specs(model: dict[str, float]) -> dict[str, Param]:
-    def prob(low: float, high: float) -> Any:
-        return lambda v: low < v < high
+def _prob(low: float, high: float) -> Any:
+    return lambda v: low < v < high
 
-    return {
-        "resolution": Param(float, 5.0, lambda v: v > 0, "> 0", "cells per metre"),
-        "backend": Param(str, "native", lambda v: v in _BACKENDS, "native|reference"),
-        "sensor_model": Param(str, "matlab", lambda v: v in SENSOR_MODELS, "matlab|octomap"),
-        "max_range": Param(float, 100.0, lambda v: v > 0 or v == -1, "> 0, or -1 = unlimited",
-                           "longer rays are truncated and their end not marked occupied"),
-        "prob_hit": Param(float, model["prob_hit"], prob(0.5, 1), "0.5 < p < 1"),
-        "prob_miss": Param(float, model["prob_miss"], prob(0, 0.5), "0 < p < 0.5"),
-        "clamp_min": Param(float, model["clamp_min"], prob(0, 0.5), "0 < p < 0.5"),
-        "clamp_max": Param(float, model["clamp_max"], prob(0.5, 1), "0.5 < p < 1"),
-        "occupancy_threshold": Param(float, model["occupancy_threshold"], prob(0, 1),
-                                     "0 < p < 1"),
-    }
+
+@dataclass(frozen=True)
+class OctomapParams(Record):
+    """Octomap parameters; unset probabilities come from ``sensor_model``."""
+
+    OWNER: ClassVar[str] = "octomap"
+    resolution: float = param(5.0, lambda v: v > 0, "> 0", "cells per metre")
+    backend: str = param("native", lambda v: v in _BACKENDS, "native|reference",
+                         "our numba tree or the C++ OctoMap library")
+    sensor_model: str = param("matlab", lambda v: v in SENSOR_MODELS, "matlab|octomap",
+                              "defaults of the four probabilities")
+    max_range: float = param(100.0, lambda v: v > 0 or v == -1, "> 0, or -1 = unlimited",
+                             "longer rays are truncated and their end not marked occupied")
+    prob_hit: float | None = param(None, _prob(0.5, 1), "0.5 < p < 1")
+    prob_miss: float | None = param(None, _prob(0, 0.5), "0 < p < 0.5")
+    clamp_min: float | None = param(None, _prob(0, 0.5), "0 < p < 0.5")
+    clamp_max: float | None = param(None, _prob(0.5, 1), "0.5 < p < 1")
+    occupancy_threshold: float | None = param(None, _prob(0, 1), "0 < p < 1")
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        for name, value in SENSOR_MODELS[self.sensor_model].items():
+            if getattr(self, name) is None:
+                object.__setattr__(self, name, value)
+        if self.clamp_min >= self.occupancy_threshold:  # type: ignore[operator]
+            raise ParameterError("octomap: clamp_min must be below occupancy_threshold")
+        if self.clamp_max <= self.occupancy_threshold:  # type: ignore[operator]
+            raise ParameterError("octomap: clamp_max must be above occupancy_threshold")
 
 
 class Octomap:
@@ -75,23 +93,37 @@ class Octomap:
     name: ClassVar[str] = "octomap"
     dims: ClassVar[int] = 3
     incremental: ClassVar[bool] = True
+    domain_use: ClassVar[DomainUse] = DomainUse.UNUSED
+    default_feed: ClassVar[Feed] = Feed.FRAMES
+    exports: ClassVar[frozenset[str]] = frozenset({".npz", ".bt"})
+    free_space: ClassVar[bool] = True
+    Params: ClassVar[type[Record]] = OctomapParams
 
-    def __init__(self, **params: Any) -> None:
-        model = str(params.get("sensor_model", "matlab"))
-        if model not in SENSOR_MODELS:
-            raise ParameterError(
-                f"octomap: sensor_model={model!r} out of range (matlab|octomap)"
-            )
-        self._params = parse_params("octomap", _specs(SENSOR_MODELS[model]), params)
-        if self._params["clamp_min"] >= self._params["occupancy_threshold"]:
-            raise ParameterError("octomap: clamp_min must be below occupancy_threshold")
-        if self._params["clamp_max"] <= self._params["occupancy_threshold"]:
-            raise ParameterError("octomap: clamp_max must be above occupancy_threshold")
+    def __init__(self, domain: Domain | None = None, **given: object) -> None:
+        if domain is not None:
+            raise MapperError("octomap: its domain is the fixed key space of 2^16 voxels per "
+                              "axis around 0; it takes no domain")
+        self._record = OctomapParams.parse(given)
+        self._params = self._record.as_dict()
         self._tree = _BACKENDS[self._params["backend"]](self._params)
+        self.points_outside = 0
 
     @property
-    def params(self) -> dict[str, Any]:
-        return dict(self._params)
+    def params(self) -> Record:
+        """The validated parameters, sensor-model defaults filled in."""
+        return self._record
+
+    @property
+    def domain(self) -> Domain | None:
+        """None: Octomap's key space is fixed (2^16 voxels per axis centred on 0)."""
+        return None
+
+    def _count_outside(self, pts: np.ndarray) -> np.ndarray:
+        """Points inside the key space; the others are counted (their rays are skipped)."""
+        half = TREE_MAX_VAL * self.voxel_size
+        inside = ((pts >= -half) & (pts < half)).all(axis=1)
+        self.points_outside += int(inside.size - np.count_nonzero(inside))
+        return inside
 
     @property
     def voxel_size(self) -> float:
@@ -102,12 +134,15 @@ class Octomap:
         """Integrate one scan: free space along every ray, occupied end voxels."""
         pts = check_points(points, "octomap")
         start = check_origin(origin, "octomap")
+        self._count_outside(pts)
         self._tree.insert_scan(pts, start)
 
     def build(self, points: np.ndarray, origins: np.ndarray | None = None) -> None:
         """Rebuild from a cloud; see the class docstring for the meaning of ``origins``."""
         pts = check_points(points, "octomap")
         self._tree = _BACKENDS[self._params["backend"]](self._params)
+        self.points_outside = 0
+        self._count_outside(pts)
         if origins is None:
             self._tree.insert_hits(pts)
             return
@@ -152,6 +187,10 @@ class Octomap:
         offsets = np.array([[i >> 2 & 1, i >> 1 & 1, i & 1] for i in range(8)])
         grid = (min_keys[:, None, :] + offsets[None] * side[:, None, None]).reshape(-1, 3)
         return (np.unique(grid, axis=0) - TREE_MAX_VAL) * self.voxel_size
+
+    def write_native(self, path: Path, overwrite: bool = False) -> Path:
+        """The OctoMap binary tree (``.bt``), see :meth:`write_bt`."""
+        return self.write_bt(path, overwrite)
 
     def write_bt(self, path: str | Path, overwrite: bool = False) -> Path:
         """Write an OctoMap maximum-likelihood binary tree (``.bt``)."""

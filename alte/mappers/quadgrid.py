@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Square", "domain_ok", "morton_decode", "morton_encode", "parse_domain"]
+__all__ = ["Square", "morton_decode", "morton_encode"]
 
 
 
@@ -104,22 +104,3 @@ class Square:
         edge = self.size / np.exp2(level)
         centers = np.column_stack([self.xmin + (ix + 0.5) * edge, self.ymin + (iy + 0.5) * edge])
         return centers, edge
-
-
-def parse_domain(text: str) -> Square | None:
-    """``"xmin,ymin,size"`` or ``"xmin,ymin,zmin,size"`` (zmin ignored); ``""`` -> None."""
-    if not text.strip():
-        return None
-    values = [float(v) for v in text.split(",")]
-    if len(values) not in (3, 4) or not np.isfinite(values).all() or values[-1] <= 0:
-        raise ValueError(f"domain {text!r}: expected xmin,ymin,size with size > 0")
-    return Square(values[0], values[1], values[-1])
-
-
-def domain_ok(text: str) -> bool:
-    """True when :func:`parse_domain` accepts ``text``."""
-    try:
-        parse_domain(text)
-    except ValueError:
-        return False
-    return True

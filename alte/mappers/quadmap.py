@@ -4,7 +4,7 @@ A subclass names the value columns it keeps per cell (:meth:`QuadMap._values`),
 decides splits from the statistics (:meth:`QuadMap._split`) and turns leaf
 statistics into heights, values and occupancy (:meth:`QuadMap._leaf_values`).
 
-Domain. ``domain="xmin,ymin,size"`` fixes the root square before data arrive:
+Domain. A :class:`~alte.mappers.domain.Domain` fixes the root square before data arrive:
 points outside it are dropped and counted in :attr:`QuadMap.points_outside`. With
 no domain, :meth:`~QuadMap.build` uses the bounding square of the cloud, and the
 first :meth:`~QuadMap.insert` uses a power-of-two square aligned on its own size holding
@@ -17,13 +17,17 @@ a batch build with ``domain`` set to the grown root (:attr:`QuadMap.square`).
 
 from __future__ import annotations
 
-from typing import Any, ClassVar
+from pathlib import Path
+from typing import ClassVar
 
 import numpy as np
 
-from alte.mappers.base import Cells, Param, check_points, parse_params
+from alte.errors import MapperError
+from alte.mappers.base import Cells, Feed, check_points
+from alte.mappers.domain import Domain, DomainUse, check_domain
 from alte.mappers.levelstats import LevelStats
-from alte.mappers.quadgrid import Square, parse_domain
+from alte.mappers.quadgrid import Square
+from alte.params import Record
 
 __all__ = ["QuadMap", "rectangle_corners"]
 
@@ -44,12 +48,19 @@ class QuadMap:
     name: ClassVar[str] = "quadmap"
     dims: ClassVar[int] = 2
     incremental: ClassVar[bool] = True
-    SPECS: ClassVar[dict[str, Param]] = {}
+    domain_use: ClassVar[DomainUse] = DomainUse.OPTIONAL
+    default_feed: ClassVar[Feed] = Feed.FRAMES
+    exports: ClassVar[frozenset[str]] = frozenset({".npz"})
+    free_space: ClassVar[bool] = False
+    Params: ClassVar[type[Record]] = Record
     _NVALUES: ClassVar[int] = 1
 
-    def __init__(self, **params: Any) -> None:
-        self._params = parse_params(self.name, self.SPECS, params)
-        self._fixed = parse_domain(self._params["domain"])
+    def __init__(self, domain: Domain | None = None, **given: object) -> None:
+        domain = check_domain(self.name, domain)
+        self._record = self.Params.parse(given)
+        self._params = self._record.as_dict()
+        self._zmin = 0.0 if domain is None else domain.zmin
+        self._fixed = None if domain is None else Square(domain.xmin, domain.ymin, domain.size)
         self._reset(self._fixed)
 
     # -- hooks ---------------------------------------------------------------------------
@@ -80,9 +91,20 @@ class QuadMap:
 
     # -- protocol ------------------------------------------------------------------------
     @property
-    def params(self) -> dict[str, Any]:
+    def params(self) -> Record:
         """The validated parameters, defaults filled in."""
-        return dict(self._params)
+        return self._record
+
+    @property
+    def domain(self) -> Domain | None:
+        """The root square (the given domain, or the one grown from the data so far)."""
+        if self.square is None:
+            return None
+        return Domain(self.square.xmin, self.square.ymin, self._zmin, self.square.size)
+
+    def write_native(self, path: Path, overwrite: bool = False) -> Path:
+        """2D maps have no format of their own: export ``.npz`` cells instead."""
+        raise MapperError(f"{self.name}: no native map format; export .npz instead")
 
     def _reset(self, square: Square | None) -> None:
         self.square: Square | None = square

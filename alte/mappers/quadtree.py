@@ -18,9 +18,9 @@ The ground plane is a parameter, fixed for the whole map: ``ground="z0"`` (the p
 refitting per frame would change heights already inserted). The core works on the
 plane as an array, :attr:`Quadtree.plane`.
 
-The thesis' Quadtree runs once on the final cloud; this one also inserts frame by
-frame, revisiting only the cells the frame touches, and ends with the same map as
-the batch build (the split rule depends on a cell's own count only). Leaves without
+The thesis' Quadtree runs once on the final cloud (``default_feed`` is batch); this one
+also inserts frame by frame, revisiting only the cells the frame touches, and ends with
+the same map as the batch build (the split rule depends on a cell's own count only). Leaves without
 points (siblings of split cells) are *unknown*: NaN height and value, not occupied.
 
 Cells: ``centers[:, 2]`` is the leaf's mean z, ``value`` the thresholded statistic
@@ -32,17 +32,19 @@ holds per-level statistics down to ``max_depth`` (needed to split a leaf later).
 
 from __future__ import annotations
 
-from typing import Any, ClassVar
+from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
 from alte.errors import AlteError, MapperError
 from alte.mappers.alte2d import plane_height
-from alte.mappers.base import Param
-from alte.mappers.quadgrid import domain_ok
+from alte.mappers.base import Feed
+from alte.mappers.domain import Domain
 from alte.mappers.quadmap import QuadMap
+from alte.params import Record, param
 
-__all__ = ["Quadtree", "parse_ground"]
+__all__ = ["Quadtree", "QuadtreeParams", "parse_ground"]
 
 RULES = ("mean", "max")
 
@@ -66,28 +68,33 @@ def _ground_ok(text: str) -> bool:
     return True
 
 
+@dataclass(frozen=True)
+class QuadtreeParams(Record):
+    """Quadtree parameters (module docstring)."""
+
+    OWNER: ClassVar[str] = "quadtree"
+    max_points: int = param(200, lambda v: v >= 1, "max_points >= 1",
+                            "split a cell holding more points than this")
+    max_depth: int = param(12, lambda v: 0 <= v <= 24, "0 <= max_depth <= 24",
+                           "deepest level (guard against duplicate points)")
+    height_threshold: float = param(0.5, lambda v: v >= 0, "height_threshold >= 0",
+                                    "m above the ground plane for an occupied leaf")
+    occupancy: str = param("mean", lambda v: v in RULES, "mean or max",
+                           "statistic of the leaf's heights compared with the threshold")
+    ground: str = param("0", _ground_ok, "z0, a,b,c,d (non-vertical) or fit",
+                        "ground plane the heights are measured from")
+
+
 class Quadtree(QuadMap):
     """Point-count quadtree with a height-above-ground occupancy rule (module docstring)."""
 
     name: ClassVar[str] = "quadtree"
-    SPECS: ClassVar[dict[str, Param]] = {
-        "max_points": Param(int, 200, lambda v: v >= 1, "max_points >= 1",
-                            "split a cell holding more points than this"),
-        "max_depth": Param(int, 12, lambda v: 0 <= v <= 24, "0 <= max_depth <= 24",
-                           "deepest level (guard against duplicate points)"),
-        "height_threshold": Param(float, 0.5, lambda v: v >= 0, "height_threshold >= 0",
-                                  "m above the ground plane for an occupied leaf"),
-        "occupancy": Param(str, "mean", lambda v: v in RULES, "mean or max",
-                           "statistic of the leaf's heights compared with the threshold"),
-        "ground": Param(str, "0", _ground_ok, "z0, a,b,c,d (non-vertical) or fit",
-                        "ground plane the heights are measured from"),
-        "domain": Param(str, "", domain_ok, "'' or xmin,ymin,size with size > 0",
-                        "fixed root square; '' = grow from the data"),
-    }
+    default_feed: ClassVar[Feed] = Feed.BATCH
+    Params: ClassVar[type[Record]] = QuadtreeParams
     _NVALUES: ClassVar[int] = 2  # z, height above the plane
 
-    def __init__(self, **params: Any) -> None:
-        super().__init__(**params)
+    def __init__(self, domain: Domain | None = None, **given: object) -> None:
+        super().__init__(domain, **given)
         #: Ground plane (a, b, c, d); None until ``build`` fits it (``ground="fit"``).
         self.plane: np.ndarray | None = parse_ground(self._params["ground"])
 

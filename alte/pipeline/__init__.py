@@ -1,1 +1,34 @@
-"""The pipeline: an input and a map specification -> a map run."""
+"""The pipeline: an input and a map specification -> a map run.
+
+``run(input, MapSpec(...), FrameSpec(...))`` is the one path from a bag, a terrain
+folder or a point file to a map (:mod:`~alte.pipeline.run`); ``prepare`` registers
+an input once for several maps (:mod:`~alte.pipeline.prepare`); the specifications
+and their policies are in :mod:`~alte.pipeline.spec`.
+"""
+
+from alte.pipeline.prepare import Registered, cache_key, merged_cloud, prepare
+from alte.pipeline.run import FrameLog, MapRun, RunInfo, Snapshot, resolve_domain, run
+from alte.pipeline.source import InputKind, Source, StreamCounts, open_input, stream_frames
+from alte.pipeline.spec import DomainPolicy, FrameSpec, MapSpec, PoseSource
+
+__all__ = [
+    "DomainPolicy",
+    "FrameLog",
+    "FrameSpec",
+    "InputKind",
+    "MapRun",
+    "MapSpec",
+    "PoseSource",
+    "Registered",
+    "RunInfo",
+    "Snapshot",
+    "Source",
+    "StreamCounts",
+    "cache_key",
+    "merged_cloud",
+    "open_input",
+    "prepare",
+    "resolve_domain",
+    "run",
+    "stream_frames",
+]

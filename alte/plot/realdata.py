@@ -18,7 +18,7 @@ from matplotlib.colors import ListedColormap
 from matplotlib.figure import Figure
 
 from alte.notebook import save_figure as _save_figure
-from alte.studies.experiments import MapRun
+from alte.studies.experiments import Measured
 from alte.studies.realdata.data import GroundRun
 
 __all__ = ["OUTCOMES", "ground_figure", "outcomes", "save_figure", "show_maps"]
@@ -68,11 +68,11 @@ def save_figure(fig: Figure | None, out_dir: str | os.PathLike[str], name: str) 
     return None if fig is None else _save_figure(fig, out_dir, name)
 
 
-def show_maps(runs: Sequence[MapRun], out_dir: str | os.PathLike[str] | None = None,
-              name: str | None = None, title: str = "") -> Path | None:
+def show_maps(runs: Sequence[Measured], out_dir: str | os.PathLike[str] | None = None,
+              name: str | None = None, title: str = "") -> None:
     """Occupied cells of each map side by side (linked cameras); nothing for no runs."""
     if not runs:
-        return None
+        return
     from alte.plot.maps import add_cells_3d
     from alte.plot.render import new_plotter, show
 
@@ -81,7 +81,7 @@ def show_maps(runs: Sequence[MapRun], out_dir: str | os.PathLike[str] | None = N
         plotter.subplot(0, i)
         add_cells_3d(plotter, run.mapper.cells(), show_edges=False,
                      scalar_bar_args={"title": f"height {i} [m]"})
-        plotter.add_text(f"{title} {run.mapper_name}: {run.metrics['occupied_cells']} occupied",
+        plotter.add_text(f"{title} {run.name}: {run.metrics.occupied_cells} occupied",
                          font_size=9)
     plotter.link_views()
-    return show(plotter, out_dir, name)
+    show(plotter, out_dir, name)

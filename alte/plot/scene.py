@@ -4,6 +4,14 @@ ground/clusters, pose history and the obstacle map.
 3D views go to a pyvista plotter (off-screen unless interactive, see
 :mod:`alte.plot.render`); 2D plots are matplotlib figures. Helpers only draw
 arrays they are given.
+
+Attitude, stated once for every figure and text of alte (:func:`attitude_deg`, and
+the ``--mount`` strings of :class:`alte.types.Mount`): **roll, pitch, yaw in degrees
+are intrinsic z-y-x angles** (yaw about z, then pitch about the new y, then roll
+about the new x: the aerospace convention), which is the same rotation as extrinsic
+x-y-z angles (roll, pitch, yaw) about the fixed axes. Each angle wraps at +-180 deg,
+as the motion-capture attitude of the thesis' experimental terrains does (2.2.4,
+fig. 4.32).
 """
 
 from __future__ import annotations
@@ -12,11 +20,25 @@ from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
+from scipy.spatial.transform import Rotation
+
+from alte.types import Trajectory
+
+#: Attitude angle names in the one convention of the module docstring.
+ANGLE_NAMES = ("roll", "pitch", "yaw")
+
+
+def attitude_deg(quaternions: np.ndarray) -> np.ndarray:
+    """(F, 3) roll, pitch, yaw in degrees (intrinsic z-y-x; module docstring)."""
+    rot = Rotation.from_quat(np.asarray(quaternions, dtype=np.float64).reshape(-1, 4))
+    return rot.as_euler("ZYX", degrees=True)[:, ::-1]
 
 __all__ = [
+    "ANGLE_NAMES",
     "add_cloud",
     "add_ground_and_clusters",
     "add_scene",
+    "attitude_deg",
     "plot_obstacle_map",
     "plot_pose_history",
     "plot_scans",
@@ -94,17 +116,19 @@ def plot_scans(scans: Sequence[np.ndarray], times: Sequence[float], max_points: 
     return fig
 
 
-def plot_pose_history(times: np.ndarray, positions: np.ndarray, angles_deg: np.ndarray,
-                      angle_names: Sequence[str] = ("roll", "pitch", "yaw")) -> Any:
-    """Position and attitude against time (thesis figs. 4.2, 4.26, 4.32)."""
+def plot_pose_history(trajectory: Trajectory, title: str = "") -> Any:
+    """Position and attitude against time (thesis figs. 4.2, 4.26, 4.32; the angle
+    convention is the module docstring's)."""
     import matplotlib.pyplot as plt
 
     fig, (top, bottom) = plt.subplots(2, 1, figsize=(8, 5.5), sharex=True)
+    times = trajectory.times
     for i, axis in enumerate("xyz"):
-        top.plot(times, positions[:, i], label=axis)
-    for i, name in enumerate(angle_names):
-        bottom.plot(times, angles_deg[:, i], label=name)
-    top.set(ylabel="position [m]")
+        top.plot(times, trajectory.positions[:, i], label=axis)
+    angles = attitude_deg(trajectory.quaternions)
+    for i, name in enumerate(ANGLE_NAMES):
+        bottom.plot(times, angles[:, i], label=name)
+    top.set(ylabel="position [m]", title=title)
     bottom.set(ylabel="attitude [deg]", xlabel="time [s]")
     top.legend(loc="upper right")
     bottom.legend(loc="upper right")

@@ -1,6 +1,6 @@
-"""Matplotlib figures of chapters 4-5: pose history, trajectory, cloud and map views.
+"""Figures of chapters 4-5: the terrain, the registered cloud and map views from above.
 
-Figures take arrays (or a :class:`~alte.studies.experiments.Dataset` / mapper) and
+Figures take arrays (or a mapper / true surface) and
 return a ``matplotlib.figure.Figure``; the notebooks display and save them with
 :func:`alte.notebook.save_figure`. Maps are drawn from above: every known cell as a
 rectangle coloured by height (2D maps) or by its top (occupied 3D cells, drawn low to
@@ -15,45 +15,10 @@ from typing import Any
 import numpy as np
 from matplotlib.collections import PolyCollection
 from matplotlib.figure import Figure
-from scipy.spatial.transform import Rotation
 
-__all__ = ["add_terrain", "cloud_figure", "map_grid_figure", "pose_figure", "trajectory_figure"]
+__all__ = ["add_terrain", "cloud_figure", "map_grid_figure"]
 
 _MAX_DOTS = 60_000
-
-
-def pose_figure(info: dict[str, Any]) -> Figure:
-    """Position and attitude (roll, pitch, yaw in degrees) against time (figs. 4.2, 4.8...)."""
-    fig = Figure(figsize=(9, 5))
-    ax_p, ax_a = fig.subplots(2, 1, sharex=True)
-    t = info["time_s"]
-    for i, axis in enumerate("xyz"):
-        ax_p.plot(t, info["positions"][:, i], label=axis)
-    euler = Rotation.from_quat(info["quaternions"]).as_euler("xyz", degrees=True)
-    for i, name in enumerate(("roll", "pitch", "yaw")):
-        ax_a.plot(t, euler[:, i], label=name)
-    ax_p.set_ylabel("position [m]")
-    ax_a.set_ylabel("attitude [deg]")
-    ax_a.set_xlabel("time [s]")
-    for ax in (ax_p, ax_a):
-        ax.legend(loc="upper right", fontsize=8)
-        ax.grid(alpha=0.3)
-    return fig
-
-
-def trajectory_figure(info: dict[str, Any]) -> Figure:
-    """The vehicle's path in 3D (figs. 4.3, 4.9...)."""
-    fig = Figure(figsize=(6, 5))
-    ax = fig.add_subplot(projection="3d")
-    p = info["positions"]
-    ax.plot(p[:, 0], p[:, 1], p[:, 2])
-    ax.scatter(*p[0], color="green", label="start")
-    ax.scatter(*p[-1], color="red", label="end")
-    ax.set_xlabel("x [m]")
-    ax.set_ylabel("y [m]")
-    ax.set_zlabel("z [m]")
-    ax.legend()
-    return fig
 
 
 def cloud_figure(points: np.ndarray, title: str = "registered cloud") -> Figure:

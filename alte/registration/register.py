@@ -30,9 +30,11 @@ from alte.types import Frame, Mount
 __all__ = [
     "ManoeuvreFilter",
     "Registration",
+    "RegistrationCounts",
     "check_options",
     "crop",
     "crop_mask",
+    "empty_reason",
     "register",
     "register_frames",
 ]
@@ -94,29 +96,47 @@ class ManoeuvreFilter:
         return self.reason(frame) is None
 
 
-_COUNT_KEYS = (
-    "frames_in", "frames_kept", "frames_dropped_rate", "frames_dropped_offset",
-    "frames_dropped_empty", "points_in", "points_dropped_nonfinite", "points_dropped_crop",
-    "points_registered",
-)
+@dataclass
+class RegistrationCounts:
+    """Frames and points in, dropped by reason, and out; updated as frames stream through."""
+
+    frames_in: int = 0
+    frames_kept: int = 0
+    frames_dropped_rate: int = 0
+    frames_dropped_offset: int = 0
+    frames_dropped_empty: int = 0
+    points_in: int = 0
+    points_dropped_nonfinite: int = 0
+    points_dropped_crop: int = 0
+    points_registered: int = 0
+    points_out: int = 0
+
+    def drop_frame(self, reason: str) -> None:
+        """Count a frame dropped for ``reason`` (rate, offset or empty)."""
+        name = f"frames_dropped_{reason}"
+        setattr(self, name, getattr(self, name) + 1)
+
+    def as_dict(self) -> dict[str, int]:
+        """Counts by name (JSON-ready)."""
+        return dict(vars(self))
 
 
 def _frame_points(
-    frame: Frame, mount: Mount, box: np.ndarray | None, counts: dict[str, int]
+    frame: Frame, mount: Mount, box: np.ndarray | None, counts: RegistrationCounts
 ) -> np.ndarray:
     """Registered, finite, cropped points of one frame."""
     raw = np.asarray(frame.points, dtype=np.float64)
     if raw.ndim != 2 or raw.shape[1] != 3:
         raise RegistrationError(f"frame at stamp {frame.stamp}: points have shape {raw.shape}")
-    counts["points_in"] += len(raw)
+    counts.points_in += len(raw)
     pts = register_frame(frame, mount)
     finite = np.isfinite(pts).all(axis=1)
     if not finite.all():
-        counts["points_dropped_nonfinite"] += len(pts) - int(finite.sum())
+        counts.points_dropped_nonfinite += len(pts) - int(finite.sum())
         pts = pts[finite]
     if box is not None:
         inside = crop_mask(pts, box)
-        counts["points_dropped_crop"] += len(pts) - int(inside.sum())
+        counts.points_dropped_crop += len(pts) - int(inside.sum())
         pts = pts[inside]
     return pts
 
@@ -125,27 +145,30 @@ def _iterate(
     frames: Iterable[Frame],
     mount: Mount,
     *,
-    counts: dict[str, int],
+    counts: RegistrationCounts,
     voxel: float | None,
     crop_box: tuple[float, ...] | None,
     gate: ManoeuvreFilter,
+    merge: GridAccumulator | None,
     progress: bool,
 ) -> Iterator[tuple[Frame, np.ndarray, np.ndarray]]:
     box = None if crop_box is None else np.asarray(crop_box, dtype=np.float64)
     for frame in tqdm(frames, desc="register", unit="frame", disable=not progress):
-        counts["frames_in"] += 1
+        counts.frames_in += 1
         reason = gate.reason(frame)
         if reason is not None:
-            counts[f"frames_dropped_{reason}"] += 1
+            counts.drop_frame(reason)
             continue
         pts = _frame_points(frame, mount, box, counts)
         if len(pts) == 0:
-            counts["frames_dropped_empty"] += 1
+            counts.drop_frame("empty")
             continue
+        if merge is not None:
+            merge.add(pts)
         if voxel is not None:
             pts = grid_average(pts, voxel)
-        counts["frames_kept"] += 1
-        counts["points_registered"] += len(pts)
+        counts.frames_kept += 1
+        counts.points_registered += len(pts)
         yield frame, pts, sensor_origin(frame, mount)
 
 
@@ -172,21 +195,22 @@ def register_frames(
     max_rate: float | None = None,
     max_offset: float | None = None,
     progress: bool = False,
-    counts: dict[str, int] | None = None,
+    counts: RegistrationCounts | None = None,
+    merge: GridAccumulator | None = None,
 ) -> Iterator[tuple[Frame, np.ndarray, np.ndarray]]:
     """Yield ``(frame, inertial points, sensor origin)`` per kept frame, for incremental mappers.
 
     Points are registered (eq. 2.2), stripped of NaN/inf, cropped to ``crop_box``
     and grid-averaged with ``voxel`` (when given). Frames dropped by the manoeuvre
-    filter or left without points are skipped; pass a dict as ``counts`` to get
-    the tally (updated as frames stream through).
+    filter or left without points are skipped; pass a :class:`RegistrationCounts` as
+    ``counts`` to get the tally (updated as frames stream through). ``merge`` receives
+    each kept frame's points before down-sampling (the box-grid merge of the cloud).
     """
     gate = check_options(voxel, crop_box, max_rate, max_offset)
-    tally = dict.fromkeys(_COUNT_KEYS, 0) if counts is None else counts
-    tally.update(dict.fromkeys(_COUNT_KEYS, 0))
+    tally = RegistrationCounts() if counts is None else counts
     return _iterate(
-        frames, mount, counts=tally, voxel=voxel, crop_box=crop_box, gate=gate, progress=progress
-    )
+        frames, mount, counts=tally, voxel=voxel, crop_box=crop_box, gate=gate, merge=merge,
+        progress=progress)
 
 
 @dataclass(frozen=True)
@@ -203,7 +227,7 @@ class Registration:
     origins: np.ndarray
     frame_points: np.ndarray
     stamps: np.ndarray
-    counts: dict[str, int]
+    counts: RegistrationCounts
 
 
 def register(
@@ -222,7 +246,7 @@ def register(
     through a :class:`GridAccumulator` (cell means weighted by raw point counts);
     without it the registered points are concatenated.
     """
-    counts: dict[str, int] = {}
+    counts = RegistrationCounts()
     merged = GridAccumulator(voxel) if voxel is not None else None
     parts: list[np.ndarray] = []
     origins, stamps, sizes = [], [], []
@@ -239,23 +263,22 @@ def register(
         origins.append(origin)
         stamps.append(frame.stamp)
     if not origins:
-        raise RegistrationError(_empty_reason(counts))
+        raise RegistrationError(empty_reason(counts))
     points = np.vstack(parts) if merged is None else merged.points()
-    counts["points_registered"] = int(sum(sizes))
-    counts["points_out"] = len(points)
+    counts.points_registered = int(sum(sizes))
+    counts.points_out = len(points)
     return Registration(
         points, np.asarray(origins), np.asarray(sizes, np.int64),
         np.asarray(stamps, np.int64), counts,
     )
 
 
-def _empty_reason(counts: dict[str, int]) -> str:
+def empty_reason(counts: RegistrationCounts) -> str:
     """Explain why no frame survived registration."""
-    if counts.get("frames_in", 0) == 0:
+    if counts.frames_in == 0:
         return "no frames to register: the input held no frames"
     dropped = ", ".join(
-        f"{counts[k]} {k.removeprefix('frames_dropped_')}"
-        for k in ("frames_dropped_rate", "frames_dropped_offset", "frames_dropped_empty")
-        if counts.get(k)
-    )
-    return f"no frame left to register: all {counts['frames_in']} frames dropped ({dropped})"
+        f"{n} {why}" for why, n in (("rate", counts.frames_dropped_rate),
+                                    ("offset", counts.frames_dropped_offset),
+                                    ("empty", counts.frames_dropped_empty)) if n)
+    return f"no frame left to register: all {counts.frames_in} frames dropped ({dropped})"

@@ -107,6 +107,16 @@ def _injected(run: Run, run_dir: Path, data_dir: Path) -> dict[str, Any]:
     return {k: str(v) for k, v in given.items() if k in run.defaults}
 
 
+def _kernel_config() -> Any:
+    """Kernels encrypt their local TCP traffic (CurveZMQ, which the python3 kernelspec
+    declares) when pyzmq can, instead of ipykernel warning about plain text per run."""
+    import zmq
+    from traitlets.config import Config
+
+    return Config({"KernelManager": {"transport_encryption": "auto"}} if zmq.has("curve")
+                  else {})
+
+
 def execute_run(run: Run, run_dir: Path, data_dir: Path, cwd: Path = REPO_ROOT,
                 kernel_name: str = "python3") -> RunResult:
     """Execute one notebook into ``run_dir``; failures are returned, never raised."""
@@ -118,7 +128,8 @@ def execute_run(run: Run, run_dir: Path, data_dir: Path, cwd: Path = REPO_ROOT,
     status, error = "ok", None
     try:
         papermill.execute_notebook(str(run.notebook), str(tmp), parameters=params,
-                                   kernel_name=kernel_name, cwd=str(cwd), progress_bar=False)
+                                   kernel_name=kernel_name, cwd=str(cwd), progress_bar=False,
+                                   config=_kernel_config())
     except papermill.PapermillExecutionError as err:
         status, error = "failed", f"cell {err.exec_count}: {err.ename}: {err.evalue}"
     except Exception as err:  # dead kernel, timeout, unreadable notebook: isolate it too

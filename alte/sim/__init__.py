@@ -12,8 +12,6 @@ from alte.sim.platform import (
     Cart,
     Quadrotor,
     Trajectory,
-    observer_euler,
-    pose_history,
     tripod_mount,
 )
 from alte.sim.scenario import (
@@ -48,8 +46,6 @@ __all__ = [
     "load_ground_truth",
     "load_scenario",
     "mesh_distance",
-    "observer_euler",
-    "pose_history",
     "simulate",
     "spec_hash",
     "terrain_folder",

@@ -21,7 +21,7 @@ from scipy.spatial.transform import Rotation
 
 from alte.types import Mount
 
-__all__ = ["Cart", "Quadrotor", "Trajectory", "mocap_stream", "observer_euler", "pose_history",
+__all__ = ["Cart", "Quadrotor", "Trajectory", "mocap_stream",
            "tripod_mount"]
 
 _G = 9.81
@@ -159,26 +159,3 @@ def mocap_stream(trajectory: Trajectory, stamps_s: np.ndarray, cart: Cart,
     tilt = Rotation.from_rotvec(rng.normal(0.0, np.radians(cart.attitude_sigma_deg), pos.shape))
     quat = (tilt * rot).as_quat(canonical=True)
     return pos, quat
-
-
-def observer_euler(quaternions: np.ndarray) -> np.ndarray:
-    """Attitude as an external observer reports it: extrinsic x-y-z angles (deg), wrapping
-    at +-180 deg (thesis 2.2.4, fig. 4.32)."""
-    return Rotation.from_quat(np.asarray(quaternions)).as_euler("xyz", degrees=True)
-
-
-def pose_history(stamps_ns: np.ndarray, positions: np.ndarray, quaternions: np.ndarray,
-                 observer: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Seconds from the first stamp, positions and attitude angles (deg) for plotting.
-
-    Angles are roll, pitch, yaw (intrinsic z-y-x, the in-vehicle convention) or, with
-    ``observer``, the external observer's wrapping angles of :func:`observer_euler`.
-    """
-    stamps = np.asarray(stamps_ns, dtype=np.int64)
-    times = (stamps - stamps[0]) / 1e9 if len(stamps) else np.zeros(0)
-    quats = np.asarray(quaternions, dtype=np.float64).reshape(-1, 4)
-    if observer:
-        angles = observer_euler(quats)
-    else:
-        angles = Rotation.from_quat(quats).as_euler("ZYX", degrees=True)[:, ::-1]
-    return times, np.asarray(positions, dtype=np.float64), angles

@@ -28,7 +28,8 @@ from alte.sim.terrains import TERRAINS, Terrain
 from alte.types import Mount
 
 __all__ = ["BAG_DIR", "SCENARIO_FILE", "SIM_VERSION", "Scenario", "ensure_terrain", "get_terrain",
-           "is_current", "load_scenario", "spec_hash", "update_terrain", "write_scenario"]
+           "is_current", "load_metadata", "load_scenario", "spec_hash", "terrain_folder",
+           "update_terrain", "write_scenario"]
 
 #: Bump when the simulator's output changes for the same spec (invalidates caches).
 SIM_VERSION = 1
@@ -127,13 +128,17 @@ def is_current(folder: Path, key: str, seed: int) -> bool:
     return _file_table(folder) == meta["files"]
 
 
-def terrain_folder(out_dir: str | os.PathLike[str], name: str, frames: int | None = None) -> Path:
-    """Where a terrain lives: ``out_dir/NAME`` (full mission) or ``out_dir/NAME-Nf`` (N scans).
+def terrain_folder(out_dir: str | os.PathLike[str], name: str, frames: int | None = None,
+                   seed: int = 0) -> Path:
+    """Where a terrain lives: ``out_dir/NAME`` (full mission, seed 0), ``NAME-Nf`` (N scans),
+    ``NAME-sS`` / ``NAME-Nf-sS`` (seed S).
 
-    Reduced missions (quick runs, tests) get their own folder so they never replace
-    the full one, and concurrent runs asking for different sizes cannot collide.
+    Reduced missions (quick runs, tests) and other seeds get their own folders, so they
+    never replace the full one and concurrent runs of different sizes or seeds cannot
+    collide.
     """
-    return Path(out_dir) / (name if frames is None else f"{name}-{int(frames)}f")
+    stem = name if frames is None else f"{name}-{int(frames)}f"
+    return Path(out_dir) / (stem if seed == 0 else f"{stem}-s{int(seed)}")
 
 
 def ensure_terrain(name: str, out_dir: str | os.PathLike[str] = "data", seed: int = 0,
@@ -149,7 +154,7 @@ def update_terrain(name: str, out_dir: str | os.PathLike[str] = "data", seed: in
                    progress: bool = False) -> tuple[Path, bool]:
     """As :func:`ensure_terrain`; also says whether the terrain was (re)simulated."""
     terrain = get_terrain(name)
-    target = terrain_folder(out_dir, name, frames)
+    target = terrain_folder(out_dir, name, frames, seed)
     key = spec_hash(terrain, frames, storage)
     if not force and is_current(target, key, seed):
         return target, False
@@ -198,8 +203,8 @@ class Scenario:
         return Mount(np.asarray(mount["translation"]), np.asarray(mount["quaternion"]))
 
 
-def load_scenario(directory: str | os.PathLike[str]) -> Scenario:
-    """Read ``DIR/NAME`` (scenario.json, bag path, ground truth)."""
+def load_metadata(directory: str | os.PathLike[str]) -> dict[str, Any]:
+    """``DIR/NAME/scenario.json``, checked for the keys the pipeline reads."""
     folder = Path(directory)
     try:
         meta = json.loads((folder / SCENARIO_FILE).read_text())
@@ -211,6 +216,13 @@ def load_scenario(directory: str | os.PathLike[str]) -> Scenario:
                if k not in meta]
     if missing:
         raise SimulationError(f"{folder / SCENARIO_FILE}: missing keys {missing}")
+    return dict(meta)
+
+
+def load_scenario(directory: str | os.PathLike[str]) -> Scenario:
+    """Read ``DIR/NAME`` (scenario.json, bag path, ground truth)."""
+    folder = Path(directory)
+    meta = load_metadata(folder)
     bag = folder / meta["bag"]
     if not bag.is_dir():
         raise SimulationError(f"{folder}: bag folder {bag.name!r} is missing")

@@ -31,7 +31,9 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from alte.studies.experiments import Dataset, TruthOptions, run_mapper
+from alte.metrics.maps import TruthOptions
+from alte.pipeline import Registered
+from alte.studies.experiments import Measured, measure
 from alte.studies.tables import best_row
 from alte.studies.thesis import QUALITATIVE
 
@@ -120,9 +122,9 @@ def qualitative_table(number: int, inputs: Mapping[str, Inputs]) -> pd.DataFrame
     return pd.DataFrame(rows)
 
 
-def qualitative_inputs(sweeps: Mapping[str, tuple[pd.DataFrame, Sequence[Any]]],
+def qualitative_inputs(sweeps: Mapping[str, tuple[pd.DataFrame, Sequence[Measured]]],
                        overhang: Mapping[str, float] | None = None) -> dict[str, dict[str, Any]]:
-    """Inputs of :func:`qualitative_table` from :func:`alte.studies.analysis.sweep` results.
+    """Inputs of :func:`qualitative_table` from :func:`alte.studies.experiments.sweep` results.
 
     The chosen map of each sweep is the row the comparison rule picks; ``overhang``
     maps mapper name to its completeness on the overhang objects of sim_nav_2.
@@ -130,18 +132,20 @@ def qualitative_inputs(sweeps: Mapping[str, tuple[pd.DataFrame, Sequence[Any]]],
     out = {}
     for mapper, (table, runs) in sweeps.items():
         run = runs[best_row(table)]
-        out[mapper] = {"best": run.metrics, "sweep_mhd": table["mhd_m"].to_numpy(),
+        out[mapper] = {"best": run.metrics.flat(), "sweep_mhd": table["mhd_m"].to_numpy(),
                        "incremental": bool(type(run.mapper).incremental),
                        "overhang_completeness": (overhang or {}).get(mapper, np.nan)}
     return out
 
 
-def class_completeness(data: Dataset, sweeps: Mapping[str, tuple[pd.DataFrame, Sequence[Any]]],
+def class_completeness(data: Registered,
+                       sweeps: Mapping[str, tuple[pd.DataFrame, Sequence[Measured]]],
                        truth: TruthOptions, cls: str = "overhang") -> dict[str, float]:
     """Map ``data`` (e.g. sim_nav_2) with each sweep's chosen parameters and return the
     completeness on objects of class ``cls`` per mapper (NaN when the terrain has none)."""
     out = {}
     for mapper, (table, runs) in sweeps.items():
-        run = run_mapper(data, mapper, runs[best_row(table)].params, truth=truth)
-        out[mapper] = float(run.metrics.get("completeness_by_class", {}).get(cls, np.nan))
+        found = measure(data, mapper, runs[best_row(table)].params.as_dict(), truth=truth)
+        by_class = found.metrics.truth.completeness_by_class if found.metrics.truth else {}
+        out[mapper] = float(by_class.get(cls, np.nan))
     return out

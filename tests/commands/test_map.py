@@ -9,11 +9,14 @@ import numpy as np
 import pytest
 
 from alte.cli import main
-from alte.commands.map import parse_origin, parse_sets
+from alte.commands.map import parse_domain, parse_sets
+from alte.commands.options import parse_origin
 from alte.errors import ParameterError
 from alte.mappers.alte2d import Alte2D
+from alte.mappers.domain import Domain
 from alte.mappers.quadtree import Quadtree
-from alte.types import Frame, Mount
+from alte.pipeline import DomainPolicy
+from alte.types import Box, Frame, Mount
 
 
 def terrain(n: int = 2000, seed: int = 0) -> np.ndarray:
@@ -37,7 +40,7 @@ def run_json(capsys, *argv: str) -> dict:
 def test_point_file_json_summary(capsys, cloud_file: Path) -> None:
     out = run_json(capsys, str(cloud_file), "--mapper", "alte2d", "--set", "kappa=0.01",
                    "--set", "max_res=5")
-    ref = Alte2D(kappa=0.01, max_res=5)
+    ref = Alte2D(Domain.over(Box.around(terrain())), kappa=0.01, max_res=5)
     ref.build(terrain())
     assert out["mapper"] == "alte2d" and out["params"]["kappa"] == 0.01
     assert out["frames"] == 1 and out["points"] == 2000
@@ -57,7 +60,7 @@ def test_export_npz_and_overwrite(capsys, cloud_file: Path, tmp_path: Path) -> N
     argv = ["map", str(cloud_file), "--mapper", "quadtree", "--set", "max_points=50",
             "--export", str(target)]
     assert main(argv) == 0
-    ref = Quadtree(max_points=50)
+    ref = Quadtree(Domain.over(Box.around(terrain())), max_points=50)
     ref.build(terrain())
     with np.load(target) as data:
         assert set(data.files) == {"centers", "sizes", "value", "occupied", "level"}
@@ -71,13 +74,18 @@ def test_export_npz_and_overwrite(capsys, cloud_file: Path, tmp_path: Path) -> N
 
 @pytest.mark.parametrize(("extra", "message"), [
     (["--mapper", "kriging"], "unknown mapper 'kriging'; valid: quadtree"),
-    (["--mapper", "alte2d", "--set", "tau=1"], "valid: criterion, domain, kappa"),
+    (["--mapper", "alte2d", "--set", "tau=1"], "valid: criterion, kappa, max_res, min_pts"),
+    (["--mapper", "alte2d", "--set", "domain=0,0,1"], "unknown parameter(s) domain"),
+    (["--mapper", "alte2d", "--domain", "0,0,-1"], "--domain '0,0,-1'"),
+    (["--mapper", "alte2d", "--domain", "everywhere"], "--domain 'everywhere'"),
+    (["--mapper", "alte2d", "--domain", "control"], "no control volume"),
+    (["--mapper", "alte2d", "--frames", "0"], "--frames"),
     (["--mapper", "alte2d", "--set", "kappa"], "expected KEY=VALUE"),
     (["--mapper", "alte2d", "--set", "kappa=-1"], "kappa=-1.0 out of range"),
     (["--mapper", "alte2d", "--origin", "1,2"], "--origin"),
     (["--mapper", "alte2d", "--voxel", "0"], "--voxel"),
-    (["--mapper", "alte2d", "--export", "cells.csv"], "unknown type; use .npz, .bt"),
-    (["--mapper", "alte2d", "--export", "tree.bt"], "cannot write .bt"),
+    (["--mapper", "alte2d", "--export", "cells.csv"], "writes .npz (not .csv)"),
+    (["--mapper", "alte2d", "--export", "tree.bt"], "writes .npz (not .bt)"),
 ])
 def test_errors_are_one_line(capsys, cloud_file: Path, tmp_path: Path, extra, message) -> None:
     extra = [str(tmp_path / e) if e.endswith((".csv", ".bt")) else e for e in extra]
@@ -109,6 +117,8 @@ def test_missing_input(capsys, tmp_path: Path) -> None:
 def test_parsers() -> None:
     assert parse_sets(["a=1", " b = x=y "]) == {"a": "1", "b": "x=y"}
     assert np.array_equal(parse_origin("1,2,3"), [1.0, 2.0, 3.0])
+    assert parse_domain("Data") is DomainPolicy.DATA
+    assert parse_domain("1,2,3") == Domain(1.0, 2.0, 0.0, 3.0)
     with pytest.raises(ParameterError, match="KEY=VALUE"):
         parse_sets(["=3"])
     with pytest.raises(ParameterError, match="--origin"):
@@ -128,11 +138,13 @@ def test_bag_is_mapped_frame_by_frame(capsys, tmp_path: Path) -> None:
         frames.append(Frame(stamp=(i + 1) * 100_000_000, points=ground, position=position,
                             quaternion=np.array([0.0, 0.0, 0.0, 1.0])))
     bag = io.write_frames(tmp_path / "flight", frames, Mount())
-    out = run_json(capsys, str(bag), "--mapper", "alte2d", "--set", "domain=-4,0,20",
+    out = run_json(capsys, str(bag), "--mapper", "alte2d", "--domain=-4,0,20",
                    "--set", "max_res=4", "--set", "min_pts=5")
     assert out["frames"] == 4 and out["points"] == 1200
+    assert out["domain"] == {"xmin": -4.0, "ymin": 0.0, "zmin": 0.0, "size": 20.0}
+    assert out["domain_policy"] == "explicit"
     reg = list(registration.register_frames(frames, Mount()))
-    ref = Alte2D(domain="-4,0,20", max_res=4, min_pts=5)
+    ref = Alte2D(Domain(-4, 0, 0, 20), max_res=4, min_pts=5)
     ref.build(np.concatenate([pts for _f, pts, _o in reg]))
     assert out["basis_functions"] == ref.basis_functions > 4
     assert out["occupied_cells"] == int(ref.cells().occupied.sum())
@@ -140,7 +152,7 @@ def test_bag_is_mapped_frame_by_frame(capsys, tmp_path: Path) -> None:
 
 @pytest.mark.parametrize("mapper", ["quadtree", "octomap", "alte2d", "alte3d"])
 def test_bag_without_domain_maps_with_every_mapper(capsys, tmp_path: Path, mapper) -> None:
-    """No ``--set domain``: the cube over the registered frames becomes the domain."""
+    """No ``--domain``: a plain bag's domain is the cube over its registered frames."""
     from alte import io
     from alte.registration import register_frames
 
@@ -154,7 +166,9 @@ def test_bag_without_domain_maps_with_every_mapper(capsys, tmp_path: Path, mappe
     assert out["basis_functions"] > 0
     # 600 scattered points are too sparse for 3D-ALTE's density rule to occupy a cell
     assert out["occupied_cells"] > 0 or mapper == "alte3d"
-    if mapper != "octomap":  # octomap has no domain: it keys voxels around a local origin
-        lo = np.concatenate([p for _f, p, _o in register_frames(frames, Mount())]).min(axis=0)
-        domain = [float(v) for v in out["params"]["domain"].split(",")]
-        np.testing.assert_array_equal(domain[:3], lo)
+    if mapper == "octomap":  # no domain: it keys voxels around a local origin
+        assert out["domain"] is None and out["domain_policy"] == "none (fixed key space)"
+    else:
+        points = np.concatenate([p for _f, p, _o in register_frames(frames, Mount())])
+        assert out["domain_policy"] == "data"
+        assert out["domain"] == Domain.over(Box.around(points)).as_dict()

@@ -34,7 +34,7 @@ def test_read_frames_interpolates_poses_and_reads_mount(ros, tmp_path, storage):
         assert frame.pose_offset_s == 0.0 and frame.angular_rate > 0.5
     np.testing.assert_allclose(fs.mount.translation, [0.1, 0.0, -0.08])
     np.testing.assert_allclose(fs.mount.quaternion, [0, 0, 0.3826834, 0.9238795], atol=1e-7)
-    assert fs.counts["scans_read"] == 4 and fs.counts["pose_samples"] == 41
+    assert fs.counts.scans_read == 4 and fs.counts.pose_samples == 41
     assert fs.notes == []
 
 
@@ -101,7 +101,7 @@ def test_nonfinite_and_empty_scans(ros, tmp_path):
     msgs.append(("/points", ros.PC2, 11 * ros.NS, empty))
     fs = read_frames(ros.write_ros2(tmp_path / "bag", msgs))
     assert len(fs) == 1 and fs.frames[0].dropped_points == 1 and len(fs.frames[0].points) == 3
-    assert fs.counts["points_nonfinite"] == 3 and fs.counts["scans_empty"] == 1
+    assert fs.counts.points_nonfinite == 3 and fs.counts.scans_empty == 1
 
 
 def test_all_scans_unusable_is_an_error(ros, tmp_path):

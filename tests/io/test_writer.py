@@ -41,7 +41,7 @@ def test_round_trip_float64_is_exact(tmp_path, storage):
     assert fs.frames == frames
     np.testing.assert_allclose(fs.mount.translation, thesis_mount().translation)
     np.testing.assert_allclose(fs.mount.quaternion, thesis_mount().quaternion, atol=1e-15)
-    assert fs.counts["frames"] == 5 and fs.notes == []
+    assert fs.counts.frames == 5 and fs.notes == []
 
 
 def test_round_trip_float32_within_1e6(tmp_path):

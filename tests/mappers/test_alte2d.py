@@ -11,9 +11,10 @@ from support.maps import assert_partition, same_cells
 
 from alte.errors import MapperError, ParameterError
 from alte.mappers.alte2d import Alte2D, plane_height
+from alte.mappers.domain import Domain
 from alte.paths import realdata_dir
 
-DOMAIN = "0,0,16"
+DOMAIN = Domain(0.0, 0.0, 0.0, 16.0)
 coords = st.floats(0.0, 16.0, allow_nan=False, width=32)
 clouds = arrays(np.float64, st.tuples(st.integers(1, 120), st.just(3)), elements=coords)
 criteria = st.sampled_from(["thesis", "binev"])
@@ -142,7 +143,7 @@ def test_growth_without_domain_equals_batch_on_grown_root(criterion) -> None:
         first = first or incr.square.size
     sq = incr.square
     assert sq.size >= 2 * first
-    batch = Alte2D(criterion=criterion, kappa=0.01, domain=f"{sq.xmin},{sq.ymin},{sq.size}")
+    batch = Alte2D(criterion=criterion, kappa=0.01, domain=Domain(sq.xmin, sq.ymin, 0.0, sq.size))
     batch.build(pts)
     assert same_cells(incr.cells(), batch.cells())
 
@@ -181,8 +182,7 @@ def test_plane_height() -> None:
     ("max_res", 2.5, "max_res"),
     ("min_pts", 0, "min_pts"),
     ("criterion", "variance", "criterion"),
-    ("domain", "1,2,3,4,5", "domain"),
-    ("tau", 1, "unknown parameter.*valid: criterion, domain, kappa, max_res, min_pts"),
+    ("tau", 1, "unknown parameter.*valid: criterion, kappa, max_res, min_pts"),
 ])
 def test_bad_parameters(key, value, match) -> None:
     with pytest.raises(ParameterError, match=match):
@@ -190,9 +190,10 @@ def test_bad_parameters(key, value, match) -> None:
 
 
 def test_string_parameters_are_coerced() -> None:
-    m = Alte2D(kappa="0.5", max_res="4", min_pts="20", criterion="binev", domain="0,0,0,8")
-    assert m.params == {"kappa": 0.5, "max_res": 4, "min_pts": 20, "criterion": "binev",
-                        "domain": "0,0,0,8"}
+    m = Alte2D(kappa="0.5", max_res="4", min_pts="20", criterion="binev", domain=Domain(0, 0, 0, 8))
+    assert m.params.as_dict() == {"kappa": 0.5, "max_res": 4, "min_pts": 20,
+                                  "criterion": "binev"}
+    assert m.domain == Domain(0, 0, 0, 8)
     assert m.square.size == 8
 
 
@@ -233,7 +234,7 @@ def test_isprs_airborne_sample() -> None:
     assert free.any() and (m2[free] <= 5.0).all()
     assert 50 < batch.basis_functions < 4**7
     sq = batch.square
-    incr = Alte2D(**kw, domain=f"{sq.xmin},{sq.ymin},{sq.size}")
+    incr = Alte2D(**kw, domain=Domain(sq.xmin, sq.ymin, 0.0, sq.size))
     for chunk in np.array_split(pts, 10):
         incr.insert(chunk, np.zeros(3))
     assert same_cells(batch.cells(), incr.cells())

@@ -10,8 +10,9 @@ from hypothesis.extra.numpy import arrays
 
 from alte.errors import MapperError, ParameterError
 from alte.mappers.alte3d import Alte3D
+from alte.mappers.domain import Domain
 
-DOMAIN = (0.0, 0.0, 0.0, 8.0)
+DOMAIN = Domain(0.0, 0.0, 0.0, 8.0)
 coords = arrays(np.float64, st.tuples(st.integers(1, 300), st.just(3)),
                 elements=st.floats(0.0, 8.0, allow_nan=False))
 
@@ -89,7 +90,7 @@ def test_coarse_max_res_gives_an_incomplete_map():
     points, domain = _terrain(60000), (0, 0, -5, 105)
     coverage = {}
     for max_res in (4, 6):
-        mapper = Alte3D(max_res=max_res, domain=domain)
+        mapper = Alte3D(max_res=max_res, domain=Domain(*domain))
         mapper.build(points)
         coverage[max_res] = _coverage(mapper.cells(), points, domain)
     assert coverage[6] > 0.9
@@ -131,7 +132,9 @@ def test_build_uses_the_bounding_cube_and_memory_grows_with_data():
     mapper = Alte3D(max_res=6)
     terrain = _terrain(20000)
     mapper.build(terrain)
-    xmin, ymin, _, size = mapper.domain
+    dom = mapper.domain
+    assert dom is not None
+    xmin, ymin, size = dom.xmin, dom.ymin, dom.size
     assert size >= 100 * 0.99 and xmin >= 0 and ymin >= 0
     large = mapper.memory_bytes
     mapper.build(np.vstack([terrain[:200] * 0.05, terrain.max(axis=0)]))  # same cube, clustered
@@ -146,9 +149,6 @@ def test_build_uses_the_bounding_cube_and_memory_grows_with_data():
     ({"occupancy_level": 20}, "occupancy_level"),
     ({"variant": "sphere"}, "variant"),
     ({"cell_height": 0}, "cell_height"),
-    ({"domain": "0,0,0"}, "domain"),
-    ({"domain": "0,0,0,-1"}, "domain"),
-    ({"domain": "a,b,c,d"}, "domain"),
     ({"max_res": 2.5}, "integer"),
     ({"kappa": 1}, "unknown parameter"),
 ])
@@ -157,15 +157,22 @@ def test_bad_parameters_raise(params, match):
         Alte3D(**params)
 
 
-def test_domain_accepts_tuple_and_string():
-    assert Alte3D(domain=(0, 0, 0, 8)).domain == Alte3D(domain="0,0,0,8").domain == DOMAIN
+def test_domain_is_typed():
+    assert Alte3D(domain=DOMAIN).domain == DOMAIN
+    with pytest.raises(MapperError, match=r"domain must be an alte\.mappers\.Domain"):
+        Alte3D(domain="0,0,0,8")  # type: ignore[arg-type]
+
+
+def test_points_outside_the_domain_are_counted_not_raised():
+    mapper = Alte3D(domain=DOMAIN, max_res=1, min_pts=1, min_pts_split=100)
+    mapper.insert(np.array([[9.0, 1.0, 1.0], [1.0, 1.0, 1.0], [1.0, 1.0, -0.5]]), np.zeros(3))
+    assert mapper.points_outside == 2
+    assert int(mapper.cells().value.sum()) == 1
 
 
 def test_bad_inputs_raise():
     with pytest.raises(MapperError, match="fixed domain"):
         Alte3D().insert(np.zeros((2, 3)), np.zeros(3))
-    with pytest.raises(MapperError, match="outside the domain"):
-        Alte3D(domain=DOMAIN).insert(np.array([[9.0, 1.0, 1.0]]), np.zeros(3))
     with pytest.raises(MapperError, match="shape"):
         Alte3D(domain=DOMAIN).insert(np.zeros((2, 2)), np.zeros(3))
     with pytest.raises(MapperError, match="NaN"):

@@ -1,41 +1,13 @@
+"""The mapper protocol's shared pieces: point checks, the registry, capabilities, export."""
+
+from pathlib import Path
+
 import numpy as np
 import pytest
 
-from alte.errors import MapperError, ParameterError
-from alte.mappers.base import Param, check_points, parse_params
-
-SPECS = {
-    "kappa": Param(float, 0.1, lambda v: v >= 0, ">= 0"),
-    "max_res": Param(int, 6, lambda v: 1 <= v <= 20, "1..20"),
-    "variant": Param(str, "cube", lambda v: v in {"cube", "fixed"}, "cube|fixed"),
-    "prune": Param(bool, True),
-}
-
-
-def test_defaults_and_coercion_from_strings():
-    out = parse_params("alte2d", SPECS, {"kappa": "0.5", "max_res": "4", "prune": "no"})
-    assert out == {"kappa": 0.5, "max_res": 4, "variant": "cube", "prune": False}
-
-
-def test_unknown_key_lists_valid_ones():
-    with pytest.raises(ParameterError, match=r"unknown parameter\(s\) kapa; valid: kappa, max_res"):
-        parse_params("alte2d", SPECS, {"kapa": 1})
-
-
-@pytest.mark.parametrize(("given", "pattern"), [
-    ({"kappa": -1.0}, r"kappa=-1\.0 out of range \(>= 0\)"),
-    ({"max_res": 0}, r"max_res=0 out of range \(1\.\.20\)"),
-    ({"max_res": 2.5}, r"max_res=2\.5 must be an integer"),
-    ({"max_res": "1.5"}, r"max_res='1\.5' must be an integer"),
-    ({"max_res": "inf"}, r"max_res='inf' must be an integer"),
-    ({"max_res": "two"}, r"max_res='two' is not a valid int"),
-    ({"kappa": "nan"}, r"kappa=nan must be finite"),
-    ({"prune": "maybe"}, r"prune='maybe' is not a boolean"),
-    ({"variant": "sphere"}, r"variant='sphere' out of range"),
-])
-def test_out_of_range_values(given, pattern):
-    with pytest.raises(ParameterError, match=pattern):
-        parse_params("alte2d", SPECS, given)
+from alte.errors import MapperError
+from alte.mappers import MAPPERS, DomainUse, Feed, Mapper, check_export, make_mapper, mapper_class
+from alte.mappers.base import check_points
 
 
 def test_check_points():
@@ -45,3 +17,35 @@ def test_check_points():
         check_points(np.zeros((3, 2)), "quadtree")
     with pytest.raises(MapperError, match="NaN or inf"):
         check_points([[0, np.nan, 0]], "quadtree")
+
+
+@pytest.mark.parametrize("name", list(MAPPERS))
+def test_every_mapper_declares_its_capabilities(name):
+    cls = mapper_class(name)
+    mapper = make_mapper(name)
+    assert isinstance(mapper, Mapper)
+    assert cls.dims in (2, 3) and isinstance(cls.incremental, bool)
+    assert isinstance(cls.domain_use, DomainUse) and isinstance(cls.default_feed, Feed)
+    assert ".npz" in cls.exports and isinstance(cls.free_space, bool)
+    assert mapper.points_outside == 0 and mapper.params == cls.Params()
+
+
+def test_capabilities_of_the_four_mappers():
+    assert MAPPERS["quadtree"].default_feed is Feed.BATCH
+    assert MAPPERS["octomap"].domain_use is DomainUse.UNUSED and MAPPERS["octomap"].free_space
+    assert MAPPERS["alte3d"].domain_use is DomainUse.REQUIRED
+    assert MAPPERS["alte2d"].domain_use is DomainUse.OPTIONAL
+    assert ".bt" in MAPPERS["octomap"].exports and ".bt" not in MAPPERS["alte3d"].exports
+
+
+def test_unknown_mapper_and_exports(tmp_path: Path):
+    with pytest.raises(MapperError, match="unknown mapper 'octree'; valid: quadtree, octomap"):
+        make_mapper("octree")
+    with pytest.raises(MapperError, match=r"mapper 'alte3d' writes \.npz \(not \.bt\)"):
+        check_export(tmp_path / "map.bt", MAPPERS["alte3d"], overwrite=False)
+    with pytest.raises(MapperError, match="no native map format"):
+        make_mapper("quadtree").write_native(tmp_path / "x.bt")
+    with pytest.raises(MapperError, match="takes no domain"):
+        from alte.mappers import Domain
+
+        make_mapper("octomap", domain=Domain(0, 0, 0, 1))

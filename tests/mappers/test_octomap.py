@@ -233,7 +233,7 @@ def test_bad_parameters_raise(params, match):
 
 def test_string_parameters_are_accepted():
     mapper = Octomap(resolution="10", max_range="-1", sensor_model="octomap")
-    assert mapper.params["resolution"] == 10.0 and mapper.params["clamp_max"] == 0.971
+    assert mapper.params.resolution == 10.0 and mapper.params.clamp_max == 0.971
 
 
 @pytest.mark.parametrize(("points", "origin", "match"), [

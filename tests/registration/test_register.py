@@ -13,6 +13,7 @@ from alte.errors import ParameterError, RegistrationError
 from alte.registration import (
     GridAccumulator,
     ManoeuvreFilter,
+    RegistrationCounts,
     box_grid_merge,
     check_options,
     crop,
@@ -187,20 +188,20 @@ def test_register_without_voxel_concatenates():
     truth, frames, mount = scene(seed=2, frames=3, n=50)
     reg = register(iter(frames), mount)
     np.testing.assert_allclose(reg.points, np.vstack(truth), atol=1e-9)
-    assert reg.counts["points_out"] == 150
+    assert reg.counts.points_out == 150
     np.testing.assert_array_equal(reg.frame_points, [50, 50, 50])
 
 
 def test_register_frames_yields_per_kept_frame():
     truth, frames, mount = scene(seed=4, frames=3, n=40)
-    counts: dict[str, int] = {}
+    counts = RegistrationCounts()
     out = list(register_frames(frames, mount, voxel=1.0, counts=counts))
     assert len(out) == 3
     for (frame, pts, origin), inertial in zip(out, truth, strict=True):
         np.testing.assert_allclose(pts, grid_average(inertial, 1.0), atol=1e-9)
         np.testing.assert_allclose(origin, sensor_origin(frame, mount))
-    assert counts["frames_kept"] == 3
-    assert counts["points_registered"] == sum(len(p) for _f, p, _o in out)
+    assert counts.frames_kept == 3
+    assert counts.points_registered == sum(len(p) for _f, p, _o in out)
 
 
 def test_register_errors_name_the_reason():

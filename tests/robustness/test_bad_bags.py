@@ -252,19 +252,23 @@ def test_far_points_dropped_by_the_control_volume(bags, capsys, tmp_path):
     assert "8 (outside crop box)" in out and "wrote 160 points" in out
 
 
-def test_far_points_dropped_by_a_2d_domain(bags, capsys, tmp_path):
-    code, out, err = bags.run_cli(capsys, "map", _far_bag(bags, tmp_path), "--mapper", "quadtree",
-                                  "--set", "domain=-64,-64,128", "--json")
+@pytest.mark.parametrize(("mapper", "domain"), [("quadtree", "-64,-64,128"),
+                                                ("alte2d", "-64,-64,128"),
+                                                ("alte3d", "-64,-64,-64,128")])
+def test_far_points_outside_a_domain_are_dropped_and_counted(bags, capsys, tmp_path, mapper,
+                                                              domain):
+    code, out, err = bags.run_cli(capsys, "map", _far_bag(bags, tmp_path), "--mapper", mapper,
+                                  f"--domain={domain}", "--json")
     assert code == 0, err
     summary = json.loads(out)
     assert summary["points_outside"] == 8 and summary["points"] == 168
 
 
-def test_far_points_outside_an_alte3d_domain_are_an_error(bags, capsys, tmp_path):
-    code, _, err = bags.run_cli(capsys, "map", _far_bag(bags, tmp_path), "--mapper", "alte3d",
-                                "--set", "domain=-64,-64,-64,128")
-    assert code == 2
-    assert "alte3d: 2 points lie outside the domain" in bags.one_line_error(err, "map")
+def test_far_points_outside_octomaps_key_space_are_counted(bags, capsys, tmp_path):
+    code, out, err = bags.run_cli(capsys, "map", _far_bag(bags, tmp_path), "--mapper", "octomap",
+                                  "--json")
+    assert code == 0, err
+    assert json.loads(out)["points_outside"] == 4  # 10,000 km is outside, 5 km is not
 
 
 def test_far_points_never_occupy_octomap_cells(bags, capsys, tmp_path):

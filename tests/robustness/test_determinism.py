@@ -22,7 +22,7 @@ NS = 1_000_000_000
 MAPPER_SETS = {
     "quadtree": ["--set", "max_points=20"],
     "alte2d": ["--set", "min_pts=3"],
-    "alte3d": ["--set", "min_pts=2", "--set", "domain=-50,-50,-50,100"],
+    "alte3d": ["--set", "min_pts=2", "--domain=-50,-50,-50,100"],
     "octomap": ["--set", "resolution=2"],
 }
 

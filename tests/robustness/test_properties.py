@@ -18,16 +18,17 @@ from scipy.spatial.transform import Rotation
 
 from alte.io.bag import read_frames
 from alte.io.writer import write_frames
-from alte.mappers import MAPPERS, make_mapper
+from alte.mappers import MAPPERS, Domain, make_mapper
 from alte.metrics.hausdorff import hausdorff
 from alte.registration import register, to_sensor
 from alte.types import Frame, Mount
 
 #: Small fixed-domain settings (16 m square / cube at 0) so incremental == batch exactly.
+CUBE = Domain(0.0, 0.0, 0.0, 16.0)
 PARAMS = {
-    "quadtree": {"max_points": 3, "max_depth": 5, "domain": "0,0,16"},
-    "alte2d": {"kappa": 0.05, "max_res": 5, "min_pts": 2, "domain": "0,0,16"},
-    "alte3d": {"max_res": 4, "min_pts": 2, "min_pts_split": 3, "domain": "0,0,0,16"},
+    "quadtree": {"max_points": 3, "max_depth": 5, "domain": CUBE},
+    "alte2d": {"kappa": 0.05, "max_res": 5, "min_pts": 2, "domain": CUBE},
+    "alte3d": {"max_res": 4, "min_pts": 2, "min_pts_split": 3, "domain": CUBE},
     "octomap": {"resolution": 2.0, "max_range": -1.0},
 }
 ORIGIN = np.array([8.0, 8.0, 15.0])

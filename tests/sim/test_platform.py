@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from alte.sim.platform import Cart, Quadrotor, Trajectory, mocap_stream, observer_euler
+from alte.plot.scene import attitude_deg
+from alte.sim.platform import Cart, Quadrotor, Trajectory, mocap_stream
 
 SQUARE = ((0.0, 0.0), (40.0, 0.0), (40.0, 30.0), (0.0, 30.0))
 
@@ -60,7 +61,7 @@ def test_mocap_stream_noise_and_observer_quaternions():
     err = np.degrees((Rotation.from_quat(quat) * true_rot.inv()).magnitude())
     assert 0.03 < np.median(err) < 0.15
     assert np.all(quat[:, 3] >= 0)  # external observer: w >= 0, so the sign flips
-    yaw = observer_euler(quat)[:, 2]
+    yaw = attitude_deg(quat)[:, 2]
     assert np.abs(np.diff(yaw)).max() > 300  # wraps through +-180 deg on the square loop
 
 

@@ -1,7 +1,8 @@
 """Landing-zone experiments: map a terrain, detect sites, score them against the truth.
 
-Data flow: :class:`~alte.studies.experiments.Dataset` -> :func:`run_mapper` (the 2D
-map) -> :func:`rasterise` over the control volume -> :func:`detect_sites` -> scores
+Data flow: a registered terrain (:func:`alte.studies.experiments.terrain`) ->
+:func:`alte.pipeline.run` (the 2D map) -> :func:`rasterise` over the control volume ->
+:func:`detect_sites` -> scores
 against :func:`truth_centres` of the same raster. :func:`landing_table` gives one row
 per terrain x mapper x parameter set: the chapter 4 parameters of the terrain and two
 rows of each chapter 5 sweep (:data:`SWEEP_ROWS`), written by
@@ -20,7 +21,8 @@ import pandas as pd
 from tqdm.auto import tqdm
 
 from alte.errors import MetricsError, ParameterError
-from alte.studies.experiments import Dataset, MapRun, load_dataset, run_mapper
+from alte.pipeline import MapRun, MapSpec, Registered, run
+from alte.studies.experiments import ground_truth, terrain
 from alte.studies.landing.detect import Centres, Detection, detect_sites
 from alte.studies.landing.params import LandingParams, landing_params
 from alte.studies.landing.raster import Grid, rasterise
@@ -53,23 +55,23 @@ class LandingRun:
     scores: dict[str, Any]
 
 
-def landing_grid(data: Dataset, params: LandingParams) -> Grid:
-    """The raster over the dataset's control volume (its cloud's extent when unknown)."""
-    bounds = data.bounds if data.bounds is not None else \
-        [data.cloud.min(axis=0), data.cloud.max(axis=0)]
-    return Grid.from_bounds(bounds, params.step)
+def landing_grid(data: Registered, params: LandingParams) -> Grid:
+    """The raster over the input's control volume (its points' extent when it has none)."""
+    box = data.spec.crop if data.spec.crop is not None else data.bounds()
+    return Grid.from_bounds(box.array(), params.step)
 
 
-def landing_truth(data: Dataset, params: LandingParams) -> Centres:
-    """Truly safe centres of a simulated dataset on :func:`landing_grid`."""
-    if data.surface is None or data.bounds is None:
-        raise MetricsError(f"landing truth: dataset {data.name} has no ground truth "
+def landing_truth(data: Registered, params: LandingParams) -> Centres:
+    """Truly safe centres of a simulated terrain on :func:`landing_grid`."""
+    truth = ground_truth(data)
+    if truth is None:
+        raise MetricsError(f"landing truth: {data.source.path} has no ground truth "
                            "(real recordings cannot be scored)")
-    return truth_centres(data.surface, landing_grid(data, params), params,
-                         z_start=float(data.bounds[1, 2]))
+    return truth_centres(truth.surface, landing_grid(data, params), params,
+                         z_start=float(truth.bounds.hi[2]))
 
 
-def evaluate_landing(data: Dataset, mapper: str, params: Mapping[str, Any] | None,
+def evaluate_landing(data: Registered, mapper: str, params: Mapping[str, Any] | None,
                      landing: LandingParams, *, truth: Centres | None = None,
                      label: str = "") -> LandingRun:
     """Map ``data`` with ``mapper``/``params``, detect sites and score them when truth exists.
@@ -80,20 +82,20 @@ def evaluate_landing(data: Dataset, mapper: str, params: Mapping[str, Any] | Non
     if mapper not in LANDING_MAPPERS:
         raise ParameterError(f"landing: mapper {mapper!r} is not a 2D mapper; use one of "
                              f"{', '.join(LANDING_MAPPERS)}")
-    run = run_mapper(data, mapper, params)
+    result = run(data, MapSpec(mapper, dict(params or {})))
     grid = landing_grid(data, landing)
-    detection = detect_sites(rasterise(run.mapper.cells(), grid), grid, landing)
-    if truth is None and data.surface is not None:
+    detection = detect_sites(rasterise(result.mapper.cells(), grid), grid, landing)
+    if truth is None and ground_truth(data) is not None:
         truth = landing_truth(data, landing)
     if truth is not None:
         scores = score_detection(detection, truth, landing)
     else:
         scores = {"sites": len(detection.sites), "chosen": len(detection.chosen)}
-    return LandingRun(data.name, label or str(dict(params or {})), landing, run, detection,
-                      truth, scores)
+    return LandingRun(data.source.name, label or str(dict(params or {})), landing, result,
+                      detection, truth, scores)
 
 
-def score_landing(dataset: Dataset, mapper: str, params: Mapping[str, Any] | None,
+def score_landing(dataset: Registered, mapper: str, params: Mapping[str, Any] | None,
                   landing_params: LandingParams) -> dict[str, Any]:
     """Scores of :func:`evaluate_landing` (precision, recall, ...) as a flat dict."""
     return evaluate_landing(dataset, mapper, params, landing_params).scores
@@ -118,7 +120,7 @@ def _row(run: LandingRun, mapper: str, params: Mapping[str, Any],
             "radius_m": landing.radius, "keep_out_m": landing.keep_out}
 
 
-def landing_table(datasets: Sequence[Dataset],
+def landing_table(datasets: Sequence[Registered],
                   landing: Mapping[str, LandingParams] | None = None, *,
                   progress: bool = True) -> tuple[pd.DataFrame, list[LandingRun]]:
     """One row per terrain x mapper x parameter set (:func:`landing_param_sets`).
@@ -126,27 +128,27 @@ def landing_table(datasets: Sequence[Dataset],
     ``landing`` maps terrain names to parameters (default: :func:`landing_params`).
     The truth is computed once per terrain.
     """
-    jobs = [(d, *s) for d in datasets for s in landing_param_sets(d.name)]
+    jobs = [(d, *s) for d in datasets for s in landing_param_sets(d.source.name)]
     rows, runs, truths = [], [], {}
     for data, label, mapper, params in tqdm(jobs, desc="landing", unit="map",
                                             disable=not progress):
-        chosen = (landing or {}).get(data.name) or landing_params(data.name)
-        if data.name not in truths and data.surface is not None:
-            truths[data.name] = landing_truth(data, chosen)
-        run = evaluate_landing(data, mapper, params, chosen, truth=truths.get(data.name),
-                               label=label)
-        runs.append(run)
-        rows.append(_row(run, mapper, params, chosen))
+        name = data.source.name
+        chosen = (landing or {}).get(name) or landing_params(name)
+        if name not in truths and ground_truth(data) is not None:
+            truths[name] = landing_truth(data, chosen)
+        found = evaluate_landing(data, mapper, params, chosen, truth=truths.get(name),
+                                 label=label)
+        runs.append(found)
+        rows.append(_row(found, mapper, params, chosen))
     return pd.DataFrame(rows), runs
 
 
 def load_terrains(names: Sequence[str], data_dir: str | os.PathLike[str] = "data",
                   seed: int = 0, frames: int | None = None,
-                  progress: bool = True) -> list[Dataset]:
-    """Simulate (when missing or stale) and load the named terrains, ``frames`` scans each."""
-    from alte.sim import ensure_terrain
-
-    return [load_dataset(ensure_terrain(name, data_dir, seed, frames), frames)
+                  progress: bool = True) -> list[Registered]:
+    """Simulate (when missing or stale) and register the named terrains, ``frames`` scans
+    each."""
+    return [terrain(name, data_dir, seed, frames)
             for name in tqdm(names, desc="terrains", unit="terrain", disable=not progress)]
 
 

@@ -20,7 +20,6 @@ from alte.studies.planning.experiment import (
 )
 from alte.studies.planning.lattice import (
     FREE,
-    FREE_SPACE_MAPPERS,
     OCCUPIED,
     POLICIES,
     UNKNOWN,
@@ -37,7 +36,6 @@ from alte.studies.planning.search import OFFSETS, PlanResult, lattice_graph, pla
 
 __all__ = [
     "FREE",
-    "FREE_SPACE_MAPPERS",
     "OCCUPIED",
     "OFFSETS",
     "PLANNING_CASES",

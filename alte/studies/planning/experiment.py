@@ -20,8 +20,8 @@ import pandas as pd
 from tqdm.auto import tqdm
 
 from alte.errors import ParameterError
-from alte.sim import ensure_terrain
-from alte.studies.experiments import Dataset, load_dataset, run_mapper
+from alte.pipeline import MapSpec, Registered, run
+from alte.studies.experiments import ground_truth, terrain
 from alte.studies.planning.lattice import POLICIES, PlanningMap, planning_map
 from alte.studies.planning.score import PathScore, score_path
 from alte.studies.planning.search import PlanResult, plan_path
@@ -124,11 +124,10 @@ def planning_rows(plans: TerrainPlans) -> list[dict[str, Any]]:
     return rows
 
 
-def _terrain_maps(data: Dataset, terrain: str, mappers: Iterable[str],
+def _terrain_maps(data: Registered, name: str, mappers: Iterable[str],
                   params: Mapping[str, Mapping[str, Any]] | None) -> dict[str, PlanningMap]:
-    chosen = mapper_params(terrain) | {k: dict(v) for k, v in (params or {}).items()}
-    return {name: planning_map(run_mapper(data, name, chosen.get(name, {})).mapper)
-            for name in mappers}
+    chosen = mapper_params(name) | {k: dict(v) for k, v in (params or {}).items()}
+    return {m: planning_map(run(data, MapSpec(m, chosen.get(m, {}))).mapper) for m in mappers}
 
 
 def planning_experiment(terrains: Sequence[str], data_dir: str | os.PathLike[str] = "data",
@@ -141,16 +140,18 @@ def planning_experiment(terrains: Sequence[str], data_dir: str | os.PathLike[str
 
     ``params`` overrides chapter 4 mapper parameters by mapper name.
     """
-    for terrain in terrains:
-        planning_case(terrain)
+    for name in terrains:
+        planning_case(name)
     bad = [p for p in policies if p not in POLICIES]
     if bad or not policies:
         raise ParameterError(f"unknown policies {bad or list(policies)}; valid: {POLICIES}")
     plans = []
-    for terrain in tqdm(terrains, desc="planning", unit="terrain", disable=not progress):
-        data = load_dataset(ensure_terrain(terrain, data_dir, seed, frames), frames)
-        maps = _terrain_maps(data, terrain, mappers, params)
-        plans.append(plan_maps(terrain, maps, planning_case(terrain), data.surface, policies))
+    for name in tqdm(terrains, desc="planning", unit="terrain", disable=not progress):
+        data = terrain(name, data_dir, seed, frames)
+        maps = _terrain_maps(data, name, mappers, params)
+        truth = ground_truth(data)
+        plans.append(plan_maps(name, maps, planning_case(name), None if truth is None
+                               else truth.surface, policies))
     table = pd.DataFrame([row for p in plans for row in planning_rows(p)])
     return table, plans
 

@@ -26,7 +26,7 @@ from scipy.spatial import cKDTree
 from alte.errors import MapperError, ParameterError
 from alte.mappers.base import Cells, Mapper
 
-__all__ = ["FREE", "FREE_SPACE_MAPPERS", "MAX_NODES", "OCCUPIED", "POLICIES", "UNKNOWN",
+__all__ = ["FREE", "MAX_NODES", "OCCUPIED", "POLICIES", "UNKNOWN",
            "Lattice", "PlanningMap", "blocked_nodes", "classify", "locate", "near_boxes",
            "planning_map"]
 
@@ -34,8 +34,6 @@ __all__ = ["FREE", "FREE_SPACE_MAPPERS", "MAX_NODES", "OCCUPIED", "POLICIES", "U
 UNKNOWN, FREE, OCCUPIED = 0, 1, 2
 #: What unknown space is taken to be.
 POLICIES: tuple[str, ...] = ("free", "occupied")
-#: Mappers whose unoccupied cells are observed free space (ray casting).
-FREE_SPACE_MAPPERS = frozenset({"octomap"})
 #: Largest lattice the planner builds (memory: about 100 bytes per node with edges).
 MAX_NODES = 3_000_000
 
@@ -125,10 +123,10 @@ class PlanningMap:
 
 def planning_map(mapper: Mapper) -> PlanningMap:
     """The planning view of a 3D mapper (Octomap: free leaves; 3D-ALTE: none)."""
-    if getattr(mapper, "dims", 3) != 3:
+    if mapper.dims != 3:
         raise MapperError(f"{mapper.name}: path planning needs a 3D map, got a "
                           f"{mapper.dims}D height map")
-    return PlanningMap.from_cells(mapper.cells(), mapper.name in FREE_SPACE_MAPPERS, mapper.name)
+    return PlanningMap.from_cells(mapper.cells(), mapper.free_space, mapper.name)
 
 
 def _level_groups(cells: Cells, name: str) -> list[tuple[np.ndarray, np.ndarray]]:

@@ -24,12 +24,19 @@ import pandas as pd
 from tqdm.auto import tqdm
 
 from alte.errors import ParameterError
-from alte.io import read_frames, read_points
-from alte.io.pointfiles import local_origin
+from alte.io.pointfiles import local_origin, read_points
 from alte.mappers import make_mapper
 from alte.paths import realdata_dir
-from alte.registration import register, register_frames
-from alte.studies.experiments import Dataset, MapRun, run_mapper
+from alte.pipeline import (
+    DomainPolicy,
+    FrameSpec,
+    MapSpec,
+    PoseSource,
+    Registered,
+    open_input,
+    prepare,
+)
+from alte.studies.experiments import Measured, measure
 from alte.studies.realdata.ground import (
     classify_ground,
     ground_errors,
@@ -38,7 +45,6 @@ from alte.studies.realdata.ground import (
     reference_labels,
 )
 from alte.studies.tables import write_csv as write_tables_csv
-from alte.types import Mount
 
 __all__ = [
     "BASELINE",
@@ -46,6 +52,7 @@ __all__ = [
     "GroundRun",
     "IsprsSample",
     "RealData",
+    "dataset_summary",
     "default_dir",
     "ground_runs",
     "ground_table",
@@ -180,60 +187,47 @@ def ground_table(runs: Sequence[GroundRun]) -> pd.DataFrame:
                           **r.metrics} for r in runs])
 
 
-def scan_dataset(data: RealData) -> Dataset | None:
+def scan_dataset(data: RealData) -> Registered | None:
     """``octomap_scan/scan.dat.bz2``: one scan, sensor at the origin (None when absent)."""
     if not data.available:
         return None
-    pts = read_points(data.file("octomap_scan", "scan.dat.bz2"))
-    return _dataset("octomap_scan", [(pts, np.zeros(3))], pts, {"points": len(pts)})
+    return prepare(open_input(data.file("octomap_scan", "scan.dat.bz2")))
 
 
 def vlp16_dataset(data: RealData, voxel: float | None = None,
-                  frames: int | None = None) -> Dataset | None:
+                  frames: int | None = None) -> Registered | None:
     """The VLP-16 packet bag decoded and registered with the identity pose (stationary
     sensor, no pose topic, identity mount); ``voxel`` grid-averages each frame and
     ``frames`` keeps at most that many rotations, evenly spaced (None: all)."""
     if not data.available:
         return None
-    if frames is not None and (isinstance(frames, bool) or not isinstance(frames, int)
-                               or frames < 1):
-        raise ParameterError(f"frames={frames!r}: expected a positive integer or None")
-    scans = read_frames(data.file("vlp16_packets", "bag"), allow_no_pose=True).frames
-    if frames is not None and frames < len(scans):
-        scans = [scans[i] for i in np.round(np.linspace(0, len(scans) - 1, frames)).astype(int)]
-    per_frame = [(pts, origin) for _, pts, origin in register_frames(scans, Mount(),
-                                                                      voxel=voxel)]
-    cloud = register(scans, Mount(), voxel=voxel).points
-    info = {"frames": len(per_frame), "points": len(cloud),
-            "raw_points": int(sum(len(f.points) for f in scans))}
-    return _dataset("vlp16_packets", per_frame, cloud, info)
+    spec = FrameSpec(frames=frames, voxel=voxel, poses=PoseSource.IDENTITY)
+    return prepare(open_input(data.file("vlp16_packets", "bag")), spec)
 
 
-def _dataset(name: str, frames: list[tuple[np.ndarray, np.ndarray]], cloud: np.ndarray,
-             info: dict[str, Any]) -> Dataset:
-    # a 1 cm margin, so that the mappers' domain does not sit exactly on the extreme points
-    lo, hi = cloud.min(axis=0), cloud.max(axis=0)
-    pad = 0.01 + 1e-5 * np.maximum(np.abs(lo), np.abs(hi))
-    bounds = np.array([lo - pad, hi + pad])
-    return Dataset(name, "nav", frames, cloud, np.array([o for _, o in frames]), None, bounds,
-                   info)
-
-
-def map_runs(dataset: Dataset | None, mappers: Mapping[str, Mapping[str, Any]],
-             progress: bool = True) -> list[MapRun]:
-    """Map ``dataset`` frame by frame with each mapper (timed, measured); [] when None."""
+def map_runs(dataset: Registered | None, mappers: Mapping[str, Mapping[str, Any]],
+             progress: bool = True) -> list[Measured]:
+    """Map ``dataset`` with each mapper over the cube of its points (timed, measured);
+    [] when None."""
     if dataset is None:
         return []
-    return [run_mapper(dataset, name, params)
-            for name, params in tqdm(mappers.items(), desc=dataset.name, disable=not progress)]
+    name = dataset.source.name
+    return [measure(dataset, m, spec=MapSpec(m, dict(p), domain=DomainPolicy.DATA))
+            for m, p in tqdm(mappers.items(), desc=name, disable=not progress)]
 
 
-def map_table(runs: Sequence[MapRun]) -> pd.DataFrame:
+def map_table(runs: Sequence[Measured]) -> pd.DataFrame:
     """Basis functions, occupied cells, time, memory, HD/MHD (cloud vs corners) per map."""
     keys = ("elapsed_s", "basis_functions", "occupied_cells", "memory_bytes", "hd_m", "mhd_m")
-    return pd.DataFrame([{"mapper": r.mapper_name,
-                          "params": ", ".join(f"{k}={v}" for k, v in r.params.items()),
-                          **{k: r.metrics[k] for k in keys}} for r in runs])
+    return pd.DataFrame([{"mapper": r.name,
+                          "params": ", ".join(f"{k}={v}" for k, v in r.params.as_dict().items()),
+                          **{k: getattr(r.metrics, k) for k in keys}} for r in runs])
+
+
+def dataset_summary(dataset: Registered) -> dict[str, Any]:
+    """Name, frames, registered points and raw points read of a real-data input."""
+    return {"name": dataset.source.name, "frames": len(dataset), "points": len(dataset.cloud),
+            "raw_points": dataset.counts.registration.points_in}
 
 
 # ---------------------------------------------------------------------- output
@@ -256,6 +250,6 @@ def _records(value: Any) -> Any:
     """Tables as lists of rows, datasets as their name and tallies, the rest as is."""
     if isinstance(value, pd.DataFrame):
         return value.to_dict(orient="records")
-    if isinstance(value, Dataset):
-        return {"name": value.name, **value.info}
+    if isinstance(value, Registered):
+        return dataset_summary(value)
     return value

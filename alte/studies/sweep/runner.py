@@ -23,8 +23,9 @@ import pandas as pd
 from tqdm.auto import tqdm
 
 from alte.errors import ParameterError, SimulationError
+from alte.pipeline import FrameSpec, Registered, open_input, prepare
 from alte.sim import ensure_terrain, terrain_folder
-from alte.studies.experiments import Dataset, flat_metrics, load_dataset, run_mapper
+from alte.studies.experiments import CACHE_DIR, measure
 from alte.studies.sweep.spec import SweepRun, SweepSpec, plan_runs
 from alte.studies.sweep.store import finished_ids, load_results, write_row
 
@@ -59,24 +60,24 @@ class SweepResult:
 
 
 @functools.lru_cache(maxsize=2)
-def _dataset(folder: str, frames: int | None, voxel: float | None) -> Dataset:
-    """Per-process cache: consecutive runs on one terrain load it once."""
-    return load_dataset(folder, frames, voxel)
+def _dataset(folder: str, frames: int | None, voxel: float | None, data_dir: str) -> Registered:
+    """Per-process memo over the on-disk registration cache (``DATA_DIR/.cache``)."""
+    return prepare(open_input(folder), FrameSpec(frames=frames, voxel=voxel),
+                   cache=Path(data_dir) / CACHE_DIR)
 
 
 def run_one(run: SweepRun, data_dir: str) -> dict[str, Any]:
     """Map one run's terrain and return its flat row (keys, ``p_*`` params, metrics)."""
     start = time.perf_counter()
-    folder = terrain_folder(data_dir, run.terrain, run.frames)
-    data = _dataset(str(folder), run.frames, run.voxel)
-    result = run_mapper(data, run.mapper, run.params, truth=run.truth)
-    metrics = flat_metrics(result.metrics)
+    folder = terrain_folder(data_dir, run.terrain, run.frames, run.seed)
+    data = _dataset(str(folder), run.frames, run.voxel, data_dir)
+    metrics = measure(data, run.mapper, run.params, truth=run.truth).metrics.flat()
     return {
         "run_id": run.run_id, "terrain": run.terrain, "frames_requested": run.frames or 0,
         "seed": run.seed, "mapper": run.mapper,
         "params_json": json.dumps(dict(run.params), sort_keys=True),
         **{f"p_{k}": v for k, v in run.params.items()},
-        "frames": int(data.info["frames"]), "points": int(data.info["points"]),
+        "frames": len(data), "points": len(data.cloud),
         **{k: v for k, v in metrics.items() if k != "elapsed_s"},
         "elapsed_s": float(metrics["elapsed_s"]), "wall_s": time.perf_counter() - start,
     }

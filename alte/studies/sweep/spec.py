@@ -21,8 +21,8 @@ from typing import Any
 
 from alte.errors import AlteError, ParameterError
 from alte.mappers import make_mapper
+from alte.metrics.maps import TruthOptions
 from alte.sim import TERRAINS
-from alte.studies.experiments import TruthOptions
 
 __all__ = ["MapperGrid", "SweepRun", "SweepSpec", "load_spec", "parse_spec", "plan_runs"]
 
@@ -148,7 +148,7 @@ def _coerce_row(source: str, key: str, mapper: str, row: Any) -> dict[str, Any]:
         if not isinstance(value, _SCALARS):
             raise _fail(source, f"{key}.{name}", f"{value!r} must be a number, string or bool")
     try:
-        resolved = make_mapper(mapper, **row).params
+        resolved = make_mapper(mapper, row).params.as_dict()
     except AlteError as err:
         raise _fail(source, key, str(err)) from err
     return {str(name): resolved[name] for name in row}

@@ -1,0 +1,98 @@
+"""Command-line options shared by the commands that read an input (``register``, ``map``).
+
+They map one to one onto :class:`alte.pipeline.FrameSpec`; a bad value is a
+:class:`~alte.errors.ParameterError` naming the flag, raised before any input is read.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+import numpy as np
+
+from alte.errors import ParameterError
+from alte.pipeline import FrameSpec, PoseSource
+from alte.types import Box, Mount
+
+__all__ = ["add_frame_options", "frame_spec", "parse_box", "parse_origin"]
+
+INPUT_HELP = ("ROS 1 .bag file or ROS 2 bag folder, a terrain folder made by `alte simulate` "
+              "(its control volume and voxel are used), or a point file")
+
+
+def add_frame_options(p: argparse.ArgumentParser, *, origin: bool = False) -> None:
+    """The flags that decide which frames are read and how they are registered."""
+    p.add_argument("input", type=Path, help=INPUT_HELP)
+    p.add_argument("--frames", type=int, default=None, metavar="N",
+                   help="read at most N scans, evenly spaced over the recording")
+    p.add_argument("--voxel", type=float, default=None, metavar="M",
+                   help="grid-average / box-grid merge cell in metres (default: a terrain "
+                        "folder's own, else keep every point)")
+    p.add_argument("--crop", default=None, metavar="XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX",
+                   help="control volume in inertial metres; points outside are dropped "
+                        "(default: a terrain folder's own)")
+    p.add_argument("--mount", default=None, metavar="X,Y,Z,ROLL,PITCH,YAW",
+                   help="sensor offset (m) and rotation (deg) on the body (default: the bag's)")
+    p.add_argument("--cloud-topic", default=None, help="PointCloud2 / VelodyneScan topic")
+    p.add_argument("--pose-topic", default=None, help="pose / odometry / TF topic")
+    p.add_argument("--no-pose", action="store_true",
+                   help="ignore poses: identity body pose for every scan (static sensor)")
+    p.add_argument("--max-rate", type=float, default=None, metavar="RAD_S",
+                   help="drop frames whose body angular rate exceeds this (rad/s)")
+    p.add_argument("--max-offset", type=float, default=None, metavar="S",
+                   help="drop frames whose nearest pose is further than this in time (s)")
+    if origin:
+        p.add_argument("--origin", default="0,0,0", metavar="X,Y,Z",
+                       help="sensor position for a point file (default 0,0,0)")
+
+
+def parse_box(text: str, flag: str = "--crop") -> Box:
+    """``xmin,ymin,zmin,xmax,ymax,zmax`` -> :class:`~alte.types.Box`."""
+    try:
+        values = [float(v) for v in text.split(",")]
+    except ValueError as err:
+        raise ParameterError(f"{flag} {text!r}: expected 6 numbers xmin,...,zmax") from err
+    if len(values) != 6:
+        raise ParameterError(f"{flag} {text!r}: expected 6 numbers xmin,...,zmax")
+    try:
+        return Box.of(values)
+    except ParameterError as err:
+        raise ParameterError(f"{flag} {text!r}: {err}") from err
+
+
+def parse_origin(text: str) -> tuple[float, float, float]:
+    """``"x,y,z"`` -> a finite 3-tuple for ``--origin``."""
+    try:
+        values = np.array([float(v) for v in text.split(",")])
+    except ValueError as err:
+        raise ParameterError(f"--origin {text!r}: expected 3 numbers x,y,z") from err
+    if values.shape != (3,) or not np.isfinite(values).all():
+        raise ParameterError(f"--origin {text!r}: expected 3 finite numbers x,y,z")
+    return (float(values[0]), float(values[1]), float(values[2]))
+
+
+def _checked(flag: str, value: float | int | None, integer: bool = False) -> None:
+    if value is None:
+        return
+    if not (np.isfinite(value) and value > 0):
+        raise ParameterError(f"{flag} {value!r}: must be > 0")
+    if integer and int(value) != value:
+        raise ParameterError(f"{flag} {value!r}: must be a whole number")
+
+
+def frame_spec(args: argparse.Namespace) -> FrameSpec:
+    """The :class:`FrameSpec` of the parsed flags (errors name the flags)."""
+    for flag, value in (("--frames", args.frames), ("--voxel", args.voxel),
+                        ("--max-rate", args.max_rate), ("--max-offset", args.max_offset)):
+        _checked(flag, value, integer=flag == "--frames")
+    if args.no_pose and args.pose_topic:
+        raise ParameterError("--no-pose and --pose-topic exclude each other")
+    mount = Mount.from_string(args.mount) if args.mount else None
+    return FrameSpec(
+        frames=args.frames, voxel=args.voxel,
+        crop=parse_box(args.crop) if args.crop else None, mount=mount,
+        cloud_topic=args.cloud_topic, pose_topic=args.pose_topic,
+        poses=PoseSource.IDENTITY if args.no_pose else PoseSource.RECORDED,
+        max_rate=args.max_rate, max_offset=args.max_offset,
+        origin=parse_origin(args.origin) if getattr(args, "origin", None) else (0.0, 0.0, 0.0))

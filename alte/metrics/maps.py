@@ -1,0 +1,149 @@
+"""All metrics of one map as one typed record: the thesis' (5.2.1) and the ground-truth ones.
+
+:func:`measure_map` takes the map, the registered cloud (set A) and, for simulated
+terrains, the true surface; it returns a :class:`MapMetrics`. ``flat()`` gives the
+scalar columns of a table row (per-class completeness as ``completeness_<class>``;
+per-object values stay in :attr:`TruthMetrics.completeness_by_object`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from alte.metrics.hausdorff import hausdorff
+
+if TYPE_CHECKING:
+    from alte.mappers.base import Mapper
+    from alte.metrics.surface import TrueSurface
+    from alte.types import Box
+
+__all__ = ["GroundTruth", "MapMetrics", "TruthMetrics", "TruthOptions", "measure_map"]
+
+_NAN = float("nan")
+
+
+@dataclass(frozen=True)
+class TruthOptions:
+    """Ground-truth metric settings (see :mod:`alte.metrics.truth`).
+
+    ``tolerance`` (m): how close a map must come to a true surface to count it as
+    mapped; ``n_samples``: surface samples drawn (3D); ``grid_step`` (m): x/y probe
+    spacing of the 2D metrics; ``seed``: sampling seed.
+    """
+
+    tolerance: float = 0.2
+    n_samples: int = 100_000
+    grid_step: float = 0.2
+    seed: int = 0
+
+
+@dataclass(frozen=True, eq=False)
+class GroundTruth:
+    """The true surface of a simulated terrain and its control volume."""
+
+    surface: TrueSurface
+    bounds: Box
+
+
+@dataclass(frozen=True)
+class TruthMetrics:
+    """Ground-truth metrics (NaN where a metric does not apply to the map's kind)."""
+
+    accuracy_mean_m: float = _NAN
+    accuracy_p95_m: float = _NAN
+    phantom_share: float = _NAN
+    completeness: float = _NAN
+    completeness_seen: float = _NAN
+    seen_share: float = _NAN
+    height_rmse_m: float = _NAN
+    unknown_share: float = _NAN
+    free_truly_free_share: float = _NAN
+    completeness_by_class: Mapping[str, float] = field(default_factory=dict)
+    completeness_by_object: Mapping[str, float] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class MapMetrics:
+    """One map's size, thesis fidelity metrics (set A = cloud, set B = corners) and truth."""
+
+    elapsed_s: float
+    basis_functions: int
+    memory_bytes: int
+    occupied_cells: int
+    cell_min_m: float
+    cell_max_m: float
+    size_octaves: float
+    hd_m: float
+    mhd_m: float
+    hd_minus_mhd_m: float
+    h_ab_m: float
+    h_ba_m: float
+    mh_ab_m: float
+    mh_ba_m: float
+    truth: TruthMetrics | None = None
+
+    def flat(self) -> dict[str, float]:
+        """Scalar metrics for a table row (see the module docstring)."""
+        out: dict[str, float] = {f.name: getattr(self, f.name)
+                                 for f in dataclasses.fields(self) if f.name != "truth"}
+        if self.truth is not None:
+            for f in dataclasses.fields(self.truth):
+                value = getattr(self.truth, f.name)
+                if not isinstance(value, Mapping):
+                    out[f.name] = value
+            for cls, value in self.truth.completeness_by_class.items():
+                out[f"completeness_{cls}"] = value
+        return out
+
+    def as_dict(self) -> dict[str, object]:
+        """Everything, nested (per-object completeness included), JSON-ready."""
+        return dataclasses.asdict(self)
+
+
+def _size_spread(mapper: Mapper) -> tuple[float, float, float]:
+    """Cell edge range of the known cells: the "adaptability" of tables 5.1-5.2."""
+    cells = mapper.cells()
+    known = np.isfinite(cells.centers).all(axis=1)
+    edge = cells.sizes[known, 0]
+    if edge.size == 0:
+        return _NAN, _NAN, _NAN
+    lo, hi = float(edge.min()), float(edge.max())
+    return lo, hi, float(np.log2(hi / lo))
+
+
+def _thesis(mapper: Mapper, cloud: np.ndarray) -> dict[str, float]:
+    """HD/MHD between the cloud and the occupied corners; NaN when nothing is occupied."""
+    corners = mapper.corners()
+    names = ("hd_m", "mhd_m", "hd_minus_mhd_m", "h_ab_m", "h_ba_m", "mh_ab_m", "mh_ba_m")
+    if len(corners) == 0 or len(cloud) == 0:  # undefined, not zero
+        return dict.fromkeys(names, _NAN)
+    hd = hausdorff(cloud, corners)
+    return dict(zip(names, (hd.hd, hd.mhd, hd.hd - hd.mhd, hd.h_ab, hd.h_ba, hd.mh_ab,
+                            hd.mh_ba), strict=True))
+
+
+def measure_map(mapper: Mapper, cloud: np.ndarray, *, elapsed_s: float,
+                truth: GroundTruth | None = None,
+                options: TruthOptions | None = None) -> MapMetrics:
+    """Every metric of ``mapper`` against the registered ``cloud`` (and ``truth``)."""
+    lo, hi, octaves = _size_spread(mapper)
+    cells = mapper.cells()
+    truth_metrics = None
+    if truth is not None:
+        from alte.metrics.truth import ground_truth_metrics
+
+        opts = options or TruthOptions()
+        truth_metrics = TruthMetrics(**ground_truth_metrics(
+            cells, truth.surface, dims=mapper.dims, cloud=cloud, bounds=truth.bounds.array(),
+            tolerance=opts.tolerance, n_samples=opts.n_samples, grid_step=opts.grid_step,
+            seed=opts.seed))
+    return MapMetrics(
+        elapsed_s=float(elapsed_s), basis_functions=int(mapper.basis_functions),
+        memory_bytes=int(mapper.memory_bytes),
+        occupied_cells=int(np.count_nonzero(cells.occupied)), cell_min_m=lo, cell_max_m=hi,
+        size_octaves=octaves, **_thesis(mapper, cloud), truth=truth_metrics)

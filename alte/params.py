@@ -1,0 +1,161 @@
+"""One way to declare and validate parameters: frozen dataclasses whose fields carry rules.
+
+Mapper parameters, sweep settings, landing limits, benchmark settings and the report's
+notebook parameters are all :class:`Record` subclasses. A field is declared with
+:func:`param` (default, check, rule, help); values given as text (``--set k=v``, YAML,
+notebook parameters) are coerced to the field's annotated type, and every failure is a
+:class:`~alte.errors.ParameterError` that names the owner, the parameter and the rule:
+``quadtree: max_points=0 out of range (max_points >= 1)``, ``alte2d: unknown
+parameter(s) kapa; valid: criterion, kappa, max_res, min_pts``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import types
+import typing
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from typing import Any, ClassVar, Literal, Self, get_args, get_origin
+
+from alte.errors import ParameterError
+
+__all__ = ["Record", "Rule", "coerce", "param"]
+
+_TRUE = {"true", "1", "yes"}
+_FALSE = {"false", "0", "no"}
+
+
+def _always(_value: object) -> bool:
+    return True
+
+
+@dataclass(frozen=True)
+class Rule:
+    """How one field is checked and explained: ``check(value)`` must hold; ``rule`` says what."""
+
+    check: Callable[[Any], bool] = _always
+    rule: str = ""
+    help: str = ""
+
+
+def param(default: Any, check: Callable[[Any], bool] = _always, rule: str = "",
+          help: str = "") -> Any:
+    """A :class:`Record` field with its default and validity rule."""
+    return field(default=default, metadata={"rule": Rule(check, rule, help)})
+
+
+def _bool(owner: str, name: str, value: object) -> bool:
+    if isinstance(value, bool):
+        return value
+    text = str(value).strip().lower()
+    if text not in _TRUE | _FALSE:
+        raise ParameterError(f"{owner}: {name}={value!r} is not a boolean")
+    return text in _TRUE
+
+
+def _int(owner: str, name: str, value: object) -> int:
+    if isinstance(value, bool):
+        raise ParameterError(f"{owner}: {name}={value!r} is not a valid int")
+    try:
+        number = float(value) if isinstance(value, str) else value
+    except ValueError as err:
+        raise ParameterError(f"{owner}: {name}={value!r} is not a valid int") from err
+    if isinstance(number, int):
+        return number
+    if not isinstance(number, float):
+        raise ParameterError(f"{owner}: {name}={value!r} is not a valid int")
+    if not math.isfinite(number) or not number.is_integer():
+        raise ParameterError(f"{owner}: {name}={value!r} must be an integer")
+    return int(number)
+
+
+def _float(owner: str, name: str, value: object) -> float:
+    if isinstance(value, bool) or not isinstance(value, str | int | float):
+        raise ParameterError(f"{owner}: {name}={value!r} is not a valid float")
+    try:
+        number = float(value)
+    except ValueError as err:
+        raise ParameterError(f"{owner}: {name}={value!r} is not a valid float") from err
+    if not math.isfinite(number):
+        raise ParameterError(f"{owner}: {name}={number!r} must be finite")
+    return number
+
+
+def coerce(owner: str, name: str, kind: Any, value: object) -> Any:
+    """``value`` as the annotated type ``kind`` (int, float, str, bool, Literal, X | None)."""
+    origin = get_origin(kind)
+    if origin in (types.UnionType, typing.Union):
+        options = [k for k in get_args(kind) if k is not type(None)]
+        if value is None or (isinstance(value, str) and value.strip().lower() in {"none", "null"}):
+            return None
+        return coerce(owner, name, options[0], value)
+    if origin is Literal:
+        allowed = get_args(kind)
+        if value not in allowed:
+            raise ParameterError(f"{owner}: {name}={value!r} out of range "
+                                 f"({'|'.join(map(str, allowed))})")
+        return value
+    converters: dict[Any, Callable[[str, str, object], Any]] = {
+        bool: _bool, int: _int, float: _float}
+    if kind in converters:
+        return converters[kind](owner, name, value)
+    if kind is str:
+        if not isinstance(value, str | int | float) or isinstance(value, bool):
+            raise ParameterError(f"{owner}: {name}={value!r} is not a valid str")
+        return str(value)
+    return value
+
+
+@dataclass(frozen=True)
+class Record:
+    """Base of validated parameter sets (see the module docstring).
+
+    Subclasses are frozen dataclasses; ``OWNER`` names them in messages. Construction
+    coerces and checks every field, so an instance is always valid.
+    """
+
+    OWNER: ClassVar[str] = "parameters"
+
+    def __post_init__(self) -> None:
+        hints = typing.get_type_hints(type(self))
+        for spec in dataclasses.fields(self):
+            value = coerce(self.OWNER, spec.name, hints[spec.name], getattr(self, spec.name))
+            rule = spec.metadata.get("rule", Rule())
+            if value is not None and not rule.check(value):
+                raise ParameterError(f"{self.OWNER}: {spec.name}={value!r} out of range "
+                                     f"({rule.rule})")
+            object.__setattr__(self, spec.name, value)
+
+    @classmethod
+    def names(cls) -> tuple[str, ...]:
+        """The parameter names, in declaration order."""
+        return tuple(f.name for f in dataclasses.fields(cls))  # type: ignore[arg-type]
+
+    @classmethod
+    def parse(cls, given: Mapping[str, object] | None = None) -> Self:
+        """An instance from ``given`` (text or typed values); unknown names raise."""
+        given = dict(given or {})
+        unknown = sorted(set(given) - set(cls.names()))
+        if unknown:
+            raise ParameterError(f"{cls.OWNER}: unknown parameter(s) {', '.join(unknown)}; "
+                                 f"valid: {', '.join(sorted(cls.names()))}")
+        return cls(**given)
+
+    def as_dict(self) -> dict[str, Any]:
+        """Parameters by name (JSON-ready scalars)."""
+        return {name: getattr(self, name) for name in self.names()}
+
+    def replace(self, **changes: object) -> Self:
+        """A copy with ``changes`` applied (validated like a new record)."""
+        return type(self).parse({**self.as_dict(), **changes})
+
+    @classmethod
+    def help(cls) -> dict[str, str]:
+        """What each parameter means and its rule, for ``--help`` texts and docs."""
+        out = {}
+        for spec in dataclasses.fields(cls):  # type: ignore[arg-type]
+            rule = spec.metadata.get("rule", Rule())
+            out[spec.name] = f"{rule.help} ({rule.rule})" if rule.rule else rule.help
+        return out

@@ -1,0 +1,175 @@
+"""Registered frames kept for reuse: in memory, or in an on-disk cache read back lazily.
+
+:func:`prepare` registers an input once per :class:`~alte.pipeline.spec.FrameSpec`:
+every frame's points laid end to end (``points`` and ``offsets``), the trajectory, the
+merged cloud (set A of the thesis' metrics) and the counts. With ``cache=DIR`` the
+result is written to ``DIR/<key>/`` (key: the input's identity and the frame spec)
+while the frames stream, and later calls memory-map it, so several maps of one input
+(a sweep, a chapter's table) register it once and never hold it all in memory.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from collections.abc import Iterator
+from contextlib import ExitStack
+from dataclasses import dataclass
+from pathlib import Path
+from typing import BinaryIO
+
+import numpy as np
+
+from alte import __version__
+from alte.errors import AlteError, RegistrationError
+from alte.fsutil import atomic_dir
+from alte.io.bag import ReadCounts
+from alte.pipeline.source import Source, StreamCounts, stream_frames
+from alte.pipeline.spec import FrameSpec
+from alte.registration.grid import GridAccumulator
+from alte.registration.register import RegistrationCounts, empty_reason
+from alte.types import Box, RegisteredFrame, Trajectory
+
+__all__ = ["Registered", "cache_key", "merged_cloud", "prepare"]
+
+#: Bump when the registered output of the same input and spec changes.
+CACHE_VERSION = 1
+_POINTS, _ARRAYS, _META = "points.f64", "arrays.npz", "meta.json"
+
+
+@dataclass(frozen=True, eq=False)
+class Registered:
+    """An input registered with one frame spec (module docstring)."""
+
+    source: Source
+    spec: FrameSpec
+    points: np.ndarray
+    offsets: np.ndarray
+    trajectory: Trajectory
+    cloud: np.ndarray
+    counts: StreamCounts
+    key: str = ""
+
+    def __len__(self) -> int:
+        return len(self.trajectory)
+
+    def frame(self, i: int) -> RegisteredFrame:
+        """Frame ``i`` (its points are a view of :attr:`points`)."""
+        t = self.trajectory
+        pts = self.points[self.offsets[i]:self.offsets[i + 1]]
+        return RegisteredFrame(int(t.stamps[i]), np.asarray(pts), t.origins[i], t.positions[i],
+                               t.quaternions[i])
+
+    def frames(self) -> Iterator[RegisteredFrame]:
+        """Every frame in order."""
+        return (self.frame(i) for i in range(len(self)))
+
+    def bounds(self) -> Box:
+        """The box of every frame's points."""
+        return Box.around(self.points)
+
+
+def cache_key(source: Source, spec: FrameSpec) -> str:
+    """sha256 of the input's identity, the resolved frame spec and the versions."""
+    text = json.dumps({"input": source.identity, "spec": spec.key(), "cache": CACHE_VERSION,
+                       "alte": __version__}, sort_keys=True)
+    return hashlib.sha256(text.encode()).hexdigest()[:32]
+
+
+def _collect(source: Source, spec: FrameSpec, sink: BinaryIO | None,
+             progress: bool) -> tuple[list[np.ndarray], np.ndarray, Trajectory, np.ndarray,
+                                      StreamCounts]:
+    """Stream the frames once: points to ``sink`` (or a list), trajectory, merged cloud."""
+    counts = StreamCounts()
+    merge = GridAccumulator(spec.voxel) if spec.voxel is not None else None
+    parts: list[np.ndarray] = []
+    sizes: list[int] = []
+    poses: list[RegisteredFrame] = []
+    for frame in stream_frames(source, spec, counts, merge=merge, progress=progress):
+        points = np.ascontiguousarray(frame.points, dtype=np.float64)
+        if sink is None:
+            parts.append(points)
+        else:
+            sink.write(points.tobytes())
+        sizes.append(len(points))
+        poses.append(RegisteredFrame(frame.stamp, np.empty((0, 3)), frame.origin,
+                                     frame.position, frame.quaternion))
+    if not sizes:
+        raise RegistrationError(f"{source.path}: {empty_reason(counts.registration)}")
+    offsets = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
+    cloud = merge.points() if merge is not None else np.empty((0, 3))
+    counts.registration.points_out = len(cloud) if merge is not None else int(offsets[-1])
+    return parts, offsets, Trajectory.of(poses), cloud, counts
+
+
+def _meta(source: Source, spec: FrameSpec, counts: StreamCounts) -> dict[str, object]:
+    return {"input": str(source.path), "spec": spec.key(), "counts": counts.as_dict()}
+
+
+def _write(target: Path, source: Source, spec: FrameSpec, progress: bool) -> None:
+    with ExitStack() as stack:
+        tmp = stack.enter_context(atomic_dir(target, overwrite=False))
+        tmp.mkdir(parents=True)
+        sink = stack.enter_context((tmp / _POINTS).open("wb"))
+        _, offsets, traj, cloud, counts = _collect(source, spec, sink, progress)
+        sink.close()
+        np.savez(tmp / _ARRAYS, offsets=offsets, stamps=traj.stamps, positions=traj.positions,
+                 quaternions=traj.quaternions, origins=traj.origins, cloud=cloud)
+        (tmp / _META).write_text(json.dumps(_meta(source, spec, counts), indent=1))
+
+
+def _counts(raw: dict[str, object]) -> StreamCounts:
+    read = ReadCounts(**raw["read"])  # type: ignore[arg-type]
+    reg = RegistrationCounts(**raw["registration"])  # type: ignore[arg-type]
+    return StreamCounts(read, reg, int(raw["scans"]), int(raw["selected"]),  # type: ignore[call-overload]
+                        list(raw["notes"]))  # type: ignore[call-overload]
+
+
+def _load(folder: Path, source: Source, spec: FrameSpec, key: str) -> Registered:
+    meta = json.loads((folder / _META).read_text())
+    with np.load(folder / _ARRAYS) as arrays:
+        a = {k: arrays[k] for k in arrays.files}
+    total = int(a["offsets"][-1])
+    points = np.memmap(folder / _POINTS, dtype=np.float64, mode="r", shape=(total, 3)) \
+        if total else np.empty((0, 3))
+    cloud = a["cloud"] if spec.voxel is not None else points
+    traj = Trajectory(a["stamps"], a["positions"], a["quaternions"], a["origins"])
+    return Registered(source, spec, points, a["offsets"], traj, cloud, _counts(meta["counts"]),
+                      key)
+
+
+def prepare(source: Source, spec: FrameSpec | None = None, *, cache: Path | None = None,
+            progress: bool = False) -> Registered:
+    """Register ``source`` once (module docstring); ``spec`` is resolved against the input."""
+    resolved = source.resolve(spec or FrameSpec())
+    key = cache_key(source, resolved)
+    if cache is None:
+        parts, offsets, traj, cloud, counts = _collect(source, resolved, None, progress)
+        points = np.concatenate(parts) if parts else np.empty((0, 3))
+        return Registered(source, resolved, points, offsets, traj,
+                          cloud if resolved.voxel is not None else points, counts, key)
+    folder = Path(cache) / key
+    if not (folder / _META).is_file():
+        try:
+            _write(folder, source, resolved, progress)
+        except AlteError:  # another process finished it first: read theirs
+            if not (folder / _META).is_file():
+                raise
+    return _load(folder, source, resolved, key)
+
+
+
+def merged_cloud(source: Source, spec: FrameSpec | None = None, *,
+                 progress: bool = False) -> tuple[np.ndarray, StreamCounts]:
+    """The input's merged registered cloud (thesis 2.1.3), streamed: with a voxel only the
+    box grid is held, never the frames; without one every registered point is kept."""
+    resolved = source.resolve(spec or FrameSpec())
+    counts = StreamCounts()
+    merge = GridAccumulator(resolved.voxel) if resolved.voxel is not None else None
+    parts = [f.points for f in stream_frames(source, resolved, counts, merge=merge,
+                                             progress=progress) if merge is None]
+    if counts.registration.frames_kept == 0:
+        raise RegistrationError(f"{source.path}: {empty_reason(counts.registration)}")
+    cloud = merge.points() if merge is not None else np.concatenate(parts)
+    counts.registration.points_out = len(cloud)
+    return cloud, counts

@@ -1,0 +1,115 @@
+"""What a map run is asked to do: which frames and how they are registered, which map.
+
+A :class:`FrameSpec` fixes everything that decides the registered frames (frame
+selection, voxel, crop, mount, topics, pose source, manoeuvre filter): two runs with
+equal frame specs on one input share their registration (the cache key). A
+:class:`MapSpec` names the mapper, its parameters, the domain policy and the feed.
+``None`` means "the input's own": a terrain folder brings its control volume (crop
+and domain) and its registration voxel; a bag or point file brings neither.
+"""
+
+from __future__ import annotations
+
+import enum
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from alte.errors import ParameterError
+from alte.mappers.base import Feed
+from alte.mappers.domain import Domain
+from alte.registration.grid import check_voxel
+from alte.types import Box, Mount
+
+__all__ = ["DomainPolicy", "FrameSpec", "MapSpec", "PoseSource"]
+
+
+class DomainPolicy(enum.Enum):
+    """Where a map's root cell comes from when no explicit :class:`Domain` is given.
+
+    ``AUTO``: the control volume when the input has one (a terrain folder), else the
+    data. ``CONTROL``: the cube over the control volume (thesis 3.3: "an overall domain
+    is defined"). ``DATA``: the cube over the registered points the map receives
+    (found by a first pass over the frames when they are streamed).
+    """
+
+    AUTO = "auto"
+    CONTROL = "control"
+    DATA = "data"
+
+
+class PoseSource(enum.Enum):
+    """Where each scan's pose comes from: the bag's pose topic, or none (identity)."""
+
+    RECORDED = "recorded"
+    IDENTITY = "identity"
+
+
+@dataclass(frozen=True)
+class FrameSpec:
+    """How the input becomes registered frames (module docstring).
+
+    ``frames``: at most that many scans, evenly spaced over the cloud topic (None: all);
+    ``voxel`` (m): per-frame grid average and the merged cloud's box grid; ``crop``:
+    the control volume points are kept in; ``origin``: the sensor position of a point
+    file; ``max_rate`` (rad/s) / ``max_offset`` (s): the fast-manoeuvre filter.
+    """
+
+    frames: int | None = None
+    voxel: float | None = None
+    crop: Box | None = None
+    mount: Mount | None = None
+    cloud_topic: str | None = None
+    pose_topic: str | None = None
+    poses: PoseSource = PoseSource.RECORDED
+    max_rate: float | None = None
+    max_offset: float | None = None
+    origin: tuple[float, float, float] = (0.0, 0.0, 0.0)
+
+    def __post_init__(self) -> None:
+        if self.frames is not None and (isinstance(self.frames, bool)
+                                        or not isinstance(self.frames, int) or self.frames < 1):
+            raise ParameterError(f"frames={self.frames!r}: expected a positive integer or None")
+        if self.voxel is not None:
+            object.__setattr__(self, "voxel", check_voxel(self.voxel))
+        for name in ("max_rate", "max_offset"):
+            value = getattr(self, name)
+            if value is not None and not (np.isfinite(value) and value > 0):
+                raise ParameterError(f"{name}={value!r} must be a positive finite number")
+        origin = np.asarray(self.origin, dtype=np.float64).reshape(-1)
+        if origin.shape != (3,) or not np.isfinite(origin).all():
+            raise ParameterError(f"origin {self.origin!r}: expected 3 finite numbers x,y,z")
+        object.__setattr__(self, "origin", tuple(float(v) for v in origin))
+
+    def key(self) -> dict[str, object]:
+        """Everything that decides the registered frames, JSON-ready (the cache key)."""
+        return {"frames": self.frames, "voxel": self.voxel,
+                "crop": None if self.crop is None else list(self.crop.values()),
+                "mount": None if self.mount is None else self.mount.to_string(),
+                "cloud_topic": self.cloud_topic, "pose_topic": self.pose_topic,
+                "poses": self.poses.value, "max_rate": self.max_rate,
+                "max_offset": self.max_offset, "origin": list(self.origin)}
+
+
+@dataclass(frozen=True)
+class MapSpec:
+    """Which map: mapper name and parameters, domain (or policy), feed, time-lapse.
+
+    ``feed`` None uses the mapper's own protocol (``Mapper.default_feed``: the thesis
+    built Quadtree once on the final cloud and fed the others frame by frame);
+    ``snapshots`` keeps the cells that many times over the run (time-lapse figures)
+    and counts the basis functions after every frame.
+    """
+
+    mapper: str
+    params: Mapping[str, object] = field(default_factory=dict)
+    domain: Domain | DomainPolicy = DomainPolicy.AUTO
+    feed: Feed | None = None
+    snapshots: int = 0
+
+    def __post_init__(self) -> None:
+        if isinstance(self.snapshots, bool) or not isinstance(self.snapshots, int) \
+                or self.snapshots < 0:
+            raise ParameterError(f"snapshots={self.snapshots!r}: expected an integer >= 0")
+        object.__setattr__(self, "params", dict(self.params))
