@@ -27,6 +27,7 @@ from alte.io.bag import ReadCounts
 from alte.pipeline.source import Source, StreamCounts, stream_frames
 from alte.pipeline.spec import FrameSpec
 from alte.registration.grid import GridAccumulator
+from alte.registration.odometry import PoseCounts
 from alte.registration.register import RegistrationCounts, empty_reason
 from alte.types import Box, RegisteredFrame, Trajectory
 
@@ -121,8 +122,9 @@ def _write(target: Path, source: Source, spec: FrameSpec, progress: bool) -> Non
 def _counts(raw: dict[str, object]) -> StreamCounts:
     read = ReadCounts(**raw["read"])  # type: ignore[arg-type]
     reg = RegistrationCounts(**raw["registration"])  # type: ignore[arg-type]
+    poses = PoseCounts(**raw.get("poses", {}))  # type: ignore[arg-type]
     return StreamCounts(read, reg, int(raw["scans"]), int(raw["selected"]),  # type: ignore[call-overload]
-                        list(raw["notes"]))  # type: ignore[call-overload]
+                        list(raw["notes"]), poses)  # type: ignore[call-overload]
 
 
 def _load(folder: Path, source: Source, spec: FrameSpec, key: str) -> Registered:
