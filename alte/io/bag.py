@@ -34,10 +34,12 @@ from alte.io.reader import (
 )
 from alte.types import Frame, Mount
 
-__all__ = ["BagInfo", "FrameSet", "FrameStream", "ReadCounts", "ReadOptions", "evenly_spaced",
-           "inspect_bag", "read_frames"]
+__all__ = ["NO_POSE_NOTE", "BagInfo", "FrameSet", "FrameStream", "ReadCounts", "ReadOptions",
+           "evenly_spaced", "inspect_bag", "read_frames"]
 
 _IDENTITY_Q = np.array([0.0, 0.0, 0.0, 1.0])
+#: The note of a stream read without poses (callers that pose the scans otherwise replace it).
+NO_POSE_NOTE = "no pose topic: every frame has the identity pose"
 
 
 @dataclass
@@ -384,5 +386,5 @@ def _sources(
             f"{bag}: no pose topic ({', '.join(POSE_TYPES)}) for {cloud}; "
             f"pass allow_no_pose=True to read it unposed; {topic_listing(topics)}"
         )
-    notes.append("no pose topic: every frame has the identity pose")
+    notes.append(NO_POSE_NOTE)
     return cloud, None, None, used_mount

@@ -27,6 +27,7 @@ from alte.io.bag import ReadCounts
 from alte.pipeline.source import Source, StreamCounts, stream_frames
 from alte.pipeline.spec import FrameSpec
 from alte.registration.grid import GridAccumulator
+from alte.registration.odometry import PoseCounts
 from alte.registration.register import RegistrationCounts, empty_reason
 from alte.types import Box, RegisteredFrame, Trajectory
 
@@ -122,7 +123,9 @@ def _counts(raw: dict[str, Any]) -> StreamCounts:
     """The counts of a cache's metadata (parsed JSON, as ``StreamCounts.as_dict`` wrote it)."""
     read = ReadCounts(**raw["read"])
     reg = RegistrationCounts(**raw["registration"])
-    return StreamCounts(read, reg, int(raw["scans"]), int(raw["selected"]), list(raw["notes"]))
+    poses = PoseCounts(**raw.get("poses", {}))
+    return StreamCounts(read, reg, int(raw["scans"]), int(raw["selected"]), list(raw["notes"]),
+                        poses)
 
 
 def _load(folder: Path, source: Source, spec: FrameSpec, key: str) -> Registered:
