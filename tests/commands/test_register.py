@@ -62,6 +62,7 @@ def fake_io(monkeypatch):
             self.scans = self.selected = len(frames)
             self.notes: list[str] = []
             self.counts = ReadCounts(scans_read=len(frames))
+            self.track = object()  # a recorded pose stream: the frames keep their poses
 
         def __iter__(self):
             return iter(frames)
