@@ -56,7 +56,7 @@ class NativeTree:
         Rays are walked by as many threads as numba may use (``NUMBA_NUM_THREADS``)."""
         blocks, bits = scan_blocks(points.astype(np.float32), origin.astype(np.float32),
                                    self.voxel, self.max_range, capacity=self._scan_blocks + 64,
-                                   threads=numba.config.NUMBA_NUM_THREADS)
+                                   threads=int(numba.config.NUMBA_NUM_THREADS))  # type: ignore[attr-defined]  # set at import by numba
         self._scan_blocks = blocks.size + blocks.size // 4
         self._update(blocks, bits)
 

@@ -22,6 +22,9 @@ from alte.errors import MapperError
 from alte.mappers._blockset import EMPTY, WORDS, find_slot, rehash
 from alte.mappers._raycast import TREE_DEPTH, TREE_MAX_VAL, morton_decode
 
+#: The voxel store: hash slots, their rows, block ids and float32 log-odds pages.
+Store = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+
 __all__ = ["PAGE", "Leaves", "VoxelStore", "check_origin", "leaf_geometry", "prune", "write_bt"]
 
 _THREE = np.uint64(3)
@@ -130,7 +133,8 @@ class VoxelStore:
 
 
 @numba.njit(cache=True)
-def _apply(store, n: int, scan, model) -> int:
+def _apply(store: Store, n: int, scan: tuple[np.ndarray, np.ndarray],
+           model: tuple[np.float32, np.float32, np.float32, np.float32]) -> int:
     """Clamped float32 add of ``miss``/``hit`` at every set bit of the ``scan``'s blocks;
     ``model`` is (miss, hit, clamp low, clamp high); returns the new block count."""
     slots, rows, blocks, pages = store
@@ -150,7 +154,7 @@ def _apply(store, n: int, scan, model) -> int:
             update = miss if w < WORDS else hit
             base = (w % WORDS) * 64
             while word:
-                i = base + trailing_zeros(word)
+                i = base + trailing_zeros(word)  # type: ignore[call-arg]  # numba intrinsic
                 word &= word - np.uint64(1)
                 value = page[at, i]
                 if np.isnan(value):
@@ -160,7 +164,7 @@ def _apply(store, n: int, scan, model) -> int:
 
 
 @numba.njit(cache=True)
-def _collect(blocks, pages, n):
+def _collect(blocks: np.ndarray, pages: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
     """Observed voxels in Morton order: blocks sorted, voxels by local index within."""
     count = 0
     for row in range(n):

@@ -25,7 +25,12 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from alte.mappers._blockset import LOCAL, row_of
+from alte.mappers._blockset import LOCAL, Table, row_of
+
+#: A ray (or rays): origin, origin key, end(s), end key(s).
+Ray = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+#: Per-axis (step, tMax, tDelta) of a voxel walk.
+Axis = tuple[int, float, float]
 
 __all__ = ["TREE_DEPTH", "TREE_MAX_VAL", "morton", "morton_decode", "morton_encode", "prepare",
            "walk_dense", "walk_hashed"]
@@ -139,7 +144,8 @@ def _ends(points: np.ndarray, origin: np.ndarray, max_range: float, factor: floa
 
 
 @numba.njit(cache=True, inline="always")
-def _axis(delta: np.float32, lf: np.float32, okey: int, origin: np.float32, res: float):
+def _axis(delta: np.float32, lf: np.float32, okey: int, origin: np.float32,
+          res: float) -> tuple[int, float, float]:
     """Amanatides & Woo set-up of one axis exactly as OctoMap: (step, tMax, tDelta)."""
     di = delta / lf  # float direction component
     if di == 0.0:
@@ -151,7 +157,7 @@ def _axis(delta: np.float32, lf: np.float32, okey: int, origin: np.float32, res:
 
 
 @numba.njit(cache=True, inline="always")
-def _dilated(step: int, mask: int):
+def _dilated(step: int, mask: int) -> tuple[int, int]:
     """(fill, wrap) of one axis' dilated local index: ``((l | fill) + step) & mask`` moves
     it one voxel, and it equals ``wrap`` exactly when the walk left the block."""
     if step > 0:
@@ -160,7 +166,7 @@ def _dilated(step: int, mask: int):
 
 
 @numba.njit(cache=True, inline="always")
-def _start(ray, res: float):
+def _start(ray: Ray, res: float) -> tuple[Axis, Axis, Axis, float, int]:
     """Per-axis (step, tMax, tDelta), the float ray length and the steps to the end key."""
     origin, okey, end, ekey = ray
     dx, dy, dz = end[0] - origin[0], end[1] - origin[1], end[2] - origin[2]
@@ -171,7 +177,7 @@ def _start(ray, res: float):
 
 
 @numba.njit(cache=True)
-def walk_dense(ray, res: float, limit: int, grid, box) -> None:
+def walk_dense(ray: Ray, res: float, limit: int, grid: np.ndarray, box: np.ndarray) -> None:
     """Set the bits of the free keys of ``computeRayKeys(origin, end)`` in a dense array;
     ``ray`` is (origin, origin key, end, end key).
 
@@ -218,7 +224,7 @@ def walk_dense(ray, res: float, limit: int, grid, box) -> None:
 
 
 @numba.njit(cache=True)
-def walk_hashed(ray, res: float, limit: int, table, n_blocks: int) -> int:
+def walk_hashed(ray: Ray, res: float, limit: int, table: Table, n_blocks: int) -> int:
     """Set the bits of the free keys of ``computeRayKeys(origin, end)`` in a hashed block
     set (``_blockset``; room reserved by the caller); return the new block count;
     ``ray`` is (origin, origin key, end, end key).
@@ -267,7 +273,8 @@ def walk_hashed(ray, res: float, limit: int, table, n_blocks: int) -> int:
 
 
 @numba.njit(cache=True)
-def prepare(points: np.ndarray, origin: np.ndarray, res: float, max_range: float):
+def prepare(points: np.ndarray, origin: np.ndarray, res: float,
+            max_range: float) -> Ray:
     """Origin key (-1 entries when off the key space), ray ends, their keys, hit flags."""
     factor = 1.0 / res
     okey = np.empty(3, dtype=np.int64)
