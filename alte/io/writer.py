@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
 from pathlib import Path
-from typing import Any
+from typing import Any, TypedDict, Unpack
 
 import numpy as np
 from rosbags.rosbag2 import StoragePlugin, Writer
@@ -23,7 +23,7 @@ from alte.fsutil import atomic_dir
 from alte.io.pointcloud2 import encode_pointcloud2, make_header
 from alte.types import Frame, Mount
 
-__all__ = ["STORAGES", "write_bag", "write_frames"]
+__all__ = ["STORAGES", "BagOptions", "write_bag", "write_frames"]
 
 STORAGES = {"sqlite3": StoragePlugin.SQLITE3, "mcap": StoragePlugin.MCAP}
 _POSE = "geometry_msgs/msg/PoseStamped"
@@ -126,7 +126,7 @@ def write_bag(  # noqa: PLR0917 - positional arrays as specified for the simulat
     world_frame: str = "map",
     body_frame: str = "base_link",
     sensor_frame: str = "velodyne",
-    dtype: Any = np.float32,
+    dtype: type[np.floating[Any]] = np.float32,
     overwrite: bool = False,
     progress: bool = False,
 ) -> Path:
@@ -164,7 +164,22 @@ def write_bag(  # noqa: PLR0917 - positional arrays as specified for the simulat
     return target
 
 
-def write_frames(path: str | Path, frames: Sequence[Frame], mount: Mount | None, **kw: Any) -> Path:
+class BagOptions(TypedDict, total=False):
+    """Keywords of :func:`write_bag` after its arrays (topics, storage, frames, dtype)."""
+
+    cloud_topic: str
+    pose_topic: str
+    storage: str
+    world_frame: str
+    body_frame: str
+    sensor_frame: str
+    dtype: type[np.floating[Any]]
+    overwrite: bool
+    progress: bool
+
+
+def write_frames(path: str | Path, frames: Sequence[Frame], mount: Mount | None,
+                 **kw: Unpack[BagOptions]) -> Path:
     """Write frames as a bag, each pose at its frame's stamp (keywords as :func:`write_bag`)."""
     if not frames:
         raise BagError(f"{path}: no frames to write")
