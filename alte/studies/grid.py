@@ -21,6 +21,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 
 from alte.errors import ParameterError
@@ -45,12 +46,14 @@ TRADEOFF_COLUMNS = ("terrain", "case", "mapper", "params", "seed", "basis_functi
 OCCUPIED_SIZE = "size_occupied"
 #: Name of the evaluation-only ablation that keeps only the thesis' own settings.
 THESIS_ROWS = "thesis_rows"
-_DROP = ("run_id", "params_json", "frames_requested", "wall_s")
+_DROP = ("run_id", "params_json", "frames_requested", "wall_s", "cpu_s")
 
 
 @dataclass(frozen=True)
 class Grid:
-    """A finished grid: base trade-off table, every variant's rows, and how it ran."""
+    """A finished grid: base trade-off table, every variant's rows, and how it ran
+    (``seconds``: this call's wall time; ``cpu_s``: CPU seconds of all its runs, reused
+    ones included, i.e. what the grid costs on idle cores)."""
 
     spec: SweepSpec
     table: pd.DataFrame
@@ -59,6 +62,7 @@ class Grid:
     ran: int
     seconds: float
     failed: list[str] = field(default_factory=list)
+    cpu_s: float = float("nan")
 
     @property
     def variant_texts(self) -> dict[str, str]:
@@ -101,8 +105,10 @@ def run_grid(spec_path: str | os.PathLike[str], *, scheduler: str = "local", wor
               for r, msg in result.failed]
     variants = tradeoff_table(variant_table(spec, result.table))
     base = variants[variants["variant"] == BASE].drop(columns="variant")
+    cpu = (result.table["cpu_s"].astype(float).sum(min_count=len(result.table))  # all or NaN
+           if "cpu_s" in result.table else np.nan)
     return Grid(spec, base.reset_index(drop=True), variants, len(result.table), result.ran,
-                seconds, failed)
+                seconds, failed, float(cpu))
 
 
 def thesis_rows(table: pd.DataFrame) -> pd.DataFrame:

@@ -125,6 +125,7 @@ def test_run_grid_end_to_end(tmp_path):
     grid = run_grid(spec, scheduler="serial", data_dir=str(tmp_path / "data"),
                     output=tmp_path / "runs", progress=False, frames=2, seeds=[3, 4])
     assert grid.spec.frames == 2 and grid.spec.seeds == (3, 4) and not grid.failed
+    assert grid.cpu_s > 0 and grid.seconds > 0
     assert grid.runs == grid.ran == 8 + 8  # set B changes both 2D mappers' runs
     assert len(grid.table) == 8 and set(grid.table["seed"]) == {3, 4}
     assert set(TRADEOFF_COLUMNS) - {"accuracy_mean_m"} <= set(grid.table.columns)

@@ -24,8 +24,8 @@ __all__ = ["KEY_COLUMNS", "TIMING_COLUMNS", "finished_ids", "load_results", "wri
 
 #: Columns identifying a run (then ``p_<param>`` columns, then the metrics).
 KEY_COLUMNS = ("run_id", "terrain", "frames_requested", "seed", "mapper", "params_json")
-#: Wall-clock columns: the only ones that differ between repeated runs.
-TIMING_COLUMNS = ("elapsed_s", "wall_s")
+#: Timing columns: the only ones that differ between repeated runs.
+TIMING_COLUMNS = ("elapsed_s", "wall_s", "cpu_s")
 
 _PREFIX, _SUFFIX = "run-", ".parquet"
 
