@@ -55,8 +55,7 @@ def _bag(ctx: Context, terrain: str) -> Path:
     folder = ensure_terrain(terrain, workload_dir(cfg.data_dir, cfg.quick),
                             frames=QUICK_FRAMES if cfg.quick else None)
     source = open_input(folder)
-    if source.bag is None:
-        raise FileNotFoundError(f"{folder}: no bag")
+    assert source.bag is not None, "a terrain folder names its bag"
     return source.bag
 
 
