@@ -33,7 +33,7 @@ RSS_SPREAD = LIMITS[9] - 1.0
 #: 3D-ALTE's ceiling for ``alte map BAG`` (MB).
 RSS_CEILING_MB = 300.0
 #: ``--set`` arguments of each measured mapper (Octomap at the bench's 0.2 m).
-MAPPER_SETS: dict[str, tuple[str, ...]] = {"alte3d": (), "octomap": ("--set", "resolution=0.2")}
+MAPPER_SETS: dict[str, tuple[str, ...]] = {"alte3d": (), "octomap": ("--set", "resolution=5")}
 TERRAIN = "sim_nav_1"
 
 

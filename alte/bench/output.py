@@ -38,7 +38,7 @@ def miss_note(result: Result) -> str:
     if result.unit == "exponent":
         return f"row {result.row} {result.case}: exponent {result.ours:.2f} vs n log n's " \
                f"{result.peer:.2f}"
-    bound = LIMITS[result.row]
+    bound = float(result.detail.get("limit", LIMITS[result.row]))
     return (f"row {result.row} {result.case}: ratio {result.ratio:.3g}, target <= {bound:.3g} "
             f"(missed by {result.ratio / bound:.2f}x)")
 

@@ -22,6 +22,7 @@ from alte.bench.core import BenchConfig, Context, Result
 from alte.bench.maps import batch_builds, insert_latency, octomap_memory, octomap_speed
 from alte.bench.memory import map_memory
 from alte.bench.scaling import scaling
+from alte.bench.stream import scan_peer, streaming_chain
 from alte.bench.timing import machine_info, peak_rss_bytes
 from alte.bench.wall import report_wall_time
 from alte.errors import ParameterError
@@ -41,6 +42,8 @@ ROWS: dict[int, tuple[str, Row]] = {
     7: ("scaling 10^4..10^7 points", scaling),
     8: ("make report wall time vs thesis MATLAB", report_wall_time),
     9: ("alte map peak RSS: a mission flown 4x vs once", map_memory),
+    10: ("alte map BAG: wall time vs mission time, per-frame latency", streaming_chain),
+    11: ("Octomap native vs DUFOMap (UFOMap) scan integration", scan_peer),
 }
 
 

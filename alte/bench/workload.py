@@ -64,8 +64,7 @@ def load_workload(terrain: str, data_dir: str | Path, *, quick: bool = False,
                    cache=Path(data_dir) / ".cache", progress=progress)
     scans = [(np.array(f.points), np.asarray(f.origin, float)) for f in data.frames()]
     box = data.spec.crop if data.spec.crop is not None else data.bounds()
-    if data.spec.voxel is None:
-        raise ParameterError(f"bench: {folder} gives no registration voxel (scenario.json)")
+    assert data.spec.voxel is not None, "a terrain folder gives its registration voxel"
     return Workload(terrain, scans, np.array(data.cloud), np.asarray(box.values(), float),
                     float(data.spec.voxel))
 

@@ -31,7 +31,7 @@ def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) 
     parser.add_argument("--quick", action="store_true",
                         help="tiny inputs (a few simulated scans): a smoke run in seconds")
     parser.add_argument("--only", type=_rows, default=None, metavar="ROWS",
-                        help="comma-separated row numbers to run (default: all, 1-8)")
+                        help="comma-separated row numbers to run (default: all, 1-11)")
     parser.add_argument("--repeats", type=int, default=5, help="timed repeats (default 5)")
     parser.add_argument("--warmup", type=int, default=1, help="discarded warm-up runs")
     parser.add_argument("--frames", type=int, default=None,
