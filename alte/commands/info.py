@@ -38,7 +38,7 @@ def pose_source(info: BagInfo) -> str:
     """What ``alte map``/``register`` use for poses by default (``--poses`` unset)."""
     if info.pose_topic:
         return f"recorded ({info.pose_topic})"
-    return "odometry (no pose topic: LiDAR odometry with kiss-icp, from the first scan's frame)"
+    return "odometry (no pose topic: LiDAR odometry, in the first scan's body frame)"
 
 
 def format_info(info: BagInfo) -> list[str]:

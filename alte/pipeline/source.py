@@ -22,8 +22,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from alte.errors import BagError, ParameterError, PointFileError, PoseError
+from alte.errors import BagError, ParameterError, PointFileError, TopicError
 from alte.io.bag import NO_POSE_NOTE, FrameStream, ReadCounts
+from alte.io.pose import POSE_TYPES
 from alte.pipeline.spec import FrameSpec, PoseSource
 from alte.registration.grid import GridAccumulator, grid_average
 from alte.registration.odometry import PoseCounts, odometry_frames, refine_frames
@@ -151,7 +152,8 @@ def _odometry(stream: FrameStream, probe: FrameStream, spec: FrameSpec,
             start = (at.positions[0], at.quaternions[0])
     anchor = f"the recorded pose of the first scan ({probe.pose_topic})" if start is not None \
         else "the first scan's body frame"
-    stream.notes.append(f"poses from LiDAR odometry (kiss-icp), anchored at {anchor}")
+    method = "point-to-plane" if spec.odometry.method == "plane" else "kiss-icp"
+    stream.notes.append(f"poses from LiDAR odometry ({method}), anchored at {anchor}")
     yield from odometry_frames(itertools.chain([first], frames), stream.mount, counts=counts,
                                params=spec.odometry, start=start)
 
@@ -161,15 +163,17 @@ def _posed(source: Source, spec: FrameSpec, counts: PoseCounts,
     """The scan stream and its frames posed as ``spec.poses`` says (:class:`PoseSource`)."""
     choice = spec.poses
     counts.source = choice.value
-    if choice in (PoseSource.IDENTITY, PoseSource.RECORDED):
-        identity = choice is PoseSource.IDENTITY
-        stream = _open(source, spec, "" if identity else spec.pose_topic, progress,
-                       allow_no_pose=identity)
+    if choice is PoseSource.IDENTITY:
+        stream = _open(source, spec, "", progress)
         return stream, iter(stream)
     probe = _open(source, spec, spec.pose_topic, progress)
-    if choice is PoseSource.REFINE and probe.track is None:
-        raise PoseError(f"{probe.path}: --poses refine (poses=refine) needs recorded poses to "
-                        "refine, and the bag has no pose topic; use --poses odometry")
+    if choice in (PoseSource.RECORDED, PoseSource.REFINE) and probe.track is None:
+        raise TopicError(f"{probe.path}: --poses {choice.value} needs the bag's poses and it "
+                         f"has no pose topic ({', '.join(POSE_TYPES)}) for "
+                         f"{probe.cloud_topic}; use --poses odometry (LiDAR odometry) or "
+                         "--poses identity (static sensor)")
+    if choice is PoseSource.RECORDED:
+        return probe, iter(probe)
     if choice is PoseSource.REFINE:
         return probe, refine_frames(iter(probe), probe.mount, counts=counts,
                                     params=spec.odometry)
