@@ -38,10 +38,11 @@ _BT_DATA = b"\ndata\n"
 def shown_cells(cells: Cells, dims: int, everything: bool = False) -> np.ndarray:
     """Mask of the cells drawn: occupied (3D maps) or known (2D height maps: a free leaf is
     ground at its height); ``everything`` adds the free cells of a 3D map."""
-    known = np.isfinite(cells.centers).all(axis=1)
+    known: np.ndarray = np.all(np.isfinite(cells.centers), axis=1)
     if dims == 2 or everything:
         return known
-    return known & cells.occupied
+    shown: np.ndarray = known & cells.occupied
+    return shown
 
 
 def height_colours(z: np.ndarray) -> np.ndarray:

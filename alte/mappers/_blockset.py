@@ -11,8 +11,11 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-__all__ = ["EMPTY", "LOCAL", "WORDS", "find_slot", "keys_to_blocks", "new_table", "rehash",
-           "reserve", "row_of", "set_bit", "union"]
+__all__ = ["EMPTY", "LOCAL", "WORDS", "Table", "find_slot", "keys_to_blocks", "new_table",
+           "rehash", "reserve", "row_of", "set_bit", "union"]
+
+#: A block set: hash slots, the row of each slot, bit rows (N, 16), block code of each row.
+Table = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
 
 EMPTY = np.uint64(0xFFFFFFFFFFFFFFFF)
 _GOLDEN = np.uint64(0x9E3779B97F4A7C15)
@@ -34,7 +37,8 @@ def find_slot(slots: np.ndarray, block: np.uint64) -> int:
 
 
 @numba.njit(cache=True)
-def rehash(slots: np.ndarray, blocks: np.ndarray, n_blocks: int, size: int):
+def rehash(slots: np.ndarray, blocks: np.ndarray, n_blocks: int, size: int,
+           ) -> tuple[np.ndarray, np.ndarray]:
     """Hash table of ``size`` slots (a power of two) holding the first ``n_blocks`` blocks."""
     new_slots = np.full(size, EMPTY, dtype=np.uint64)
     new_rows = np.zeros(size, dtype=np.int64)
@@ -46,7 +50,7 @@ def rehash(slots: np.ndarray, blocks: np.ndarray, n_blocks: int, size: int):
 
 
 @numba.njit(cache=True)
-def new_table(capacity: int):
+def new_table(capacity: int) -> Table:
     """An empty table with room for ``capacity`` blocks."""
     capacity = max(capacity, 16)
     size = 1 << int(np.ceil(np.log2(2 * capacity)))
@@ -55,7 +59,7 @@ def new_table(capacity: int):
 
 
 @numba.njit(cache=True)
-def reserve(table, n_blocks: int, need: int):
+def reserve(table: Table, n_blocks: int, need: int) -> Table:
     """``table`` with room for ``need`` more blocks (rows doubled, hash kept half empty)."""
     slots, rows, bits, blocks = table
     if n_blocks + need > blocks.size:
@@ -74,7 +78,7 @@ def reserve(table, n_blocks: int, need: int):
 
 
 @numba.njit(cache=True, inline="always")
-def row_of(table, block: np.uint64, n_blocks: int):
+def row_of(table: Table, block: np.uint64, n_blocks: int) -> tuple[int, int]:
     """Row of ``block`` (added if new; room reserved by the caller); returns (row, n_blocks)."""
     slots, rows, _, blocks = table
     j = find_slot(slots, block)
@@ -94,7 +98,7 @@ def set_bit(bits: np.ndarray, row: int, word0: int, key: np.ndarray) -> None:
 
 
 @numba.njit(cache=True)
-def keys_to_blocks(keys: np.ndarray, word0: int):
+def keys_to_blocks(keys: np.ndarray, word0: int) -> tuple[np.ndarray, np.ndarray]:
     """Blocks and bit rows of Morton ``keys``, set in the words from ``word0``."""
     table = reserve(new_table(keys.size // 64), 0, keys.size)
     n_blocks = 0
@@ -106,7 +110,7 @@ def keys_to_blocks(keys: np.ndarray, word0: int):
 
 
 @numba.njit(cache=True)
-def union(blocks: np.ndarray, bits: np.ndarray, capacity: int):
+def union(blocks: np.ndarray, bits: np.ndarray, capacity: int) -> tuple[Table, int]:
     """Table of the rows ``bits`` (block codes ``blocks``, repeats OR-ed); (table, n_blocks)."""
     table = reserve(new_table(capacity), 0, blocks.size)
     n_blocks = 0

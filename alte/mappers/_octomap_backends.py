@@ -56,7 +56,9 @@ class NativeTree:
         Rays are walked by as many threads as numba may use (``NUMBA_NUM_THREADS``)."""
         blocks, bits = scan_blocks(points.astype(np.float32), origin.astype(np.float32),
                                    self.voxel, self.max_range, capacity=self._scan_blocks + 64,
-                                   threads=numba.config.NUMBA_NUM_THREADS)
+                                   # numba.config reads its settings from the environment at
+                                   # import and declares none of them.
+                                   threads=numba.config.NUMBA_NUM_THREADS)  # type: ignore[attr-defined]
         self._scan_blocks = blocks.size + blocks.size // 4
         self._update(blocks, bits)
 

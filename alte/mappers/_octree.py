@@ -11,6 +11,7 @@ again with the same value on the next update), so leaves, leaf counts and the
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -53,6 +54,10 @@ def check_origin(origin: object, owner: str) -> np.ndarray:
 #: time, so no insert ever copies the map.
 PAGE = 1024
 _PAGE_SHIFT = 10
+
+
+#: A voxel store as the kernels take it: hash slots, slot rows, block codes, pages.
+_Store = tuple[np.ndarray, np.ndarray, np.ndarray, Sequence[np.ndarray]]
 
 
 def _page() -> np.ndarray:
@@ -130,7 +135,8 @@ class VoxelStore:
 
 
 @numba.njit(cache=True)
-def _apply(store, n: int, scan, model) -> int:
+def _apply(store: _Store, n: int, scan: tuple[np.ndarray, np.ndarray],
+           model: tuple[np.float32, np.float32, np.float32, np.float32]) -> int:
     """Clamped float32 add of ``miss``/``hit`` at every set bit of the ``scan``'s blocks;
     ``model`` is (miss, hit, clamp low, clamp high); returns the new block count."""
     slots, rows, blocks, pages = store
@@ -150,7 +156,9 @@ def _apply(store, n: int, scan, model) -> int:
             update = miss if w < WORDS else hit
             base = (w % WORDS) * 64
             while word:
-                i = base + trailing_zeros(word)
+                # A numba intrinsic: compiled code passes the value alone (its Python
+                # signature starts with numba's typing context).
+                i = base + trailing_zeros(word)  # type: ignore[call-arg]
                 word &= word - np.uint64(1)
                 value = page[at, i]
                 if np.isnan(value):
@@ -160,7 +168,8 @@ def _apply(store, n: int, scan, model) -> int:
 
 
 @numba.njit(cache=True)
-def _collect(blocks, pages, n):
+def _collect(blocks: np.ndarray, pages: Sequence[np.ndarray],
+             n: int) -> tuple[np.ndarray, np.ndarray]:
     """Observed voxels in Morton order: blocks sorted, voxels by local index within."""
     count = 0
     for row in range(n):

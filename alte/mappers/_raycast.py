@@ -25,7 +25,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from alte.mappers._blockset import LOCAL, row_of
+from alte.mappers._blockset import LOCAL, Table, row_of
 
 __all__ = ["TREE_DEPTH", "TREE_MAX_VAL", "morton", "morton_decode", "morton_encode", "prepare",
            "walk_dense", "walk_hashed"]
@@ -34,10 +34,10 @@ TREE_DEPTH = 16
 TREE_MAX_VAL = 32768
 _KEY_LIMIT = 2 * TREE_MAX_VAL
 
-#: A ray's arrays: origin, origin key, end, end key, float and integer workspaces.
-_Ray = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]
-#: The block-bitmap key set: hash slots, slot rows, bit rows, row blocks.
-_Table = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+#: A ray's arrays: origin, origin key, end, end key.
+_Ray = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+#: One axis of a ray walk: step (-1, 0, 1), tMax, tDelta.
+_Axis = tuple[int, float, float]
 
 
 @numba.njit(cache=True, inline="always")
@@ -139,7 +139,8 @@ def _ends(points: np.ndarray, origin: np.ndarray, max_range: float, factor: floa
 
 
 @numba.njit(cache=True, inline="always")
-def _axis(delta: np.float32, lf: np.float32, okey: int, origin: np.float32, res: float):
+def _axis(delta: np.float32, lf: np.float32, okey: int, origin: np.float32,
+          res: float) -> _Axis:
     """Amanatides & Woo set-up of one axis exactly as OctoMap: (step, tMax, tDelta)."""
     di = delta / lf  # float direction component
     if di == 0.0:
@@ -151,7 +152,7 @@ def _axis(delta: np.float32, lf: np.float32, okey: int, origin: np.float32, res:
 
 
 @numba.njit(cache=True, inline="always")
-def _dilated(step: int, mask: int):
+def _dilated(step: int, mask: int) -> tuple[int, int]:
     """(fill, wrap) of one axis' dilated local index: ``((l | fill) + step) & mask`` moves
     it one voxel, and it equals ``wrap`` exactly when the walk left the block."""
     if step > 0:
@@ -160,7 +161,7 @@ def _dilated(step: int, mask: int):
 
 
 @numba.njit(cache=True, inline="always")
-def _start(ray, res: float):
+def _start(ray: _Ray, res: float) -> tuple[_Axis, _Axis, _Axis, float, int]:
     """Per-axis (step, tMax, tDelta), the float ray length and the steps to the end key."""
     origin, okey, end, ekey = ray
     dx, dy, dz = end[0] - origin[0], end[1] - origin[1], end[2] - origin[2]
@@ -171,7 +172,7 @@ def _start(ray, res: float):
 
 
 @numba.njit(cache=True)
-def walk_dense(ray, res: float, limit: int, grid, box) -> None:
+def walk_dense(ray: _Ray, res: float, limit: int, grid: np.ndarray, box: np.ndarray) -> None:
     """Set the bits of the free keys of ``computeRayKeys(origin, end)`` in a dense array;
     ``ray`` is (origin, origin key, end, end key).
 
@@ -218,7 +219,7 @@ def walk_dense(ray, res: float, limit: int, grid, box) -> None:
 
 
 @numba.njit(cache=True)
-def walk_hashed(ray, res: float, limit: int, table, n_blocks: int) -> int:
+def walk_hashed(ray: _Ray, res: float, limit: int, table: Table, n_blocks: int) -> int:
     """Set the bits of the free keys of ``computeRayKeys(origin, end)`` in a hashed block
     set (``_blockset``; room reserved by the caller); return the new block count;
     ``ray`` is (origin, origin key, end, end key).
@@ -267,7 +268,8 @@ def walk_hashed(ray, res: float, limit: int, table, n_blocks: int) -> int:
 
 
 @numba.njit(cache=True)
-def prepare(points: np.ndarray, origin: np.ndarray, res: float, max_range: float):
+def prepare(points: np.ndarray, origin: np.ndarray, res: float, max_range: float,
+            ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Origin key (-1 entries when off the key space), ray ends, their keys, hit flags."""
     factor = 1.0 / res
     okey = np.empty(3, dtype=np.int64)

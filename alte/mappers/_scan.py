@@ -32,21 +32,25 @@ DENSE_MAX_WORDS = 1 << 21
 #: Rays per chunk below which a scan is walked in the calling thread.
 _MIN_CHUNK = 256
 _POOLS: dict[int, ThreadPoolExecutor] = {}
+#: Rays of a scan (or a chunk of it): origin, its key, ray ends, their keys.
+_Rays = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
 
 
 @numba.njit(cache=True, inline="always")
-def _skip(okey, k) -> bool:
+def _skip(okey: np.ndarray, k: np.ndarray) -> bool:
     """A ray is walked when its end key is valid and differs from the origin's."""
-    return k[0] < 0 or (k[0] == okey[0] and k[1] == okey[1] and k[2] == okey[2])
+    skip: bool = k[0] < 0 or (k[0] == okey[0] and k[1] == okey[1] and k[2] == okey[2])
+    return skip
 
 
 @numba.njit(cache=True, inline="always")
-def _limit(okey, k) -> int:
-    return abs(k[0] - okey[0]) + abs(k[1] - okey[1]) + abs(k[2] - okey[2]) + 5
+def _limit(okey: np.ndarray, k: np.ndarray) -> int:
+    limit: int = abs(k[0] - okey[0]) + abs(k[1] - okey[1]) + abs(k[2] - okey[2]) + 5
+    return limit
 
 
 @numba.njit(cache=True)
-def _box(okey, ekeys):
+def _box(okey: np.ndarray, ekeys: np.ndarray) -> np.ndarray:
     """Block box of the origin and the valid ray ends, padded by one block: (x0, y0, z0,
     nbx, nby, nbz). A walk strays at most 4 voxels from its own box, so it stays inside."""
     lo, hi = okey >> 3, okey >> 3
@@ -59,7 +63,7 @@ def _box(okey, ekeys):
 
 
 @numba.njit(cache=True, nogil=True)
-def _rays_dense(rays, res: float, box):
+def _rays_dense(rays: _Rays, res: float, box: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Blocks and bit rows of ``rays`` (origin, its key, ends, their keys), walked into a
     dense bit array over ``box``."""
     origin, okey, ends, ekeys = rays
@@ -88,7 +92,7 @@ def _rays_dense(rays, res: float, box):
 
 
 @numba.njit(cache=True, nogil=True)
-def _rays_hashed(rays, res: float, capacity: int):
+def _rays_hashed(rays: _Rays, res: float, capacity: int) -> tuple[np.ndarray, np.ndarray]:
     """Blocks and bit rows of ``rays`` (as :func:`_rays_dense`), walked into a hash table."""
     origin, okey, ends, ekeys = rays
     table, n_blocks = new_table(capacity), 0
@@ -104,7 +108,8 @@ def _rays_hashed(rays, res: float, capacity: int):
 
 
 @numba.njit(cache=True)
-def _finish(blocks: np.ndarray, bits: np.ndarray, ekeys: np.ndarray, hit: np.ndarray):
+def _finish(blocks: np.ndarray, bits: np.ndarray, ekeys: np.ndarray, hit: np.ndarray,
+            ) -> tuple[np.ndarray, np.ndarray]:
     """Union of the rays' blocks plus the occupied end voxels; free bits lose occupied ones."""
     table, n_blocks = union(blocks, bits, blocks.size + 64)
     table = reserve(table, n_blocks, ekeys.shape[0])

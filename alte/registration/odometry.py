@@ -18,7 +18,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, replace
-from typing import ClassVar
+from typing import ClassVar, Protocol
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -96,7 +96,15 @@ def scene_scale(points: np.ndarray, params: OdometryParams) -> tuple[float, floa
     return max_range, voxel, params.refine_voxel or max(typical / 60.0, 0.01)
 
 
-def _kiss(points: np.ndarray, params: OdometryParams) -> object:
+class _Odometry(Protocol):
+    """What :func:`odometry_frames` uses of a ``kiss_icp.kiss_icp.KissICP`` pipeline."""
+
+    last_pose: np.ndarray
+
+    def register_frame(self, frame: np.ndarray, timestamps: np.ndarray) -> object: ...
+
+
+def _kiss(points: np.ndarray, params: OdometryParams) -> _Odometry:
     """A KISS-ICP pipeline scaled to the scene of ``points``."""
     from kiss_icp.config import KISSConfig
     from kiss_icp.kiss_icp import KissICP
@@ -108,7 +116,8 @@ def _kiss(points: np.ndarray, params: OdometryParams) -> object:
     config.mapping.voxel_size = voxel
     config.adaptive_threshold.initial_threshold = 2.0 * voxel
     config.adaptive_threshold.min_motion_th = 0.1 * voxel
-    return KissICP(config)
+    pipeline: _Odometry = KissICP(config)
+    return pipeline
 
 
 def _rate(previous: Frame | None, rotation: np.ndarray, stamp: int) -> float:
@@ -127,14 +136,14 @@ def odometry_frames(frames: Iterable[Frame], mount: Mount, *, counts: PoseCounts
     body_sensor = _mount(mount)
     sensor_body = np.linalg.inv(body_sensor)
     anchor = pose_matrix(*start) if start is not None else np.eye(4)
-    odometry = None
+    odometry: _Odometry | None = None
     previous: Frame | None = None
     for frame in frames:
         points = np.asarray(frame.points, dtype=np.float64)
         if odometry is None:
             odometry = _kiss(points, params)
-        odometry.register_frame(points, np.zeros(len(points)))  # type: ignore[attr-defined]
-        sensor = odometry.last_pose  # type: ignore[attr-defined]
+        odometry.register_frame(points, np.zeros(len(points)))
+        sensor = odometry.last_pose
         position, quaternion = _pose(anchor @ body_sensor @ sensor @ sensor_body)
         counts.frames += 1
         out = replace(frame, position=position, quaternion=quaternion, pose_offset_s=0.0,
