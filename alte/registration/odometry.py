@@ -137,13 +137,15 @@ class _PlaneMap:
         merged = o3d.geometry.PointCloud(o3d.utility.Vector3dVector(
             np.vstack([self.points, *self.pending]))).voxel_down_sample(self.voxel)
         near = np.linalg.norm(np.asarray(merged.points) - sensor[:3, 3], axis=1) <= self.radius
-        target = merged.select_by_index(np.flatnonzero(near))
+        target = merged.select_by_index(np.flatnonzero(near).tolist())
         target.estimate_normals(o3d.geometry.KDTreeSearchParamHybrid(6.0 * self.voxel, 40))
         self.points, self.pending, self.target = np.asarray(target.points), [], target
 
     def align(self, source: Any, guess: np.ndarray) -> tuple[np.ndarray, float]:
         """The sensor pose placing ``source`` on the map, from ``guess``; inlier fraction."""
-        from open3d.pipelines import registration as reg
+        import open3d as o3d
+
+        reg = o3d.pipelines.registration
 
         reach = 6.0 * self.voxel
         method = reg.TransformationEstimationPointToPlane(reg.TukeyLoss(k=reach / 2))
