@@ -21,6 +21,8 @@ __all__ = ["COMMANDS", "main"]
 COMMANDS: dict[str, str] = {
     "map": "alte.commands.map",
     "info": "alte.commands.info",
+    "export": "alte.commands.export",
+    "odometry": "alte.commands.odometry",
     "report": "alte.commands.report",
     "register": "alte.commands.register",
     "simulate": "alte.commands.simulate",

@@ -14,10 +14,10 @@ from alte.errors import BagError
 from alte.io.bag import BagInfo, inspect_bag
 from alte.pipeline import InputKind, Source, open_input
 
-__all__ = ["add_parser", "format_info", "run"]
+__all__ = ["add_parser", "format_info", "pose_source", "run"]
 
 
-def add_parser(subparsers: argparse._SubParsersAction) -> None:
+def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Register ``alte info``."""
     p = subparsers.add_parser(
         "info",
@@ -34,6 +34,13 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run)
 
 
+def pose_source(info: BagInfo) -> str:
+    """What ``alte map``/``register`` use for poses by default (``--poses`` unset)."""
+    if info.pose_topic:
+        return f"recorded ({info.pose_topic})"
+    return "odometry (no pose topic: LiDAR odometry, in the first scan's body frame)"
+
+
 def format_info(info: BagInfo) -> list[str]:
     """Human-readable lines for :func:`run`."""
     width = max((len(name) for name in info.topics), default=0)
@@ -44,6 +51,7 @@ def format_info(info: BagInfo) -> list[str]:
     ]
     lines.append(f"cloud:     {info.cloud_topic or '-'} ({info.frames} scans)")
     lines.append(f"pose:      {info.pose_topic or '-'}")
+    lines.append(f"poses:     {pose_source(info)}")
     if info.mount is not None:
         lines.append(f"mount:     {info.mount.to_string()} (x,y,z m, roll,pitch,yaw deg)")
     lines += [f"note:      {note}" for note in info.notes]
@@ -77,7 +85,8 @@ def run(args: argparse.Namespace) -> int:
     info = inspect_bag(source.bag, cloud_topic=args.cloud_topic, pose_topic=args.pose_topic)
     terrain = _terrain(source)
     if args.json:
-        print(json.dumps({**info.to_dict(), **terrain}, sort_keys=True))
+        print(json.dumps({**info.to_dict(), **terrain, "pose_source": pose_source(info)},
+                         sort_keys=True))
     else:
         print("\n".join(format_info(info) + format_terrain(terrain)))
     return 0

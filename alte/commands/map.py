@@ -16,25 +16,24 @@ import numpy as np
 
 from alte.commands.options import add_frame_options, frame_spec
 from alte.errors import ParameterError
+from alte.export import ExportOptions
+from alte.export import export_map as export_mcap
+from alte.fsutil import refuse_overwrite
 from alte.mappers import MAPPERS, Domain, Feed, check_export, export_map, mapper_class
 from alte.pipeline import DomainPolicy, MapRun, MapSpec, open_input, run
 
-__all__ = ["add_parser", "parse_domain", "parse_sets", "run_command"]
+__all__ = ["add_map_options", "add_parser", "export_options", "map_spec", "mapped",
+           "parse_domain", "parse_sets", "print_summary", "run_command"]
 
-_SUMMARY_KEYS = ("mapper", "params", "input", "input_kind", "domain_policy", "domain", "feed",
+_SUMMARY_KEYS = ("mapper", "params", "input", "input_kind", "pose_source", "domain_policy",
+                 "domain", "feed",
                  "frames", "points", "points_dropped_nonfinite", "points_dropped_crop",
                  "points_outside", "local_origin", "elapsed_s", "wall_s", "basis_functions",
-                 "occupied_cells", "memory_bytes", "metrics", "export")
+                 "occupied_cells", "memory_bytes", "metrics", "export", "mcap")
 
 
-def add_parser(subparsers: argparse._SubParsersAction) -> None:
-    """Register ``alte map``."""
-    p = subparsers.add_parser(
-        "map", help="build a terrain map from a bag, a terrain folder or a point cloud file",
-        description="Build a map with one of the mappers (quadtree, octomap, alte2d, alte3d) "
-                    "through the pipeline: read, register, crop, down-sample, map. Values that "
-                    "start with '-' need '=': --origin=-1,0,2.")
-    add_frame_options(p, origin=True)
+def add_map_options(p: argparse.ArgumentParser) -> None:
+    """The flags that choose the map (shared by ``alte map`` and ``alte export``)."""
     p.add_argument("--mapper", required=True, help=", ".join(MAPPERS))
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", dest="sets",
                    help="mapper parameter (repeatable), e.g. --set kappa=0.1")
@@ -44,15 +43,32 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--feed", choices=[f.value for f in Feed], default=None,
                    help="insert frame by frame, or build once on the merged cloud (default: "
                         "the mapper's protocol: Quadtree batch, the others frames)")
-    p.add_argument("--metrics", action="store_true",
-                   help="also measure the map: HD/MHD against the registered cloud and, for "
-                        "a terrain folder, the ground-truth metrics")
     p.add_argument("--cache", type=Path, default=None, metavar="DIR",
                    help="keep the registered frames in DIR for the next run of this input")
     p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument("--timeline", type=int, default=None, metavar="N",
+                   help="with --mcap: write the map every N mapped scans, stamped with the "
+                        "scan's time (the map as it grows; batch feeds switch to frames)")
+
+
+def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
+    """Register ``alte map``."""
+    p = subparsers.add_parser(
+        "map", help="build a terrain map from a bag, a terrain folder or a point cloud file",
+        description="Build a map with one of the mappers (quadtree, octomap, alte2d, alte3d) "
+                    "through the pipeline: read, register, crop, down-sample, map. Values that "
+                    "start with '-' need '=': --origin=-1,0,2.")
+    add_frame_options(p, origin=True)
+    add_map_options(p)
+    p.add_argument("--metrics", action="store_true",
+                   help="also measure the map: HD/MHD against the registered cloud and, for "
+                        "a terrain folder, the ground-truth metrics")
     p.add_argument("--export", type=Path, default=None, metavar="FILE",
                    help="write the cells (.npz) or an OctoMap tree (.bt, octomap only)")
-    p.add_argument("--force", action="store_true", help="overwrite --export if it exists")
+    p.add_argument("--mcap", type=Path, default=None, metavar="FILE",
+                   help="also write a ROS 2 MCAP for Foxglove / RViz (see alte export)")
+    p.add_argument("--force", action="store_true",
+                   help="overwrite --export / --mcap if they exist")
     p.set_defaults(func=run_command)
 
 
@@ -85,12 +101,13 @@ def _summary(result: MapRun, metrics: bool) -> dict[str, object]:
         from alte.metrics.maps import measure_map
 
         source = open_input(result.info.input)
+        assert result.cloud is not None  # run(..., cloud=True) kept it for the metrics
         out["metrics"] = measure_map(result.mapper, result.cloud, elapsed_s=result.elapsed_s,
                                      truth=source.ground_truth()).as_dict()
     return out
 
 
-def _print(summary: dict[str, object], as_json: bool) -> None:
+def print_summary(summary: dict[str, object], as_json: bool) -> None:
     if as_json:
         print(json.dumps(summary, sort_keys=True, default=str))
         return
@@ -99,20 +116,49 @@ def _print(summary: dict[str, object], as_json: bool) -> None:
             print(f"{key}: {summary[key]}")
 
 
-def run_command(args: argparse.Namespace) -> int:
-    """Build the map, print the summary, export when asked."""
+def map_spec(args: argparse.Namespace) -> MapSpec:
+    """The :class:`MapSpec` of the parsed flags, parameters checked before any read."""
     spec = MapSpec(args.mapper, parse_sets(args.sets), parse_domain(args.domain),
                    Feed(args.feed) if args.feed else None)
-    frames = frame_spec(args)
-    cls = mapper_class(args.mapper)
-    cls.Params.parse(spec.params)  # fail on a bad --set before the long read
+    mapper_class(args.mapper).Params.parse(spec.params)  # fail on a bad --set before the read
+    return spec
+
+
+def mapped(args: argparse.Namespace, mcap: Path | None, options: ExportOptions,
+           cloud: bool = False) -> tuple[MapRun, dict[str, int]]:
+    """Run the map (and write the MCAP when ``mcap`` is given); message counts per topic."""
+    spec, frames, source = map_spec(args), frame_spec(args), open_input(args.input)
+    if mcap is None:
+        return run(source, spec, frames, cache=args.cache, cloud=cloud,
+                   progress=not args.json), {}
+    return export_mcap(source, mcap, spec, frames, options=options, cache=args.cache,
+                      overwrite=args.force, progress=not args.json)
+
+
+def export_options(args: argparse.Namespace, mcap: Path | None) -> ExportOptions:
+    """``--timeline`` and the MCAP flags, checked (and the target refused) before the read."""
+    if mcap is None:
+        if args.timeline is not None:
+            raise ParameterError("--timeline writes the growing map into --mcap FILE; add it")
+        return ExportOptions()
+    if mcap.suffix.lower() != ".mcap":
+        raise ParameterError(f"--mcap {mcap}: the file name must end in .mcap")
+    refuse_overwrite(mcap, args.force)
+    return ExportOptions(args.timeline, scans=not getattr(args, "no_scans", False),
+                         all_cells=getattr(args, "all_cells", False))
+
+
+def run_command(args: argparse.Namespace) -> int:
+    """Build the map, print the summary, export when asked."""
+    options = export_options(args, args.mcap)
     if args.export is not None:
-        check_export(args.export, cls, args.force)
-    result = run(open_input(args.input), spec, frames, cache=args.cache,
-                 cloud=args.metrics, progress=not args.json)
+        check_export(args.export, mapper_class(args.mapper), args.force)
+    result, topics = mapped(args, args.mcap, options, cloud=args.metrics)
     summary = _summary(result, args.metrics)
+    if topics:
+        summary["mcap"] = {"file": str(args.mcap), "messages": topics}
     if args.export is not None:
         export_map(result.mapper, args.export, args.force, np.asarray(result.info.local_origin))
         summary["export"] = str(args.export)
-    _print(summary, args.json)
+    print_summary(summary, args.json)
     return 0

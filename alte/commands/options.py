@@ -36,8 +36,13 @@ def add_frame_options(p: argparse.ArgumentParser, *, origin: bool = False) -> No
                    help="sensor offset (m) and rotation (deg) on the body (default: the bag's)")
     p.add_argument("--cloud-topic", default=None, help="PointCloud2 / VelodyneScan topic")
     p.add_argument("--pose-topic", default=None, help="pose / odometry / TF topic")
+    p.add_argument("--poses", choices=[s.value for s in PoseSource], default=None,
+                   help="where scan poses come from: recorded (the pose topic), odometry "
+                        "(LiDAR odometry, kiss-icp), refine (recorded, aligned scan to map), "
+                        "identity (static sensor); default: recorded, or odometry when the "
+                        "bag has no pose topic")
     p.add_argument("--no-pose", action="store_true",
-                   help="ignore poses: identity body pose for every scan (static sensor)")
+                   help="ignore poses: identity body pose for every scan (= --poses identity)")
     p.add_argument("--max-rate", type=float, default=None, metavar="RAD_S",
                    help="drop frames whose body angular rate exceeds this (rad/s)")
     p.add_argument("--max-offset", type=float, default=None, metavar="S",
@@ -81,18 +86,29 @@ def _checked(flag: str, value: float | int | None, integer: bool = False) -> Non
         raise ParameterError(f"{flag} {value!r}: must be a whole number")
 
 
+def _poses(args: argparse.Namespace) -> PoseSource:
+    """``--poses`` (``--no-pose`` is ``--poses identity``); unset is ``auto``."""
+    chosen = getattr(args, "poses", None)
+    if args.no_pose and chosen not in (None, PoseSource.IDENTITY.value):
+        raise ParameterError(f"--no-pose and --poses {chosen} exclude each other")
+    if args.no_pose:
+        return PoseSource.IDENTITY
+    return PoseSource(chosen) if chosen else PoseSource.AUTO
+
+
 def frame_spec(args: argparse.Namespace) -> FrameSpec:
     """The :class:`FrameSpec` of the parsed flags (errors name the flags)."""
     for flag, value in (("--frames", args.frames), ("--voxel", args.voxel),
                         ("--max-rate", args.max_rate), ("--max-offset", args.max_offset)):
         _checked(flag, value, integer=flag == "--frames")
-    if args.no_pose and args.pose_topic:
-        raise ParameterError("--no-pose and --pose-topic exclude each other")
+    poses = _poses(args)
+    if poses is PoseSource.IDENTITY and args.pose_topic:
+        raise ParameterError("--no-pose (--poses identity) and --pose-topic exclude each other")
     mount = Mount.from_string(args.mount) if args.mount else None
     return FrameSpec(
         frames=args.frames, voxel=args.voxel,
         crop=parse_box(args.crop) if args.crop else None, mount=mount,
         cloud_topic=args.cloud_topic, pose_topic=args.pose_topic,
-        poses=PoseSource.IDENTITY if args.no_pose else PoseSource.RECORDED,
+        poses=poses,
         max_rate=args.max_rate, max_offset=args.max_offset,
         origin=parse_origin(args.origin) if getattr(args, "origin", None) else (0.0, 0.0, 0.0))

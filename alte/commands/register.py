@@ -5,17 +5,20 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+import numpy as np
+
 from alte.commands.options import add_frame_options, frame_spec
-from alte.errors import PointFileError
+from alte.errors import ParameterError, PointFileError
+from alte.export import export_registered
 from alte.fsutil import refuse_overwrite
 from alte.io.pointfiles import WRITE_SUFFIXES, write_points
-from alte.pipeline import StreamCounts, merged_cloud, open_input
+from alte.pipeline import StreamCounts, merged_cloud, open_input, prepare
 from alte.registration import RegistrationCounts
 
 __all__ = ["add_parser", "format_counts", "run"]
 
 
-def add_parser(subparsers: argparse._SubParsersAction) -> None:
+def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Register ``alte register``."""
     p = subparsers.add_parser(
         "register", help="register a bag's scans into one inertial point cloud",
@@ -26,7 +29,10 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     add_frame_options(p)
     p.add_argument("--out", type=Path, required=True,
                    help="output cloud: .ply, .pcd, .npz, .las, .laz, .xyz")
-    p.add_argument("--force", action="store_true", help="overwrite --out if it exists")
+    p.add_argument("--mcap", type=Path, default=None, metavar="FILE",
+                   help="also write the scans, poses, trajectory and cloud as a ROS 2 MCAP "
+                        "(Foxglove, RViz)")
+    p.add_argument("--force", action="store_true", help="overwrite --out / --mcap if they exist")
     p.set_defaults(func=run)
 
 
@@ -48,16 +54,32 @@ def _reader_line(counts: StreamCounts) -> str:
     return f"bag: {parts}" if parts else "bag: read"
 
 
+def _check_mcap(path: Path, force: bool) -> None:
+    if path.suffix.lower() != ".mcap":
+        raise ParameterError(f"--mcap {path}: the file name must end in .mcap")
+    refuse_overwrite(path, force)
+
+
 def run(args: argparse.Namespace) -> int:
     """Read, register, write; print the counts."""
     if args.out.suffix.lower() not in WRITE_SUFFIXES:
         raise PointFileError(f"--out {args.out}: unknown point file type; use {WRITE_SUFFIXES}")
     refuse_overwrite(args.out, args.force)  # fail before the long read
     spec = frame_spec(args)
-    cloud, counts = merged_cloud(open_input(args.input), spec, progress=True)
+    if args.mcap is not None:
+        _check_mcap(args.mcap, args.force)
+        reg = prepare(open_input(args.input), spec, progress=True)
+        cloud, counts = np.asarray(reg.cloud), reg.counts
+        topics = export_registered(reg, args.mcap, overwrite=args.force)
+    else:
+        cloud, counts = merged_cloud(open_input(args.input), spec, progress=True)
     write_points(args.out, cloud, overwrite=args.force)
     print(_reader_line(counts))
     for line in format_counts(counts.registration):
         print(line)
+    print(f"poses: {counts.poses.source}")
     print(f"wrote {len(cloud)} points to {args.out}")
+    if args.mcap is not None:
+        print(f"wrote {sum(topics.values())} messages to {args.mcap}: "
+              + ", ".join(f"{t} {n}" for t, n in topics.items()))
     return 0

@@ -12,7 +12,7 @@ from __future__ import annotations
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, TypedDict, Unpack
 
 import numpy as np
 from tqdm.auto import tqdm
@@ -34,10 +34,13 @@ from alte.io.reader import (
 )
 from alte.types import Frame, Mount
 
-__all__ = ["BagInfo", "FrameSet", "FrameStream", "ReadCounts", "ReadOptions", "evenly_spaced",
-           "inspect_bag", "read_frames"]
+__all__ = ["NO_POSE_NOTE", "BagInfo", "FrameSet", "FrameStream", "ReadCounts", "ReadOptions",
+           "StreamOptions",
+           "evenly_spaced", "inspect_bag", "read_frames"]
 
 _IDENTITY_Q = np.array([0.0, 0.0, 0.0, 1.0])
+#: The note of a stream read without poses (callers that pose the scans otherwise replace it).
+NO_POSE_NOTE = "no pose topic: every frame has the identity pose"
 
 
 @dataclass
@@ -337,7 +340,21 @@ def _raise_empty(stream: FrameStream, counts: ReadCounts, stamps: _StampRange) -
     )
 
 
-def read_frames(path: str | Path, **options: Any) -> FrameSet:
+class StreamOptions(TypedDict, total=False):
+    """Keywords of :class:`FrameStream` (and :func:`read_frames`)."""
+
+    cloud_topic: str | None
+    pose_topic: str | None
+    mount: Mount | None
+    allow_no_pose: bool
+    body_frame: str | None
+    frames: int | None
+    max_gap_s: float
+    return_mode: str
+    progress: bool
+
+
+def read_frames(path: str | Path, **options: Unpack[StreamOptions]) -> FrameSet:
     """Every posed scan of a bag in a list (see :class:`FrameStream` for ``options``).
 
     Topics are detected by message type unless given (``pose_topic=""`` forces
@@ -384,5 +401,5 @@ def _sources(
             f"{bag}: no pose topic ({', '.join(POSE_TYPES)}) for {cloud}; "
             f"pass allow_no_pose=True to read it unposed; {topic_listing(topics)}"
         )
-    notes.append("no pose topic: every frame has the identity pose")
+    notes.append(NO_POSE_NOTE)
     return cloud, None, None, used_mount

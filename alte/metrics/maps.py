@@ -18,6 +18,7 @@ import numpy as np
 from alte.errors import MetricsError
 from alte.mappers.quadmap import rectangle_corners
 from alte.metrics.hausdorff import hausdorff
+from alte.params import Record, param
 
 if TYPE_CHECKING:
     from alte.mappers.base import Cells, Mapper
@@ -37,18 +38,18 @@ SET_B = ("corners", "centers", "occupied")
 
 
 @dataclass(frozen=True)
-class TruthOptions:
-    """Ground-truth metric settings (see :mod:`alte.metrics.truth`).
+class TruthOptions(Record):
+    """Ground-truth metric settings (see :mod:`alte.metrics.truth`), a parameter record."""
 
-    ``tolerance`` (m): how close a map must come to a true surface to count it as
-    mapped; ``n_samples``: surface samples drawn (3D); ``grid_step`` (m): x/y probe
-    spacing of the 2D metrics; ``seed``: sampling seed.
-    """
+    OWNER = "truth"
 
-    tolerance: float = 0.2
-    n_samples: int = 100_000
-    grid_step: float = 0.2
-    seed: int = 0
+    tolerance: float = param(0.2, lambda v: v > 0, "tolerance > 0",
+                             "how close a map must come to a true surface to map it (m)")
+    n_samples: int = param(100_000, lambda v: v >= 1, "n_samples >= 1",
+                           "surface samples drawn (3D)")
+    grid_step: float = param(0.2, lambda v: v > 0, "grid_step > 0",
+                             "x/y probe spacing of the 2D metrics (m)")
+    seed: int = param(0, lambda v: v >= 0, "seed >= 0", "sampling seed")
 
 
 @dataclass(frozen=True, eq=False)

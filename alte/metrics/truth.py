@@ -146,7 +146,8 @@ def accuracy(centers: np.ndarray, sizes: np.ndarray, surface: TrueSurface,
 def completeness(samples: SurfaceSamples, centers: np.ndarray, sizes: np.ndarray,
                  tolerance: float) -> np.ndarray:
     """Per sample: True when an occupied box lies within ``tolerance`` of it."""
-    return np.isfinite(distance_to_boxes(samples.points, centers, sizes, tolerance))
+    covered: np.ndarray = np.isfinite(distance_to_boxes(samples.points, centers, sizes, tolerance))
+    return covered
 
 
 def completeness_by_object(samples: SurfaceSamples, covered: np.ndarray,

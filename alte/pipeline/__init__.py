@@ -7,13 +7,22 @@ and their policies are in :mod:`~alte.pipeline.spec`.
 """
 
 from alte.pipeline.prepare import Registered, cache_key, merged_cloud, prepare
-from alte.pipeline.run import FrameLog, MapRun, RunInfo, Snapshot, resolve_domain, run
+from alte.pipeline.run import (
+    FrameLog,
+    FrameObserver,
+    MapRun,
+    RunInfo,
+    Snapshot,
+    resolve_domain,
+    run,
+)
 from alte.pipeline.source import InputKind, Source, StreamCounts, open_input, stream_frames
 from alte.pipeline.spec import DomainPolicy, FrameSpec, MapSpec, PoseSource
 
 __all__ = [
     "DomainPolicy",
     "FrameLog",
+    "FrameObserver",
     "FrameSpec",
     "InputKind",
     "MapRun",

@@ -15,7 +15,14 @@ import numpy as np
 
 from alte.errors import RegistrationError
 from alte.mappers import Feed, make_mapper, mapper_class
-from alte.pipeline.run import Feeder, MapRun, RunInfo, local_shift, resolve_domain
+from alte.pipeline.run import (
+    Feeder,
+    FrameObserver,
+    MapRun,
+    RunInfo,
+    local_shift,
+    resolve_domain,
+)
 from alte.pipeline.source import InputKind, Source, StreamCounts, stream_frames
 from alte.pipeline.spec import FrameSpec, MapSpec
 from alte.registration.grid import GridAccumulator
@@ -55,7 +62,7 @@ class _Cloud:
 
 
 def run_live(source: Source, frames: FrameSpec, spec: MapSpec, *, cloud: bool = False,
-             progress: bool = False) -> MapRun:
+             progress: bool = False, observer: FrameObserver | None = None) -> MapRun:
     """Map ``source`` streaming its frames (``frames`` resolved against the input)."""
     cls = mapper_class(spec.mapper)
     feed = spec.feed or cls.default_feed
@@ -73,7 +80,7 @@ def run_live(source: Source, frames: FrameSpec, spec: MapSpec, *, cloud: bool = 
     anchor = first.points if source.kind is InputKind.POINTS else first.origin
     shift = local_shift(cls, lambda: np.median(np.reshape(anchor, (-1, 3)), axis=0))
     cloud_points = functools.cache(merged.points)
-    feeder = Feeder(mapper, spec, feed, shift, counts.selected)
+    feeder = Feeder(mapper, spec, feed, shift, counts.selected, observer=observer)
     log = feeder.run(itertools.chain([first], stream), cloud_points, progress)
     info = RunInfo(str(source.path), source.kind, cls.name, mapper.params,
                    mapper.domain if domain is None else domain, policy, feed, frames,

@@ -15,6 +15,7 @@ import time
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Protocol
 
 import numpy as np
 from tqdm.auto import tqdm
@@ -29,7 +30,8 @@ from alte.pipeline.source import InputKind, Source, StreamCounts, open_input
 from alte.pipeline.spec import DomainPolicy, FrameSpec, MapSpec
 from alte.types import Box, RegisteredFrame, Trajectory
 
-__all__ = ["FrameLog", "MapRun", "RunInfo", "Snapshot", "local_shift", "resolve_domain", "run"]
+__all__ = ["FrameLog", "FrameObserver", "MapRun", "RunInfo", "Snapshot", "local_shift",
+           "resolve_domain", "run"]
 
 Input = Registered | Source | str | Path
 
@@ -42,6 +44,15 @@ class Snapshot:
     time: float
     cells: Cells
     basis_functions: int
+
+
+class FrameObserver(Protocol):
+    """Called after each mapped frame (outside the timed mapper call): the frame's index
+    among the mapped frames, the frame, the map so far and the local shift its points
+    were mapped with (an exporter writes the growing map from here)."""
+
+    def __call__(self, index: int, frame: RegisteredFrame, mapper: Mapper,
+                 shift: np.ndarray) -> None: ...
 
 
 @dataclass(frozen=True, eq=False)
@@ -105,6 +116,7 @@ class MapRun:
             "params": info.params.as_dict(), "feed": info.feed.value,
             "domain": None if info.domain is None else info.domain.as_dict(),
             "domain_policy": info.domain_policy, "voxel": info.frames.voxel,
+            "pose_source": self.counts.poses.source,
             "crop": None if info.frames.crop is None else list(info.frames.crop.values()),
             "frames": len(self.log.stamps), "frames_selected": self.counts.selected,
             "points": int(self.log.points.sum()),
@@ -147,8 +159,9 @@ class Feeder:
     """Feeds frames to a mapper, timing each, keeping snapshots (the run's inner loop)."""
 
     def __init__(self, mapper: Mapper, spec: MapSpec, feed: Feed, shift: np.ndarray,
-                 total: int) -> None:
+                 total: int, *, observer: FrameObserver | None = None) -> None:
         self.mapper, self.feed, self.shift, self.total = mapper, feed, shift, total
+        self.observer = observer
         self.keep = set(_snapshot_indices(total, spec.snapshots)) if spec.snapshots else set()
         self.count_basis = spec.snapshots > 0
         self.rows: list[tuple[int, int, float, float, int]] = []
@@ -168,6 +181,8 @@ class Feeder:
         if i in self.keep:
             t0 = self.rows[0][0]
             self.snapshots.append(Snapshot(i, (f.stamp - t0) / 1e9, self.mapper.cells(), basis))
+        if self.observer is not None:
+            self.observer(i, f, self.mapper, self.shift)
 
     def run(self, frames: Iterator[RegisteredFrame], cloud: Callable[[], np.ndarray | None],
             progress: bool) -> FrameLog:
@@ -186,12 +201,14 @@ class Feeder:
 
     def log(self, build_s: float = 0.0) -> FrameLog:
         arr = np.array(self.rows, dtype=np.float64).reshape(-1, 5)
-        insert = arr[:, 2].copy()
-        if self.feed is Feed.BATCH and len(insert):
+        insert, latency = arr[:, 2].copy(), arr[:, 3].copy()
+        if self.feed is Feed.BATCH and len(insert):  # the map exists after the build only
             insert[:] = 0.0
             insert[-1] = build_s
-        return FrameLog(arr[:, 0].astype(np.int64), arr[:, 1].astype(np.int64), insert,
-                        arr[:, 3], arr[:, 4].astype(np.int64))
+            latency[-1] += build_s
+        stamps = np.array([row[0] for row in self.rows], dtype=np.int64)  # exact ns
+        return FrameLog(stamps, arr[:, 1].astype(np.int64), insert, latency,
+                        arr[:, 4].astype(np.int64))
 
 
 def _snapshot_indices(total: int, snapshots: int) -> list[int]:
@@ -212,7 +229,8 @@ def _timed(frames: Iterator[RegisteredFrame]) -> Iterator[tuple[RegisteredFrame,
         yield frame, time.perf_counter() - start
 
 
-def _from_registered(reg: Registered, spec: MapSpec, progress: bool) -> MapRun:
+def _from_registered(reg: Registered, spec: MapSpec, progress: bool,
+                     observer: FrameObserver | None = None) -> MapRun:
     cls = mapper_class(spec.mapper)
     feed = spec.feed or cls.default_feed
     points = reg.cloud if feed is Feed.BATCH else reg.points
@@ -223,7 +241,7 @@ def _from_registered(reg: Registered, spec: MapSpec, progress: bool) -> MapRun:
         else (lambda: reg.trajectory.origins[0])
     shift = local_shift(cls, first)
     start = time.perf_counter()
-    feeder = Feeder(mapper, spec, feed, shift, len(reg))
+    feeder = Feeder(mapper, spec, feed, shift, len(reg), observer=observer)
     log = feeder.run(reg.frames(), lambda: reg.cloud, progress)
     info = RunInfo(str(reg.source.path), reg.source.kind, cls.name, mapper.params,
                    mapper.domain if domain is None else domain, policy, feed, reg.spec,
@@ -237,25 +255,27 @@ def _tuple(shift: np.ndarray) -> tuple[float, float, float]:
 
 
 def run(source: Input, spec: MapSpec, frames: FrameSpec | None = None, *,
-        cache: Path | None = None, cloud: bool = False, progress: bool = False) -> MapRun:
+        cache: Path | None = None, cloud: bool = False, progress: bool = False,
+        observer: FrameObserver | None = None) -> MapRun:
     """Map ``source`` as ``spec`` says (module docstring).
 
     ``source`` is a path, a :class:`Source` or a :class:`Registered` (its frames are
     reused; ``frames`` must then be None). With ``cache`` the registration is kept in
     that folder for the next run; without it the frames are streamed from the input
     (twice when the domain must come from the data) and the merged cloud is kept only
-    with ``cloud=True`` (metrics need it) or a batch feed.
+    with ``cloud=True`` (metrics need it) or a batch feed. ``observer`` sees every
+    mapped frame and the map after it (:class:`FrameObserver`).
     """
     if isinstance(source, Registered):
         if frames is not None:
             raise ParameterError("run: a prepared registration already fixes its frames")
-        return _from_registered(source, spec, progress)
+        return _from_registered(source, spec, progress, observer)
     src = source if isinstance(source, Source) else open_input(source)
     if cache is not None:
         return _from_registered(prepare(src, frames, cache=cache, progress=progress), spec,
-                                progress)
+                                progress, observer)
     from alte.pipeline.live import run_live
 
     return run_live(src, src.resolve(frames or FrameSpec()), spec, cloud=cloud,
-                    progress=progress)
+                    progress=progress, observer=observer)
 

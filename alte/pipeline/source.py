@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import enum
 import hashlib
+import itertools
 import json
 from collections.abc import Iterator
 from dataclasses import dataclass, field, replace
@@ -21,12 +22,14 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from alte.errors import BagError, PointFileError
-from alte.io.bag import FrameStream, ReadCounts
+from alte.errors import BagError, ParameterError, PointFileError, TopicError
+from alte.io.bag import NO_POSE_NOTE, FrameStream, ReadCounts
+from alte.io.pose import POSE_TYPES
 from alte.pipeline.spec import FrameSpec, PoseSource
 from alte.registration.grid import GridAccumulator, grid_average
+from alte.registration.odometry import PoseCounts, odometry_frames, refine_frames
 from alte.registration.register import RegistrationCounts, crop_mask, register_frames
-from alte.types import Box, RegisteredFrame
+from alte.types import Box, Frame, RegisteredFrame
 
 if TYPE_CHECKING:
     from alte.metrics.maps import GroundTruth
@@ -119,21 +122,75 @@ class StreamCounts:
     scans: int = 0
     selected: int = 0
     notes: list[str] = field(default_factory=list)
+    poses: PoseCounts = field(default_factory=PoseCounts)
 
     def as_dict(self) -> dict[str, object]:
         """JSON-ready form."""
         return {"scans": self.scans, "selected": self.selected, "read": self.read.as_dict(),
-                "registration": self.registration.as_dict(), "notes": list(self.notes)}
+                "registration": self.registration.as_dict(), "notes": list(self.notes),
+                "poses": self.poses.as_dict()}
+
+
+def _open(source: Source, spec: FrameSpec, pose_topic: str | None, progress: bool,
+          allow_no_pose: bool = True) -> FrameStream:
+    return FrameStream(source.bag or source.path, cloud_topic=spec.cloud_topic,
+                       pose_topic=pose_topic, mount=spec.mount, allow_no_pose=allow_no_pose,
+                       frames=spec.frames, progress=progress)
+
+
+def _odometry(stream: FrameStream, probe: FrameStream, spec: FrameSpec,
+              counts: PoseCounts) -> Iterator[Frame]:
+    """KISS-ICP poses, anchored at the recorded pose of the first scan when there is one."""
+    frames = iter(stream)
+    first = next(frames, None)
+    if first is None:
+        return
+    start = None
+    if probe.track is not None:
+        at = probe.track.interpolate([first.stamp], probe.options.max_gap_s)
+        if at.valid[0]:
+            start = (at.positions[0], at.quaternions[0])
+    anchor = f"the recorded pose of the first scan ({probe.pose_topic})" if start is not None \
+        else "the first scan's body frame"
+    method = "point-to-plane" if spec.odometry.method == "plane" else "kiss-icp"
+    stream.notes.append(f"poses from LiDAR odometry ({method}), anchored at {anchor}")
+    yield from odometry_frames(itertools.chain([first], frames), stream.mount, counts=counts,
+                               params=spec.odometry, start=start)
+
+
+def _posed(source: Source, spec: FrameSpec, counts: PoseCounts,
+           progress: bool) -> tuple[FrameStream, Iterator[Frame]]:
+    """The scan stream and its frames posed as ``spec.poses`` says (:class:`PoseSource`)."""
+    choice = spec.poses
+    counts.source = choice.value
+    if choice is PoseSource.IDENTITY:
+        stream = _open(source, spec, "", progress)
+        return stream, iter(stream)
+    probe = _open(source, spec, spec.pose_topic, progress)
+    if choice in (PoseSource.RECORDED, PoseSource.REFINE) and probe.track is None:
+        raise TopicError(f"{probe.path}: --poses {choice.value} needs the bag's poses and it "
+                         f"has no pose topic ({', '.join(POSE_TYPES)}) for "
+                         f"{probe.cloud_topic}; use --poses odometry (LiDAR odometry) or "
+                         "--poses identity (static sensor)")
+    if choice is PoseSource.RECORDED:
+        return probe, iter(probe)
+    if choice is PoseSource.REFINE:
+        return probe, refine_frames(iter(probe), probe.mount, counts=counts,
+                                    params=spec.odometry)
+    if choice is PoseSource.AUTO and probe.track is not None:
+        counts.source = PoseSource.RECORDED.value
+        return probe, iter(probe)
+    counts.source = PoseSource.ODOMETRY.value
+    stream = probe if probe.track is None else _open(source, spec, "", progress)
+    stream.notes[:] = [n for n in stream.notes if n != NO_POSE_NOTE]
+    return stream, _odometry(stream, probe, spec, counts)
 
 
 def _bag_frames(source: Source, spec: FrameSpec, counts: StreamCounts,
                 merge: GridAccumulator | None, progress: bool) -> Iterator[RegisteredFrame]:
-    identity = spec.poses is PoseSource.IDENTITY
-    stream = FrameStream(source.bag or source.path, cloud_topic=spec.cloud_topic,
-                         pose_topic="" if identity else spec.pose_topic, mount=spec.mount,
-                         allow_no_pose=identity, frames=spec.frames, progress=progress)
+    stream, posed = _posed(source, spec, counts.poses, progress)
     counts.scans, counts.selected, counts.notes = stream.scans, stream.selected, stream.notes
-    frames = register_frames(iter(stream), stream.mount, voxel=spec.voxel,
+    frames = register_frames(posed, stream.mount, voxel=spec.voxel,
                              crop_box=None if spec.crop is None else spec.crop.values(),
                              max_rate=spec.max_rate, max_offset=spec.max_offset,
                              counts=counts.registration, merge=merge)
@@ -149,6 +206,10 @@ def _file_frames(source: Source, spec: FrameSpec, counts: StreamCounts,
     """A point file as one frame: finite, cropped, grid-averaged, seen from ``spec.origin``."""
     from alte.io.pointfiles import read_points_info
 
+    if spec.poses in (PoseSource.ODOMETRY, PoseSource.REFINE):
+        raise ParameterError(f"{source.path}: --poses {spec.poses.value} needs a bag of scans; "
+                             "a point file is one frame seen from --origin")
+    counts.poses.source = "origin"
     info = read_points_info(source.path)
     reg = counts.registration
     counts.scans = counts.selected = counts.read.scans_read = counts.read.frames = 1

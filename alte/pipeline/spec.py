@@ -20,6 +20,7 @@ from alte.errors import ParameterError
 from alte.mappers.base import Feed
 from alte.mappers.domain import Domain
 from alte.registration.grid import check_voxel
+from alte.registration.odometry import OdometryParams
 from alte.types import Box, Mount
 
 __all__ = ["DomainPolicy", "FrameSpec", "MapSpec", "PoseSource"]
@@ -40,9 +41,18 @@ class DomainPolicy(enum.Enum):
 
 
 class PoseSource(enum.Enum):
-    """Where each scan's pose comes from: the bag's pose topic, or none (identity)."""
+    """Where each scan's pose comes from.
 
+    ``AUTO``: the bag's pose topic, or LiDAR odometry when it has none (noted in the
+    counts). ``RECORDED``: the pose topic (an error without one). ``ODOMETRY``: KISS-ICP
+    over the scans, anchored at the recorded pose of the first scan when there is one.
+    ``REFINE``: the recorded poses aligned scan-to-map. ``IDENTITY``: none (static sensor).
+    """
+
+    AUTO = "auto"
     RECORDED = "recorded"
+    ODOMETRY = "odometry"
+    REFINE = "refine"
     IDENTITY = "identity"
 
 
@@ -53,7 +63,8 @@ class FrameSpec:
     ``frames``: at most that many scans, evenly spaced over the cloud topic (None: all);
     ``voxel`` (m): per-frame grid average and the merged cloud's box grid; ``crop``:
     the control volume points are kept in; ``origin``: the sensor position of a point
-    file; ``max_rate`` (rad/s) / ``max_offset`` (s): the fast-manoeuvre filter.
+    file; ``max_rate`` (rad/s) / ``max_offset`` (s): the fast-manoeuvre filter;
+    ``odometry``: how odometry and refinement align scans (``poses`` odometry, refine).
     """
 
     frames: int | None = None
@@ -62,10 +73,11 @@ class FrameSpec:
     mount: Mount | None = None
     cloud_topic: str | None = None
     pose_topic: str | None = None
-    poses: PoseSource = PoseSource.RECORDED
+    poses: PoseSource = PoseSource.AUTO
     max_rate: float | None = None
     max_offset: float | None = None
     origin: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    odometry: OdometryParams = field(default_factory=OdometryParams)
 
     def __post_init__(self) -> None:
         if self.frames is not None and (isinstance(self.frames, bool)
@@ -89,7 +101,8 @@ class FrameSpec:
                 "mount": None if self.mount is None else self.mount.to_string(),
                 "cloud_topic": self.cloud_topic, "pose_topic": self.pose_topic,
                 "poses": self.poses.value, "max_rate": self.max_rate,
-                "max_offset": self.max_offset, "origin": list(self.origin)}
+                "max_offset": self.max_offset, "origin": list(self.origin),
+                "odometry": self.odometry.as_dict()}
 
 
 @dataclass(frozen=True)

@@ -7,7 +7,7 @@ ground truth: ``ensure_terrain(name)`` makes ``data/NAME/`` (cached by spec and 
 """
 
 from alte.sim.groundtruth import load_ground_truth, mesh_distance, write_ground_truth
-from alte.sim.mission import Simulation, simulate
+from alte.sim.mission import Simulation, TruePoses, simulate, true_poses
 from alte.sim.platform import (
     Cart,
     Quadrotor,
@@ -40,6 +40,7 @@ __all__ = [
     "Terrain",
     "TerrainSpec",
     "Trajectory",
+    "TruePoses",
     "ensure_terrain",
     "get_terrain",
     "load_ground_truth",
@@ -49,6 +50,7 @@ __all__ = [
     "spec_hash",
     "terrain_folder",
     "tripod_mount",
+    "true_poses",
     "write_ground_truth",
     "write_scenario",
 ]

@@ -24,7 +24,7 @@ from alte.sim.sensor import VLP16, cast, measure
 from alte.sim.terrains import Terrain
 from alte.types import Mount
 
-__all__ = ["START_NS", "Simulation", "scan_indices", "simulate"]
+__all__ = ["START_NS", "Simulation", "TruePoses", "scan_indices", "simulate", "true_poses"]
 
 #: Stamp of the mission start (2023-11-14T22:13:20Z), fixed for byte-identical bags.
 START_NS = 1_700_000_000_000_000_000
@@ -74,7 +74,8 @@ def _acquisition_times(terrain: Terrain, seed: int, stamps_s: np.ndarray,
         return stamps_s
     rng = _rng(seed, terrain.spec.name, 1)
     jitter = rng.normal(0.0, platform.jitter_s, terrain.spec.frames)[index]
-    return stamps_s + platform.time_offset_s + jitter
+    late: np.ndarray = stamps_s + platform.time_offset_s + jitter
+    return late
 
 
 def _pose_stream(terrain: Terrain, traj: Trajectory, seed: int,
@@ -91,17 +92,46 @@ def _pose_stream(terrain: Terrain, traj: Trajectory, seed: int,
     return pose_stamps.astype(np.int64), pos, quat
 
 
+@dataclass(frozen=True, eq=False)
+class TruePoses:
+    """The body's true pose when each scan was taken, keyed by the scan's (bag) stamp.
+
+    For the experimental cases the scan stamps are early (desynchronization), so these
+    differ from the recorded pose stream interpolated at the stamps; this is the truth
+    a pose estimate (odometry, refinement) is scored against.
+    """
+
+    stamps: np.ndarray
+    positions: np.ndarray
+    quaternions: np.ndarray
+
+
+def _mission(terrain: Terrain, seed: int, frames: int | None, sensor: VLP16
+             ) -> tuple[np.ndarray, np.ndarray, Trajectory, np.ndarray]:
+    """Scan indices, stamps, trajectory and true acquisition times (s from start)."""
+    _rng(seed, terrain.spec.name)  # validates the seed
+    index = scan_indices(terrain.spec.frames, frames)
+    period = round(1e9 / sensor.rate_hz)
+    stamps = START_NS + _SCAN_PHASE_NS + period * index
+    traj = Trajectory(terrain.spec.platform, terrain.spec.frames * period / 1e9)
+    acq = _acquisition_times(terrain, seed, (stamps - START_NS) / 1e9, index)
+    return index, stamps, traj, acq
+
+
+def true_poses(terrain: Terrain, seed: int = 0, frames: int | None = None,
+               sensor: VLP16 | None = None) -> TruePoses:
+    """True body poses at every simulated scan of ``simulate(terrain, seed, frames)``."""
+    _, stamps, traj, acq = _mission(terrain, seed, frames, sensor or VLP16())
+    pos, rot = traj.pose(acq)
+    return TruePoses(stamps.astype(np.int64), pos, rot.as_quat(canonical=False))
+
+
 def simulate(terrain: Terrain, seed: int = 0, frames: int | None = None,
              sensor: VLP16 | None = None, progress: bool = False) -> Simulation:
     """Simulate ``terrain``'s mission (all scans, or ``frames`` evenly spaced ones)."""
     sensor = sensor or VLP16()
     spec, mount = terrain.spec, terrain.spec.mount
-    _rng(seed, spec.name)  # validates the seed
-    index = scan_indices(spec.frames, frames)
-    period = round(1e9 / sensor.rate_hz)
-    stamps = START_NS + _SCAN_PHASE_NS + period * index
-    traj = Trajectory(spec.platform, spec.frames * period / 1e9)
-    acq = _acquisition_times(terrain, seed, (stamps - START_NS) / 1e9, index)
+    index, stamps, traj, acq = _mission(terrain, seed, frames, sensor)
     body_pos, body_rot = traj.pose(acq)
     sensor_pos = body_pos + body_rot.apply(mount.translation)
     sensor_rot = body_rot * mount.rotation

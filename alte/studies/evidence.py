@@ -216,7 +216,11 @@ def _resized(check: Check | AllOf, size: str | None) -> Check | AllOf:
     if size is None:
         return check
     if isinstance(check, AllOf):
-        return AllOf(tuple(_resized(p, size) for p in check.parts))  # type: ignore[misc]
+        return AllOf(tuple(_resized_check(p, size) for p in check.parts))
+    return _resized_check(check, size)
+
+
+def _resized_check(check: Check, size: str) -> Check:
     changes: dict[str, Any] = {f.name: size for f in fields(check)
                                if getattr(check, f.name) == "basis_functions"}
     return replace(check, **changes)

@@ -23,7 +23,16 @@ from alte.errors import ParameterError
 from alte.mappers import Mapper
 from alte.metrics.maps import GroundTruth, MapMetrics, TruthOptions, measure_map
 from alte.params import Record
-from alte.pipeline import FrameSpec, MapRun, MapSpec, Registered, open_input, prepare, run
+from alte.pipeline import (
+    FrameSpec,
+    InputKind,
+    MapRun,
+    MapSpec,
+    Registered,
+    open_input,
+    prepare,
+    run,
+)
 from alte.studies.thesis import SWEEPS, sweep_table
 
 __all__ = ["CACHE_DIR", "Measured", "ground_truth", "measure", "sweep", "terrain"]
@@ -76,7 +85,10 @@ def _truth(folder: str) -> GroundTruth | None:
 
 
 def ground_truth(data: Registered) -> GroundTruth | None:
-    """The terrain's true surface and control volume (loaded once per process)."""
+    """The terrain's true surface and control volume (loaded once per process); None for
+    an input that is not a simulated terrain."""
+    if data.source.kind is not InputKind.TERRAIN:
+        return None
     return _truth(str(data.source.path))
 
 

@@ -20,6 +20,7 @@ import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import cast
 
 import numpy as np
 import pandas as pd
@@ -198,7 +199,9 @@ def front_order(short: pd.DataFrame, whole: pd.DataFrame, *,
                 continue
             both = means[0].add_suffix("_short").join(means[1].add_suffix("_whole"), how="inner")
             for key, r in both.iterrows():
-                terrain, level = str(key[0]), float(key[1])  # type: ignore[index]
+                # Row keys of the (terrain, level) index are tuples; pandas-stubs say Hashable.
+                terrain_key, level_key = cast("tuple[str, float]", key)
+                terrain, level = str(terrain_key), float(level_key)
                 lead = [_lead(r[f"{pair[0]}_{k}"], r[f"{pair[1]}_{k}"], higher, pair)
                         for k in ("short", "whole")]
                 if all(lead):

@@ -49,3 +49,18 @@ def test_info_errors_exit_2(bag, tmp_path, capsys):
     assert "alte info: error: bag" in capsys.readouterr().err
     assert main(["info", str(bag), "--pose-topic", "/lidar"]) == 2
     assert "pose topic /lidar has type sensor_msgs/msg/PointCloud2" in capsys.readouterr().err
+
+
+def test_info_says_which_pose_source_is_used(bag, tmp_path, capsys):
+    assert main(["info", str(bag)]) == 0
+    assert "poses:     recorded (/vicon)" in capsys.readouterr().out
+    clouds = [(NS + k * NS // 10, np.full((4, 3), float(k))) for k in range(3)]
+    bare = tmp_path / "bare"
+    from support.bagtools import TS, write_ros2
+
+    from alte.io.pointcloud2 import encode_pointcloud2
+
+    write_ros2(bare, [("/lidar", "sensor_msgs/msg/PointCloud2", s,
+                       encode_pointcloud2(p, s, "lidar", TS)) for s, p in clouds])
+    assert main(["info", str(bare), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["pose_source"].startswith("odometry")

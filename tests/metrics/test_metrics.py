@@ -14,6 +14,7 @@ from alte.mappers.base import Cells
 from alte.metrics import (
     TrueSurface,
     cell_at_xy,
+    directed_distances,
     distance_to_boxes,
     free_space_truth,
     ground_truth_metrics,
@@ -43,6 +44,26 @@ def test_hausdorff_matches_brute_force(a, b):
     swapped = hausdorff(b, a)
     assert swapped.hd == pytest.approx(res.hd) and swapped.mhd == pytest.approx(res.mhd)
     assert swapped.h_ab == pytest.approx(res.h_ba) and swapped.mh_ab == pytest.approx(res.mh_ba)
+
+
+def test_distances_equal_open3d_and_scipy_to_the_last_bit():
+    """The KD-tree's nearest distances are open3d's (the benchmark peer) and scipy's."""
+    import open3d as o3d
+    from scipy.spatial import cKDTree
+
+    rng = np.random.default_rng(7)
+    a = rng.normal(0, 20, (20_000, 3))
+    b = np.round(rng.normal(0, 20, (6_000, 3)) / 0.2) * 0.2  # lattice corners, like a map's
+    for src, dst in ((a, b), (b, a)):
+        ours = directed_distances(src, dst)
+        cloud = o3d.geometry.PointCloud(o3d.utility.Vector3dVector(src))
+        peer = np.asarray(cloud.compute_point_cloud_distance(
+            o3d.geometry.PointCloud(o3d.utility.Vector3dVector(dst))))
+        assert np.array_equal(ours, peer)
+        assert np.array_equal(ours, cKDTree(dst).query(src, k=1)[0])
+    res = hausdorff(a, b)
+    assert res.h_ab == directed_distances(a, b).max()
+    assert res.mh_ba == directed_distances(b, a).mean()
 
 
 def test_hausdorff_zero_on_identical_sets():

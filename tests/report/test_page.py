@@ -22,7 +22,9 @@ def test_run_page_model(tmp_path: Path) -> None:
     assert ("points", "120,161") in ch4.results and ("rows", "0, 1, 2") in ch4.results
     assert all(name not in ("maps", "sites", "table", "captions") for name, _ in ch4.results)
     assert ch5.error == "cell 2: ValueError: <boom>" and ch5.status == "failed"
-    assert [t.title for t in page.key_tables] == ["Table 5.10: best 2D maps by the thesis' rule"]
+    assert [t.title for t in page.key_tables] == ["Table 5.10: best 2D maps by the thesis' rule",
+                                                  "MHD at equal size",
+                                                  "Ablations: what moves the verdicts"]
     others = {t.title: t for t in page.tables}
     assert set(others) == {"extra.csv", "tradeoff.csv"}
     assert others["tradeoff.csv"].view is None and "rows" in others["tradeoff.csv"].caption

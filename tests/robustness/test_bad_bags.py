@@ -23,9 +23,9 @@ def _argv(command: str, bag: Path, tmp_path: Path) -> list[object]:
     return ["map", bag, "--mapper", "alte2d", "--json", "--export", tmp_path / "cells.npz"]
 
 
-def _fails(bags, capsys, command: str, bag: Path, tmp_path: Path) -> str:
+def _fails(bags, capsys, command: str, bag: Path, tmp_path: Path, *extra: object) -> str:
     """Run ``command`` on ``bag``: exit 2, one error line, no output file; return the line."""
-    code, out, err = bags.run_cli(capsys, *_argv(command, bag, tmp_path))
+    code, out, err = bags.run_cli(capsys, *_argv(command, bag, tmp_path), *extra)
     assert code == 2, (out, err)
     assert not (tmp_path / "cloud.ply").exists() and not (tmp_path / "cells.npz").exists()
     assert not [p for p in tmp_path.iterdir() if p.name.endswith(".part")]
@@ -91,10 +91,28 @@ def test_truncated_bag(bags, capsys, tmp_path, storage, fraction):
 
 
 @pytest.mark.parametrize("command", COMMANDS)
-def test_clouds_without_poses(bags, capsys, tmp_path, command):
+@pytest.mark.parametrize("poses", ["recorded", "refine"])
+def test_clouds_without_poses(bags, capsys, tmp_path, command, poses):
     bag = bags.write_ros2(tmp_path / "nopose", bags.mission(poses=False))
-    line = _fails(bags, capsys, command, bag, tmp_path)
-    assert f"{bag}: no pose topic" in line and "/points [sensor_msgs/msg/PointCloud2]" in line
+    line = _fails(bags, capsys, command, bag, tmp_path, "--poses", poses)
+    assert f"{bag}: --poses {poses} needs the bag's poses and it has no pose topic" in line
+    assert "for /points; use --poses odometry" in line
+
+
+def test_clouds_without_poses_use_odometry_and_say_so(bags, capsys, tmp_path):
+    bag = bags.write_ros2(tmp_path / "nopose", bags.mission(poses=False))
+    code, out, err = bags.run_cli(capsys, *_argv("map", bag, tmp_path))
+    assert code == 0, err
+    summary = json.loads(out)
+    assert summary["pose_source"] == "odometry" and summary["frames"] == 4
+    assert any("poses from LiDAR odometry" in n for n in summary["counts"]["notes"])
+    assert "poses: odometry" in _register(bags, capsys, bag, tmp_path)
+
+
+def test_no_pose_and_poses_exclude_each_other(bags, capsys, tmp_path):
+    bag = bags.write_ros2(tmp_path / "nopose", bags.mission(poses=False))
+    line = _fails(bags, capsys, "register", bag, tmp_path, "--no-pose", "--poses", "odometry")
+    assert "--no-pose and --poses odometry exclude each other" in line
 
 
 def test_clouds_without_poses_recover_with_no_pose(bags, capsys, tmp_path):

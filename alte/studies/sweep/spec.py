@@ -129,15 +129,10 @@ def _truth(source: str, value: Any) -> TruthOptions:
         return TruthOptions()
     if not isinstance(value, Mapping):
         raise _fail(source, "truth", f"{value!r} must be a mapping")
-    valid = [f.name for f in dataclasses.fields(TruthOptions)]
-    _check_keys(source, "truth", value, valid)
     try:
-        opts = TruthOptions(**{k: type(getattr(TruthOptions(), k))(v) for k, v in value.items()})
-    except (TypeError, ValueError) as err:
-        raise _fail(source, "truth", str(err)) from err
-    if opts.tolerance <= 0 or opts.grid_step <= 0 or opts.n_samples < 1:
-        raise _fail(source, "truth", f"{value!r}: tolerance, grid_step and n_samples must be > 0")
-    return opts
+        return TruthOptions.parse({str(k): v for k, v in value.items()})
+    except ParameterError as err:  # the record's message names "truth" and the key
+        raise ParameterError(f"{source}: {err}") from err
 
 
 def _grid_rows(source: str, key: str, grid: Any) -> list[dict[str, Any]]:

@@ -1,0 +1,96 @@
+"""LiDAR odometry and pose refinement on simulated missions, scored against the truth."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from support.missions import first_scans, unposed_bag
+
+from alte.cli import main
+from alte.errors import ParameterError, TopicError
+from alte.pipeline import FrameSpec, PoseSource, merged_cloud, open_input, prepare
+from alte.registration.odometry import OdometryParams, PoseCounts, pose_matrix, refine_frames
+from alte.sim import get_terrain, mesh_distance, simulate, true_poses, write_scenario
+from alte.types import Frame, Mount
+
+SCANS = 60
+
+
+@pytest.fixture(scope="module")
+def unposed(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, np.ndarray, np.ndarray]:
+    """The first 6 s of exp_nav_1 (10 Hz, cart among buoys and pillars) without poses."""
+    sim, truth = first_scans("exp_nav_1", SCANS)
+    bag = unposed_bag(tmp_path_factory.mktemp("odometry") / "bag", sim, SCANS)
+    return bag, truth.positions, pose_matrix(truth.positions[0], truth.quaternions[0])
+
+
+def test_bag_without_poses_maps_with_odometry(unposed, capsys) -> None:
+    bag, positions, start = unposed
+    assert main(["map", str(bag), "--poses", "odometry", "--mapper", "alte2d", "--json"]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["pose_source"] == "odometry" and summary["frames"] == SCANS
+    voxel = get_terrain("exp_nav_1").spec.registration_voxel
+    reg = prepare(open_input(bag), FrameSpec(poses=PoseSource.ODOMETRY, voxel=voxel))
+    assert len(reg) == SCANS and reg.counts.poses.frames == SCANS
+    cloud = np.asarray(reg.cloud) @ start[:3, :3].T + start[:3, 3]  # the odometry frame is
+    scene = get_terrain("exp_nav_1").scene                          # the first body frame
+    assert mesh_distance(cloud, scene).mean() < 0.1
+    moved = reg.trajectory.positions @ start[:3, :3].T + start[:3, 3]
+    travelled = np.linalg.norm(positions[-1] - positions[0])
+    assert travelled > 1.5
+    assert np.linalg.norm(moved[-1] - positions[SCANS - 1]) < 0.25 * travelled
+
+
+def test_auto_poses_fall_back_to_odometry(unposed) -> None:
+    bag, _, _ = unposed
+    cloud, counts = merged_cloud(open_input(bag), FrameSpec(frames=5))
+    assert counts.poses.source == "odometry" and len(cloud) > 0
+    assert any("anchored at the first scan's body frame" in n for n in counts.notes)
+
+
+def test_refine_improves_a_desynchronised_mission(tmp_path: Path) -> None:
+    terrain = get_terrain("exp_nav_2")
+    folder = write_scenario(tmp_path / "exp_nav_2", terrain, simulate(terrain, frames=40),
+                            seed=0, frames=40)
+    source = open_input(folder)
+    scene = terrain.scene
+    recorded, plain = merged_cloud(source, FrameSpec(poses=PoseSource.RECORDED))
+    refined, counts = merged_cloud(source, FrameSpec(poses=PoseSource.REFINE))
+    before = mesh_distance(recorded, scene).mean()
+    after = mesh_distance(refined, scene).mean()
+    assert after < 0.8 * before
+    assert counts.poses.source == "refine" and counts.poses.corrected > 20
+    assert counts.registration.frames_kept == plain.registration.frames_kept  # none dropped
+
+
+def test_refine_counts_corrections_above_the_bound() -> None:
+    rng = np.random.default_rng(0)
+    xy = rng.uniform(-4, 4, (4000, 2))
+    ground = np.column_stack([xy, np.zeros(4000)])
+    walls = np.column_stack([np.full(2000, 4.0), rng.uniform(-4, 4, 2000), rng.uniform(0, 2, 2000)])
+    box = np.vstack([ground, walls, walls[:, [1, 0, 2]]]) - [0.0, 0.0, 1.0]
+    frames = [Frame(k, box, np.array([0.3 * k, 0.0, 0.0]) if k == 2 else np.zeros(3),
+                    np.array([0.0, 0.0, 0.0, 1.0])) for k in range(4)]
+    counts = PoseCounts()
+    out = list(refine_frames(frames, Mount(), counts=counts,
+                             params=OdometryParams(max_correction=0.2, voxel=0.1)))
+    assert counts.frames == 4 and counts.corrections_above_bound == 1
+    assert np.allclose(out[2].position, [0.6, 0.0, 0.0])  # kept as recorded
+    assert np.allclose(out[3].position, 0.0, atol=0.02)
+    truth = true_poses(get_terrain("exp_nav_2"), frames=3)
+    assert truth.positions.shape == (3, 3)
+
+
+def test_pose_errors_are_typed(unposed, tmp_path: Path) -> None:
+    bag, _, _ = unposed
+    with pytest.raises(TopicError, match="--poses refine needs the bag's poses"):
+        merged_cloud(open_input(bag), FrameSpec(poses=PoseSource.REFINE))
+    points = tmp_path / "cloud.npz"
+    np.savez(points, points=np.ones((10, 3)))
+    with pytest.raises(ParameterError, match="--poses odometry needs a bag of scans"):
+        merged_cloud(open_input(points), FrameSpec(poses=PoseSource.ODOMETRY))
+    with pytest.raises(ParameterError, match=r"odometry: method='icp' out of range"):
+        OdometryParams(method="icp")
