@@ -17,7 +17,7 @@ from alte.commands.options import add_frame_options
 __all__ = ["add_parser", "run"]
 
 
-def add_parser(subparsers: argparse._SubParsersAction) -> None:
+def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Register ``alte export``."""
     p = subparsers.add_parser(
         "export", help="map an input and write the result as a ROS 2 MCAP (Foxglove, RViz)",

@@ -19,7 +19,7 @@ from alte.studies.odometry import odometry_table, write_odometry_table
 __all__ = ["add_parser", "run"]
 
 
-def add_parser(subparsers: argparse._SubParsersAction) -> None:
+def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Register ``alte odometry``."""
     p = subparsers.add_parser(
         "odometry", help="score LiDAR odometry and pose refinement on the simulated terrains",

@@ -137,13 +137,13 @@ class _PlaneMap:
         merged = o3d.geometry.PointCloud(o3d.utility.Vector3dVector(
             np.vstack([self.points, *self.pending]))).voxel_down_sample(self.voxel)
         near = np.linalg.norm(np.asarray(merged.points) - sensor[:3, 3], axis=1) <= self.radius
-        target = merged.select_by_index(np.flatnonzero(near))
+        target = merged.select_by_index(np.flatnonzero(near).tolist())
         target.estimate_normals(o3d.geometry.KDTreeSearchParamHybrid(6.0 * self.voxel, 40))
         self.points, self.pending, self.target = np.asarray(target.points), [], target
 
     def align(self, source: Any, guess: np.ndarray) -> tuple[np.ndarray, float]:
         """The sensor pose placing ``source`` on the map, from ``guess``; inlier fraction."""
-        from open3d.pipelines import registration as reg
+        from open3d.pipelines import registration as reg  # type: ignore[import-not-found]
 
         reach = 6.0 * self.voxel
         method = reg.TransformationEstimationPointToPlane(reg.TukeyLoss(k=reach / 2))
@@ -163,7 +163,7 @@ class _DenseMap:
 
     def add(self, scan: np.ndarray, sensor: np.ndarray) -> None:
         """Add the scan (sensor frame) placed at ``sensor``; forget what is out of reach."""
-        import small_gicp
+        import small_gicp  # type: ignore[import-not-found, unused-ignore]
 
         placed = scan @ sensor[:3, :3].T + sensor[:3, 3]
         merged = small_gicp.voxelgrid_sampling(np.vstack([self.points, placed]), self.voxel / 2,
@@ -173,7 +173,7 @@ class _DenseMap:
 
     def align(self, scan: np.ndarray, guess: np.ndarray) -> tuple[np.ndarray, float]:
         """The sensor pose placing ``scan`` on the map from ``guess``; inlier fraction."""
-        import small_gicp
+        import small_gicp  # type: ignore[import-not-found, unused-ignore]
 
         target = small_gicp.voxelgrid_sampling(self.points, self.voxel, num_threads=_THREADS)
         tree = small_gicp.KdTree(target, num_threads=_THREADS)
@@ -189,8 +189,8 @@ class _Kiss:
     """KISS-ICP scaled to the scene of the first scan (module docstring)."""
 
     def __init__(self, points: np.ndarray, params: OdometryParams) -> None:
-        from kiss_icp.config import KISSConfig
-        from kiss_icp.kiss_icp import KissICP
+        from kiss_icp.config import KISSConfig  # type: ignore[import-untyped]
+        from kiss_icp.kiss_icp import KissICP  # type: ignore[import-untyped]
 
         max_range, voxel = scene_scale(points, params)
         config = KISSConfig()
