@@ -25,6 +25,7 @@ report-quick: bootstrap
 
 lint: bootstrap
 	$(PY) -m ruff check alte tests bench
+	$(PY) -m mypy
 
 test: lint
 	$(PY) -m pytest -n 2 --dist loadfile tests notebooks --nbval-lax $(PYTEST_ARGS)

@@ -131,7 +131,7 @@ class Record:
     @classmethod
     def names(cls) -> tuple[str, ...]:
         """The parameter names, in declaration order."""
-        return tuple(f.name for f in dataclasses.fields(cls))  # type: ignore[arg-type]
+        return tuple(f.name for f in dataclasses.fields(cls))
 
     @classmethod
     def parse(cls, given: Mapping[str, object] | None = None) -> Self:
@@ -155,7 +155,7 @@ class Record:
     def help(cls) -> dict[str, str]:
         """What each parameter means and its rule, for ``--help`` texts and docs."""
         out = {}
-        for spec in dataclasses.fields(cls):  # type: ignore[arg-type]
+        for spec in dataclasses.fields(cls):
             rule = spec.metadata.get("rule", Rule())
             out[spec.name] = f"{rule.help} ({rule.rule})" if rule.rule else rule.help
         return out

@@ -3,7 +3,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from alte.errors import PoseError
-from alte.types import Frame, Mount, as_points, thesis_mount
+from alte.types import Frame, Mount, as_points, finite_rows, rows_all, thesis_mount
 
 
 def _frame(**kw):
@@ -62,3 +62,13 @@ def test_thesis_mount_looks_forward_30_deg_down():
     look = thesis_mount().rotation.apply([0.0, 1.0, 0.0])  # sensor +y: centre of the FoV
     np.testing.assert_allclose(look, [np.cos(np.radians(30)), 0, -np.sin(np.radians(30))],
                                atol=1e-12)
+
+
+def test_rows_all_and_finite_rows_match_numpy() -> None:
+    rng = np.random.default_rng(3)
+    pts = rng.normal(size=(500, 3))
+    assert finite_rows(pts) is None
+    pts[[3, 70, 71], [0, 2, 1]] = [np.nan, np.inf, -np.inf]
+    assert np.array_equal(finite_rows(pts), np.isfinite(pts).all(axis=1))
+    mask = rng.random((200, 4)) > 0.2
+    assert np.array_equal(rows_all(mask), mask.all(axis=1))

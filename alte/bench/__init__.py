@@ -1,4 +1,4 @@
-"""Performance benchmark of issue 6: our stages against real peers, as ratios.
+"""Performance benchmark: our stages against real peers, as ratios.
 
 ``alte bench`` (or ``make bench``) runs :data:`ROWS` and writes ``reports/bench.md``,
 ``reports/bench.json`` and ``reports/bench_scaling.png``. Every figure is the median

@@ -1,4 +1,4 @@
-"""The benchmark suite: the rows of issue 6 by number, run in one process.
+"""The benchmark suite: its rows by number, run in one process.
 
 :data:`ROWS` maps a row number to its title and function; :func:`run_bench` runs
 the selected rows in order (sharing loaded terrains and the Octomap passes) and
@@ -20,7 +20,9 @@ from tqdm.auto import tqdm
 from alte.bench.clouds import cloud_stages, hausdorff_speed
 from alte.bench.core import BenchConfig, Context, Result
 from alte.bench.maps import batch_builds, insert_latency, octomap_memory, octomap_speed
+from alte.bench.memory import map_memory
 from alte.bench.scaling import scaling
+from alte.bench.stream import scan_peer, streaming_chain
 from alte.bench.timing import machine_info, peak_rss_bytes
 from alte.bench.wall import report_wall_time
 from alte.errors import ParameterError
@@ -39,6 +41,9 @@ ROWS: dict[int, tuple[str, Row]] = {
     6: ("grid average / MSAC / clustering vs open3d", cloud_stages),
     7: ("scaling 10^4..10^7 points", scaling),
     8: ("make report wall time vs thesis MATLAB", report_wall_time),
+    9: ("alte map peak RSS: a mission flown 4x vs once", map_memory),
+    10: ("alte map BAG: wall time vs mission time, per-frame latency", streaming_chain),
+    11: ("Octomap native vs DUFOMap (UFOMap) scan integration", scan_peer),
 }
 
 

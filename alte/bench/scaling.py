@@ -42,7 +42,8 @@ def whole_scans(frames: Sequence[tuple[np.ndarray, np.ndarray]],
     if n > total:
         pts = np.vstack([p for p, _ in frames])
         origins = np.repeat(np.array([o for _, o in frames]), sizes, axis=0)
-        return tuple(tile_points(pts, math.ceil(n / total) * total, origins))
+        tiled, tiled_origins = tile_points(pts, math.ceil(n / total) * total, origins)
+        return tiled, tiled_origins
     k = max(1, round(len(frames) * n / total))
     pick = np.unique(np.round(np.linspace(0, len(frames) - 1, k)).astype(int))
     chosen = [frames[i] for i in pick]
@@ -63,13 +64,13 @@ def scaling_cases(ctx: Context) -> dict[str, Case]:
         def make(n: int) -> tuple[int, Callable[[], object]]:
             (pts,) = tile_points(ctx.workload(TERRAIN_OF[name]).cloud, n)
             params = mapper_params(TERRAIN_OF[name])[name]
-            return len(pts), lambda: make_mapper(name, **params).build(pts)
+            return len(pts), lambda: make_mapper(name, params).build(pts)
         return make
 
     def octomap(n: int) -> tuple[int, Callable[[], object]]:
         pts, origins = whole_scans(ctx.workload(NAV).frames, n)
         params = mapper_params(NAV)["octomap"]
-        return len(pts), lambda: make_mapper("octomap", **params).build(pts, origins)
+        return len(pts), lambda: make_mapper("octomap", params).build(pts, origins)
 
     def metrics(n: int) -> tuple[int, Callable[[], object]]:
         (pts,) = tile_points(ctx.workload(NAV).cloud, n)
@@ -82,7 +83,8 @@ def scaling_cases(ctx: Context) -> dict[str, Case]:
 def predicted_seconds(sizes: list[int], seconds: list[float], n: int) -> float:
     """Seconds expected at ``n`` from the last timing and the slope so far (>= 1)."""
     slope = max(1.0, fit_exponent(sizes, seconds)) if len(sizes) >= 2 else 1.0
-    return seconds[-1] * (n / sizes[-1]) ** slope
+    predicted: float = seconds[-1] * (n / sizes[-1]) ** slope
+    return predicted
 
 
 def _one_case(ctx: Context, name: str, make: Case) -> Result:

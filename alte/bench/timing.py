@@ -77,7 +77,8 @@ def measure(funcs: Mapping[str, Callable[[], object]], repeats: int = 5,
     return {name: Sample(tuple(t)) for name, t in times.items()}
 
 
-def fit_exponent(sizes: Sequence[float], seconds: Sequence[float]) -> float:
+def fit_exponent(sizes: Sequence[float] | np.ndarray,
+                 seconds: Sequence[float] | np.ndarray) -> float:
     """Slope of log(seconds) against log(size): the empirical complexity exponent."""
     x, y = np.log(np.asarray(sizes, float)), np.log(np.asarray(seconds, float))
     if np.unique(x).size < 2 or not np.isfinite(y).all():
@@ -86,7 +87,7 @@ def fit_exponent(sizes: Sequence[float], seconds: Sequence[float]) -> float:
     return float(np.polyfit(x, y, 1)[0])
 
 
-def nlogn_exponent(sizes: Sequence[float]) -> float:
+def nlogn_exponent(sizes: Sequence[float] | np.ndarray) -> float:
     """The slope :func:`fit_exponent` gives for exact n log n over ``sizes`` (about 1.1)."""
     n = np.asarray(sizes, float)
     return fit_exponent(n, n * np.log(n))

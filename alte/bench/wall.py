@@ -9,6 +9,7 @@ machine, and the thesis times the mappers alone).
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 from alte.bench.core import Context, Result
 from alte.studies.thesis import COMPARISONS, SWEEPS
@@ -24,7 +25,7 @@ def thesis_total_s() -> float:
     return float(sweeps + repeated)
 
 
-def stage_shares(record: dict) -> dict[str, float]:
+def stage_shares(record: dict[str, Any]) -> dict[str, float]:
     """Each notebook run's share of the report's wall time; the rest is simulation/publishing."""
     total = float(record.get("seconds") or 0.0)
     runs = {r["name"]: float(r.get("seconds") or 0.0) for r in record.get("runs", [])}

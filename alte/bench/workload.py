@@ -53,15 +53,20 @@ def workload_dir(data_dir: str | Path, quick: bool) -> Path:
 
 def load_workload(terrain: str, data_dir: str | Path, *, quick: bool = False,
                   frames: int | None = None, progress: bool = False) -> Workload:
-    """Simulate ``terrain`` if missing, register it; ``frames`` keeps that many scans evenly."""
+    """Simulate ``terrain`` if missing, register it through the pipeline (cached under
+    ``DATA_DIR/.cache``); ``frames`` keeps that many scans evenly."""
+    from alte.pipeline import FrameSpec, open_input, prepare
     from alte.sim import ensure_terrain
-    from alte.studies.experiments import load_dataset
 
     folder = ensure_terrain(terrain, workload_dir(data_dir, quick),
                             frames=QUICK_FRAMES if quick else None, progress=progress)
-    data = load_dataset(folder, frames=frames, progress=progress)
-    return Workload(terrain, data.frames, data.cloud, np.asarray(data.bounds, float),
-                    float(data.info["voxel_m"]))
+    data = prepare(open_input(folder), FrameSpec(frames=frames),
+                   cache=Path(data_dir) / ".cache", progress=progress)
+    scans = [(np.array(f.points), np.asarray(f.origin, float)) for f in data.frames()]
+    box = data.spec.crop if data.spec.crop is not None else data.bounds()
+    assert data.spec.voxel is not None, "a terrain folder gives its registration voxel"
+    return Workload(terrain, scans, np.array(data.cloud), np.asarray(box.values(), float),
+                    float(data.spec.voxel))
 
 
 def tile_points(points: np.ndarray, count: int, *extra: np.ndarray) -> list[np.ndarray]:

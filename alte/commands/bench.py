@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
-from typing import Any
 
 __all__ = ["add_parser", "run"]
 
@@ -23,7 +22,7 @@ def _sizes(text: str) -> tuple[int, ...]:
         raise argparse.ArgumentTypeError(f"--sizes {text!r}: expected counts like 1e4,1e5") from err
 
 
-def add_parser(subparsers: Any) -> None:
+def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Register ``bench``."""
     parser = subparsers.add_parser(
         "bench", help="run the performance benchmark (issue 6)",
@@ -32,7 +31,7 @@ def add_parser(subparsers: Any) -> None:
     parser.add_argument("--quick", action="store_true",
                         help="tiny inputs (a few simulated scans): a smoke run in seconds")
     parser.add_argument("--only", type=_rows, default=None, metavar="ROWS",
-                        help="comma-separated row numbers to run (default: all, 1-8)")
+                        help="comma-separated row numbers to run (default: all, 1-11)")
     parser.add_argument("--repeats", type=int, default=5, help="timed repeats (default 5)")
     parser.add_argument("--warmup", type=int, default=1, help="discarded warm-up runs")
     parser.add_argument("--frames", type=int, default=None,

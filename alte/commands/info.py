@@ -17,7 +17,7 @@ from alte.pipeline import InputKind, Source, open_input
 __all__ = ["add_parser", "format_info", "pose_source", "run"]
 
 
-def add_parser(subparsers: argparse._SubParsersAction) -> None:
+def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Register ``alte info``."""
     p = subparsers.add_parser(
         "info",

@@ -51,7 +51,7 @@ def add_map_options(p: argparse.ArgumentParser) -> None:
                         "scan's time (the map as it grows; batch feeds switch to frames)")
 
 
-def add_parser(subparsers: argparse._SubParsersAction) -> None:
+def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Register ``alte map``."""
     p = subparsers.add_parser(
         "map", help="build a terrain map from a bag, a terrain folder or a point cloud file",
@@ -101,6 +101,7 @@ def _summary(result: MapRun, metrics: bool) -> dict[str, object]:
         from alte.metrics.maps import measure_map
 
         source = open_input(result.info.input)
+        assert result.cloud is not None  # run(..., cloud=True) kept it for the metrics
         out["metrics"] = measure_map(result.mapper, result.cloud, elapsed_s=result.elapsed_s,
                                      truth=source.ground_truth()).as_dict()
     return out

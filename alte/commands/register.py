@@ -18,7 +18,7 @@ from alte.registration import RegistrationCounts
 __all__ = ["add_parser", "format_counts", "run"]
 
 
-def add_parser(subparsers: argparse._SubParsersAction) -> None:
+def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Register ``alte register``."""
     p = subparsers.add_parser(
         "register", help="register a bag's scans into one inertial point cloud",

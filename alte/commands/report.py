@@ -12,7 +12,7 @@ from alte.report import PLAN, build_plan, load_plan, parse_param, run_report
 __all__ = ["add_parser", "run"]
 
 
-def add_parser(subparsers: argparse._SubParsersAction) -> None:
+def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Register ``alte report``."""
     p = subparsers.add_parser(
         "report", help="execute the notebooks and build reports/index.html",

@@ -15,7 +15,7 @@ from alte.sim.terrains import TERRAINS
 __all__ = ["add_parser", "run"]
 
 
-def add_parser(subparsers: argparse._SubParsersAction) -> None:
+def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Register ``alte simulate``."""
     p = subparsers.add_parser(
         "simulate", help="simulate benchmark terrains as ROS 2 bags with ground truth",

@@ -4,12 +4,11 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
-from typing import Any
 
 __all__ = ["add_parser", "run"]
 
 
-def add_parser(subparsers: Any) -> None:
+def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Register ``sweep``."""
     parser = subparsers.add_parser(
         "sweep", help="run a grid of terrains x mappers x parameters (resumable, Dask)",
@@ -27,6 +26,8 @@ def add_parser(subparsers: Any) -> None:
                         help="Parquet dataset folder (default: the spec's output)")
     parser.add_argument("--frames", type=int, default=None,
                         help="scans per terrain, overriding the spec's frames")
+    parser.add_argument("--seeds", type=int, nargs="+", default=None, metavar="SEED",
+                        help="simulation seeds, overriding the spec's seed(s)")
     parser.add_argument("--data", type=Path, default=None,
                         help="terrain folder, overriding the spec's data_dir")
     parser.add_argument("--no-progress", action="store_true", help="hide progress bars")
@@ -42,6 +43,8 @@ def run(args: argparse.Namespace) -> int:
         spec = override(spec, frames=args.frames)
     if args.data is not None:
         spec = override(spec, data_dir=str(args.data))
+    if args.seeds is not None:
+        spec = override(spec, seeds=args.seeds)
     result = run_sweep(spec, scheduler=args.scheduler, workers=args.workers, output=args.out,
                        progress=not args.no_progress)
     for failed, message in result.failed:

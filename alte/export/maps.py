@@ -38,10 +38,11 @@ _BT_DATA = b"\ndata\n"
 def shown_cells(cells: Cells, dims: int, everything: bool = False) -> np.ndarray:
     """Mask of the cells drawn: occupied (3D maps) or known (2D height maps: a free leaf is
     ground at its height); ``everything`` adds the free cells of a 3D map."""
-    known = np.asarray(np.isfinite(cells.centers).all(axis=1), dtype=bool)
+    known: np.ndarray = np.isfinite(cells.centers).all(axis=1)
     if dims == 2 or everything:
         return known
-    return np.asarray(known & cells.occupied, dtype=bool)
+    shown: np.ndarray = known & np.asarray(cells.occupied, dtype=bool)
+    return shown
 
 
 def height_colours(z: np.ndarray) -> np.ndarray:

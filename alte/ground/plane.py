@@ -120,7 +120,8 @@ def _refine(pts: np.ndarray, model: np.ndarray, threshold: float) -> np.ndarray:
         return model
     mean = inliers.mean(axis=0)
     normal = np.linalg.svd(inliers - mean, full_matrices=False)[2][-1]
-    return np.r_[normal, -normal @ mean]
+    refined: np.ndarray = np.r_[normal, -normal @ mean]
+    return refined
 
 
 def _msac_cost(pts: np.ndarray, model: np.ndarray, threshold: float) -> float:
@@ -229,7 +230,8 @@ def fit_plane_open3d(
 def height_above(points: np.ndarray, plane: PlaneFit) -> np.ndarray:
     """Signed distance of every point to the plane (N,), positive above (normal side)."""
     pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
-    return pts @ plane.normal + plane.d
+    height: np.ndarray = pts @ plane.normal + plane.d
+    return height
 
 
 def obstacle_mask(points: np.ndarray, plane: PlaneFit, height: float = 0.3) -> np.ndarray:

@@ -12,7 +12,7 @@ from __future__ import annotations
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, TypedDict, Unpack
 
 import numpy as np
 from tqdm.auto import tqdm
@@ -35,6 +35,7 @@ from alte.io.reader import (
 from alte.types import Frame, Mount
 
 __all__ = ["NO_POSE_NOTE", "BagInfo", "FrameSet", "FrameStream", "ReadCounts", "ReadOptions",
+           "StreamOptions",
            "evenly_spaced", "inspect_bag", "read_frames"]
 
 _IDENTITY_Q = np.array([0.0, 0.0, 0.0, 1.0])
@@ -339,7 +340,21 @@ def _raise_empty(stream: FrameStream, counts: ReadCounts, stamps: _StampRange) -
     )
 
 
-def read_frames(path: str | Path, **options: Any) -> FrameSet:
+class StreamOptions(TypedDict, total=False):
+    """Keywords of :class:`FrameStream` (and :func:`read_frames`)."""
+
+    cloud_topic: str | None
+    pose_topic: str | None
+    mount: Mount | None
+    allow_no_pose: bool
+    body_frame: str | None
+    frames: int | None
+    max_gap_s: float
+    return_mode: str
+    progress: bool
+
+
+def read_frames(path: str | Path, **options: Unpack[StreamOptions]) -> FrameSet:
     """Every posed scan of a bag in a list (see :class:`FrameStream` for ``options``).
 
     Topics are detected by message type unless given (``pose_topic=""`` forces

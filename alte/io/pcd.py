@@ -94,14 +94,16 @@ def read_pcd(path: Path) -> np.ndarray:
     raw = path.read_bytes()
     header, offset = _pcd_header(raw, path)
     dtype = _pcd_dtype(header, path)
+    names = dtype.names
+    assert names is not None  # _pcd_dtype builds a structured dtype
     try:
         count = int(header.get("POINTS", header.get("WIDTH", ["0"]))[0])
     except ValueError as err:
         raise PointFileError(f"{path}: bad POINTS line {header.get('POINTS')}") from err
     kind = header["DATA"][0].lower() if header["DATA"] else ""
-    fields = [name.rsplit("_", 1)[0] for name in dtype.names]
+    fields = [name.rsplit("_", 1)[0] for name in names]
     if kind == "ascii":
-        counts = [dtype[name].shape[0] for name in dtype.names]
+        counts = [dtype[name].shape[0] for name in names]
         starts = np.cumsum([0, *counts[:-1]])
         table = read_table(path, offset=offset)
         if table.shape[1] != sum(counts):
@@ -115,7 +117,7 @@ def read_pcd(path: Path) -> np.ndarray:
         data = _pcd_decompress(raw[offset:], dtype, count, path)
     else:
         raise PointFileError(f"{path}: unknown PCD DATA encoding {kind!r}")
-    columns = [data[dtype.names[fields.index(c)]][:, 0] for c in "xyz"]
+    columns = [data[names[fields.index(c)]][:, 0] for c in "xyz"]
     return np.column_stack(columns).astype(np.float64)
 
 
@@ -131,6 +133,7 @@ def _pcd_decompress(blob: bytes, dtype: np.dtype, count: int, path: Path) -> np.
         raise PointFileError(f"{path}: corrupt LZF data in binary_compressed PCD")
     out = np.empty(count, dtype)
     start = 0
+    assert dtype.names is not None  # _pcd_dtype builds a structured dtype
     for name in dtype.names:  # one contiguous column per field
         width = dtype[name].itemsize * count
         out[name] = body[start : start + width].view(dtype[name].base).reshape(count, -1)

@@ -8,11 +8,12 @@ padding (``row_step > width * point_step``) are cut to their payload first.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 
 from alte.errors import BagError
+from alte.types import finite_rows
 
 __all__ = ["POINTFIELD_DTYPES", "decode_pointcloud2", "encode_pointcloud2", "make_header"]
 
@@ -33,7 +34,7 @@ _XYZ = ("x", "y", "z")
 
 def _xyz_dtype(msg: Any, topic: str) -> np.dtype:
     """Structured dtype holding x, y, z at their offsets, ``itemsize == point_step``."""
-    order = ">" if msg.is_bigendian else "<"
+    order: Literal[">", "<"] = ">" if msg.is_bigendian else "<"
     fields = {}
     needed = 0
     for field in msg.fields:
@@ -102,11 +103,10 @@ def decode_pointcloud2(msg: Any, topic: str = "PointCloud2") -> tuple[np.ndarray
     points = np.empty((count, 3), dtype=np.float64)
     for axis, name in enumerate(_XYZ):
         points[:, axis] = records[name]
-    finite = np.isfinite(points).all(axis=1)
-    dropped = int(count - np.count_nonzero(finite))
-    if dropped:
-        points = points[finite]
-    return points, dropped
+    finite = finite_rows(points)
+    if finite is None:
+        return points, 0
+    return points[finite], int(count - np.count_nonzero(finite))
 
 
 def encode_pointcloud2(
@@ -138,11 +138,13 @@ def encode_pointcloud2(
     table = np.empty(pts.shape[0], dtype=record)
     for name, values in columns.items():
         table[name] = values
+    layout = record.fields
+    assert layout is not None  # a structured dtype has fields
     types = typestore.types
     fields = [
         types["sensor_msgs/msg/PointField"](
             name=name,
-            offset=record.fields[name][1],
+            offset=layout[name][1],
             datatype=_CODES[fmt.newbyteorder("=")],
             count=1,
         )

@@ -13,6 +13,7 @@ shifted by :func:`local_origin` before centimetre cells are computed.
 from __future__ import annotations
 
 import os
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -113,7 +114,7 @@ def _read_ply(path: Path) -> np.ndarray:
     _check_ply_complete(path)
 
     with o3d.utility.VerbosityContextManager(o3d.utility.VerbosityLevel.Error):
-        cloud = o3d.io.read_point_cloud(str(path), format="ply")
+        cloud = o3d.io.read_point_cloud(path, format="ply")
     return np.asarray(cloud.points, dtype=np.float64).copy()
 
 
@@ -204,7 +205,8 @@ def _write_las(tmp: Path, points: np.ndarray, compress: bool) -> None:
         las.write(fh, do_compress=compress)
 
 
-_WRITERS = {".pcd": write_pcd, ".ply": _write_ply, ".npz": _write_npz}
+_WRITERS: dict[str, Callable[[Path, np.ndarray], None]] = {
+    ".pcd": write_pcd, ".ply": _write_ply, ".npz": _write_npz}
 _WRITERS |= {s: _write_text for s in _TEXT}
 _WRITERS |= {
     ".las": lambda t, p: _write_las(t, p, False),
@@ -242,4 +244,5 @@ def local_origin(points: np.ndarray, quantum: float = 1000.0) -> np.ndarray:
     if not np.isfinite(arr).all():
         raise ParameterError("points hold non-finite coordinates; cannot choose an origin")
     centre = 0.5 * (arr.min(axis=0) + arr.max(axis=0))
-    return np.round(centre / quantum) * quantum + 0.0  # + 0.0 turns -0.0 into 0.0
+    origin: np.ndarray = np.round(centre / quantum) * quantum + 0.0  # + 0.0: -0.0 -> 0.0
+    return origin

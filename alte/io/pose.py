@@ -12,7 +12,7 @@ from __future__ import annotations
 import warnings
 from dataclasses import dataclass
 from functools import cached_property
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 from scipy.spatial.transform import Rotation, Slerp
@@ -21,6 +21,7 @@ from alte.errors import PoseError
 
 __all__ = [
     "POSE_TYPES",
+    "PoseRecord",
     "PoseSamples",
     "PoseTrack",
     "header_stamp",
@@ -35,6 +36,17 @@ POSE_TYPES = (
     "nav_msgs/msg/Odometry",
     "tf2_msgs/msg/TFMessage",
 )
+
+
+class PoseRecord(NamedTuple):
+    """One pose of a message: frames, stamp and ``(x, y, z, qx, qy, qz, qw)``."""
+
+    parent: str
+    child: str
+    stamp_ns: int
+    values: tuple[float, ...]
+
+
 #: Factors (within 3x) that betray stamps in the wrong unit (ms or s read as ns).
 _UNIT_FACTORS = {1e6: "milliseconds vs nanoseconds", 1e9: "seconds vs nanoseconds"}
 
@@ -210,7 +222,7 @@ def _values(position: Any, orientation: Any) -> tuple[float, ...]:
     return (position.x, position.y, position.z, o.x, o.y, o.z, o.w)
 
 
-def pose_records(msg: Any, msgtype: str, log_time: int) -> list[tuple[str, str, int, tuple]]:
+def pose_records(msg: Any, msgtype: str, log_time: int) -> list[PoseRecord]:
     """``(parent, child, stamp_ns, (x, y, z, qx, qy, qz, qw))`` for each pose in ``msg``.
 
     PoseStamped has no child frame (``""``); a TFMessage yields one record per
@@ -219,7 +231,7 @@ def pose_records(msg: Any, msgtype: str, log_time: int) -> list[tuple[str, str, 
     if msgtype == "geometry_msgs/msg/PoseStamped":
         pose = msg.pose
         return [
-            (
+            PoseRecord(
                 msg.header.frame_id,
                 "",
                 header_stamp(msg.header, log_time),
@@ -229,7 +241,7 @@ def pose_records(msg: Any, msgtype: str, log_time: int) -> list[tuple[str, str, 
     if msgtype == "nav_msgs/msg/Odometry":
         pose = msg.pose.pose
         return [
-            (
+            PoseRecord(
                 msg.header.frame_id,
                 msg.child_frame_id,
                 header_stamp(msg.header, log_time),
@@ -238,7 +250,7 @@ def pose_records(msg: Any, msgtype: str, log_time: int) -> list[tuple[str, str, 
         ]
     if msgtype == "tf2_msgs/msg/TFMessage":
         return [
-            (
+            PoseRecord(
                 tf.header.frame_id,
                 tf.child_frame_id,
                 header_stamp(tf.header, log_time),
@@ -250,7 +262,7 @@ def pose_records(msg: Any, msgtype: str, log_time: int) -> list[tuple[str, str, 
 
 
 def select_tf_child(
-    records: list[tuple[str, str, int, tuple]], sensor: str | None, body: str | None, source: str
+    records: list[PoseRecord], sensor: str | None, body: str | None, source: str
 ) -> str:
     """The body frame among the child frames of ``/tf`` records.
 

@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import Any
 
 import apsw
+import numpy as np
 from rosbags.highlevel import AnyReader, AnyReaderError
 from rosbags.rosbag1 import ReaderError as Reader1Error
 from rosbags.rosbag2 import ReaderError as Reader2Error
@@ -219,5 +220,5 @@ def static_mount(reader: AnyReader, sensor: str | None, path: Path) -> tuple[Mou
     for log_time, msgtype, msg in read_messages(reader, TF_STATIC, path):
         for parent, child, _, values in pose_records(msg, msgtype, log_time):
             if child == sensor:
-                return Mount(values[:3], values[3:]), parent
+                return Mount(np.asarray(values[:3]), np.asarray(values[3:])), parent
     return None, ""

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
 from pathlib import Path
-from typing import Any
+from typing import Any, TypedDict, Unpack
 
 import numpy as np
 from rosbags.rosbag2 import StoragePlugin, Writer
@@ -23,13 +23,15 @@ from alte.fsutil import atomic_dir
 from alte.io.pointcloud2 import encode_pointcloud2, make_header
 from alte.types import Frame, Mount
 
-__all__ = ["STORAGES", "write_bag", "write_frames"]
+__all__ = ["STORAGES", "BagOptions", "write_bag", "write_frames"]
 
 STORAGES = {"sqlite3": StoragePlugin.SQLITE3, "mcap": StoragePlugin.MCAP}
 _POSE = "geometry_msgs/msg/PoseStamped"
 _PC2 = "sensor_msgs/msg/PointCloud2"
 _TF = "tf2_msgs/msg/TFMessage"
 _TYPESTORE = get_typestore(Stores.ROS2_HUMBLE)
+#: Poses to interleave with the clouds: stamps, positions, quaternions, write order.
+_Poses = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
 
 
 def _pose_arrays(
@@ -81,7 +83,7 @@ class _BagOut:
         data = _TYPESTORE.serialize_cdr(msg, self.conns[topic].msgtype)
         self.writer.write(self.conns[topic], int(stamp), data)
 
-    def poses_until(self, poses: tuple, until: int | None) -> None:
+    def poses_until(self, poses: _Poses, until: int | None) -> None:
         """Write the not yet written poses stamped at or before ``until`` (all for None)."""
         stamps, pos, quat, order = poses
         while self.next_pose < order.size and (
@@ -97,7 +99,7 @@ class _BagOut:
             self.next_pose += 1
 
     def clouds(
-        self, clouds: Iterable[tuple[int, np.ndarray]], poses: tuple, progress: bool
+        self, clouds: Iterable[tuple[int, np.ndarray]], poses: _Poses, progress: bool
     ) -> None:
         """Write every scan, each preceded by the poses up to its stamp."""
         topic = self.names["cloud"]
@@ -124,7 +126,7 @@ def write_bag(  # noqa: PLR0917 - positional arrays as specified for the simulat
     world_frame: str = "map",
     body_frame: str = "base_link",
     sensor_frame: str = "velodyne",
-    dtype: Any = np.float32,
+    dtype: type[np.floating[Any]] = np.float32,
     overwrite: bool = False,
     progress: bool = False,
 ) -> Path:
@@ -162,7 +164,22 @@ def write_bag(  # noqa: PLR0917 - positional arrays as specified for the simulat
     return target
 
 
-def write_frames(path: str | Path, frames: Sequence[Frame], mount: Mount | None, **kw: Any) -> Path:
+class BagOptions(TypedDict, total=False):
+    """Keywords of :func:`write_bag` after its arrays (topics, storage, frames, dtype)."""
+
+    cloud_topic: str
+    pose_topic: str
+    storage: str
+    world_frame: str
+    body_frame: str
+    sensor_frame: str
+    dtype: type[np.floating[Any]]
+    overwrite: bool
+    progress: bool
+
+
+def write_frames(path: str | Path, frames: Sequence[Frame], mount: Mount | None,
+                 **kw: Unpack[BagOptions]) -> Path:
     """Write frames as a bag, each pose at its frame's stamp (keywords as :func:`write_bag`)."""
     if not frames:
         raise BagError(f"{path}: no frames to write")

@@ -72,5 +72,5 @@ def export_map(mapper: Mapper, path: Path, overwrite: bool = False,
     if shift is not None:
         arrays["centers"] = arrays["centers"] + np.asarray(shift, dtype=np.float64)
     with atomic_path(path, overwrite=overwrite) as tmp, tmp.open("wb") as fh:
-        np.savez(fh, **arrays)
+        np.savez(fh, allow_pickle=False, **arrays)  # numeric arrays only
     return path

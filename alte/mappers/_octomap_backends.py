@@ -1,6 +1,6 @@
 """The two Octomap backends behind :class:`alte.mappers.octomap.Octomap`.
 
-``NativeTree`` is our implementation (numba ray casting, sorted Morton arrays);
+``NativeTree`` is our implementation (numba ray casting into blocks of voxels);
 ``ReferenceTree`` wraps the C++ OctoMap library through ``pyoctomap``. Both offer
 the same small interface so the mapper and :func:`compare_backends` treat them alike.
 """
@@ -11,16 +11,13 @@ import tempfile
 from pathlib import Path
 from typing import Any
 
+import numba
 import numpy as np
 
+from alte.mappers._blockset import WORDS, keys_to_blocks
 from alte.mappers._octree import Leaves, VoxelStore, prune, write_bt
-from alte.mappers._raycast import (
-    TREE_DEPTH,
-    TREE_MAX_VAL,
-    morton_decode,
-    morton_encode,
-    scan_keys,
-)
+from alte.mappers._raycast import TREE_DEPTH, TREE_MAX_VAL, morton_decode, morton_encode
+from alte.mappers._scan import scan_blocks
 
 __all__ = ["NativeTree", "ReferenceTree", "SensorModel", "logodds", "tree_leaves", "voxel_keys"]
 
@@ -43,7 +40,7 @@ class SensorModel:
 
 
 class NativeTree:
-    """Per-voxel float32 log-odds in sorted Morton-key runs (see ``_octree.VoxelStore``)."""
+    """Per-voxel float32 log-odds in hashed 8x8x8 blocks (see ``_octree.VoxelStore``)."""
 
     def __init__(self, params: dict[str, Any]) -> None:
         self.voxel = 1.0 / params["resolution"]
@@ -51,27 +48,25 @@ class NativeTree:
         self.model = SensorModel(params)
         self.store = VoxelStore()
         self._leaves: Leaves | None = None
+        self._scan_blocks = 1024  # block count of the last scan: the next one's table size
 
     def insert_scan(self, points: np.ndarray, origin: np.ndarray) -> None:
-        """OctoMap ``insertPointCloud``: each voxel updated once, occupied beats free."""
-        free, occ = scan_keys(
-            points.astype(np.float32), origin.astype(np.float32), self.voxel, self.max_range
-        )
-        if occ.size and free.size:
-            at = np.minimum(np.searchsorted(occ, free), occ.size - 1)
-            free = free[occ[at] != free]
-        self._update(free, self.model.miss)
-        self._update(occ, self.model.hit)
+        """OctoMap ``insertPointCloud``: each voxel updated once, occupied beats free.
+
+        Rays are walked by as many threads as numba may use (``NUMBA_NUM_THREADS``)."""
+        blocks, bits = scan_blocks(points.astype(np.float32), origin.astype(np.float32),
+                                   self.voxel, self.max_range, capacity=self._scan_blocks + 64,
+                                   threads=int(numba.config.NUMBA_NUM_THREADS))  # type: ignore[attr-defined]  # set at import by numba
+        self._scan_blocks = blocks.size + blocks.size // 4
+        self._update(blocks, bits)
 
     def insert_hits(self, points: np.ndarray) -> None:
         """Mark the voxels holding ``points`` occupied once (no ray casting)."""
-        self._update(voxel_keys(points, self.voxel), self.model.hit)
+        self._update(*keys_to_blocks(voxel_keys(points, self.voxel), WORDS))
 
-    def _update(self, keys: np.ndarray, value: np.float32) -> None:
-        if keys.size == 0:
-            return
-        updates = np.full(keys.size, value, dtype=np.float32)
-        self.store.update(keys, updates, self.model.clamp)
+    def _update(self, blocks: np.ndarray, bits: np.ndarray) -> None:
+        model = self.model
+        self.store.update(blocks, bits, model.miss, model.hit, model.clamp)
         self._leaves = None
 
     @property
@@ -98,8 +93,7 @@ class NativeTree:
 
     @property
     def memory_bytes(self) -> int:
-        keys, log_odds = self.store.fold()
-        return int(keys.nbytes + log_odds.nbytes)
+        return self.store.nbytes
 
     def write_bt(self, path: Path) -> None:
         leaves = self.leaves()

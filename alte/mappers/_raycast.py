@@ -4,16 +4,20 @@ Everything here reproduces the OctoMap library that ``pyoctomap`` 1.2 ships (its
 ``computeRayKeys`` keeps the ray length as float and casts the half-voxel step to
 float; checked ray by ray against it) bit for bit: points and origins are float32
 (``point3d``), keys are ``floor(coord / res) + 32768`` per axis for a tree of depth 16,
-and :func:`scan_keys` walks each ray exactly like ``OcTreeBaseImpl::computeRayKeys``
-(Amanatides & Woo, with OctoMap's float/double mix) inside ``computeUpdate``
-(max-range truncation, endpoint marked occupied only when within range).
-Keys leave the kernels as 48-bit Morton codes (x in the lowest bit of each triple),
-so sorting them puts the eight children of every octree node next to each other.
+:func:`walk_dense` / :func:`walk_hashed` step along each ray exactly like
+``OcTreeBaseImpl::computeRayKeys`` (Amanatides & Woo, with OctoMap's float/double
+mix), and :func:`prepare` truncates rays at the maximum range like ``computeUpdate``.
+Keys are 48-bit Morton codes (x in the lowest bit of each triple), so sorting them
+puts the eight children of every octree node next to each other. ``_scan`` drives
+the walks over a scan and de-duplicates the keys.
 
-Per-scan de-duplication of ray voxels (OctoMap's ``KeySet``) is a set of 8x8x8 bit
-blocks: an open-addressing hash table maps a block code (key >> 9) to a row of 512
-bits. Consecutive voxels of a ray mostly share a block, so one probe serves several
-voxels; memory follows the blocks a scan touches, not its bounding box.
+A walk keeps its voxel in scalars: its key and its local Morton index in the 8x8x8
+block, kept per axis in dilated form (x on bits 0, 3, 6; y and z shifted by 1 and 2)
+and moved by one add that also tells when the walk leaves the block. The key can
+equal the end key only after exactly |dk|_1 steps (each axis moves monotonically),
+so it is compared then alone. The step limit |dk|_1 + 5 only stops a ray that float
+round-off carries past its end voxel, so a walk strays at most 4 voxels from the box
+of its origin and end keys.
 """
 
 from __future__ import annotations
@@ -21,11 +25,24 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-__all__ = ["TREE_DEPTH", "TREE_MAX_VAL", "morton_decode", "morton_encode", "scan_keys"]
+from alte.mappers._blockset import LOCAL, Table, row_of
+
+#: A ray (or rays): origin, origin key, end(s), end key(s).
+Ray = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+#: Per-axis (step, tMax, tDelta) of a voxel walk.
+Axis = tuple[int, float, float]
+
+__all__ = ["TREE_DEPTH", "TREE_MAX_VAL", "morton", "morton_decode", "morton_encode", "prepare",
+           "walk_dense", "walk_hashed"]
 
 TREE_DEPTH = 16
 TREE_MAX_VAL = 32768
 _KEY_LIMIT = 2 * TREE_MAX_VAL
+
+#: A ray's arrays: origin, origin key, end, end key, float and integer workspaces.
+_Ray = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+#: The block-bitmap key set: hash slots, slot rows, bit rows, row blocks.
+_Table = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
 
 
 @numba.njit(cache=True, inline="always")
@@ -49,7 +66,7 @@ def _compact(v: np.uint64) -> np.uint64:
 
 
 @numba.njit(cache=True, inline="always")
-def _morton(kx: int, ky: int, kz: int) -> np.uint64:
+def morton(kx: int, ky: int, kz: int) -> np.uint64:
     return (
         _spread(np.uint64(kx))
         | (_spread(np.uint64(ky)) << np.uint64(1))
@@ -62,7 +79,7 @@ def morton_encode(keys: np.ndarray) -> np.ndarray:
     """(N, 3) integer keys in [0, 65536) -> (N,) uint64 Morton codes."""
     out = np.empty(keys.shape[0], dtype=np.uint64)
     for i in range(keys.shape[0]):
-        out[i] = _morton(keys[i, 0], keys[i, 1], keys[i, 2])
+        out[i] = morton(keys[i, 0], keys[i, 1], keys[i, 2])
     return out
 
 
@@ -90,11 +107,13 @@ def _key(coord: np.float32, factor: float) -> int:
 @numba.njit(cache=True, inline="always")
 def _norm(dx: np.float32, dy: np.float32, dz: np.float32) -> float:
     """``Vector3::norm``: float squares and sum, double square root."""
-    return np.sqrt(np.float64(dx * dx + dy * dy + dz * dz))
+    norm: float = np.sqrt(np.float64(dx * dx + dy * dy + dz * dz))
+    return norm
 
 
 @numba.njit(cache=True)
-def _ends(points: np.ndarray, origin: np.ndarray, max_range: float, factor: float):
+def _ends(points: np.ndarray, origin: np.ndarray, max_range: float, factor: float,
+          ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Ray ends (truncated at ``max_range``), their keys and whether each end is a hit."""
     n = points.shape[0]
     ends = np.empty((n, 3), dtype=np.float32)
@@ -124,189 +143,141 @@ def _ends(points: np.ndarray, origin: np.ndarray, max_range: float, factor: floa
     return ends, keys, hit
 
 
-_EMPTY = np.uint64(0xFFFFFFFFFFFFFFFF)
-_GOLDEN = np.uint64(0x9E3779B97F4A7C15)
-_LOW9 = np.uint64(511)
+@numba.njit(cache=True, inline="always")
+def _axis(delta: np.float32, lf: np.float32, okey: int, origin: np.float32,
+          res: float) -> tuple[int, float, float]:
+    """Amanatides & Woo set-up of one axis exactly as OctoMap: (step, tMax, tDelta)."""
+    di = delta / lf  # float direction component
+    if di == 0.0:
+        return 0, np.finfo(np.float64).max, np.finfo(np.float64).max
+    step = 1 if di > 0.0 else -1
+    half = np.float64(np.float32(step * res * 0.5))  # (float) cast as in OctoMap
+    border = (np.float64(okey - TREE_MAX_VAL) + 0.5) * res + half
+    return step, (border - np.float64(origin)) / np.float64(di), res / abs(np.float64(di))
+
+
+@numba.njit(cache=True, inline="always")
+def _dilated(step: int, mask: int) -> tuple[int, int]:
+    """(fill, wrap) of one axis' dilated local index: ``((l | fill) + step) & mask`` moves
+    it one voxel, and it equals ``wrap`` exactly when the walk left the block."""
+    if step > 0:
+        return 511 & ~mask, 0
+    return 0, mask
+
+
+@numba.njit(cache=True, inline="always")
+def _start(ray: Ray, res: float) -> tuple[Axis, Axis, Axis, float, int]:
+    """Per-axis (step, tMax, tDelta), the float ray length and the steps to the end key."""
+    origin, okey, end, ekey = ray
+    dx, dy, dz = end[0] - origin[0], end[1] - origin[1], end[2] - origin[2]
+    lf = np.float32(_norm(dx, dy, dz))  # float length = (float) direction.norm()
+    last = abs(ekey[0] - okey[0]) + abs(ekey[1] - okey[1]) + abs(ekey[2] - okey[2])
+    return (_axis(dx, lf, okey[0], origin[0], res), _axis(dy, lf, okey[1], origin[1], res),
+            _axis(dz, lf, okey[2], origin[2], res), np.float64(lf), last)
 
 
 @numba.njit(cache=True)
-def _find(slots: np.ndarray, block: np.uint64) -> int:
-    """Slot of ``block`` in the table, or of the empty slot where it belongs."""
-    mask = np.uint64(slots.size - 1)
-    j = ((block * _GOLDEN) >> np.uint64(32)) & mask
-    while slots[j] != block and slots[j] != _EMPTY:
-        j = (j + np.uint64(1)) & mask
-    return int(j)
+def walk_dense(ray: Ray, res: float, limit: int, grid: np.ndarray, box: np.ndarray) -> None:
+    """Set the bits of the free keys of ``computeRayKeys(origin, end)`` in a dense array;
+    ``ray`` is (origin, origin key, end, end key).
 
-
-@numba.njit(cache=True)
-def _rehash(slots, rows, blocks, n_blocks):
-    """Table twice as large holding the first ``n_blocks`` blocks."""
-    new_slots = np.full(slots.size * 2, _EMPTY, dtype=np.uint64)
-    new_rows = np.zeros(slots.size * 2, dtype=np.int64)
-    for r in range(n_blocks):
-        j = _find(new_slots, blocks[r])
-        new_slots[j] = blocks[r]
-        new_rows[j] = r
-    return new_slots, new_rows
-
-
-@numba.njit(cache=True)
-def _grow_rows(bits, blocks):
-    new_bits = np.zeros((bits.shape[0] * 2, 8), dtype=np.uint64)
-    new_bits[: bits.shape[0]] = bits
-    new_blocks = np.zeros(blocks.size * 2, dtype=np.uint64)
-    new_blocks[: blocks.size] = blocks
-    return new_bits, new_blocks
-
-
-@numba.njit(cache=True)
-def _collect(bits: np.ndarray, blocks: np.ndarray, n_blocks: int, count: int) -> np.ndarray:
-    """All keys of the set, sorted (blocks sorted, bits in Morton order within a block)."""
-    out = np.empty(count, dtype=np.uint64)
-    n = 0
-    for r in np.argsort(blocks[:n_blocks]):
-        base = blocks[r] << np.uint64(9)
-        for w in range(8):
-            word = bits[r, w]
-            b = 0
-            while word != np.uint64(0):
-                if word & np.uint64(1):
-                    out[n] = base | np.uint64(w * 64 + b)
-                    n += 1
-                word >>= np.uint64(1)
-                b += 1
-    return out
-
-
-@numba.njit(cache=True)
-def _row(slots, rows, blocks, block, n_blocks):
-    """Row of ``block`` in the bit array, adding the block if new; returns (row, n_blocks)."""
-    j = _find(slots, block)
-    if slots[j] == _EMPTY:
-        slots[j] = block
-        rows[j] = n_blocks
-        blocks[n_blocks] = block
-        n_blocks += 1
-    return rows[j], n_blocks
-
-
-@numba.njit(cache=True)
-def _setup(ray, res):
-    """Amanatides & Woo initialisation exactly as OctoMap; returns the ray length.
-
-    Fills the per-scan workspaces: ``work`` = (tMax, tDelta), ``iwork`` = (key, step).
+    ``grid`` has 8 uint64 words per 8x8x8 block of the block box ``box`` (x0, y0, z0,
+    nbx, nby, nbz; x fastest), so entering a block adds a fixed jump to the word offset.
     """
-    origin, okey, end, _, work, iwork = ray
-    d = (end[0] - origin[0], end[1] - origin[1], end[2] - origin[2])
-    lf = np.float32(_norm(d[0], d[1], d[2]))  # float length = (float) direction.norm()
-    for i in range(3):
-        iwork[0, i] = okey[i]
-        iwork[1, i] = 0
-        work[0, i] = np.finfo(np.float64).max
-        work[1, i] = np.finfo(np.float64).max
-        di = d[i] / lf
-        if di != 0.0:
-            iwork[1, i] = 1 if di > 0.0 else -1
-            half = np.float64(np.float32(iwork[1, i] * res * 0.5))  # (float) cast as in OctoMap
-            border = (np.float64(okey[i] - TREE_MAX_VAL) + 0.5) * res + half
-            work[0, i] = (border - np.float64(origin[i])) / np.float64(di)
-            work[1, i] = res / abs(np.float64(di))
-    return np.float64(lf)
+    (sx, tx, ddx), (sy, ty, ddy), (sz, tz, ddz), length, last = _start(ray, res)
+    okey, ekey = ray[1], ray[3]
+    cx, cy, cz = okey[0], okey[1], okey[2]
+    lx, ly, lz = LOCAL[cx & 7], LOCAL[cy & 7] << 1, LOCAL[cz & 7] << 2
+    fx, wx = _dilated(sx, 73)
+    fy, wy = _dilated(sy, 146)
+    fz, wz = _dilated(sz, 292)
+    nbx, nbxy = box[3], box[3] * box[4]
+    base = 8 * ((cx >> 3) - box[0] + nbx * ((cy >> 3) - box[1]) + nbxy * ((cz >> 3) - box[2]))
+    jx, jy, jz = 8 * sx, 8 * sy * nbx, 8 * sz * nbxy
+    local = lx | ly | lz
+    grid[base + (local >> 6)] |= np.uint64(1) << np.uint64(local & 63)
+    for s in range(1, limit):
+        if tx < ty and tx < tz:
+            cx += sx
+            tx += ddx
+            lx = ((lx | fx) + sx) & 73
+            if lx == wx:
+                base += jx
+        elif ty < tz and not tx < ty:
+            cy += sy
+            ty += ddy
+            ly = ((ly | fy) + (sy << 1)) & 146
+            if ly == wy:
+                base += jy
+        else:
+            cz += sz
+            tz += ddz
+            lz = ((lz | fz) + (sz << 2)) & 292
+            if lz == wz:
+                base += jz
+        if s == last and cx == ekey[0] and cy == ekey[1] and cz == ekey[2]:
+            break
+        if min(tx, ty, tz) > length:
+            break
+        local = lx | ly | lz
+        grid[base + (local >> 6)] |= np.uint64(1) << np.uint64(local & 63)
 
 
 @numba.njit(cache=True)
-def _walk(ray, res, limit, table, n_blocks):
-    """Add the keys of ``computeRayKeys(origin, end)`` to the set; return (new keys, n_blocks).
+def walk_hashed(ray: Ray, res: float, limit: int, table: Table, n_blocks: int) -> int:
+    """Set the bits of the free keys of ``computeRayKeys(origin, end)`` in a hashed block
+    set (``_blockset``; room reserved by the caller); return the new block count;
+    ``ray`` is (origin, origin key, end, end key).
 
-    A ray visits at most |dk| + 1 voxels; ``limit`` (|dk| + 4) only stops a ray
-    that float round-off carries past its end voxel (it then stops on the length test).
+    Entering a block costs a hash probe, so this serves scans too wide for a dense array.
     """
-    ekey, work, iwork = ray[3], ray[4], ray[5]
-    slots, rows, bits, blocks = table
-    length = _setup(ray, res)
-    t_max, t_delta, cur, step = work[0], work[1], iwork[0], iwork[1]
-    added, last, row = 0, _EMPTY, 0
-    for it in range(limit):
-        if it > 0:
-            dim = (0 if t_max[0] < t_max[2] else 2) if t_max[0] < t_max[1] else (
-                1 if t_max[1] < t_max[2] else 2)
-            cur[dim] += step[dim]
-            t_max[dim] += t_delta[dim]
-            if cur[0] == ekey[0] and cur[1] == ekey[1] and cur[2] == ekey[2]:
-                break
-            if min(t_max[0], t_max[1], t_max[2]) > length:
-                break
-        key = _morton(cur[0], cur[1], cur[2])
-        if key >> np.uint64(9) != last:
-            last = key >> np.uint64(9)
-            row, n_blocks = _row(slots, rows, blocks, last, n_blocks)
-        low = key & _LOW9
-        bit = np.uint64(1) << (low & np.uint64(63))
-        old = bits[row, low >> np.uint64(6)]
-        if not old & bit:
-            bits[row, low >> np.uint64(6)] = old | bit
-            added += 1
-    return added, n_blocks
+    (sx, tx, ddx), (sy, ty, ddy), (sz, tz, ddz), length, last = _start(ray, res)
+    okey, ekey = ray[1], ray[3]
+    cx, cy, cz = okey[0], okey[1], okey[2]
+    lx, ly, lz = LOCAL[cx & 7], LOCAL[cy & 7] << 1, LOCAL[cz & 7] << 2
+    fx, wx = _dilated(sx, 73)
+    fy, wy = _dilated(sy, 146)
+    fz, wz = _dilated(sz, 292)
+    row, n_blocks = row_of(table, morton(cx >> 3, cy >> 3, cz >> 3), n_blocks)
+    grid = table[2].reshape(-1)
+    base = 16 * row
+    local = lx | ly | lz
+    grid[base + (local >> 6)] |= np.uint64(1) << np.uint64(local & 63)
+    for s in range(1, limit):
+        moved = False
+        if tx < ty and tx < tz:
+            cx += sx
+            tx += ddx
+            lx = ((lx | fx) + sx) & 73
+            moved = lx == wx
+        elif ty < tz and not tx < ty:
+            cy += sy
+            ty += ddy
+            ly = ((ly | fy) + (sy << 1)) & 146
+            moved = ly == wy
+        else:
+            cz += sz
+            tz += ddz
+            lz = ((lz | fz) + (sz << 2)) & 292
+            moved = lz == wz
+        if s == last and cx == ekey[0] and cy == ekey[1] and cz == ekey[2]:
+            break
+        if min(tx, ty, tz) > length:
+            break
+        if moved:
+            row, n_blocks = row_of(table, morton(cx >> 3, cy >> 3, cz >> 3), n_blocks)
+            base = 16 * row
+        local = lx | ly | lz
+        grid[base + (local >> 6)] |= np.uint64(1) << np.uint64(local & 63)
+    return n_blocks
 
 
 @numba.njit(cache=True)
-def _reserve(table, n_blocks: int, need: int):
-    """Grow ``table`` so ``need`` more blocks fit (rows and a half-empty hash table)."""
-    slots, rows, bits, blocks = table
-    while n_blocks + need > blocks.size:
-        bits, blocks = _grow_rows(bits, blocks)
-    while 2 * (n_blocks + need) > slots.size:
-        slots, rows = _rehash(slots, rows, blocks, n_blocks)
-    return slots, rows, bits, blocks
-
-
-@numba.njit(cache=True)
-def _free_keys(origin, okey, ends, ekeys, res):
-    """Sorted unique keys of every ray's free voxels (empty when the origin is off the tree)."""
-    table = (
-        np.full(1 << 12, _EMPTY, dtype=np.uint64),
-        np.zeros(1 << 12, dtype=np.int64),
-        np.zeros((1 << 11, 8), dtype=np.uint64),
-        np.zeros(1 << 11, dtype=np.uint64),
-    )
-    work = np.empty((2, 3), dtype=np.float64)
-    iwork = np.empty((2, 3), dtype=np.int64)
-    n_blocks = 0
-    count = 0
-    if okey.min() < 0:
-        return np.empty(0, dtype=np.uint64)
-    for i in range(ends.shape[0]):
-        k = ekeys[i]
-        if k[0] < 0 or (k[0] == okey[0] and k[1] == okey[1] and k[2] == okey[2]):
-            continue
-        limit = abs(k[0] - okey[0]) + abs(k[1] - okey[1]) + abs(k[2] - okey[2]) + 5
-        table = _reserve(table, n_blocks, limit + 1)
-        ray = (origin, okey, ends[i], k, work, iwork)
-        added, n_blocks = _walk(ray, res, limit, table, n_blocks)
-        count += added
-    return _collect(table[2], table[3], n_blocks, count)
-
-
-@numba.njit(cache=True)
-def scan_keys(points: np.ndarray, origin: np.ndarray, res: float, max_range: float):
-    """Sorted unique free and occupied Morton keys of one scan (OctoMap ``computeUpdate``).
-
-    ``points`` (N, 3) and ``origin`` (3,) are float32. Free keys that are also
-    occupied are NOT removed here (the caller does it on the sorted arrays). Rays
-    whose origin or end lies outside the key range are skipped, as OctoMap does.
-    Ray voxels are de-duplicated on the fly in a block-bitmap hash set, so the
-    cost is one bit test per visited voxel and no sort of the repeats.
-    """
+def prepare(points: np.ndarray, origin: np.ndarray, res: float,
+            max_range: float) -> Ray:
+    """Origin key (-1 entries when off the key space), ray ends, their keys, hit flags."""
     factor = 1.0 / res
     okey = np.empty(3, dtype=np.int64)
     for i in range(3):
         okey[i] = _key(origin[i], factor)
-    ends, ekeys, hit = _ends(points, origin, max_range, factor)
-    occ = np.empty(points.shape[0], dtype=np.uint64)
-    n_occ = 0
-    for i in range(points.shape[0]):
-        if ekeys[i, 0] >= 0 and hit[i]:
-            occ[n_occ] = _morton(ekeys[i, 0], ekeys[i, 1], ekeys[i, 2])
-            n_occ += 1
-    return _free_keys(origin, okey, ends, ekeys, res), np.unique(occ[:n_occ])
+    return (okey, *_ends(points, origin, max_range, factor))

@@ -55,7 +55,8 @@ def plane_height(ground: float | np.ndarray, xy: np.ndarray) -> np.ndarray:
     if plane.shape != (4,) or not np.isfinite(plane).all() or abs(plane[2]) < 1e-9:
         raise ValueError(f"ground {plane.tolist()}: expected a z value or a non-vertical plane "
                          "a,b,c,d (a x + b y + c z + d = 0)")
-    return -(plane[0] * xy[:, 0] + plane[1] * xy[:, 1] + plane[3]) / plane[2]
+    height: np.ndarray = -(plane[0] * xy[:, 0] + plane[1] * xy[:, 1] + plane[3]) / plane[2]
+    return height
 
 
 @dataclass(frozen=True)
@@ -87,11 +88,13 @@ class Alte2D(QuadMap):
     def _values(self, points: np.ndarray) -> np.ndarray:
         return points[:, 2:3]
 
-    def _split(self, level: int, rows: np.ndarray) -> np.ndarray:
+    def _split(self, level: int, rows: np.ndarray | slice) -> np.ndarray:
         """Thesis rule (eq. 3.2): ``M2 > kappa`` with enough points, below ``max_res``."""
         n = self.stats.column(level, "n")[rows]
         m2 = self.stats.column(level, "m2")[rows]
-        return (n >= self._params["min_pts"]) & (level < self.depth) & (m2 > self._params["kappa"])
+        split: np.ndarray = ((n >= self._params["min_pts"]) & (level < self.depth)
+                             & (m2 > self._params["kappa"]))
+        return split
 
     def _update_splits(self, touched: list[np.ndarray] | None) -> None:
         if self._params["criterion"] == "thesis":
@@ -124,7 +127,8 @@ class Alte2D(QuadMap):
         dev = self.stats.column(level + 1, "mean") - c_parent
         terms = self.stats.column(level + 1, "n") * dev * dev
         per_parent = np.bincount(parent_pos, terms, minlength=len(self.stats.keys[level]))
-        return per_parent[rows] / m
+        share: np.ndarray = per_parent[rows] / m
+        return share
 
     def _leaf_values(self, level: np.ndarray, rows: np.ndarray, centers: np.ndarray,
                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

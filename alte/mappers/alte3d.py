@@ -59,7 +59,8 @@ class Alte3DParams(Record):
 
 
 def _pack(ix: np.ndarray, iy: np.ndarray, iz: np.ndarray) -> np.ndarray:
-    return (ix << (2 * _BITS)) | (iy << _BITS) | iz
+    keys: np.ndarray = (ix << (2 * _BITS)) | (iy << _BITS) | iz
+    return keys
 
 
 def _unpack(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -151,6 +152,7 @@ class Alte3D:
     def _finest_keys(self, pts: np.ndarray) -> np.ndarray:
         """Packed cell keys at level max_res; points outside the domain are dropped, counted."""
         dom = self._domain
+        assert dom is not None  # insert and build set the domain first
         n = 1 << self._params["max_res"]
         axes = 2 if self._params["variant"] == "fixed_altitude" else 3
         inside = dom.inside(pts, axes)
@@ -206,6 +208,7 @@ class Alte3D:
         return Cells((lo + hi) / 2, hi - lo, value.astype(np.float64), value >= need, level)
 
     def _bounds(self, keys: np.ndarray, level: int) -> tuple[np.ndarray, np.ndarray]:
+        assert self._domain is not None  # cells() returns early without one
         xmin, ymin, zmin, size = (self._domain.xmin, self._domain.ymin, self._domain.zmin,
                                   self._domain.size)
         edge = size / (1 << level)
@@ -246,7 +249,8 @@ def _children(keys: np.ndarray, variant: str) -> np.ndarray:
     return np.sort(np.concatenate(kids))
 
 
-def _merge(keys, counts, new_keys, new_counts):
+def _merge(keys: np.ndarray, counts: np.ndarray, new_keys: np.ndarray,
+           new_counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Add ``new_counts`` at sorted unique ``new_keys`` into the sorted table."""
     pos = np.searchsorted(keys, new_keys)
     found = pos < keys.size

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from alte.errors import MapperError, ParameterError
-from alte.types import Box
+from alte.types import Box, rows_all
 
 __all__ = ["Domain", "DomainUse", "check_domain"]
 
@@ -56,7 +56,8 @@ class Domain:
         """The cube anchored at ``box.lo`` whose edge covers the box's longest side."""
         extent = float(np.max(box.hi - box.lo))
         size = extent * (1 + _REL) + _ABS if extent > 0 else 1.0
-        return cls(*(float(v) for v in box.lo), size)
+        xmin, ymin, zmin = (float(v) for v in box.lo)
+        return cls(xmin, ymin, zmin, size)
 
     @classmethod
     def parse(cls, text: str) -> Domain:
@@ -86,7 +87,7 @@ class Domain:
     def inside(self, points: np.ndarray, dims: int = 3) -> np.ndarray:
         """Mask of the (N, 3) points in the closed cube (first ``dims`` axes only)."""
         rel = (np.asarray(points, dtype=np.float64)[:, :dims] - self.lo[:dims]) / self.size
-        return ((rel >= 0.0) & (rel <= 1.0)).all(axis=1)
+        return rows_all((rel >= 0.0) & (rel <= 1.0))
 
     def text(self) -> str:
         """``"xmin,ymin,zmin,size"`` (round-trips through :meth:`parse`)."""

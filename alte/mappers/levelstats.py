@@ -3,20 +3,32 @@
 For every level ``0..depth`` of a square domain this keeps the sorted Morton keys of
 the non-empty cells and, per cell, the count ``n`` and for each value column its mean,
 ``M2`` (sum of squared deviations, merged with Chan's parallel formula) and maximum.
-Known cells are updated in place; new cells go to a level's *pending* part, folded into
-the sorted part only when it outgrows a quarter of it or a reader needs it, so the
-copying is amortised like a doubling array (see :class:`LevelStats`).
+An insertion runs in compiled kernels (``_cellstats``): the frame's points are sorted
+and aggregated once at the finest level and merged upwards; at each level a hash
+index finds known cells, which are updated in place, and new cells are appended
+after the others (*pending*). Pending cells are sorted in only when a reader needs
+the sorted arrays, so an insertion costs O(frame x depth) whatever the map's size,
+with no copying of the map (storage grows rarely: doubling, from a generous first
+size that the OS pages in only as it is used).
 """
 
 from __future__ import annotations
 
+import mmap
 from collections.abc import Iterator
 from contextlib import contextmanager
 
-import numba
 import numpy as np
+from numpy.typing import DTypeLike
 
 from alte.errors import MapperError
+from alte.mappers._cellstats import (
+    aggregate_points,
+    combine,
+    fill_index,
+    merge_cells,
+    sort_keys,
+)
 
 __all__ = ["MAX_DEPTH", "LevelStats"]
 
@@ -24,67 +36,23 @@ __all__ = ["MAX_DEPTH", "LevelStats"]
 MAX_DEPTH = 24
 
 
-def _segments(keys: np.ndarray) -> np.ndarray:
-    """Start index of every run of equal values in sorted ``keys``."""
-    return np.flatnonzero(np.r_[True, keys[1:] != keys[:-1]])
+#: Rows a level's storage first grows to when an insertion meets it (allocated lazily by
+#: the OS: untouched rows cost no memory); it doubles from there.
+_FIRST_CAPACITY = 1 << 22
+#: Levels of at most this many cells (``4**level``) index their rows densely (4 bytes a
+#: cell, paged in by the OS only where data lie); deeper levels hash.
+_DENSE_CELLS = 1 << 24
 
 
-def _aggregate_points(values: np.ndarray, starts: np.ndarray) -> np.ndarray:
-    """Rows ``n, mean.., m2.., max..`` of runs of points (values sorted by cell)."""
-    counts = np.diff(np.r_[starts, len(values)]).astype(np.float64)
-    mean = np.add.reduceat(values, starts, axis=0) / counts[:, None]
-    dev = values - np.repeat(mean, counts.astype(np.int64), axis=0)
-    m2 = np.add.reduceat(dev * dev, starts, axis=0)
-    return np.column_stack([counts, mean, m2, np.maximum.reduceat(values, starts, axis=0)])
+def _lazy_zeros(shape: tuple[int, ...], dtype: DTypeLike) -> np.ndarray:
+    """A zeroed array in anonymous memory that the OS maps 4 KiB at a time on first touch.
 
-
-@numba.njit(cache=True)
-def _run_sum(x: np.ndarray, a: int, b: int) -> float:
-    """``x[a] + (x[a+1] + ... + x[b-1])``: the order of ``np.add.reduceat`` on short runs."""
-    if b - a == 1:
-        return x[a]
-    rest = x[a + 1]
-    for i in range(a + 2, b):
-        rest += x[i]
-    return x[a] + rest
-
-
-@numba.njit(cache=True)
-def _combine(rows: np.ndarray, starts: np.ndarray, nv: int) -> np.ndarray:
-    """Merge runs of aggregate rows (children -> parent) with Chan's formula.
-
-    Compiled (the build's hot loop); ``sum(n_j c_j) / n`` and ``sum(M2_j + n_j (c_j - c)^2)``
-    in numpy's order, so runs of up to 4 children give the bits of the reduceat form.
-    """
-    out = np.empty((len(starts), rows.shape[1]))
-    term = np.empty(len(rows))
-    for s in range(len(starts)):
-        a, b = starts[s], starts[s + 1] if s + 1 < len(starts) else len(rows)
-        out[s, 0] = count = _run_sum(rows[:, 0], a, b)
-        for j in range(nv):
-            for i in range(a, b):
-                term[i] = rows[i, 0] * rows[i, 1 + j]
-            out[s, 1 + j] = mean = _run_sum(term, a, b) / count
-            for i in range(a, b):
-                dev = rows[i, 1 + j] - mean
-                term[i] = rows[i, 1 + nv + j] + rows[i, 0] * dev * dev
-            out[s, 1 + nv + j] = _run_sum(term, a, b)
-            out[s, 1 + 2 * nv + j] = rows[a:b, 1 + 2 * nv + j].max()
-    return out
-
-
-def _pair(a: np.ndarray, b: np.ndarray, nv: int) -> np.ndarray:
-    """Merge aggregate rows ``a`` and ``b`` element-wise."""
-    na, nb = a[:, :1], b[:, :1]
-    n = na + nb
-    delta = b[:, 1:1 + nv] - a[:, 1:1 + nv]
-    mean = a[:, 1:1 + nv] + delta * (nb / n)
-    m2 = a[:, 1 + nv:1 + 2 * nv] + b[:, 1 + nv:1 + 2 * nv] + delta * delta * (na * nb / n)
-    return np.column_stack([n, mean, m2, np.maximum(a[:, 1 + 2 * nv:], b[:, 1 + 2 * nv:])])
-
-
-_PENDING_FRACTION = 0.25  # fold a level once its pending cells exceed this share of the sorted
-_PENDING_MIN = 4096  # ... and this many
+    numpy advises transparent huge pages for big arrays; then the first touch of every
+    2 MiB zeroes (and may compact memory for) a whole huge page, a stall of milliseconds
+    in whichever insertion meets it. Small pages spread that cost evenly."""
+    count = int(np.prod(shape))
+    buffer = mmap.mmap(-1, max(count * np.dtype(dtype).itemsize, 1))
+    return np.frombuffer(buffer, dtype, count).reshape(shape)
 
 
 class _PerLevel:
@@ -115,10 +83,12 @@ class LevelStats:
     """Per level: sorted Morton keys, aggregate rows ``n, mean, m2, max`` and a split flag.
 
     Each level stores its cells in arrays with growth slack: a prefix sorted by key,
-    then *pending* cells in arrival order found through a small sorted index. Readers
-    (``keys[l]``, ``rows[l]``, ``split[l]``, :meth:`column`, :meth:`leaves`) fold the
-    pending cells in first, so they always see sorted arrays; inside :meth:`deferred`
-    nothing folds and row numbers are the ones :meth:`add` returned.
+    then *pending* cells in arrival order; an index over all of them (dense or hashed,
+    see ``_cellstats``; built when an insertion first needs it) finds a key's row.
+    Readers (``keys[l]``, ``rows[l]``, ``split[l]``, :meth:`column`, :meth:`leaves`)
+    fold the pending cells in first, so they always see sorted arrays; :meth:`add`
+    never folds, and inside :meth:`deferred` nothing does, so row numbers stay the ones
+    :meth:`add` returned.
     """
 
     def __init__(self, depth: int, nvalues: int) -> None:
@@ -132,8 +102,7 @@ class LevelStats:
         self._s = [np.empty(0, bool) for _ in levels]
         self._n = [0 for _ in levels]  # cells held
         self._sorted = [0 for _ in levels]  # length of the sorted prefix
-        self._pk = [np.empty(0, np.int64) for _ in levels]  # pending keys, sorted
-        self._ps = [np.empty(0, np.int64) for _ in levels]  # ... and their storage slots
+        self._index: list[np.ndarray | None] = [None for _ in levels]  # None: to rebuild
         self._defer = 0
         self.keys = _PerLevel(self, self._k)
         self.rows = _PerLevel(self, self._r)
@@ -158,90 +127,78 @@ class LevelStats:
         finally:
             self._defer -= 1
 
-    def add(self, fine_keys: np.ndarray, values: np.ndarray) -> list[np.ndarray]:
-        """Add points given by finest-level keys and (N, nv) values; rows touched per level."""
-        order = np.argsort(fine_keys, kind="stable")
-        keys = fine_keys[order]
-        starts = _segments(keys)
-        agg = _aggregate_points(values[order], starts)
-        keys = keys[starts]
+    def add(self, fine_keys: np.ndarray, values: np.ndarray) -> list[np.ndarray] | None:
+        """Add points given by finest-level keys and (N, nv) values; the rows touched per
+        level, or None when the map was empty (every row is new)."""
+        was_empty = not any(self._n)
+        keys, order = sort_keys(np.asarray(fine_keys, np.int64), 2 * self.depth)
+        keys, agg = aggregate_points(keys, np.ascontiguousarray(values[order], float))
         touched: list[np.ndarray] = [np.empty(0, np.int64)] * (self.depth + 1)
         for level in range(self.depth, -1, -1):
             if level < self.depth:
-                keys = keys >> 2
-                starts = _segments(keys)
-                agg = _combine(agg, starts, self.nv)
-                keys = keys[starts]
+                keys, agg = combine(keys, agg, self.nv)
             touched[level] = self._merge(level, keys, agg)
-        return touched
+        return None if was_empty else touched
 
     def _merge(self, level: int, keys: np.ndarray, agg: np.ndarray) -> np.ndarray:
         if not self._n[level]:  # empty level (a build): take the arrays as they are
             self._k[level], self._r[level] = keys, agg
             self._s[level] = np.zeros(len(keys), bool)
             self._n[level] = self._sorted[level] = len(keys)
+            self._index[level] = None
             return np.arange(len(keys))
-        slot = self._find(level, keys)
-        hit = slot >= 0
-        rows = self._r[level]
-        rows[slot[hit]] = _pair(rows[slot[hit]], agg[hit], self.nv)
-        if hit.all():
-            return slot
-        slot[~hit] = self._append(level, keys[~hit], agg[~hit])
-        pending = self._n[level] - self._sorted[level]
-        if pending > max(_PENDING_MIN, _PENDING_FRACTION * self._sorted[level]) and not self._defer:
-            self.fold(level)
-            return np.searchsorted(self._k[level][:self._n[level]], keys)
-        return slot
+        index = self._reserve(level, len(keys))
+        store = (self._k[level], self._r[level], self._s[level], index)
+        touched, self._n[level] = merge_cells(store, self._n[level], (keys, agg), self.nv,
+                                              self._dense(level))
+        return touched
 
-    def _find(self, level: int, keys: np.ndarray) -> np.ndarray:
-        """Storage slot of each (sorted, unique) key at ``level``; -1 when absent."""
-        slot = np.full(len(keys), -1, np.int64)
-        for have, where in ((self._k[level][:self._sorted[level]], None),
-                            (self._pk[level], self._ps[level])):
-            rest = np.flatnonzero(slot < 0)
-            pos = np.searchsorted(have, keys[rest])
-            ok = pos < len(have)
-            ok[ok] = have[pos[ok]] == keys[rest[ok]]
-            slot[rest[ok]] = pos[ok] if where is None else where[pos[ok]]
-        return slot
+    def _dense(self, level: int) -> bool:
+        return bool(4**level <= _DENSE_CELLS)
 
-    def _append(self, level: int, keys: np.ndarray, agg: np.ndarray) -> np.ndarray:
-        """Store new cells after the others and index them as pending; their slots."""
-        n, k = self._n[level], len(keys)
-        if n + k > len(self._k[level]):  # grow the storage, doubling
-            cap = max(n + k, 2 * len(self._k[level]))
+    def _reserve(self, level: int, k: int) -> np.ndarray:
+        """Room for ``k`` more cells at ``level``; the index of its rows (a hashed one
+        kept at most half full)."""
+        n = self._n[level]
+        if n + k > len(self._k[level]):
+            cap = max(n + k, 2 * len(self._k[level]), min(4**level, _FIRST_CAPACITY))
             for store in (self._k, self._r, self._s):
-                grown = np.empty((cap, *store[level].shape[1:]), store[level].dtype)
+                grown = _lazy_zeros((cap, *store[level].shape[1:]), store[level].dtype)
                 grown[:n] = store[level][:n]
                 store[level] = grown
-        self._k[level][n:n + k] = keys
-        self._r[level][n:n + k] = agg
-        self._s[level][n:n + k] = False
-        slots = np.arange(n, n + k)
-        at = np.searchsorted(self._pk[level], keys)
-        self._pk[level] = np.insert(self._pk[level], at, keys)
-        self._ps[level] = np.insert(self._ps[level], at, slots)
-        self._n[level] = n + k
-        return slots
+            if not self._dense(level):
+                self._index[level] = None
+        index = self._index[level]
+        if index is None:
+            if self._dense(level):
+                index = _lazy_zeros((4**level,), np.int32)
+            else:
+                index = np.full(2 << int(2 * len(self._k[level])).bit_length(), -1, np.int64)
+            fill_index(index, self._k[level], n, self._dense(level))
+            self._index[level] = index
+        return index
 
     def fold(self, level: int) -> None:
-        """Merge ``level``'s pending cells into its sorted prefix (not while deferred)."""
+        """Sort ``level``'s pending cells into its sorted prefix (not while deferred)."""
         n, done = self._n[level], self._sorted[level]
         if n == done or self._defer:
             return
-        dest = np.searchsorted(self._k[level][:done], self._pk[level])
+        keys = self._k[level]
+        slots = done + np.argsort(keys[done:n], kind="stable")
+        dest = np.searchsorted(keys[:done], keys[slots])
         dest += np.arange(len(dest))  # final places of the pending cells, in key order
         first = int(dest[0])  # the sorted cells before it stay put
         order = np.empty(n - first, np.int64)
         moved = np.ones(n - first, bool)
         moved[dest - first] = False
         order[moved] = np.arange(first, done)
-        order[dest - first] = self._ps[level]
+        order[dest - first] = slots
         for store in (self._k, self._r, self._s):
             store[level][first:n] = store[level][order]
         self._sorted[level] = n
-        self._pk[level] = self._ps[level] = np.empty(0, np.int64)
+        index = self._index[level]
+        if index is not None:  # same keys, new rows
+            fill_index(index, self._k[level], n, self._dense(level))
 
     def shift_up(self, quadrant: int) -> None:
         """Re-key for a root twice as large holding the old root in ``quadrant`` (0-3).
@@ -260,10 +217,12 @@ class LevelStats:
         self._r[0] = self._r[0][:self._n[0]]
         for level in range(self.depth + 1):
             self._s[level] = np.zeros(self._n[level], bool)
+            self._index[level] = None
 
     @property
     def nbytes(self) -> int:
-        """Bytes of the cells' keys, rows and flags (not counting storage growth slack)."""
+        """Bytes of the cells' keys, rows and flags: the map itself, not the insertion's
+        growth slack or row index (up to 4 bytes per cell of a level's touched area)."""
         row = 8 * (1 + 3 * self.nv)
         return sum(n * (8 + row + 1) for n in self._n)
 

@@ -13,21 +13,22 @@ frames can be inserted one at a time with no ``domain`` parameter.
 from __future__ import annotations
 
 import time
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, ClassVar
+from typing import Any, ClassVar, Protocol
 
 import numpy as np
 
 from alte.errors import MapperError, ParameterError
 from alte.fsutil import atomic_path
-from alte.mappers._octomap_backends import NativeTree, ReferenceTree, tree_leaves
+from alte.mappers._octomap_backends import NativeTree, ReferenceTree, SensorModel, tree_leaves
 from alte.mappers._octree import Leaves, check_origin, leaf_geometry
 from alte.mappers._raycast import TREE_DEPTH, TREE_MAX_VAL
 from alte.mappers.base import Cells, Feed, check_points
 from alte.mappers.domain import Domain, DomainUse
 from alte.params import Record, param
+from alte.types import rows_all
 
 __all__ = ["SENSOR_MODELS", "Octomap", "OctomapParams", "compare_backends", "occupied_voxels",
            "read_bt"]
@@ -40,7 +41,25 @@ SENSOR_MODELS: dict[str, dict[str, float]] = {
     "octomap": {"prob_hit": 0.7, "prob_miss": 0.4, "clamp_min": 0.1192, "clamp_max": 0.971,
                 "occupancy_threshold": 0.5},
 }
-_BACKENDS = {"native": NativeTree, "reference": ReferenceTree}
+
+
+class _Backend(Protocol):
+    """What the mapper asks of a backend (:mod:`alte.mappers._octomap_backends`)."""
+
+    model: SensorModel
+
+    def insert_scan(self, points: np.ndarray, origin: np.ndarray) -> None: ...
+    def insert_hits(self, points: np.ndarray) -> None: ...
+    def leaves(self) -> Leaves: ...
+    def write_bt(self, path: Path) -> None: ...
+    @property
+    def num_leaves(self) -> int: ...
+    @property
+    def memory_bytes(self) -> int: ...
+
+
+_BACKENDS: dict[str, Callable[[dict[str, Any]], _Backend]] = {
+    "native": NativeTree, "reference": ReferenceTree}
 
 
 def _prob(low: float, high: float) -> Any:
@@ -70,9 +89,11 @@ class OctomapParams(Record):
         for name, value in SENSOR_MODELS[self.sensor_model].items():
             if getattr(self, name) is None:
                 object.__setattr__(self, name, value)
-        if self.clamp_min >= self.occupancy_threshold:  # type: ignore[operator]
+        low, high, threshold = self.clamp_min, self.clamp_max, self.occupancy_threshold
+        assert low is not None and high is not None and threshold is not None  # filled above
+        if low >= threshold:
             raise ParameterError("octomap: clamp_min must be below occupancy_threshold")
-        if self.clamp_max <= self.occupancy_threshold:  # type: ignore[operator]
+        if high <= threshold:
             raise ParameterError("octomap: clamp_max must be above occupancy_threshold")
 
 
@@ -121,14 +142,14 @@ class Octomap:
     def _count_outside(self, pts: np.ndarray) -> np.ndarray:
         """Points inside the key space; the others are counted (their rays are skipped)."""
         half = TREE_MAX_VAL * self.voxel_size
-        inside = ((pts >= -half) & (pts < half)).all(axis=1)
+        inside = rows_all((pts >= -half) & (pts < half))
         self.points_outside += int(inside.size - np.count_nonzero(inside))
         return inside
 
     @property
     def voxel_size(self) -> float:
         """Edge of a finest voxel in metres (1 / resolution)."""
-        return 1.0 / self._params["resolution"]
+        return 1.0 / self._record.resolution
 
     def insert(self, points: np.ndarray, origin: np.ndarray) -> None:
         """Integrate one scan: free space along every ray, occupied end voxels."""
@@ -204,7 +225,8 @@ def _subset(leaves: Leaves, mask: np.ndarray) -> Leaves:
     return Leaves(leaves.prefix[mask], leaves.depth[mask], leaves.value[mask])
 
 
-def leaves_to_cells(leaves: Leaves, voxel: float, occupied_log_odds: float) -> Cells:
+def leaves_to_cells(leaves: Leaves, voxel: float,
+                    occupied_log_odds: float | np.float32) -> Cells:
     """Cells of pruned leaves: centres, cubic sizes, probability, occupied flag, depth."""
     _, side, centers = leaf_geometry(leaves, voxel)
     value = 1.0 - 1.0 / (1.0 + np.exp(leaves.value.astype(np.float64)))
@@ -212,7 +234,7 @@ def leaves_to_cells(leaves: Leaves, voxel: float, occupied_log_odds: float) -> C
     return Cells(centers, sizes, value, leaves.value > occupied_log_odds, leaves.depth.copy())
 
 
-def occupied_voxels(leaves: Leaves, occupied_log_odds: float) -> np.ndarray:
+def occupied_voxels(leaves: Leaves, occupied_log_odds: float | np.float32) -> np.ndarray:
     """Depth-16 Morton keys covered by occupied leaves (a leaf is a contiguous Morton range)."""
     occ = _subset(leaves, leaves.value > occupied_log_odds)
     span = np.uint64(1) << (np.uint64(3) * (TREE_DEPTH - occ.depth).astype(np.uint64))

@@ -19,7 +19,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numba
 import numpy as np
+
+from alte.types import rows_all
 
 __all__ = ["Square", "morton_decode", "morton_encode"]
 
@@ -43,15 +46,50 @@ def _compact1by1(v: np.ndarray) -> np.ndarray:
     return v
 
 
+@numba.njit(cache=True, inline="always")
+def _spread(v: int) -> int:
+    """:func:`_part1by1` of one index below 2^32."""
+    v &= 0x00000000FFFFFFFF
+    v = (v | (v << 16)) & 0x0000FFFF0000FFFF
+    v = (v | (v << 8)) & 0x00FF00FF00FF00FF
+    v = (v | (v << 4)) & 0x0F0F0F0F0F0F0F0F
+    v = (v | (v << 2)) & 0x3333333333333333
+    return (v | (v << 1)) & 0x5555555555555555
+
+
+@numba.njit(cache=True)
+def _locate(xy: np.ndarray, corner: tuple[float, float], size: float,
+            cells: int) -> tuple[np.ndarray, np.ndarray]:
+    """Morton keys of ``xy``'s cells (clipped to the grid) and whether each point lies in
+    the closed square: :meth:`Square.keys` and :meth:`Square.contains` in one pass."""
+    keys = np.empty(xy.shape[0], dtype=np.int64)
+    inside = np.empty(xy.shape[0], dtype=np.bool_)
+    for i in range(xy.shape[0]):
+        rx, ry = (xy[i, 0] - corner[0]) / size, (xy[i, 1] - corner[1]) / size
+        inside[i] = rx >= 0.0 and rx <= 1.0 and ry >= 0.0 and ry <= 1.0
+        ix = min(max(np.floor(rx * cells), 0.0), cells - 1.0)
+        iy = min(max(np.floor(ry * cells), 0.0), cells - 1.0)
+        keys[i] = _spread(int(ix)) | (_spread(int(iy)) << 1)
+    return keys, inside
+
+
 def morton_encode(ix: np.ndarray, iy: np.ndarray) -> np.ndarray:
     """Interleave cell indices (x in the even bits) into int64 keys."""
-    return (_part1by1(ix) | (_part1by1(iy) << np.uint64(1))).astype(np.int64)
+    keys: np.ndarray = (_part1by1(ix) | (_part1by1(iy) << np.uint64(1))).astype(np.int64)
+    return keys
 
 
 def morton_decode(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Inverse of :func:`morton_encode`."""
     k = np.asarray(keys).astype(np.uint64)
     return (_compact1by1(k).astype(np.int64), _compact1by1(k >> np.uint64(1)).astype(np.int64))
+
+
+def _extent(xy: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Per-column minimum and maximum of (N, 2) points (column by column: numpy reduces
+    an (N, 2) array along axis 0 two values at a time, many times slower)."""
+    return (np.array([xy[:, 0].min(), xy[:, 1].min()]),
+            np.array([xy[:, 0].max(), xy[:, 1].max()]))
 
 
 @dataclass(frozen=True)
@@ -65,15 +103,15 @@ class Square:
     @classmethod
     def bounding(cls, xy: np.ndarray) -> Square:
         """Smallest square anchored at the minimum corner holding ``xy`` (size 1 if a point)."""
-        lo = xy.min(axis=0)
-        size = float((xy.max(axis=0) - lo).max())
+        lo, hi = _extent(xy)
+        size = float((hi - lo).max())
         return cls(float(lo[0]), float(lo[1]), size if size > 0 else 1.0)
 
     @classmethod
     def dyadic(cls, xy: np.ndarray) -> Square:
         """Power-of-two square on a grid of its own size holding ``xy`` (root of a growing map)."""
-        lo = xy.min(axis=0)
-        extent = float((xy.max(axis=0) - lo).max())
+        lo, hi = _extent(xy)
+        extent = float((hi - lo).max())
         size = float(np.exp2(np.ceil(np.log2(extent)))) if extent > 0 else 1.0
         xmin, ymin = np.floor(lo / size) * size
         return cls(float(xmin), float(ymin), size)
@@ -82,7 +120,14 @@ class Square:
         """Mask of the points inside the square; ``closed=False`` excludes the upper edges."""
         rel = (xy - (self.xmin, self.ymin)) / self.size
         upper = (rel <= 1.0) if closed else (rel < 1.0)
-        return ((rel >= 0.0) & upper).all(axis=1)
+        inside: np.ndarray = rows_all((rel >= 0.0) & upper)
+        return inside
+
+    def locate(self, xy: np.ndarray, level: int) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`keys` and :meth:`contains` (closed) of ``xy`` (N, 2), computed together."""
+        found: tuple[np.ndarray, np.ndarray] = _locate(
+            np.asarray(xy, dtype=np.float64), (self.xmin, self.ymin), self.size, 1 << level)
+        return found
 
     def keys(self, xy: np.ndarray, level: int) -> np.ndarray:
         """Morton keys of the level-``level`` cells holding ``xy`` (upper edge -> last cell)."""

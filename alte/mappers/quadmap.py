@@ -72,17 +72,18 @@ class QuadMap:
     def _values(self, points: np.ndarray) -> np.ndarray:
         raise NotImplementedError
 
-    def _split(self, level: int, rows: np.ndarray) -> np.ndarray:
+    def _split(self, level: int, rows: np.ndarray | slice) -> np.ndarray:
         raise NotImplementedError
 
     def _update_splits(self, touched: list[np.ndarray] | None) -> None:
-        """Recompute the split flags of the ``touched`` rows per level (None: all rows).
+        """Recompute the split flags of the ``touched`` rows per level (None: all rows,
+        as a slice: no gathering of whole columns).
 
         Deferred: ``touched`` are storage rows that a fold of pending cells would move.
         """
         with self.stats.deferred():
             for level in range(self.depth + 1):
-                rows = np.arange(self.stats.size(level)) if touched is None else touched[level]
+                rows = slice(None) if touched is None else touched[level]
                 self.stats.split[level][rows] = self._split(level, rows)
 
     def _leaf_values(self, level: np.ndarray, rows: np.ndarray, centers: np.ndarray,
@@ -136,24 +137,32 @@ class QuadMap:
             self._add(pts)
 
     def _grow(self, xy: np.ndarray) -> None:
+        assert self.square is not None  # callers set the root square first
         grown = False
-        while not self.square.contains(xy, closed=False).all():
-            self.square, quadrant = self.square.doubled(xy)
+        square = self._root()
+        while not square.contains(xy, closed=False).all():
+            square, quadrant = square.doubled(xy)
+            self.square = square
             self.stats.shift_up(quadrant)
             grown = True
         if grown:
             self._update_splits(None)
 
+    def _root(self) -> Square:
+        assert self.square is not None, "insert and build set the root before adding points"
+        return self.square
+
     def _add(self, pts: np.ndarray) -> None:
-        inside = self.square.contains(pts[:, :2])
-        self.points_outside += int((~inside).sum())
-        pts = pts[inside]
+        keys, inside = self._root().locate(pts[:, :2], self.depth)
+        kept = int(np.count_nonzero(inside))
+        self.points_outside += len(pts) - kept
+        if kept < len(pts):
+            pts, keys = pts[inside], keys[inside]
         self._cells = None
-        if not len(pts):
+        if not kept:
             return
-        self.points_inserted += len(pts)
-        self._update_splits(self.stats.add(self.square.keys(pts[:, :2], self.depth),
-                                           self._values(pts)))
+        self.points_inserted += kept
+        self._update_splits(self.stats.add(keys, self._values(pts)))
 
     def cells(self) -> Cells:
         """Leaves of the partition; unknown (empty) leaves have NaN height and value."""
@@ -178,7 +187,8 @@ class QuadMap:
         if self.square is None:
             return np.empty(0, np.int64)
         level, _keys, rows = self.stats.leaves()
-        return np.nan_to_num(self.leaf_stat(level, rows, "n")).astype(np.int64)
+        counts: np.ndarray = np.nan_to_num(self.leaf_stat(level, rows, "n")).astype(np.int64)
+        return counts
 
     def leaf_stat(self, level: np.ndarray, rows: np.ndarray, what: str, j: int = 0) -> np.ndarray:
         """Statistic ``what`` of value ``j`` for leaves (NaN for unknown leaves)."""

@@ -126,12 +126,14 @@ class Quadtree(QuadMap):
         super().build(points, origins)
 
     def _values(self, points: np.ndarray) -> np.ndarray:
+        assert self.plane is not None  # insert and build refuse to go on without one
         above = points[:, 2] - plane_height(self.plane, points[:, :2])
         return np.column_stack([points[:, 2], above])
 
-    def _split(self, level: int, rows: np.ndarray) -> np.ndarray:
+    def _split(self, level: int, rows: np.ndarray | slice) -> np.ndarray:
         n = self.stats.column(level, "n")[rows]
-        return (n > self._params["max_points"]) & (level < self.depth)
+        split: np.ndarray = (n > self._params["max_points"]) & (level < self.depth)
+        return split
 
     def _leaf_values(self, level: np.ndarray, rows: np.ndarray, centers: np.ndarray,
                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -15,31 +15,41 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from alte.errors import MetricsError
+from alte.mappers.quadmap import rectangle_corners
 from alte.metrics.hausdorff import hausdorff
+from alte.params import Record, param
 
 if TYPE_CHECKING:
-    from alte.mappers.base import Mapper
+    from alte.mappers.base import Cells, Mapper
     from alte.metrics.surface import TrueSurface
     from alte.types import Box
 
-__all__ = ["GroundTruth", "MapMetrics", "TruthMetrics", "TruthOptions", "measure_map"]
+__all__ = ["SET_B", "GroundTruth", "MapMetrics", "TruthMetrics", "TruthOptions", "measure_map",
+           "set_b_points"]
 
 _NAN = float("nan")
+#: Definitions of set B (the map's points in HD/MHD): ``corners`` of every basis function
+#: (thesis 5.2.1, fig. 5.1) or their ``centers``, either way of the occupied cells (3D) or
+#: of every cell with a height (2D: a height map's free cells are ground); ``occupied``:
+#: corners of the cells the mapper marks occupied (2D: Quadtree's height-above-ground
+#: rule; every known cell of 2D-ALTE; 3D: the same as ``corners``).
+SET_B = ("corners", "centers", "occupied")
 
 
 @dataclass(frozen=True)
-class TruthOptions:
-    """Ground-truth metric settings (see :mod:`alte.metrics.truth`).
+class TruthOptions(Record):
+    """Ground-truth metric settings (see :mod:`alte.metrics.truth`), a parameter record."""
 
-    ``tolerance`` (m): how close a map must come to a true surface to count it as
-    mapped; ``n_samples``: surface samples drawn (3D); ``grid_step`` (m): x/y probe
-    spacing of the 2D metrics; ``seed``: sampling seed.
-    """
+    OWNER = "truth"
 
-    tolerance: float = 0.2
-    n_samples: int = 100_000
-    grid_step: float = 0.2
-    seed: int = 0
+    tolerance: float = param(0.2, lambda v: v > 0, "tolerance > 0",
+                             "how close a map must come to a true surface to map it (m)")
+    n_samples: int = param(100_000, lambda v: v >= 1, "n_samples >= 1",
+                           "surface samples drawn (3D)")
+    grid_step: float = param(0.2, lambda v: v > 0, "grid_step > 0",
+                             "x/y probe spacing of the 2D metrics (m)")
+    seed: int = param(0, lambda v: v >= 0, "seed >= 0", "sampling seed")
 
 
 @dataclass(frozen=True, eq=False)
@@ -105,9 +115,8 @@ class MapMetrics:
         return dataclasses.asdict(self)
 
 
-def _size_spread(mapper: Mapper) -> tuple[float, float, float]:
+def _size_spread(cells: Cells) -> tuple[float, float, float]:
     """Cell edge range of the known cells: the "adaptability" of tables 5.1-5.2."""
-    cells = mapper.cells()
     known = np.isfinite(cells.centers).all(axis=1)
     edge = cells.sizes[known, 0]
     if edge.size == 0:
@@ -116,23 +125,39 @@ def _size_spread(mapper: Mapper) -> tuple[float, float, float]:
     return lo, hi, float(np.log2(hi / lo))
 
 
-def _thesis(mapper: Mapper, cloud: np.ndarray) -> dict[str, float]:
-    """HD/MHD between the cloud and the occupied corners; NaN when nothing is occupied."""
-    corners = mapper.corners()
+def set_b_points(mapper: Mapper, cells: Cells, rule: str = "corners") -> np.ndarray:
+    """Set B of the thesis' HD/MHD by ``rule`` (see :data:`SET_B`), (M, 3)."""
+    if rule not in SET_B:
+        raise MetricsError(f"set B {rule!r}: expected one of {', '.join(SET_B)}")
+    if rule == "corners" or (rule == "occupied" and mapper.dims == 3):
+        return mapper.corners()
+    keep = np.isfinite(cells.centers).all(axis=1)
+    if mapper.dims == 3 or rule == "occupied":
+        keep &= cells.occupied.astype(bool)
+    if rule == "occupied":
+        return rectangle_corners(cells, keep)
+    return np.asarray(cells.centers[keep], dtype=np.float64)
+
+
+def _thesis(points: np.ndarray, cloud: np.ndarray) -> dict[str, float]:
+    """HD/MHD between the cloud and set B; NaN when set B is empty (nothing occupied)."""
     names = ("hd_m", "mhd_m", "hd_minus_mhd_m", "h_ab_m", "h_ba_m", "mh_ab_m", "mh_ba_m")
-    if len(corners) == 0 or len(cloud) == 0:  # undefined, not zero
+    if len(points) == 0 or len(cloud) == 0:  # undefined, not zero
         return dict.fromkeys(names, _NAN)
-    hd = hausdorff(cloud, corners)
+    hd = hausdorff(cloud, points)
     return dict(zip(names, (hd.hd, hd.mhd, hd.hd - hd.mhd, hd.h_ab, hd.h_ba, hd.mh_ab,
                             hd.mh_ba), strict=True))
 
 
 def measure_map(mapper: Mapper, cloud: np.ndarray, *, elapsed_s: float,
-                truth: GroundTruth | None = None,
-                options: TruthOptions | None = None) -> MapMetrics:
-    """Every metric of ``mapper`` against the registered ``cloud`` (and ``truth``)."""
-    lo, hi, octaves = _size_spread(mapper)
-    cells = mapper.cells()
+                truth: GroundTruth | None = None, options: TruthOptions | None = None,
+                set_b: str = "corners") -> MapMetrics:
+    """Every metric of ``mapper`` against the registered ``cloud`` (and ``truth``);
+    ``set_b`` defines the map's points of HD/MHD (:data:`SET_B`)."""
+    if set_b not in SET_B:
+        raise MetricsError(f"set B {set_b!r}: expected one of {', '.join(SET_B)}")
+    cells = mapper.cells()  # once: a large Octomap's leaves take seconds to list
+    lo, hi, octaves = _size_spread(cells)
     truth_metrics = None
     if truth is not None:
         from alte.metrics.truth import ground_truth_metrics
@@ -146,4 +171,5 @@ def measure_map(mapper: Mapper, cloud: np.ndarray, *, elapsed_s: float,
         elapsed_s=float(elapsed_s), basis_functions=int(mapper.basis_functions),
         memory_bytes=int(mapper.memory_bytes),
         occupied_cells=int(np.count_nonzero(cells.occupied)), cell_min_m=lo, cell_max_m=hi,
-        size_octaves=octaves, **_thesis(mapper, cloud), truth=truth_metrics)
+        size_octaves=octaves, **_thesis(set_b_points(mapper, cells, set_b), cloud),
+        truth=truth_metrics)

@@ -14,6 +14,7 @@ import numpy as np
 import open3d as o3d
 
 from alte.errors import MetricsError
+from alte.tensors import to_array, to_tensor
 
 __all__ = ["SurfaceSamples", "TrueSurface"]
 
@@ -35,10 +36,6 @@ class SurfaceSamples:
     def subset(self, mask: np.ndarray) -> SurfaceSamples:
         """The samples where ``mask`` is true."""
         return SurfaceSamples(self.points[mask], self.object_ids[mask])
-
-
-def _tensor(points: np.ndarray) -> o3d.core.Tensor:
-    return o3d.core.Tensor(np.ascontiguousarray(points, dtype=np.float32))
 
 
 class TrueSurface:
@@ -69,15 +66,18 @@ class TrueSurface:
         self.classes = dict(classes or {})
         self._scene = o3d.t.geometry.RaycastingScene()
         mesh = o3d.t.geometry.TriangleMesh()
-        mesh.vertex.positions = _tensor(self.vertices)
-        mesh.triangle.indices = o3d.core.Tensor(self.triangles.astype(np.uint32))
+        mesh.vertex.positions = to_tensor(self.vertices)
+        mesh.triangle.indices = to_tensor(self.triangles, np.uint32)
         self._scene.add_triangles(mesh)
-        self._objects: list[tuple[np.ndarray, np.ndarray, object]] | None = None
+        self._objects: list[tuple[np.ndarray, np.ndarray,
+                                  o3d.t.geometry.RaycastingScene]] | None = None
 
     def triangle_areas(self) -> np.ndarray:
         """Area of every triangle (m^2)."""
         v = self.vertices[self.triangles]
-        return 0.5 * np.linalg.norm(np.cross(v[:, 1] - v[:, 0], v[:, 2] - v[:, 0]), axis=1)
+        areas: np.ndarray = 0.5 * np.linalg.norm(np.cross(v[:, 1] - v[:, 0], v[:, 2] - v[:, 0]),
+                                                 axis=1)
+        return areas
 
     def sample(self, count: int, seed: int = 0,
                bounds: np.ndarray | None = None) -> SurfaceSamples:
@@ -107,9 +107,10 @@ class TrueSurface:
         """Unsigned distance from each point (N, 3) to the nearest triangle."""
         if len(points) == 0:
             return np.zeros(0)
-        return self._scene.compute_distance(_tensor(points)).numpy().astype(np.float64)
+        return to_array(self._scene.compute_distance(to_tensor(points)), np.float64)
 
-    def _object_scenes(self) -> list[tuple[np.ndarray, np.ndarray, object]]:
+    def _object_scenes(self) -> list[tuple[np.ndarray, np.ndarray,
+                                           o3d.t.geometry.RaycastingScene]]:
         """Per object: x/y bounds, top height and a raycasting scene of its triangles alone."""
         if self._objects is None:
             self._objects = []
@@ -117,9 +118,9 @@ class TrueSurface:
                 tris = self.triangles[self.object_ids == oid]
                 verts = self.vertices[tris.reshape(-1)]
                 scene = o3d.t.geometry.RaycastingScene()
-                scene.add_triangles(_tensor(verts),
-                                    o3d.core.Tensor(np.arange(verts.shape[0], dtype=np.uint32)
-                                                    .reshape(-1, 3)))
+                scene.add_triangles(to_tensor(verts),
+                                    to_tensor(np.arange(verts.shape[0]).reshape(-1, 3),
+                                              np.uint32))
                 self._objects.append((verts.min(0), verts.max(0), scene))
         return self._objects
 
@@ -139,7 +140,7 @@ class TrueSurface:
             if cand.size == 0:
                 continue
             rays = np.hstack([points[cand], np.broadcast_to(_UP, (cand.size, 3))])
-            hits = scene.count_intersections(_tensor(rays)).numpy()
+            hits = to_array(scene.count_intersections(to_tensor(rays)), np.int64)
             out[cand[(hits % 2) == 1]] = True
         return out
 
@@ -148,5 +149,6 @@ class TrueSurface:
         top = float(self.vertices[:, 2].max()) + 1.0 if z_start is None else z_start
         origin = np.column_stack([xy, np.full(len(xy), top)])
         down = np.broadcast_to([0.0, 0.0, -1.0], origin.shape)
-        t_hit = self._scene.cast_rays(_tensor(np.hstack([origin, down])))["t_hit"].numpy()
+        t_hit = to_array(self._scene.cast_rays(to_tensor(np.hstack([origin, down])))["t_hit"],
+                         np.float32)
         return np.where(np.isfinite(t_hit), top - t_hit.astype(np.float64), np.nan)

@@ -86,12 +86,21 @@ def distance_to_boxes(points: np.ndarray, centers: np.ndarray, sizes: np.ndarray
     return out
 
 
+def _lattice_keys(ij: np.ndarray) -> np.ndarray:
+    """One int64 per (i, j) lattice index pair (each shifted into 32 bits)."""
+    shifted = np.clip(ij, -(1 << 30), (1 << 30) - 1) + (1 << 30)
+    return np.asarray((shifted[:, 0] << 32) | shifted[:, 1], dtype=np.int64)
+
+
 def cell_at_xy(xy: np.ndarray, centers: np.ndarray, sizes: np.ndarray) -> np.ndarray:
     """Index of the 2D cell whose x/y rectangle holds each point, -1 where none does.
 
-    Within one size group the cells of a tree lie on a lattice, so the containing cell
-    is the nearest centre; containment is then checked exactly.
+    Within one size group the cells of a tree lie on a lattice, so a point's lattice
+    index (floor of its offset over the cell size) names the only cell that can hold
+    it, found by a sorted-key lookup; a point on a cell edge is also tried against the
+    cells below it on that axis. Containment is then checked exactly (edges included).
     """
+    xy = np.asarray(xy, dtype=np.float64)
     found = np.full(len(xy), -1, dtype=np.int64)
     if len(xy) == 0 or len(centers) == 0:
         return found
@@ -99,10 +108,24 @@ def cell_at_xy(xy: np.ndarray, centers: np.ndarray, sizes: np.ndarray) -> np.nda
     groups, inverse = _size_groups(half)
     for g, h in enumerate(groups):
         sel = np.flatnonzero(inverse.reshape(-1) == g)
-        _, nearest = cKDTree(centers[sel, :2]).query(xy, k=1, workers=-1)
-        cand = sel[nearest]
-        inside = np.all(np.abs(xy - centers[cand, :2]) <= h + 1e-9, axis=1) & (found < 0)
-        found[inside] = cand[inside]
+        step = np.maximum(2.0 * h, 1e-12)
+        origin = centers[sel[0], :2] - h
+        keys = _lattice_keys(np.rint((centers[sel, :2] - h - origin) / step).astype(np.int64))
+        order = np.argsort(keys)
+        sorted_keys = keys[order]
+        todo = np.flatnonzero(found < 0)
+        rel = (xy[todo] - origin) / step
+        low = np.floor(rel)
+        on_edge = (low == rel).astype(np.int64)  # per axis: also try the cell below
+        for shift in ((0, 0), (1, 0), (0, 1), (1, 1)):
+            rows = np.all(on_edge >= shift, axis=1)
+            pts = todo[rows]
+            query = _lattice_keys(low[rows].astype(np.int64) - np.asarray(shift))
+            pos = np.minimum(np.searchsorted(sorted_keys, query), len(sorted_keys) - 1)
+            cand = sel[order[pos]]
+            inside = ((sorted_keys[pos] == query) & (found[pts] < 0)
+                      & np.all(np.abs(xy[pts] - centers[cand, :2]) <= h + 1e-9, axis=1))
+            found[pts[inside]] = cand[inside]
     return found
 
 
@@ -123,7 +146,8 @@ def accuracy(centers: np.ndarray, sizes: np.ndarray, surface: TrueSurface,
 def completeness(samples: SurfaceSamples, centers: np.ndarray, sizes: np.ndarray,
                  tolerance: float) -> np.ndarray:
     """Per sample: True when an occupied box lies within ``tolerance`` of it."""
-    return np.isfinite(distance_to_boxes(samples.points, centers, sizes, tolerance))
+    covered: np.ndarray = np.isfinite(distance_to_boxes(samples.points, centers, sizes, tolerance))
+    return covered
 
 
 def completeness_by_object(samples: SurfaceSamples, covered: np.ndarray,

@@ -16,7 +16,7 @@ from collections.abc import Iterator
 from contextlib import ExitStack
 from dataclasses import dataclass
 from pathlib import Path
-from typing import BinaryIO
+from typing import Any, BinaryIO
 
 import numpy as np
 
@@ -119,12 +119,13 @@ def _write(target: Path, source: Source, spec: FrameSpec, progress: bool) -> Non
         (tmp / _META).write_text(json.dumps(_meta(source, spec, counts), indent=1))
 
 
-def _counts(raw: dict[str, object]) -> StreamCounts:
-    read = ReadCounts(**raw["read"])  # type: ignore[arg-type]
-    reg = RegistrationCounts(**raw["registration"])  # type: ignore[arg-type]
-    poses = PoseCounts(**raw.get("poses", {}))  # type: ignore[arg-type]
-    return StreamCounts(read, reg, int(raw["scans"]), int(raw["selected"]),  # type: ignore[call-overload]
-                        list(raw["notes"]), poses)  # type: ignore[call-overload]
+def _counts(raw: dict[str, Any]) -> StreamCounts:
+    """The counts of a cache's metadata (parsed JSON, as ``StreamCounts.as_dict`` wrote it)."""
+    read = ReadCounts(**raw["read"])
+    reg = RegistrationCounts(**raw["registration"])
+    poses = PoseCounts(**raw.get("poses", {}))
+    return StreamCounts(read, reg, int(raw["scans"]), int(raw["selected"]), list(raw["notes"]),
+                        poses)
 
 
 def _load(folder: Path, source: Source, spec: FrameSpec, key: str) -> Registered:

@@ -201,12 +201,13 @@ class Feeder:
 
     def log(self, build_s: float = 0.0) -> FrameLog:
         arr = np.array(self.rows, dtype=np.float64).reshape(-1, 5)
-        insert = arr[:, 2].copy()
-        if self.feed is Feed.BATCH and len(insert):
+        insert, latency = arr[:, 2].copy(), arr[:, 3].copy()
+        if self.feed is Feed.BATCH and len(insert):  # the map exists after the build only
             insert[:] = 0.0
             insert[-1] = build_s
+            latency[-1] += build_s
         stamps = np.array([row[0] for row in self.rows], dtype=np.int64)  # exact ns
-        return FrameLog(stamps, arr[:, 1].astype(np.int64), insert, arr[:, 3],
+        return FrameLog(stamps, arr[:, 1].astype(np.int64), insert, latency,
                         arr[:, 4].astype(np.int64))
 
 

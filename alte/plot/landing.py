@@ -89,7 +89,7 @@ def plot_landing_runs(runs: Sequence[LandingRun], ncols: int = 2, panel_size: fl
                                                     nrows * panel_size), squeeze=False)
     for ax, run in zip(axes.flat, runs, strict=False):
         s = run.scores
-        title = (f"{run.terrain} {run.map_run.mapper_name} ({run.label})\n"
+        title = (f"{run.terrain} {run.map_run.info.mapper} ({run.label})\n"
                  f"precision {s.get('precision', np.nan):.2f}, "
                  f"recall {s.get('recall', np.nan):.2f}")
         plot_landing(run.detection, run.landing, ax, truth=run.truth, title=title)

@@ -9,7 +9,7 @@ cells without points) are drawn grey, never like ground.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -39,6 +39,12 @@ def _rectangles(cells: Cells) -> np.ndarray:
     return cells.centers[:, None, :2] + _SIGNS_2D[None] * half
 
 
+def _polygons(verts: np.ndarray) -> Sequence[np.ndarray]:
+    """``verts`` as ``PolyCollection`` takes them: the (K, 4, 2) array itself, which
+    matplotlib handles in one piece (its stubs ask for a sequence of polygons)."""
+    return cast("Sequence[np.ndarray]", verts)
+
+
 def _frame_axes(ax: Any, verts: np.ndarray, title: str | None) -> None:
     if len(verts):
         lo, hi = verts.reshape(-1, 2).min(axis=0), verts.reshape(-1, 2).max(axis=0)
@@ -64,7 +70,7 @@ def _occupancy_panel(cells: Cells, ax: Any, verts: np.ndarray, height_threshold:
         occupied = known & (np.nan_to_num(above, nan=-np.inf) > height_threshold)
     colours = np.where(occupied[:, None], (0.0, 0.0, 0.0, 1.0), (1.0, 1.0, 1.0, 1.0))
     colours[~known & ~occupied] = UNKNOWN_COLOR
-    occ = PolyCollection(verts, facecolors=colours, edgecolors=(0.5, 0.5, 0.5, 1.0),
+    occ = PolyCollection(_polygons(verts), facecolors=colours, edgecolors=(0.5, 0.5, 0.5, 1.0),
                          linewidths=0.2)
     ax.add_collection(occ)
     handles = [mpl.patches.Patch(facecolor=c, edgecolor="k", label=lab) for c, lab in
@@ -95,7 +101,7 @@ def plot_map_2d(cells: Cells, ax_segments: Any, ax_occupancy: Any | None = None,
     norm = mpl.colors.Normalize(*(np.nanmin(z), np.nanmax(z)) if known.any() else (0, 1))
     colours = np.tile(UNKNOWN_COLOR, (len(cells), 1))
     colours[known] = mpl.colormaps[cmap](norm(z[known]))
-    seg = PolyCollection(verts, facecolors=colours, edgecolors="k", linewidths=0.2)
+    seg = PolyCollection(_polygons(verts), facecolors=colours, edgecolors="k", linewidths=0.2)
     ax_segments.add_collection(seg)
     mappable = mpl.cm.ScalarMappable(norm=norm, cmap=cmap)
     ax_segments.figure.colorbar(mappable, ax=ax_segments, label="height [m]", shrink=0.8)

@@ -40,7 +40,8 @@ def _collisions(plans: TerrainPlans, path: np.ndarray) -> np.ndarray:
     samples, _ = densify(path, max(plans.case.clearance / 4, 1e-3))
     bad = plans.surface.inside(samples) | (plans.surface.distance(samples)
                                            < plans.case.clearance)
-    return samples[bad]
+    colliding: np.ndarray = samples[bad]
+    return colliding
 
 
 def _panel(ax: Any, plans: TerrainPlans, mapper: str) -> None:

@@ -81,7 +81,8 @@ def _reduce(
 def grid_average(points: np.ndarray, voxel: float) -> np.ndarray:
     """Grid-average down-sample (thesis 2.1.3): each cell's points merge into their mean."""
     _keys, sums, counts = grid_average_with_counts(points, voxel)
-    return sums / counts[:, None]
+    means: np.ndarray = sums / counts[:, None]
+    return means
 
 
 def box_grid_merge(cloud_a: np.ndarray, cloud_b: np.ndarray, voxel: float) -> np.ndarray:

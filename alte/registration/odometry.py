@@ -143,7 +143,9 @@ class _PlaneMap:
 
     def align(self, source: Any, guess: np.ndarray) -> tuple[np.ndarray, float]:
         """The sensor pose placing ``source`` on the map, from ``guess``; inlier fraction."""
-        from open3d.pipelines import registration as reg  # type: ignore[import-not-found]
+        import open3d as o3d
+
+        reg = o3d.pipelines.registration
 
         reach = 6.0 * self.voxel
         method = reg.TransformationEstimationPointToPlane(reg.TukeyLoss(k=reach / 2))
@@ -166,7 +168,7 @@ class _DenseMap:
 
     def add(self, scan: np.ndarray, sensor: np.ndarray) -> None:
         """Add the scan (sensor frame) placed at ``sensor``; forget what is out of reach."""
-        import small_gicp  # type: ignore[import-not-found, unused-ignore]
+        import small_gicp
 
         placed = scan @ sensor[:3, :3].T + sensor[:3, 3]
         merged = small_gicp.voxelgrid_sampling(np.vstack([self.points, placed]), self.voxel / 2,
@@ -182,7 +184,7 @@ class _DenseMap:
 
     def align(self, scan: np.ndarray, guess: np.ndarray) -> tuple[np.ndarray, float]:
         """The sensor pose placing ``scan`` on the map from ``guess``; inlier fraction."""
-        import small_gicp  # type: ignore[import-not-found, unused-ignore]
+        import small_gicp
 
         target, tree = self.target
         source = small_gicp.voxelgrid_sampling(scan, self.voxel, num_threads=_THREADS)
@@ -196,8 +198,8 @@ class _Kiss:
     """KISS-ICP scaled to the scene of the first scan (module docstring)."""
 
     def __init__(self, points: np.ndarray, params: OdometryParams) -> None:
-        from kiss_icp.config import KISSConfig  # type: ignore[import-untyped]
-        from kiss_icp.kiss_icp import KissICP  # type: ignore[import-untyped]
+        from kiss_icp.config import KISSConfig
+        from kiss_icp.kiss_icp import KissICP
 
         max_range, voxel = scene_scale(points, params)
         config = KISSConfig()

@@ -24,8 +24,8 @@ from tqdm import tqdm
 
 from alte.errors import ParameterError, RegistrationError
 from alte.registration.grid import GridAccumulator, check_voxel, grid_average
-from alte.registration.transform import register_frame, sensor_origin
-from alte.types import Frame, Mount
+from alte.registration.transform import register_with_origin
+from alte.types import Frame, Mount, finite_rows, rows_all
 
 __all__ = [
     "ManoeuvreFilter",
@@ -49,13 +49,14 @@ def crop_mask(points: np.ndarray, box: tuple[float, ...] | np.ndarray) -> np.nda
             "xmin,ymin,zmin,xmax,ymax,zmax with min <= max"
         )
     pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
-    return np.all((pts >= arr[:3]) & (pts <= arr[3:]), axis=1)
+    return rows_all((pts >= arr[:3]) & (pts <= arr[3:]))
 
 
 def crop(points: np.ndarray, box: tuple[float, ...] | np.ndarray) -> np.ndarray:
     """Keep only the points inside the control volume (thesis 2.2.4)."""
     pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
-    return pts[crop_mask(pts, box)]
+    kept: np.ndarray = pts[crop_mask(pts, box)]
+    return kept
 
 
 def _check_limit(name: str, value: float | None) -> float | None:
@@ -123,22 +124,22 @@ class RegistrationCounts:
 
 def _frame_points(
     frame: Frame, mount: Mount, box: np.ndarray | None, counts: RegistrationCounts
-) -> np.ndarray:
-    """Registered, finite, cropped points of one frame."""
+) -> tuple[np.ndarray, np.ndarray]:
+    """Registered, finite, cropped points of one frame and the sensor origin (one pose)."""
     raw = np.asarray(frame.points, dtype=np.float64)
     if raw.ndim != 2 or raw.shape[1] != 3:
         raise RegistrationError(f"frame at stamp {frame.stamp}: points have shape {raw.shape}")
     counts.points_in += len(raw)
-    pts = register_frame(frame, mount)
-    finite = np.isfinite(pts).all(axis=1)
-    if not finite.all():
+    pts, origin = register_with_origin(frame, mount)
+    finite = finite_rows(pts)
+    if finite is not None:
         counts.points_dropped_nonfinite += len(pts) - int(finite.sum())
         pts = pts[finite]
     if box is not None:
         inside = crop_mask(pts, box)
         counts.points_dropped_crop += len(pts) - int(inside.sum())
         pts = pts[inside]
-    return pts
+    return pts, origin
 
 
 def _iterate(
@@ -159,7 +160,7 @@ def _iterate(
         if reason is not None:
             counts.drop_frame(reason)
             continue
-        pts = _frame_points(frame, mount, box, counts)
+        pts, origin = _frame_points(frame, mount, box, counts)
         if len(pts) == 0:
             counts.drop_frame("empty")
             continue
@@ -169,7 +170,7 @@ def _iterate(
             pts = grid_average(pts, voxel)
         counts.frames_kept += 1
         counts.points_registered += len(pts)
-        yield frame, pts, sensor_origin(frame, mount)
+        yield frame, pts, origin
 
 
 def check_options(

@@ -11,7 +11,7 @@ import numpy as np
 
 from alte.types import Frame, Mount
 
-__all__ = ["register_frame", "sensor_origin", "sensor_pose", "to_sensor"]
+__all__ = ["register_frame", "register_with_origin", "sensor_origin", "sensor_pose", "to_sensor"]
 
 
 def sensor_pose(frame: Frame, mount: Mount) -> tuple[np.ndarray, np.ndarray]:
@@ -24,9 +24,15 @@ def sensor_pose(frame: Frame, mount: Mount) -> tuple[np.ndarray, np.ndarray]:
 
 def register_frame(frame: Frame, mount: Mount) -> np.ndarray:
     """Eq. 2.2: R_P^I = R_B^I + DCM_B^I R_S/B^B + DCM_B^I DCM_S^B R_P/S^S for every point."""
+    return register_with_origin(frame, mount)[0]
+
+
+def register_with_origin(frame: Frame, mount: Mount) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`register_frame` and :func:`sensor_origin` from one evaluation of the pose."""
     matrix, origin = sensor_pose(frame, mount)
     points = np.asarray(frame.points, dtype=np.float64).reshape(-1, 3)
-    return points @ matrix.T + origin
+    registered: np.ndarray = points @ matrix.T + origin
+    return registered, origin
 
 
 def sensor_origin(frame: Frame, mount: Mount) -> np.ndarray:
@@ -37,4 +43,5 @@ def sensor_origin(frame: Frame, mount: Mount) -> np.ndarray:
 def to_sensor(points: np.ndarray, frame: Frame, mount: Mount) -> np.ndarray:
     """Inverse of :func:`register_frame`: inertial points back into the sensor frame."""
     matrix, origin = sensor_pose(frame, mount)
-    return (np.asarray(points, dtype=np.float64).reshape(-1, 3) - origin) @ matrix
+    local: np.ndarray = (np.asarray(points, dtype=np.float64).reshape(-1, 3) - origin) @ matrix
+    return local

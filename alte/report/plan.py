@@ -17,6 +17,7 @@ from pathlib import Path
 from typing import Any
 
 from alte.errors import ParameterError, ReportError
+from alte.sim.terrains import TERRAINS as SIMULATED
 
 __all__ = [
     "PLAN",
@@ -31,10 +32,7 @@ __all__ = [
 ]
 
 #: The eight mission profiles of chapter 4 (simulated and experimental, navigation and landing).
-TERRAINS: tuple[str, ...] = (
-    "sim_nav_1", "sim_nav_2", "sim_lan_1", "sim_lan_2",
-    "exp_nav_1", "exp_nav_2", "exp_lan_1", "exp_lan_2",
-)
+TERRAINS: tuple[str, ...] = tuple(SIMULATED)
 #: Terrains chapter 4 is run on in quick mode (one navigation, one landing profile).
 QUICK_TERRAINS: tuple[str, ...] = ("sim_nav_1", "sim_lan_1")
 #: Scans per terrain in quick mode, the same in every notebook: the simulated terrain
@@ -85,7 +83,8 @@ PLAN: tuple[Entry, ...] = (
           {"FRAMES": None}),
     *(_ch4(terrain) for terrain in TERRAINS),
     Entry("ch5_analysis", "ch5_analysis.ipynb", {"FRAMES": QUICK_FRAMES},
-          {"FRAMES": None, "ROWS": None},
+          {"FRAMES": None, "ROWS": None, "GRID_SPEC": "notebooks/sweeps/tradeoff.yaml",
+           "SCHEDULER": "local", "WORKERS": 2},
           terrains=("sim_nav_1", "sim_lan_2", "sim_nav_2")),
     Entry("ch7_sensitivity", "ch7_sensitivity.ipynb", {"FRAMES": QUICK_FRAMES},
           {"FRAMES": None, "SPEC": "notebooks/sweeps/report.yaml", "SCHEDULER": "local"},

@@ -88,7 +88,8 @@ def read_record(run_dir: str | os.PathLike[str]) -> dict[str, Any] | None:
     """The run's record, or ``None`` for a run that did not finish."""
     path = Path(run_dir) / RUN_RECORD
     try:
-        return json.loads(path.read_text())
+        record: dict[str, Any] = json.loads(path.read_text())
+        return record
     except FileNotFoundError:
         return None
     except ValueError as err:

@@ -16,6 +16,7 @@ import numpy as np
 from alte.errors import PointFileError
 from alte.fsutil import atomic_path
 from alte.sim.scene import CLASSES, Scene, SceneObject
+from alte.tensors import to_array, to_tensor
 
 __all__ = ["GROUND_TRUTH_FILE", "load_ground_truth", "mesh_distance", "read_ground_truth",
            "write_ground_truth"]
@@ -95,7 +96,5 @@ def load_ground_truth(directory: str | os.PathLike[str]) -> Scene:
 
 def mesh_distance(points: np.ndarray, scene: Scene) -> np.ndarray:
     """Unsigned distance (N,) from each point to the nearest triangle of ``scene``."""
-    import open3d as o3d
-
-    pts = np.ascontiguousarray(points, dtype=np.float32).reshape(-1, 3)
-    return scene.raycaster().compute_distance(o3d.core.Tensor(pts)).numpy().astype(np.float64)
+    pts = np.asarray(points).reshape(-1, 3)
+    return to_array(scene.raycaster().compute_distance(to_tensor(pts)), np.float64)

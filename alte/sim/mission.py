@@ -74,7 +74,8 @@ def _acquisition_times(terrain: Terrain, seed: int, stamps_s: np.ndarray,
         return stamps_s
     rng = _rng(seed, terrain.spec.name, 1)
     jitter = rng.normal(0.0, platform.jitter_s, terrain.spec.frames)[index]
-    return stamps_s + platform.time_offset_s + jitter
+    late: np.ndarray = stamps_s + platform.time_offset_s + jitter
+    return late
 
 
 def _pose_stream(terrain: Terrain, traj: Trajectory, seed: int,

@@ -16,6 +16,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy.interpolate import CubicSpline
 from scipy.spatial.transform import Rotation
 
@@ -96,12 +97,14 @@ class Trajectory:
         r, v, d = self._ramp, self._speed, self.duration
         tc = np.clip(t, 0.0, d)
 
-        def ramp_dist(x: np.ndarray) -> np.ndarray:  # integral of v (1 - cos(pi x / r)) / 2
-            x = np.clip(x, 0.0, r)
-            return 0.5 * v * (x - r / np.pi * np.sin(np.pi * x / r))
+        def ramp_dist(x: ArrayLike) -> np.ndarray:  # integral of v (1 - cos(pi x / r)) / 2
+            xc = np.clip(x, 0.0, r)
+            dist: np.ndarray = 0.5 * v * (xc - r / np.pi * np.sin(np.pi * xc / r))
+            return dist
 
-        return ramp_dist(tc) + v * np.clip(tc - r, 0.0, d - 2 * r) + (
+        travelled: np.ndarray = ramp_dist(tc) + v * np.clip(tc - r, 0.0, d - 2 * r) + (
             ramp_dist(r) - ramp_dist(d - tc)) * (tc > d - r)
+        return travelled
 
     def xy(self, t: np.ndarray) -> np.ndarray:
         """Horizontal position (K, 2) at times ``t``."""
@@ -117,21 +120,20 @@ class Trajectory:
         """Body position (K, 3) and body-to-inertial rotation at times ``t``."""
         t = np.atleast_1d(np.asarray(t, dtype=np.float64))
         if isinstance(self.platform, Quadrotor):
-            return self._quadrotor_pose(t)
-        return self._cart_pose(t)
+            return self._quadrotor_pose(t, self.platform)
+        return self._cart_pose(t, self.platform)
 
-    def _quadrotor_pose(self, t: np.ndarray) -> tuple[np.ndarray, Rotation]:
+    def _quadrotor_pose(self, t: np.ndarray, quad: Quadrotor) -> tuple[np.ndarray, Rotation]:
         h = 0.02
         acc = (self.xy(t + h) - 2 * self.xy(t) + self.xy(t - h)) / h**2
         yaw = self.heading(t)
         fwd = acc[:, 0] * np.cos(yaw) + acc[:, 1] * np.sin(yaw)
         lat = -acc[:, 0] * np.sin(yaw) + acc[:, 1] * np.cos(yaw)
         pitch, roll = np.arctan(fwd / _G), -np.arctan(lat / _G)
-        pos = np.column_stack([self.xy(t), np.full(len(t), self.platform.altitude)])
+        pos = np.column_stack([self.xy(t), np.full(len(t), quad.altitude)])
         return pos, Rotation.from_euler("ZYX", np.column_stack([yaw, pitch, roll]))
 
-    def _cart_pose(self, t: np.ndarray) -> tuple[np.ndarray, Rotation]:
-        cart: Cart = self.platform  # type: ignore[assignment]
+    def _cart_pose(self, t: np.ndarray, cart: Cart) -> tuple[np.ndarray, Rotation]:
         ph = cart.phases
         w = np.radians(cart.wobble_deg)
         roll = w * (0.6 * np.sin(2.1 * t + ph[0]) + 0.4 * np.sin(5.3 * t + ph[1]))

@@ -62,8 +62,8 @@ def spec_hash(terrain: Terrain, frames: int | None, storage: str,
     return digest.hexdigest()
 
 
-def _file_table(root: Path) -> dict[str, dict[str, Any]]:
-    table = {}
+def _file_table(root: Path) -> dict[str, dict[str, int | str]]:
+    table: dict[str, dict[str, int | str]] = {}
     for path in sorted(p for p in root.rglob("*") if p.is_file()):
         rel = path.relative_to(root).as_posix()
         if rel != SCENARIO_FILE:
@@ -125,7 +125,7 @@ def is_current(folder: Path, key: str, seed: int) -> bool:
         return False
     if meta.get("spec_hash") != key or meta.get("seed") != seed or not meta.get("files"):
         return False
-    return _file_table(folder) == meta["files"]
+    return bool(_file_table(folder) == meta["files"])
 
 
 def terrain_folder(out_dir: str | os.PathLike[str], name: str, frames: int | None = None,

@@ -9,9 +9,14 @@ prisms, spheres, ground rectangles); every block is one object with a class from
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+from alte.tensors import to_tensor
+
+if TYPE_CHECKING:
+    import open3d as o3d
 
 __all__ = ["CLASSES", "Scene", "SceneBuilder", "SceneObject"]
 
@@ -48,7 +53,8 @@ class Scene:
     def class_ids(self) -> np.ndarray:
         """Class index per triangle."""
         lut = np.array([o.class_id for o in self.objects], dtype=np.uint8)
-        return lut[self.object_ids]
+        ids: np.ndarray = lut[self.object_ids]
+        return ids
 
     @property
     def labels(self) -> dict[int, str]:
@@ -60,13 +66,12 @@ class Scene:
         """Object id -> object class."""
         return {i: o.cls for i, o in enumerate(self.objects)}
 
-    def raycaster(self) -> Any:
+    def raycaster(self) -> o3d.t.geometry.RaycastingScene:
         """An ``open3d.t.geometry.RaycastingScene`` holding the mesh (geometry id 0)."""
         import open3d as o3d
 
         rc = o3d.t.geometry.RaycastingScene()
-        rc.add_triangles(o3d.core.Tensor(self.vertices.astype(np.float32)),
-                         o3d.core.Tensor(self.triangles.astype(np.uint32)))
+        rc.add_triangles(to_tensor(self.vertices), to_tensor(self.triangles, np.uint32))
         return rc
 
     def bounds(self) -> np.ndarray:
@@ -188,4 +193,5 @@ class SceneBuilder:
 def _yawed(local: np.ndarray, yaw_deg: float) -> np.ndarray:
     c, s = np.cos(np.radians(yaw_deg)), np.sin(np.radians(yaw_deg))
     rot = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-    return local @ rot.T
+    yawed: np.ndarray = local @ rot.T
+    return yawed

@@ -14,9 +14,15 @@ sheet's 3 cm accuracy), truncated at 4 sigma.
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from scipy.spatial.transform import Rotation
+
+from alte.tensors import to_array, to_tensor
+
+if TYPE_CHECKING:
+    import open3d as o3d
 
 __all__ = ["FIRING_ORDER_DEG", "VLP16", "Hits", "cast", "measure"]
 
@@ -75,24 +81,22 @@ class Hits:
     triangle: np.ndarray
 
 
-def cast(raycaster: object, positions: np.ndarray, rotations: Rotation,
+def cast(raycaster: o3d.t.geometry.RaycastingScene, positions: np.ndarray, rotations: Rotation,
          directions: np.ndarray) -> Hits:
     """Cast the sensor's rays from K poses in one ``RaycastingScene.cast_rays`` call.
 
     ``positions`` (K, 3) and ``rotations`` (K) are the sensor poses in the scene
     frame, ``directions`` (M, 3) the rays in the sensor frame.
     """
-    import open3d as o3d
-
     world = np.einsum("kij,mj->kmi", rotations.as_matrix().reshape(-1, 3, 3), directions)
     k, m = world.shape[:2]
     origins = np.broadcast_to(np.asarray(positions, dtype=np.float64)[:, None, :], (k, m, 3))
-    rays = np.concatenate([origins, world], axis=2).reshape(-1, 6).astype(np.float32)
-    out = raycaster.cast_rays(o3d.core.Tensor(rays))
-    dist = out["t_hit"].numpy().astype(np.float64).reshape(k, m)
-    normals = out["primitive_normals"].numpy().astype(np.float64).reshape(k, m, 3)
+    rays = np.concatenate([origins, world], axis=2).reshape(-1, 6)
+    out = raycaster.cast_rays(to_tensor(rays))
+    dist = to_array(out["t_hit"], np.float64).reshape(k, m)
+    normals = to_array(out["primitive_normals"], np.float64).reshape(k, m, 3)
     cos = np.abs(np.einsum("kmi,kmi->km", normals, world))
-    tri = out["primitive_ids"].numpy().astype(np.int64).reshape(k, m)
+    tri = to_array(out["primitive_ids"], np.int64).reshape(k, m)
     tri[~np.isfinite(dist)] = -1
     return Hits(dist, cos, tri)
 

@@ -60,7 +60,8 @@ class Terrain:
     scene: Scene
 
 
-def _pad(extent: tuple[float, float, float, float], margin: float = 60.0) -> tuple[float, ...]:
+def _pad(extent: tuple[float, float, float, float],
+         margin: float = 60.0) -> tuple[float, float, float, float]:
     """Ground beyond the region of interest, so every beam of every scan returns."""
     return (extent[0] - margin, extent[1] - margin, extent[2] + margin, extent[3] + margin)
 

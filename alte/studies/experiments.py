@@ -23,7 +23,16 @@ from alte.errors import ParameterError
 from alte.mappers import Mapper
 from alte.metrics.maps import GroundTruth, MapMetrics, TruthOptions, measure_map
 from alte.params import Record
-from alte.pipeline import FrameSpec, MapRun, MapSpec, Registered, open_input, prepare, run
+from alte.pipeline import (
+    FrameSpec,
+    InputKind,
+    MapRun,
+    MapSpec,
+    Registered,
+    open_input,
+    prepare,
+    run,
+)
 from alte.studies.thesis import SWEEPS, sweep_table
 
 __all__ = ["CACHE_DIR", "Measured", "ground_truth", "measure", "sweep", "terrain"]
@@ -76,20 +85,24 @@ def _truth(folder: str) -> GroundTruth | None:
 
 
 def ground_truth(data: Registered) -> GroundTruth | None:
-    """The terrain's true surface and control volume (loaded once per process)."""
+    """The terrain's true surface and control volume (loaded once per process); None for
+    an input that is not a simulated terrain."""
+    if data.source.kind is not InputKind.TERRAIN:
+        return None
     return _truth(str(data.source.path))
 
 
 def measure(data: Registered, mapper: str, params: Mapping[str, object] | None = None, *,
             truth: TruthOptions | None = None, spec: MapSpec | None = None,
-            progress: bool = False) -> Measured:
+            set_b: str = "corners", progress: bool = False) -> Measured:
     """Map ``data`` with ``mapper`` and ``params`` and measure it (``truth``: also against
-    the true surface). ``spec`` replaces the default map specification when given."""
+    the true surface; ``set_b``: the map's points of HD/MHD, see
+    :data:`alte.metrics.maps.SET_B`). ``spec`` replaces the default map specification."""
     chosen = spec or MapSpec(mapper, dict(params or {}))
     result = run(data, chosen, progress=progress)
     metrics = measure_map(result.mapper, data.cloud, elapsed_s=result.elapsed_s,
                           truth=ground_truth(data) if truth is not None else None,
-                          options=truth)
+                          options=truth, set_b=set_b)
     return Measured(result, metrics)
 
 

@@ -160,13 +160,18 @@ def _sweep_trends(number: int, ours: pd.DataFrame) -> list[dict[str, Any]]:
 
 def _comparison_trends(number: int, table: pd.DataFrame) -> list[dict[str, Any]]:
     by = table.set_index("mapper")
+
+    def lower(column: str, low: str, high: str) -> bool:
+        values = by[column].astype(np.float64)
+        return bool(values[low] < values[high])
+
     out = []
     for text, low, high, metric in COMPARISON_TRENDS[number]:
         tcol = "thesis_hd_minus_mhd_m" if metric == "hd_minus_mhd_m" else _THESIS_COLS[metric]
         out.append({"table": f"5.{number}", "trend": text,
                     "thesis_rho": np.nan, "ours_rho": np.nan,
-                    "holds_in_thesis": bool(by.at[low, tcol] < by.at[high, tcol]),
-                    "holds_on_ours": bool(by.at[low, metric] < by.at[high, metric])})
+                    "holds_in_thesis": lower(tcol, low, high),
+                    "holds_on_ours": lower(metric, low, high)})
     return out
 
 

@@ -10,11 +10,12 @@ Note: the thesis' column "MHD - HD" in tables 5.10/5.11 holds HD - MHD (e.g.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TypedDict
 
 import pandas as pd
 
 from alte.errors import ParameterError
+from alte.sim.terrains import TERRAINS
 
 __all__ = [
     "CASE_MAPPERS",
@@ -24,29 +25,54 @@ __all__ = [
     "QUALITATIVE",
     "SWEEPS",
     "TERRAIN_CASE",
+    "MapperParams",
+    "PointCloudRef",
+    "Sweep",
+    "SweepRow",
     "mapper_params",
     "qualitative_table",
     "sweep_table",
 ]
 
-#: Case of every terrain of chapter 4: "nav" (urban navigation, 3D) or "lan" (landing, 2D).
-TERRAIN_CASE: dict[str, str] = {
-    "sim_nav_1": "nav", "sim_nav_2": "nav", "sim_lan_1": "lan", "sim_lan_2": "lan",
-    "exp_nav_1": "nav", "exp_nav_2": "nav", "exp_lan_1": "lan", "exp_lan_2": "lan",
-}
+#: Parameters of one mapper by name, as the thesis gives them (all numbers).
+MapperParams = dict[str, float]
+
+#: One row of a sweep table: (params, elapsed s, basis functions, HD m, MHD m).
+SweepRow = tuple[MapperParams, float, int, float, float]
+
+
+class Sweep(TypedDict):
+    """A sweep table of chapter 5 (5.7, 5.8, 5.9, 5.12): one mapper on one terrain."""
+
+    mapper: str
+    terrain: str
+    rows: list[SweepRow]
+
+
+class PointCloudRef(TypedDict):
+    """The registered cloud a table of section 5.2 (5.5, 5.6) was computed on."""
+
+    terrain: str
+    frames: int
+    points: int
+
+
+#: Case of every terrain of chapter 4: "nav" (urban navigation, 3D) or "lan" (landing, 2D),
+#: as its name says (``sim_nav_1``); a test checks it against each terrain's own spec.
+TERRAIN_CASE: dict[str, str] = {name: name.split("_")[1] for name in TERRAINS}
 
 #: Mappers the thesis applied per case (chapter 4 and tables 5.1-5.4).
 CASE_MAPPERS: dict[str, tuple[str, str]] = {"nav": ("octomap", "alte3d"),
                                             "lan": ("quadtree", "alte2d")}
 
-_NAV_SIM = {"octomap": {"resolution": 5.0},
+_NAV_SIM: dict[str, MapperParams] = {"octomap": {"resolution": 5.0},
             "alte3d": {"max_res": 6, "min_pts": 10, "min_pts_split": 20}}
-_NAV_EXP = {"octomap": {"resolution": 10.0},
+_NAV_EXP: dict[str, MapperParams] = {"octomap": {"resolution": 10.0},
             "alte3d": {"max_res": 5, "min_pts": 5, "min_pts_split": 10}}
-_ALTE2D = {"kappa": 0.1, "max_res": 6, "min_pts": 10}
+_ALTE2D: MapperParams = {"kappa": 0.1, "max_res": 6, "min_pts": 10}
 
 #: Chapter 4 parameters per terrain and mapper (sections 4.1.1-4.2.4).
-CH4_PARAMS: dict[str, dict[str, dict[str, Any]]] = {
+CH4_PARAMS: dict[str, dict[str, MapperParams]] = {
     "sim_nav_1": _NAV_SIM, "sim_nav_2": _NAV_SIM,
     "sim_lan_1": {"quadtree": {"max_points": 200}, "alte2d": _ALTE2D},
     "sim_lan_2": {"quadtree": {"max_points": 25}, "alte2d": _ALTE2D},
@@ -56,13 +82,13 @@ CH4_PARAMS: dict[str, dict[str, dict[str, Any]]] = {
 }
 
 #: Tables 5.5 and 5.6: frames and points of the registered clouds analysed in 5.2.
-POINT_CLOUDS: dict[int, dict[str, Any]] = {
+POINT_CLOUDS: dict[int, PointCloudRef] = {
     5: {"terrain": "sim_nav_1", "frames": 569, "points": 381187},
     6: {"terrain": "sim_lan_2", "frames": 508, "points": 439032},
 }
 
 #: Tables 5.7, 5.8, 5.9, 5.12: (params, elapsed s, basis functions, HD m, MHD m) per row.
-SWEEPS: dict[int, dict[str, Any]] = {
+SWEEPS: dict[int, Sweep] = {
     7: {"mapper": "quadtree", "terrain": "sim_lan_2", "rows": [
         ({"max_points": 25}, 43.38, 24343, 5.515, 1.235),
         ({"max_points": 100}, 5.51, 7048, 5.310, 1.029),
@@ -120,7 +146,7 @@ QUALITATIVE: dict[int, dict[str, dict[str, str]]] = {
 }
 
 
-def mapper_params(terrain: str) -> dict[str, dict[str, Any]]:
+def mapper_params(terrain: str) -> dict[str, MapperParams]:
     """The chapter 4 parameters of ``terrain``'s two mappers (copies, safe to modify)."""
     try:
         return {name: dict(p) for name, p in CH4_PARAMS[terrain].items()}

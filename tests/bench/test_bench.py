@@ -82,9 +82,9 @@ def test_config_and_row_selection_errors():
         BenchConfig(sizes=(1, 10))
     with pytest.raises(ParameterError, match="budget_s"):
         BenchConfig(budget_s=0)
-    with pytest.raises(ParameterError, match=r"unknown row\(s\) \[9\]"):
-        select_rows([1, 9])
-    assert select_rows(None) == sorted(ROWS) == list(range(1, 9))
+    with pytest.raises(ParameterError, match=r"unknown row\(s\) \[99\]"):
+        select_rows([1, 99])
+    assert select_rows(None) == sorted(ROWS) == list(range(1, 12))
     assert BenchConfig(quick=True).scaling_sizes == (3000, 6000, 12000)
     assert BenchConfig().scaling_sizes[-1] == 10**7
 
@@ -144,15 +144,23 @@ def quick_bench(tmp_path_factory):
 
 def test_quick_bench_runs_every_row_and_writes_its_outputs(quick_bench):
     assert quick_bench.errors == {}
-    assert {r.row for r in quick_bench.results} == set(range(1, 9))
+    assert {r.row for r in quick_bench.results} == set(range(1, 12))
     for r in quick_bench.results:
         if r.row != 8:
             assert math.isfinite(r.ours) and r.peer > 0, r.case
     row1 = next(r for r in quick_bench.results if r.row == 1)
-    assert row1.detail["jaccard"] >= 0.999 and row1.detail["frames"] == 3
+    assert row1.detail["jaccard"] == 1.0 and row1.detail["frames"] == 3
+    assert row1.detail["leaves_native"] == row1.detail["leaves_reference"] > 0
     hd = [r for r in quick_bench.results if r.row == 4]
-    assert all(r.detail["hd_m"] == pytest.approx(r.detail["hd_open3d_m"]) for r in hd)
-    assert len([r for r in quick_bench.results if r.row == 5]) == 4
+    assert all(r.detail["hd_m"] == r.detail["hd_open3d_m"] for r in hd)
+    assert all(r.detail["mhd_m"] == r.detail["mhd_open3d_m"] for r in hd)
+    latency = [r for r in quick_bench.results if r.row == 5]
+    assert len(latency) == 4
+    assert [r.detail["same"] for r in latency if "same" in r.detail] == [True, True]
+    chain = [r for r in quick_bench.results if r.row == 10]
+    assert len(chain) == 8 and all(r.detail["frames"] == 6 for r in chain)
+    assert all(r.detail["latency_ms"]["max"] >= r.detail["insert_ms"]["max"] for r in chain)
+    assert [r.detail["frames"] for r in quick_bench.results if r.row == 11] == [3]
     paths = write_outputs(quick_bench, quick_bench.config.reports_dir)
     record = json.loads(paths["json"].read_text())
     assert record["machine"]["cpu"] and len(record["results"]) == len(quick_bench.results)

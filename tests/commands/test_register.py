@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 from pathlib import Path
-from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -11,12 +10,16 @@ from support.synthetic import make_frame, scene
 
 from alte.cli import main
 from alte.commands import register as command
-from alte.commands.register import format_counts, parse_box
+from alte.commands.options import parse_box
+from alte.commands.register import format_counts
 from alte.errors import ParameterError
 from alte.io import read_frames, write_frames
+from alte.io.bag import ReadCounts
 from alte.io.pointfiles import read_points
 from alte.paths import realdata_dir
-from alte.registration import crop, grid_average, register_frame
+from alte.pipeline import InputKind, Source
+from alte.pipeline import source as source_module
+from alte.registration import RegistrationCounts, crop, grid_average, register_frame
 from alte.types import Mount
 
 BOX = (-4.0, -4.0, -4.0, 4.0, 4.0, 4.0)
@@ -46,22 +49,31 @@ def test_register_bag_end_to_end(tmp_path, capsys):
 
 @pytest.fixture
 def fake_io(monkeypatch):
-    """Replace the bag reader and point writer by in-memory fakes."""
+    """Replace the bag stream and point writer by in-memory fakes."""
     _truth, frames, mount = scene(seed=1, frames=3, n=100)
     frames.append(make_frame(frames[0].points, frames[0].position, frames[0].quaternion,
                              rate=9.0))
     calls: dict[str, object] = {}
 
-    def read_frames(path, **kwargs):
-        calls["read"] = (path, kwargs)
-        return SimpleNamespace(frames=frames, mount=kwargs["mount"] or mount,
-                               counts={"scans_read": 4})
+    class Stream:
+        def __init__(self, path, **kwargs):
+            calls["read"] = (path, kwargs)
+            self.mount = kwargs["mount"] or mount
+            self.scans = self.selected = len(frames)
+            self.notes: list[str] = []
+            self.counts = ReadCounts(scans_read=len(frames))
+            self.track = object()  # a recorded pose stream: the frames keep their poses
+
+        def __iter__(self):
+            return iter(frames)
 
     def write_points(path, points, overwrite=False):
         calls["write"] = (path, points, overwrite)
         Path(path).write_text("cloud")
 
-    monkeypatch.setattr(command, "read_frames", read_frames)
+    monkeypatch.setattr(command, "open_input",
+                        lambda path: Source(Path(path), InputKind.BAG, bag=Path(path)))
+    monkeypatch.setattr(source_module, "FrameStream", Stream)
     monkeypatch.setattr(command, "write_points", write_points)
     return calls
 
@@ -89,9 +101,9 @@ def test_command_passes_options_and_prints_counts(tmp_path, capsys, fake_io):
 @pytest.mark.parametrize(("extra", "match"), [
     (["--crop", "1,2,3"], "--crop '1,2,3': expected 6 numbers"),
     (["--crop", "a,b,c,d,e,f"], "expected 6 numbers"),
-    (["--crop", "1,1,1,0,0,0"], "crop box"),
-    (["--voxel", "0"], "voxel=0.0"),
-    (["--max-offset", "-1"], "max_offset_s"),
+    (["--crop", "1,1,1,0,0,0"], "min must be <= max"),
+    (["--voxel", "0"], "--voxel 0.0: must be > 0"),
+    (["--max-offset", "-1"], "--max-offset -1.0: must be > 0"),
     (["--mount", "1,2"], "--mount '1,2'"),
     (["--out", "c.png"], "unknown point file type"),
 ])
@@ -119,14 +131,10 @@ def test_all_frames_dropped_is_an_error(tmp_path, capsys, fake_io):
 
 
 def test_parse_box_and_format_counts():
-    assert parse_box("-1,-2,-3,1,2,3") == (-1, -2, -3, 1, 2, 3)
+    assert parse_box("-1,-2,-3,1,2,3").values() == (-1, -2, -3, 1, 2, 3)
     with pytest.raises(ParameterError, match="expected 6 numbers"):
         parse_box("1,2")
-    counts = dict.fromkeys(
-        ["frames_in", "frames_kept", "frames_dropped_rate", "frames_dropped_offset",
-         "frames_dropped_empty", "points_in", "points_dropped_nonfinite",
-         "points_dropped_crop", "points_registered", "points_out"], 0)
-    counts.update(frames_in=3, frames_dropped_offset=2, points_dropped_crop=7)
+    counts = RegistrationCounts(frames_in=3, frames_dropped_offset=2, points_dropped_crop=7)
     lines = format_counts(counts)
     assert "2 (pose offset)" in lines[0]
     assert "7 (outside crop box)" in lines[1]

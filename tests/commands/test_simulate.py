@@ -22,8 +22,8 @@ def test_simulate_all_with_mcap(tmp_path, capsys):
     out = capsys.readouterr().out
     for name in TERRAINS:
         assert f"{name}: 2 frames" in out
-        assert (tmp_path / f"{name}-2f" / "bag" / "bag.mcap").is_file()
-        assert json.loads((tmp_path / f"{name}-2f" / "scenario.json").read_text())["seed"] == 5
+        assert (tmp_path / f"{name}-2f-s5" / "bag" / "bag.mcap").is_file()
+        assert json.loads((tmp_path / f"{name}-2f-s5" / "scenario.json").read_text())["seed"] == 5
 
 
 def test_unknown_terrain_is_a_one_line_error(tmp_path, capsys):

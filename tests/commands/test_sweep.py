@@ -49,11 +49,20 @@ def test_overrides_frames_out_and_data(spec_file, tmp_path, capsys):
     assert load_results(tmp_path / "other")["frames"].eq(3).all()
 
 
+def test_seeds_override(spec_file, tmp_path, capsys):
+    argv = ["sweep", str(spec_file), "--scheduler", "serial", "--no-progress", "--frames", "3",
+            "--seeds", "1", "2"]
+    assert main(argv) == 0
+    assert "6 rows in" in capsys.readouterr().out
+    assert sorted(set(load_results(tmp_path / "runs")["seed"])) == [1, 2]
+    assert (tmp_path / "data" / "sim_lan_1-3f-s2").is_dir()
+
+
 def test_failed_runs_exit_1(spec_file, capsys, monkeypatch):
     def broken(*args, **kwargs):
         raise RuntimeError("mapper crashed")
 
-    monkeypatch.setattr(sweep_runner, "run_mapper", broken)
+    monkeypatch.setattr(sweep_runner, "measure", broken)
     assert main(["sweep", str(spec_file), "--scheduler", "serial", "--no-progress"]) == 1
     out = capsys.readouterr().out
     assert "failed: sim_lan_1 quadtree {'max_points': 300}: RuntimeError: mapper crashed" in out
@@ -64,6 +73,7 @@ def test_failed_runs_exit_1(spec_file, capsys, monkeypatch):
     (["--frames", "0"], "frames=0: expected a positive integer"),
     (["--scheduler", "mars"], "--scheduler 'mars': expected serial"),
     (["--workers", "0"], "--workers 0: must be at least 1"),
+    (["--seeds", "-1"], "seeds=[-1]: expected a non-empty list of integers >= 0"),
 ])
 def test_bad_options_are_one_line_errors(spec_file, capsys, args, message):
     assert main(["sweep", str(spec_file), "--no-progress", *args]) == 2

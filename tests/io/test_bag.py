@@ -65,8 +65,8 @@ def test_scans_outside_poses_and_in_gaps_are_dropped_and_counted(ros, tmp_path):
                      max_gap_s=0.3)
     assert [f.stamp for f in fs.frames] == [int(10.1 * ros.NS), int(10.2 * ros.NS)]
     c = fs.counts
-    assert (c["scans_read"], c["scans_outside_poses"], c["scans_in_pose_gap"]) == (6, 1, 3)
-    assert c["frames"] == 2
+    assert (c.scans_read, c.scans_outside_poses, c.scans_in_pose_gap) == (6, 1, 3)
+    assert c.frames == 2
 
 
 def test_no_scan_in_pose_range_is_a_clock_error(ros, tmp_path):

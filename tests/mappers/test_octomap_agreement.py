@@ -1,8 +1,10 @@
-"""Native vs reference OctoMap on the simulated benchmark (mappers issue): sim_nav_1, 5 cells/m.
+"""Native vs reference OctoMap on the simulated benchmark mission: sim_nav_1, 5 cells/m.
 
 Frame by frame, same origins, thesis (MATLAB) sensor model, 100 m max range: the
-occupied voxel sets must have Jaccard >= 0.999 and the leaf counts differ by < 1 %.
-A reduced mission keeps the test to seconds; ``make bench`` runs the full one.
+occupied voxel sets must be identical (Jaccard 1.0) and so must the leaf counts.
+A reduced mission keeps the test to seconds; ``alte bench`` runs the full one. The
+scan kernels' paths (dense or hashed key sets, one thread or a pool) must give the
+very same key sets.
 """
 
 from __future__ import annotations
@@ -10,6 +12,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from alte.mappers import _scan
+from alte.mappers._blockset import WORDS
 from alte.mappers.octomap import compare_backends
 from alte.pipeline import open_input, prepare
 from alte.sim import ensure_terrain
@@ -18,9 +22,30 @@ from alte.sim import ensure_terrain
 @pytest.mark.slow
 def test_native_agrees_with_reference_on_sim_nav_1(tmp_path_factory):
     folder = ensure_terrain("sim_nav_1", tmp_path_factory.mktemp("data"), frames=12)
-    data = prepare(open_input(folder))
-    scans = [(np.array(f.points), f.origin) for f in data.frames()]
+    scans = [(np.array(f.points), f.origin) for f in prepare(open_input(folder)).frames()]
     result = compare_backends(scans, resolution=5.0, max_range=100.0)
-    assert result["jaccard"] >= 0.999, result
-    leaves = result["leaf_count_native"], result["leaf_count_reference"]
-    assert abs(leaves[0] - leaves[1]) < 0.01 * leaves[1], result
+    assert result["jaccard"] == 1.0, result
+    assert result["leaf_count_native"] == result["leaf_count_reference"] > 0, result
+
+
+def _sorted(blocks: np.ndarray, bits: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    order = np.argsort(blocks)
+    return blocks[order], bits[order]
+
+
+@pytest.mark.slow
+def test_dense_hashed_and_threaded_scans_give_the_same_keys(tmp_path_factory, monkeypatch):
+    folder = ensure_terrain("sim_nav_1", tmp_path_factory.mktemp("data"), frames=6)
+    for frame in prepare(open_input(folder)).frames():
+        points, origin = np.array(frame.points), frame.origin
+        args = (points.astype(np.float32), origin.astype(np.float32), 0.2, 100.0)
+        dense = _sorted(*_scan.scan_blocks(*args))
+        assert dense[0].size > 100 and (dense[1][:, :WORDS] & dense[1][:, WORDS:] == 0).all()
+        for threads in (2, 3):
+            threaded = _sorted(*_scan.scan_blocks(*args, threads=threads))
+            assert all(np.array_equal(a, b) for a, b in zip(dense, threaded, strict=True))
+        with monkeypatch.context() as patch:
+            patch.setattr(_scan, "DENSE_MAX_WORDS", 0)  # every scan takes the hashed path
+            for threads in (1, 2):
+                hashed = _sorted(*_scan.scan_blocks(*args, capacity=16, threads=threads))
+                assert all(np.array_equal(a, b) for a, b in zip(dense, hashed, strict=True))

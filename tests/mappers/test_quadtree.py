@@ -175,20 +175,20 @@ def test_bad_origin_and_fit_on_insert() -> None:
         Quadtree(ground="fit").build(np.zeros((2, 3)))
 
 
-@pytest.mark.parametrize("pending_min", [0, 50, 10**9])
-def test_pending_cells_fold_to_the_same_statistics(monkeypatch, pending_min) -> None:
-    """Whenever pending cells are folded, the map equals one folded after every frame."""
+@pytest.mark.parametrize(("first_capacity", "dense_cells"), [(1, 0), (50, 64), (1 << 22, 1 << 24)])
+def test_pending_cells_fold_to_the_same_statistics(monkeypatch, first_capacity,
+                                                   dense_cells) -> None:
+    """Folded after every frame or only at the end, whatever the storage growth and the
+    index (hashed, dense on coarse levels only, dense): same map."""
     pts = box_terrain(3000, seed=3)
     frames = np.array_split(pts[np.argsort(pts[:, 0])], 15)  # new cells on every frame
+    monkeypatch.setattr(levelstats, "_FIRST_CAPACITY", first_capacity)
+    monkeypatch.setattr(levelstats, "_DENSE_CELLS", dense_cells)
     eager = Quadtree(max_points=10, max_depth=7, domain=DOMAIN)
-    monkeypatch.setattr(levelstats, "_PENDING_MIN", 0)
-    monkeypatch.setattr(levelstats, "_PENDING_FRACTION", 0.0)
-    for frame in frames:
-        eager.insert(frame, np.zeros(3))
-    monkeypatch.setattr(levelstats, "_PENDING_MIN", pending_min)
-    monkeypatch.setattr(levelstats, "_PENDING_FRACTION", 0.25)
     lazy = Quadtree(max_points=10, max_depth=7, domain=DOMAIN)
     for frame in frames:
+        eager.insert(frame, np.zeros(3))
+        eager.cells()  # a reader folds the pending cells
         lazy.insert(frame, np.zeros(3))
     assert same_cells(eager.cells(), lazy.cells())
     assert lazy.memory_bytes == eager.memory_bytes

@@ -14,6 +14,7 @@ from alte.mappers.base import Cells
 from alte.metrics import (
     TrueSurface,
     cell_at_xy,
+    directed_distances,
     distance_to_boxes,
     free_space_truth,
     ground_truth_metrics,
@@ -43,6 +44,26 @@ def test_hausdorff_matches_brute_force(a, b):
     swapped = hausdorff(b, a)
     assert swapped.hd == pytest.approx(res.hd) and swapped.mhd == pytest.approx(res.mhd)
     assert swapped.h_ab == pytest.approx(res.h_ba) and swapped.mh_ab == pytest.approx(res.mh_ba)
+
+
+def test_distances_equal_open3d_and_scipy_to_the_last_bit():
+    """The KD-tree's nearest distances are open3d's (the benchmark peer) and scipy's."""
+    import open3d as o3d
+    from scipy.spatial import cKDTree
+
+    rng = np.random.default_rng(7)
+    a = rng.normal(0, 20, (20_000, 3))
+    b = np.round(rng.normal(0, 20, (6_000, 3)) / 0.2) * 0.2  # lattice corners, like a map's
+    for src, dst in ((a, b), (b, a)):
+        ours = directed_distances(src, dst)
+        cloud = o3d.geometry.PointCloud(o3d.utility.Vector3dVector(src))
+        peer = np.asarray(cloud.compute_point_cloud_distance(
+            o3d.geometry.PointCloud(o3d.utility.Vector3dVector(dst))))
+        assert np.array_equal(ours, peer)
+        assert np.array_equal(ours, cKDTree(dst).query(src, k=1)[0])
+    res = hausdorff(a, b)
+    assert res.h_ab == directed_distances(a, b).max()
+    assert res.mh_ba == directed_distances(b, a).mean()
 
 
 def test_hausdorff_zero_on_identical_sets():
@@ -90,6 +111,31 @@ def test_cell_at_xy_finds_containing_rectangle():
     sizes = np.array([[1.0, 1.0, 0.0], [1.0, 1.0, 0.0], [2.0, 2.0, 0.0]])
     xy = np.array([[0.2, 0.9], [1.9, 0.1], [0.1, 2.5], [5.0, 5.0]])
     np.testing.assert_array_equal(cell_at_xy(xy, centers, sizes), [0, 1, 2, -1])
+
+
+def test_cell_at_xy_matches_brute_force_on_a_quadtree():
+    """Leaves of a real 2D map (many sizes, edges shared) against a brute-force search."""
+    from alte.mappers import make_mapper
+
+    rng = np.random.default_rng(3)
+    pts = np.column_stack([rng.uniform(0, 32, 4000) ** 1.2 / 2, rng.uniform(0, 32, 4000),
+                           rng.normal(0, 1, 4000)])
+    tree = make_mapper("quadtree", {"max_points": 20})
+    tree.build(pts)
+    cells = tree.cells()
+    xy = np.vstack([rng.uniform(-2, 40, (3000, 2)),  # inside and outside the root
+                    cells.centers[:200, :2] + cells.sizes[:200, :2] / 2])  # on corners
+    lo = cells.centers[:, :2] - cells.sizes[:, :2] / 2
+    hi = cells.centers[:, :2] + cells.sizes[:, :2] / 2
+    inside = np.all((xy[:, None] >= lo[None] - 1e-9) & (xy[:, None] <= hi[None] + 1e-9), axis=2)
+    got = cell_at_xy(xy, cells.centers, cells.sizes)
+    assert np.array_equal(got >= 0, inside.any(axis=1))
+    assert inside[np.flatnonzero(got >= 0), got[got >= 0]].all()
+    # one cell alone: its four corners and edge midpoints are in it
+    box = np.array([[1.0, 1.0, 0.0]]), np.array([[2.0, 2.0, 0.0]])
+    rim = np.array([[0, 0], [2, 0], [0, 2], [2, 2], [1, 0], [2, 1], [1, 2], [0, 1]], float)
+    assert (cell_at_xy(rim, *box) == 0).all()
+    assert (cell_at_xy(rim + np.array([2.001, 0.0]), *box) == -1).all()
 
 
 def _scene() -> TrueSurface:

@@ -170,16 +170,16 @@ def test_register_merges_counts_and_matches_grid_average():
     cropped = [crop(t, box) for t in [*truth, truth[1][:10]]]
     np.testing.assert_allclose(reg.points, grid_average(np.vstack(cropped), 0.5), atol=1e-9)
     c = reg.counts
-    assert (c["frames_in"], c["frames_kept"]) == (9, 6)
-    assert (c["frames_dropped_rate"], c["frames_dropped_offset"], c["frames_dropped_empty"]) == (
+    assert (c.frames_in, c.frames_kept) == (9, 6)
+    assert (c.frames_dropped_rate, c.frames_dropped_offset, c.frames_dropped_empty) == (
         1, 1, 1)
-    assert c["points_in"] == 5 * 300 + 11
-    assert c["points_dropped_nonfinite"] == 1
-    assert c["points_dropped_crop"] == 5 * 300 + 10 - sum(len(p) for p in cropped)
-    assert c["points_out"] == len(reg.points)
+    assert c.points_in == 5 * 300 + 11
+    assert c.points_dropped_nonfinite == 1
+    assert c.points_dropped_crop == 5 * 300 + 10 - sum(len(p) for p in cropped)
+    assert c.points_out == len(reg.points)
     sizes = [len(grid_average(p, 0.5)) for p in cropped]
     np.testing.assert_array_equal(reg.frame_points, sizes)
-    assert c["points_registered"] == sum(sizes)
+    assert c.points_registered == sum(sizes)
     np.testing.assert_allclose(reg.origins[0], sensor_origin(frames[0], mount))
     np.testing.assert_array_equal(reg.stamps, [f.stamp for f in [*frames, nan_frame]])
 

@@ -6,6 +6,7 @@ import json
 from pathlib import Path
 
 import nbformat
+import pandas as pd
 import pytest
 
 GOOD_PARAMS = ('OUT_DIR = "reports/scratch/good"\nTABLES_DIR = "reports/scratch/tables"\n'
@@ -70,3 +71,68 @@ def write_plan(path: Path, entries: list[dict]) -> Path:
     """A JSON plan file for ``alte report --plan``."""
     path.write_text(json.dumps(entries))
     return path
+
+
+def _png(folder: Path, name: str) -> None:
+    """A small real PNG (browsers must be able to decode it)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from alte.notebook import save_figure
+
+    fig, ax = plt.subplots(figsize=(2, 1.5))
+    ax.plot([0, 1], [1, 0])
+    save_figure(fig, folder, name)
+    plt.close(fig)
+
+
+def make_front_run(run_dir: Path) -> dict:
+    """A finished run folder as the report writes it: two notebook runs (one failed), a
+    chapter 4 run with figures and results, chapter 5 with trade-off figures, the claims
+    table from a synthetic trade-off table, key and other tables. Returns its record."""
+    from support.tradeoff import Curve, synthetic_tradeoff
+
+    from alte.studies.claims import CLAIMS
+    from alte.studies.evidence import claims_table, evaluate_all
+    from alte.studies.tables import write_csv
+
+    tables = run_dir / "tables"
+    trade = synthetic_tradeoff({"alte2d": Curve(scale=0.5), "alte3d": Curve(scale=0.5)})
+    write_csv(claims_table(evaluate_all(CLAIMS[:12], trade)), tables, "claims")
+    write_csv(trade, tables, "tradeoff")
+    pd.DataFrame({"mapper": ["quadtree", "alte2d"], "params": ["max_points=150", "kappa=1"],
+                  "mhd_m": [0.618, 2.23], "thesis_mhd_m": [1.09, 0.85],
+                  "basis_functions": [1435, 232], "thesis_basis_functions": [4399, 220],
+                  "memory_bytes": [123, 456]}).to_csv(tables / "table_5_10.csv", index=False)
+    pd.DataFrame({"a": [1, 2], "b_m": [0.5, 0.25]}).to_csv(tables / "extra.csv", index=False)
+    pd.DataFrame({"case": ["lan", "lan"], "terrain": ["sim_lan_2"] * 2,
+                  "basis_functions": [1000, 1000], "mapper": ["quadtree", "alte2d"],
+                  "mhd_m": [0.61, 0.66], "ci_low_m": [0.6, 0.64], "ci_high_m": [0.62, 0.7],
+                  "seeds": [3, 3]}).to_csv(tables / "key_equal_size.csv", index=False)
+    pd.DataFrame({"id": [c.id for c in CLAIMS[:3]], "section": ["5.1"] * 3,
+                  "claim": [c.quote for c in CLAIMS[:3]], "base": ["holds"] * 3,
+                  "set_b_centers": ["holds", "does not hold", "holds"],
+                  "moves": ["", "set_b_centers", ""]}).to_csv(tables / "ablation.csv",
+                                                              index=False)
+    for name in ("terrain", "cloud", "mystery"):
+        _png(run_dir / "ch4_sim_lan_1", name)
+    for name in ("fig_5_2", "tradeoff_mhd", "equal_size_2d"):
+        _png(run_dir / "ch5_analysis", name)
+    (run_dir / "ch4_sim_lan_1" / "results.json").write_text(json.dumps(
+        {"terrain": "sim_lan_1", "frames": 40, "points": 120161, "rows": [0, 1, 2],
+         "maps": {"quadtree": {"params": {"max_points": 200}}},
+         "sites": [{"x": 1.0}], "table": "reports/x/tables/t.csv",
+         "captions": {"mystery": "A caption the notebook wrote itself."}}))
+    runs = [{"name": "ch4_sim_lan_1", "status": "ok", "seconds": 1.25,
+             "notebook": "ch4_sim_lan_1.ipynb", "html": "ch4_sim_lan_1.html", "error": None,
+             "parameters": {"TERRAIN": "sim_lan_1", "FRAMES": 40}},
+            {"name": "ch5_analysis", "status": "failed", "seconds": 0.5,
+             "notebook": "ch5_analysis.failed.ipynb", "html": "ch5_analysis.failed.html",
+             "error": "cell 2: ValueError: <boom>", "parameters": {}}]
+    for run in runs:
+        (run_dir / run["html"]).write_text("<!DOCTYPE html><title>nb</title>")
+        (run_dir / run["notebook"]).write_text("{}")
+    return {"mode": "quick", "started": "2024-01-01T00:00:00+00:00", "seconds": 2.0,
+            "runs": runs, "problems": ["terrain exp_lan_2: no data"]}

@@ -1,8 +1,9 @@
-"""HTML pages: nbconvert output, a run's index and the top index."""
+"""HTML pages: nbconvert output, a run's front page (templates) and the top index."""
 
 from __future__ import annotations
 
-import json
+from html.parser import HTMLParser
+from importlib.resources import files
 from pathlib import Path
 
 import pytest
@@ -10,7 +11,34 @@ import pytest
 from alte.errors import ReportError
 from alte.report.html import notebook_to_html, run_index_html, top_index_html
 
-from .conftest import BAD_BODY, BAD_PARAMS, make_notebook
+from .conftest import BAD_BODY, BAD_PARAMS, make_front_run, make_notebook
+
+
+class _Text(HTMLParser):
+    """Visible text of a page (not style or script) and every src/href."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.text: list[str] = []
+        self.links: list[str] = []
+        self._skip = 0
+
+    def handle_starttag(self, tag, attrs):
+        self._skip += tag in ("style", "script")
+        self.links += [v for k, v in attrs if k in ("src", "href") and v]
+
+    def handle_endtag(self, tag):
+        self._skip -= tag in ("style", "script")
+
+    def handle_data(self, data):
+        if not self._skip:
+            self.text.append(data)
+
+
+def _parse(page: str) -> _Text:
+    parser = _Text()
+    parser.feed(page)
+    return parser
 
 
 def test_notebook_to_html(tmp_path: Path) -> None:
@@ -28,39 +56,100 @@ def test_notebook_to_html_unreadable(tmp_path: Path) -> None:
     assert not (tmp_path / "x.html").exists()
 
 
-def _record() -> dict:
-    runs = [{"name": "good", "status": "ok", "seconds": 1.25, "notebook": "good.ipynb",
-             "html": "good.html", "error": None},
-            {"name": "bad", "status": "failed", "seconds": 0.5, "notebook": "bad.failed.ipynb",
-             "html": "bad.failed.html", "error": "cell 2: ValueError: <boom>"}]
-    return {"mode": "quick", "started": "2024-01-01T00:00:00+00:00", "seconds": 2.0,
-            "runs": runs, "problems": ["terrain exp_lan_2: no data"]}
+@pytest.fixture
+def front(tmp_path: Path) -> tuple[str, Path]:
+    record = make_front_run(tmp_path)
+    page = run_index_html(record, tmp_path, sorted((tmp_path / "tables").glob("*.csv")))
+    return page, tmp_path
 
 
-def test_run_index_html(tmp_path: Path) -> None:
-    (tmp_path / "good" / "figures").mkdir(parents=True)
-    (tmp_path / "good" / "figures" / "map.png").write_bytes(b"png")
-    (tmp_path / "good" / "results.json").write_text(json.dumps({"rmse": 0.125, "n": [1, 2]}))
-    (tmp_path / "tables").mkdir()
-    table = tmp_path / "tables" / "table_5_1.csv"
-    table.write_text("mapper,MHD\nquadtree,0.5\n")
-    page = run_index_html(_record(), tmp_path, [table])
-    failed_at = page.index("<b>Failed:</b>")
-    assert failed_at < page.index("<h2 id='good'")
-    assert "<a href='#bad'>bad</a>: failed" in page[failed_at:page.index("<h2 id='good'")]
+def test_front_page_order_claims_first_then_tradeoffs_tables_chapters(front) -> None:
+    page, _ = front
+    marks = ["<b>Failed:</b>", 'id="claims"', 'id="claims-table"', 'id="tradeoffs"',
+             'id="key-tables"', 'id="chapters"', 'id="tables"']
+    at = [page.index(m) for m in marks]
+    assert at == sorted(at)
+    assert '<a href="#ch5_analysis">ch5_analysis</a>: failed' in page
     assert "terrain exp_lan_2: no data" in page
-    assert "ValueError: &lt;boom&gt;" in page
-    assert "href='good.html'" in page and "href='bad.failed.ipynb'" in page
-    assert "src='good/figures/map.png'" in page
-    assert "<th>rmse</th><td>0.125</td>" in page and "[1, 2]" in page
-    assert "<td>quadtree</td>" in page and "href='tables/table_5_1.csv'" in page
-    assert "total wall time 2.0 s" in page and "<td>1.2</td>" in page
+    assert "cell 2: ValueError: &lt;boom&gt;" in page
+
+
+def test_claims_table_shows_quotes_verdicts_and_evidence(front) -> None:
+    page, _ = front
+    table = page[page.index('id="claims-table"'):page.index('id="tradeoffs"')]
+    assert table.count("<tr>") == 1 + 12
+    assert "<q>Adaptability: Quadtree Mid, 2D ALTE High</q>" in table
+    assert '<span class="verdict holds">holds</span>' in table
+    assert '<span class="verdict untested">not measurable</span>' in table
+    assert "<details><summary>numbers</summary>" in table and "95% percentile-bootstrap" in table
+
+
+def test_tradeoff_figures_and_key_tables_with_units_and_thesis_values(front) -> None:
+    page, _ = front
+    trade = page[page.index('id="tradeoffs"'):page.index('id="key-tables"')]
+    assert trade.index("ch5_analysis/figures/tradeoff_mhd.png") < trade.index(
+        "ch5_analysis/figures/equal_size_2d.png")
+    assert "<b>MHD against map size</b>" in trade and "Pareto front" in trade
+    keys = page[page.index('id="key-tables"'):page.index('id="chapters"')]
+    assert "Table 5.10: best 2D maps by the thesis&#39; rule" in keys
+    assert '<th colspan="2">MHD [m]</th>' in keys and '<th class="sub">thesis</th>' in keys
+    assert "<td>Quadtree</td>" in keys and "<td>1,435</td><td>4,399</td>" in keys
+    assert "memory" not in keys  # unpaired metrics stay in the CSV
+    assert 'href="tables/table_5_10.csv"' in keys
+
+
+def test_chapter_sections_caption_figures_and_show_only_scalar_results(front) -> None:
+    page, _ = front
+    chapters = page[page.index('id="chapters"'):page.index('id="tables"')]
+    assert "<h3>Chapter 4: terrain sim_lan_1</h3>" in chapters
+    assert '<h3 class="failed">Chapter 5: analysis</h3>' in chapters
+    assert chapters.index("figures/terrain.png") < chapters.index("figures/cloud.png")
+    assert "The simulated terrain sim_lan_1 and its control volume." in chapters
+    assert "A caption the notebook wrote itself." in chapters
+    assert 'href="ch4_sim_lan_1.html">executed notebook</a>' in chapters
+    assert "<dt>points</dt><dd>120,161</dd>" in chapters and "<dd>0, 1, 2</dd>" in chapters
+    results = chapters[chapters.index('<dl class="results">'):chapters.index("</dl>")]
+    assert "<dt>terrain</dt><dd>sim_lan_1</dd>" in results
+    assert "max_points" not in results and "sites" not in results and "table" not in results
+    assert "tradeoff_mhd" not in chapters  # shown once, in the trade-off section
+
+
+def test_no_raw_dicts_or_json_and_every_link_is_relative_and_exists(front) -> None:
+    page, run_dir = front
+    parsed = _parse(page)
+    text = "".join(parsed.text)
+    assert "{" not in text and "}" not in text and "': " not in text and '": ' not in text
+    local = [link for link in parsed.links if not link.startswith(("#", "../../"))]
+    assert local and all(not link.startswith(("/", "file:", "http")) for link in local)
+    missing = [link for link in local if not (run_dir / link).exists()]
+    assert not missing
+    other = page[page.index('id="tables"'):]
+    assert "extra.csv" in other and "b [m]" in other
+    assert "tradeoff.csv" in other and "Too long to show here" in other
+
+
+def test_run_without_claims_or_figures_says_so(tmp_path: Path) -> None:
+    record = {"mode": "full", "started": "x", "seconds": 1.0, "problems": [],
+              "runs": [{"name": "solo", "status": "ok", "seconds": 1.0}]}
+    page = run_index_html(record, tmp_path, [])
+    assert "This run has no claims table" in page
+    assert "This run made no trade-off figures." in page
+    assert "<h3>solo</h3>" in page
 
 
 def test_top_index_html() -> None:
-    finished = _record()
+    finished = {"mode": "quick", "runs": [{"status": "ok"}, {"status": "failed"}]}
     page = top_index_html([("runs/b", None), ("runs/a", finished)], "latest")
-    assert "url=latest/index.html" in page
-    assert "runs/b/index.html" in page and "interrupted (unfinished)" in page
-    assert "quick, 2 runs, 1 failed" in page
+    assert '<a href="latest/index.html"><b>Open the latest report</b></a>' in page
+    assert '<a href="runs/b/index.html">b</a>' in page and "interrupted (unfinished)" in page
+    assert "quick, 2 runs, 1 failed" in page and '<td class="failed">1</td>' in page
+    assert page.index("runs/b/index.html") < page.index("runs/a/index.html")
     assert "no finished report yet" in top_index_html([("runs/b", None)], None)
+
+
+def test_templates_ship_as_package_data() -> None:
+    folder = files("alte.report") / "templates"
+    assert {"base.html.j2", "macros.html.j2", "run.html.j2", "top.html.j2"} <= {
+        p.name for p in folder.iterdir()}
+    pyproject = Path(__file__).resolve().parents[2] / "pyproject.toml"
+    assert '"alte.report" = ["templates/*.j2"]' in pyproject.read_text()

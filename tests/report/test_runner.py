@@ -57,7 +57,7 @@ def test_record_and_index(two_reports: tuple[Path, Any, Any]) -> None:
     assert record["runs"][0]["parameters"]["OUT_DIR"] == str(first.run_dir / "good")
     assert record["runs"][0]["parameters"]["TABLES_DIR"] == str(first.run_dir / "tables")
     page = (first.run_dir / "index.html").read_text()
-    assert "<a href='#bad'>bad</a>: failed" in page and "table_5_1.csv" in page
+    assert '<a href="#bad">bad</a>: failed' in page and "table_5_1.csv" in page
 
 
 @pytest.mark.slow

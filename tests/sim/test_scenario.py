@@ -57,7 +57,7 @@ def test_cache_is_reused_only_when_spec_seed_and_files_match(tmp_path):
     assert (folder / "bag" / "bag.db3").stat().st_mtime_ns == stamp
     assert update_terrain("sim_lan_1", tmp_path, seed=1, frames=4)[1]  # other seed
     other, made = update_terrain("sim_lan_1", tmp_path, seed=1, frames=5)  # other mission
-    assert made and other == terrain_folder(tmp_path, "sim_lan_1", 5) != folder
+    assert made and other == terrain_folder(tmp_path, "sim_lan_1", 5, 1) != folder
     assert folder.is_dir()  # a reduced mission never replaces another one
     with open(other / "bag" / "bag.db3", "r+b") as fh:  # damaged after the fact
         fh.seek(200)

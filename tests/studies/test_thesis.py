@@ -5,6 +5,8 @@ from __future__ import annotations
 import pytest
 
 from alte.errors import ParameterError
+from alte.sim import TERRAINS
+from alte.sim.scenario import get_terrain
 from alte.studies.thesis import (
     CASE_MAPPERS,
     CH4_PARAMS,
@@ -18,7 +20,10 @@ from alte.studies.thesis import (
 
 
 def test_every_terrain_has_the_parameters_of_its_case():
-    for terrain, case in TERRAIN_CASE.items():
+    assert list(TERRAIN_CASE) == list(TERRAINS)
+    for terrain in TERRAINS:
+        case = get_terrain(terrain).spec.case
+        assert TERRAIN_CASE[terrain] == case
         assert set(CH4_PARAMS[terrain]) == set(CASE_MAPPERS[case])
     assert mapper_params("sim_lan_2")["quadtree"] == {"max_points": 25}
     assert mapper_params("exp_nav_1")["alte3d"] == {"max_res": 5, "min_pts": 5,

@@ -80,7 +80,7 @@ def map_obstacles(height: np.ndarray, grid: Grid, params: LandingParams,
     ``ground`` is a height (m); None fits the ground plane with MSAC (thesis 2.1.4)
     to the known pixels (at most 50 000 of them, drawn with a seeded generator).
     """
-    known = np.isfinite(height)
+    known: np.ndarray = np.isfinite(height)
     if ground is not None:
         return known & (np.abs(np.where(known, height, ground) - ground) > params.obstacle_height)
     if known.sum() < 3:
@@ -93,7 +93,9 @@ def map_obstacles(height: np.ndarray, grid: Grid, params: LandingParams,
                            reference_normal=np.array([0.0, 0.0, 1.0]), max_angle_deg=30.0)
     all_xy = grid.centers()
     above = (all_xy @ plane.normal[:2] + height.ravel() * plane.normal[2] + plane.d)
-    return known & (np.abs(np.nan_to_num(above.reshape(grid.shape))) > params.obstacle_height)
+    obstacles: np.ndarray = known & (np.abs(np.nan_to_num(above.reshape(grid.shape)))
+                                     > params.obstacle_height)
+    return obstacles
 
 
 def feasible_centres(height: np.ndarray, obstacle: np.ndarray, step: float,

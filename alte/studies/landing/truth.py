@@ -31,6 +31,7 @@ from alte.metrics import TrueSurface
 from alte.studies.landing.detect import Centres, Detection, feasible_centres
 from alte.studies.landing.params import LandingParams
 from alte.studies.landing.raster import Grid
+from alte.tensors import to_array, to_tensor
 
 __all__ = ["GROUND_CLASSES", "object_footprints", "score_detection", "top_surface",
            "truth_centres"]
@@ -62,7 +63,8 @@ def _square_overlaps(grid: Grid, rows: np.ndarray, cols: np.ndarray,
     reach = 0.5 * grid.step * np.abs(normals).sum(axis=1)
     proj = centers @ normals.T  # (pixels, axes)
     apart = (proj + reach < proj_hull.min(0)) | (proj - reach > proj_hull.max(0))
-    return ~apart.any(axis=1)
+    overlaps: np.ndarray = ~apart.any(axis=1)
+    return overlaps
 
 
 def object_footprints(surface: TrueSurface, grid: Grid, ids: np.ndarray) -> np.ndarray:
@@ -91,14 +93,13 @@ def top_surface(surface: TrueSurface, xy: np.ndarray, z_start: float,
     NaN height and id -1 where the ray hits nothing.
     """
     scene = o3d.t.geometry.RaycastingScene()
-    scene.add_triangles(o3d.core.Tensor(surface.vertices.astype(np.float32)),
-                        o3d.core.Tensor(surface.triangles.astype(np.uint32)))
+    scene.add_triangles(to_tensor(surface.vertices), to_tensor(surface.triangles, np.uint32))
     rays = np.zeros((len(xy), 6), dtype=np.float32)
     rays[:, :2], rays[:, 2], rays[:, 5] = xy, z_start, -1.0
-    hit = scene.cast_rays(o3d.core.Tensor(rays))
-    t_hit = hit["t_hit"].numpy().astype(np.float64)
+    hit = scene.cast_rays(to_tensor(rays))
+    t_hit = to_array(hit["t_hit"], np.float64)
     found = np.isfinite(t_hit)
-    prim = hit["primitive_ids"].numpy().astype(np.int64)
+    prim = to_array(hit["primitive_ids"], np.int64)
     ids = np.where(found, surface.object_ids[np.where(found, prim, 0)], -1)
     return np.where(found, z_start - t_hit, np.nan), ids
 

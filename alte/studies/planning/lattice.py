@@ -55,12 +55,13 @@ class Lattice:
                                  f"got {box.tolist()}")
         if not (np.isfinite(step) and step > 0):
             raise ParameterError(f"planning step={step!r} must be a positive number (m)")
-        shape = tuple(int(n) for n in np.floor((box[1] - box[0]) / step + 1e-9).astype(int) + 1)
+        nx, ny, nz = (int(n) for n in np.floor((box[1] - box[0]) / step + 1e-9).astype(int) + 1)
+        shape = (nx, ny, nz)
         if int(np.prod(shape)) > MAX_NODES:
             raise ParameterError(f"planning step={step} m gives {int(np.prod(shape))} lattice "
                                  f"nodes over {box.tolist()} (limit {MAX_NODES}); use a larger "
                                  "step or smaller bounds")
-        return cls(box[0].copy(), float(step), shape)  # type: ignore[arg-type]
+        return cls(box[0].copy(), float(step), shape)
 
     @property
     def size(self) -> int:
@@ -80,7 +81,8 @@ class Lattice:
     def node_points(self, indices: np.ndarray) -> np.ndarray:
         """Coordinates of the nodes with flat ``indices`` (M, 3)."""
         ijk = np.stack(np.unravel_index(np.asarray(indices, dtype=np.int64), self.shape), axis=1)
-        return self.origin + self.step * ijk
+        points: np.ndarray = self.origin + self.step * ijk
+        return points
 
     def nearest(self, point: object, name: str = "point") -> int:
         """Index of the node nearest to ``point``; raises when it lies outside the lattice."""

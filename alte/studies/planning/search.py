@@ -24,7 +24,7 @@ __all__ = ["OFFSETS", "PlanResult", "lattice_graph", "plan_path"]
 #: The 13 neighbour offsets with a positive first non-zero component (the other 13 are
 #: their opposites; the graph is undirected).
 OFFSETS: tuple[tuple[int, int, int], ...] = tuple(
-    off for off in itertools.product((-1, 0, 1), repeat=3) if off > (0, 0, 0))
+    (i, j, k) for i, j, k in itertools.product((-1, 0, 1), repeat=3) if (i, j, k) > (0, 0, 0))
 
 
 @dataclass(frozen=True, eq=False)
@@ -108,7 +108,9 @@ def plan_path(pmap: PlanningMap, start: object, goal: object, *, bounds: object,
     search_s, path = 0.0, np.empty((0, 3))
     if not status:
         t1 = time.perf_counter()
-        dist, pred = dijkstra(graph, directed=False, indices=s_node, return_predecessors=True)
+        # scipy-stubs accept only arrays as indices; scipy takes an int (1-D results).
+        dist, pred = dijkstra(graph, directed=False, indices=s_node,  # type: ignore[call-overload]
+                              return_predecessors=True)
         search_s = time.perf_counter() - t1
         status = "found" if np.isfinite(dist[g_node]) else "no_path"
         if status == "found":

@@ -82,7 +82,8 @@ def classify_ground(points: np.ndarray, surface: np.ndarray, tolerance: float) -
     if not (np.isfinite(tolerance) and tolerance >= 0):
         raise ParameterError(f"ground filter: tolerance={tolerance} must be >= 0 metres")
     with np.errstate(invalid="ignore"):
-        return np.abs(np.asarray(points)[:, 2] - surface) <= tolerance
+        ground: np.ndarray = np.abs(np.asarray(points)[:, 2] - surface) <= tolerance
+    return ground
 
 
 def ground_errors(predicted: np.ndarray, reference: np.ndarray) -> dict[str, float]:

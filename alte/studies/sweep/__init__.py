@@ -14,7 +14,14 @@ from alte.studies.sweep.analysis import (
     sensitivity_ranking,
     sensitivity_table,
 )
-from alte.studies.sweep.runner import SERIAL, SweepResult, override, run_one, run_sweep
+from alte.studies.sweep.runner import (
+    SERIAL,
+    SweepResult,
+    override,
+    run_one,
+    run_sweep,
+    variant_table,
+)
 from alte.studies.sweep.spec import (
     MapperGrid,
     SweepRun,
@@ -22,6 +29,7 @@ from alte.studies.sweep.spec import (
     load_spec,
     parse_spec,
     plan_runs,
+    plan_variants,
 )
 from alte.studies.sweep.store import (
     KEY_COLUMNS,
@@ -30,8 +38,10 @@ from alte.studies.sweep.store import (
     load_results,
     write_row,
 )
+from alte.studies.sweep.variants import BASE, Variant
 
 __all__ = [
+    "BASE",
     "KEY_COLUMNS",
     "SERIAL",
     "TIMING_COLUMNS",
@@ -39,6 +49,7 @@ __all__ = [
     "SweepResult",
     "SweepRun",
     "SweepSpec",
+    "Variant",
     "finished_ids",
     "load_results",
     "load_spec",
@@ -48,9 +59,11 @@ __all__ = [
     "param_columns",
     "parse_spec",
     "plan_runs",
+    "plan_variants",
     "run_one",
     "run_sweep",
     "sensitivity_ranking",
     "sensitivity_table",
+    "variant_table",
     "write_row",
 ]

@@ -1,10 +1,12 @@
 """Run a sweep serially or on Dask distributed, appending rows to a Parquet dataset.
 
 Data flows one way: spec -> runs (minus those already stored) -> terrains ensured
-(one task per distinct terrain, so no two workers simulate the same folder) -> one
-task per run on the workers (:func:`run_one`: load dataset, map, measure, return a
-flat row) -> the client writes each finished row to its own Parquet file. The
-client is the only writer; workers only read terrain folders.
+(one task per distinct terrain and seed: it simulates the folder if needed and
+registers it once into the cache ``DATA_DIR/.cache``, so no two workers simulate or
+register the same data) -> one task per run on the workers (:func:`run_one`: load the
+cached registration, map, measure, return a flat row) -> the client writes each
+finished row to its own Parquet file. The client is the only writer; workers only
+read terrain folders and the registration cache.
 """
 
 from __future__ import annotations
@@ -23,13 +25,13 @@ import pandas as pd
 from tqdm.auto import tqdm
 
 from alte.errors import ParameterError, SimulationError
-from alte.pipeline import FrameSpec, Registered, open_input, prepare
+from alte.pipeline import DomainPolicy, FrameSpec, MapSpec, Registered, open_input, prepare
 from alte.sim import ensure_terrain, terrain_folder
 from alte.studies.experiments import CACHE_DIR, measure
-from alte.studies.sweep.spec import SweepRun, SweepSpec, plan_runs
+from alte.studies.sweep.spec import SweepRun, SweepSpec, plan_runs, plan_variants
 from alte.studies.sweep.store import finished_ids, load_results, write_row
 
-__all__ = ["SERIAL", "SweepResult", "override", "run_one", "run_sweep"]
+__all__ = ["SERIAL", "SweepResult", "override", "run_one", "run_sweep", "variant_table"]
 
 #: How long to wait for a scheduler given by address.
 CONNECT_TIMEOUT = "10s"
@@ -67,25 +69,35 @@ def _dataset(folder: str, frames: int | None, voxel: float | None, data_dir: str
 
 
 def run_one(run: SweepRun, data_dir: str) -> dict[str, Any]:
-    """Map one run's terrain and return its flat row (keys, ``p_*`` params, metrics)."""
-    start = time.perf_counter()
+    """Map one run's terrain and return its flat row (keys, ``p_*`` params, metrics, and
+    its cost: ``wall_s`` and ``cpu_s``, the CPU seconds of every thread of the process,
+    which other load on the machine does not inflate)."""
+    start, cpu = time.perf_counter(), time.process_time()
     folder = terrain_folder(data_dir, run.terrain, run.frames, run.seed)
     data = _dataset(str(folder), run.frames, run.voxel, data_dir)
-    metrics = measure(data, run.mapper, run.params, truth=run.truth).metrics.flat()
+    spec = MapSpec(run.mapper, dict(run.params), domain=DomainPolicy(run.domain))
+    metrics = measure(data, run.mapper, truth=run.truth, spec=spec,
+                      set_b=run.set_b).metrics.flat()
     return {
         "run_id": run.run_id, "terrain": run.terrain, "frames_requested": run.frames or 0,
         "seed": run.seed, "mapper": run.mapper,
         "params_json": json.dumps(dict(run.params), sort_keys=True),
         **{f"p_{k}": v for k, v in run.params.items()},
+        "domain": run.domain, "set_b": run.set_b,
         "frames": len(data), "points": len(data.cloud),
         **{k: v for k, v in metrics.items() if k != "elapsed_s"},
         "elapsed_s": float(metrics["elapsed_s"]), "wall_s": time.perf_counter() - start,
+        "cpu_s": time.process_time() - cpu,
     }
 
 
-def _ensure(item: tuple[str, int | None, int], data_dir: str) -> str:
-    terrain, frames, seed = item
-    return str(ensure_terrain(terrain, data_dir, seed, frames))
+def _ensure(item: tuple[str, int | None, int, float | None], data_dir: str) -> str:
+    """Simulate the terrain if needed and register it into the cache (once per item)."""
+    terrain, frames, seed, voxel = item
+    folder = ensure_terrain(terrain, data_dir, seed, frames)
+    prepare(open_input(folder), FrameSpec(frames=frames, voxel=voxel),
+            cache=Path(data_dir) / CACHE_DIR)
+    return str(folder)
 
 
 def _serial_map(fn: Callable[..., Any], items: Sequence[Any], *args: Any) -> Iterator[Outcome]:
@@ -141,7 +153,7 @@ def _executor(scheduler: str, workers: int) -> Iterator[MapUnordered]:
 
 def _ensure_all(pool: MapUnordered, runs: Sequence[SweepRun], data_dir: str,
                 progress: bool) -> None:
-    items = sorted({(r.terrain, r.frames, r.seed) for r in runs}, key=str)
+    items = sorted({(r.terrain, r.frames, r.seed, r.voxel) for r in runs}, key=str)
     bar = tqdm(total=len(items), desc="terrains", unit="terrain", disable=not progress)
     with bar:
         for i, _, err in pool(_ensure, items, data_dir):
@@ -188,9 +200,24 @@ def run_sweep(spec: SweepSpec, *, scheduler: str = "local", workers: int = 2,
     return SweepResult(out, table, len(todo) - len(failed), len(runs) - len(todo), failed)
 
 
+def _seeds(changes: dict[str, Any]) -> None:
+    """Fold ``seed`` (one) into ``seeds`` (several) and check them."""
+    seed = changes.pop("seed", None)
+    if seed is not None:
+        changes["seeds"] = [seed]
+    seeds = changes.get("seeds")
+    if seeds is None:
+        return
+    if not isinstance(seeds, list | tuple) or not seeds or any(
+            isinstance(s, bool) or not isinstance(s, int) or s < 0 for s in seeds):
+        raise ParameterError(f"seeds={seeds!r}: expected a non-empty list of integers >= 0")
+    changes["seeds"] = tuple(dict.fromkeys(seeds))
+
+
 def override(spec: SweepSpec, **changes: Any) -> SweepSpec:
-    """``spec`` with other ``frames``/``data_dir``/``output``/``seed`` (CLI and notebook)."""
-    allowed = ("frames", "data_dir", "output", "seed")
+    """``spec`` with other ``frames``/``data_dir``/``output``/``seed``/``seeds`` (CLI and
+    notebook); ``None`` keeps the spec's value, except for ``frames`` (the whole mission)."""
+    allowed = ("frames", "data_dir", "output", "seed", "seeds")
     unknown = sorted(set(changes) - set(allowed))
     if unknown:
         raise ParameterError(f"sweep override {', '.join(unknown)}: valid: {', '.join(allowed)}")
@@ -198,5 +225,18 @@ def override(spec: SweepSpec, **changes: Any) -> SweepSpec:
     if frames is not None and (isinstance(frames, bool) or not isinstance(frames, int)
                                or frames < 1):
         raise ParameterError(f"frames={frames!r}: expected a positive integer or None")
+    _seeds(changes)
     return dataclasses.replace(spec, **{k: v for k, v in changes.items()
                                         if k == "frames" or v is not None})
+
+
+def variant_table(spec: SweepSpec, table: pd.DataFrame) -> pd.DataFrame:
+    """The rows of every variant of ``spec`` (base first) with a ``variant`` column: a run
+    several variants share appears once per variant. ``table``: :func:`run_sweep`'s."""
+    if table.empty:
+        return table.assign(variant=pd.Series(dtype=str))
+    rows = table.set_index("run_id", drop=False)
+    pairs = [(name, run.run_id) for name, run in plan_variants(spec) if run.run_id in rows.index]
+    out = rows.loc[[run_id for _, run_id in pairs]].reset_index(drop=True)
+    out.insert(1, "variant", [name for name, _ in pairs])
+    return out

@@ -1,8 +1,9 @@
 """Sweep specifications: a YAML grid of terrains x mappers x parameters, validated.
 
 A spec names terrains, the scans kept per terrain (``frames``), the simulation
-``seed``, where results go (``output``) and, per mapper, a ``grid`` of parameter
-lists (their cartesian product) and/or explicit ``rows``. Every run is a
+``seeds`` (or one ``seed``), where results go (``output``), per mapper a ``grid`` of
+parameter lists (their cartesian product) and/or explicit ``rows``, and optionally
+ablation ``variants`` (:mod:`alte.studies.sweep.variants`). Every run is a
 :class:`SweepRun` with a stable :attr:`SweepRun.run_id`: the sha256 of its canonical
 JSON, so a resumed sweep recognises runs it has already finished.
 """
@@ -23,11 +24,13 @@ from alte.errors import AlteError, ParameterError
 from alte.mappers import make_mapper
 from alte.metrics.maps import TruthOptions
 from alte.sim import TERRAINS
+from alte.studies.sweep.variants import Variant, parse_variants
 
-__all__ = ["MapperGrid", "SweepRun", "SweepSpec", "load_spec", "parse_spec", "plan_runs"]
+__all__ = ["MapperGrid", "SweepRun", "SweepSpec", "load_spec", "parse_spec", "plan_runs",
+           "plan_variants"]
 
-_TOP_KEYS = ("name", "terrains", "frames", "seed", "voxel", "data_dir", "output", "truth",
-             "mappers")
+_TOP_KEYS = ("name", "terrains", "frames", "seed", "seeds", "voxel", "data_dir", "output",
+             "truth", "mappers", "variants")
 _MAPPER_KEYS = ("grid", "rows", "terrains")
 _SCALARS = (bool, int, float, str)
 
@@ -43,12 +46,20 @@ class SweepRun:
     params: Mapping[str, Any]
     voxel: float | None = None
     truth: TruthOptions = field(default_factory=TruthOptions)
+    domain: str = "auto"
+    set_b: str = "corners"
 
     def key(self) -> dict[str, Any]:
-        """Everything that determines the run's result, JSON-ready."""
-        return {"terrain": self.terrain, "frames": self.frames, "seed": self.seed,
-                "mapper": self.mapper, "params": dict(sorted(self.params.items())),
-                "voxel": self.voxel, "truth": dataclasses.asdict(self.truth)}
+        """Everything that determines the run's result, JSON-ready (``domain`` and
+        ``set_b`` only when not the default, so earlier runs keep their ids)."""
+        key = {"terrain": self.terrain, "frames": self.frames, "seed": self.seed,
+               "mapper": self.mapper, "params": dict(sorted(self.params.items())),
+               "voxel": self.voxel, "truth": dataclasses.asdict(self.truth)}
+        if self.domain != "auto":
+            key["domain"] = self.domain
+        if self.set_b != "corners":
+            key["set_b"] = self.set_b
+        return key
 
     @property
     def run_id(self) -> str:
@@ -74,12 +85,13 @@ class SweepSpec:
     terrains: tuple[str, ...]
     mappers: tuple[MapperGrid, ...]
     frames: int | None = None
-    seed: int = 0
+    seeds: tuple[int, ...] = (0,)
     voxel: float | None = None
     data_dir: str = "data"
     output: str = ""
     truth: TruthOptions = field(default_factory=TruthOptions)
     source: str = "spec"
+    variants: tuple[Variant, ...] = ()
 
 
 def _fail(source: str, key: str, message: str) -> ParameterError:
@@ -117,15 +129,10 @@ def _truth(source: str, value: Any) -> TruthOptions:
         return TruthOptions()
     if not isinstance(value, Mapping):
         raise _fail(source, "truth", f"{value!r} must be a mapping")
-    valid = [f.name for f in dataclasses.fields(TruthOptions)]
-    _check_keys(source, "truth", value, valid)
     try:
-        opts = TruthOptions(**{k: type(getattr(TruthOptions(), k))(v) for k, v in value.items()})
-    except (TypeError, ValueError) as err:
-        raise _fail(source, "truth", str(err)) from err
-    if opts.tolerance <= 0 or opts.grid_step <= 0 or opts.n_samples < 1:
-        raise _fail(source, "truth", f"{value!r}: tolerance, grid_step and n_samples must be > 0")
-    return opts
+        return TruthOptions.parse({str(k): v for k, v in value.items()})
+    except ParameterError as err:  # the record's message names "truth" and the key
+        raise ParameterError(f"{source}: {err}") from err
 
 
 def _grid_rows(source: str, key: str, grid: Any) -> list[dict[str, Any]]:
@@ -180,6 +187,17 @@ def _optional_float(source: str, key: str, value: Any) -> float | None:
     return float(value)
 
 
+def _seeds(source: str, raw: Mapping[str, Any]) -> tuple[int, ...]:
+    if "seed" in raw and "seeds" in raw:
+        raise _fail(source, "seeds", "give either seed or seeds, not both")
+    if "seeds" not in raw:
+        return (int(_int(source, "seed", raw.get("seed", 0), 0) or 0),)
+    given = raw["seeds"]
+    if not isinstance(given, list) or not given:
+        raise _fail(source, "seeds", f"{given!r} must be a non-empty list of integers >= 0")
+    return tuple(dict.fromkeys(int(_int(source, "seeds", s, 0) or 0) for s in given))
+
+
 def parse_spec(raw: Any, source: str = "spec") -> SweepSpec:
     """Validate a spec mapping (as read from YAML); errors name ``source`` and the key."""
     if not isinstance(raw, Mapping):
@@ -192,16 +210,17 @@ def parse_spec(raw: Any, source: str = "spec") -> SweepSpec:
     if not isinstance(raw["mappers"], Mapping) or not raw["mappers"]:
         raise _fail(source, "mappers", "must map mapper names to their grids")
     name = str(raw.get("name") or Path(source).stem)
+    mappers = tuple(_mapper(source, str(m), body, terrains) for m, body in raw["mappers"].items())
     return SweepSpec(
-        name=name, terrains=terrains,
-        mappers=tuple(_mapper(source, str(m), body, terrains)
-                      for m, body in raw["mappers"].items()),
+        name=name, terrains=terrains, mappers=mappers,
         frames=_int(source, "frames", raw.get("frames"), 1, optional=True),
-        seed=int(_int(source, "seed", raw.get("seed", 0), 0) or 0),
+        seeds=_seeds(source, raw),
         voxel=_optional_float(source, "voxel", raw.get("voxel")),
         data_dir=str(raw.get("data_dir", "data")),
         output=str(raw.get("output") or f"reports/sweeps/{name}"),
-        truth=_truth(source, raw.get("truth")), source=source)
+        truth=_truth(source, raw.get("truth")), source=source,
+        variants=parse_variants(source, raw.get("variants"), terrains,
+                                tuple(g.mapper for g in mappers)))
 
 
 def load_spec(path: str | os.PathLike[str]) -> SweepSpec:
@@ -218,15 +237,33 @@ def load_spec(path: str | os.PathLike[str]) -> SweepSpec:
     return parse_spec(raw, str(path))
 
 
+def _variant_runs(spec: SweepSpec, variant: Variant) -> list[SweepRun]:
+    """The runs of one variant in grid order (seed, terrain, mapper, row)."""
+    terrains = variant.terrains or spec.terrains
+    return [SweepRun(terrain, spec.frames, seed, grid.mapper,
+                     variant.params_for(grid.mapper, params), spec.voxel, spec.truth,
+                     variant.domain_for(grid.mapper), variant.set_b_for(grid.mapper))
+            for seed in spec.seeds for terrain in spec.terrains if terrain in terrains
+            for grid in spec.mappers if terrain in grid.terrains for params in grid.rows]
+
+
+def plan_variants(spec: SweepSpec) -> list[tuple[str, SweepRun]]:
+    """(variant name, run) for the base grid, then every variant, in grid order; a run
+    that several variants share (module :mod:`~alte.studies.sweep.variants`) appears
+    under each, a row listed twice within one variant once."""
+    out: list[tuple[str, SweepRun]] = []
+    for variant in (Variant(), *spec.variants):
+        seen: set[str] = set()
+        for run in _variant_runs(spec, variant):
+            if run.run_id not in seen:
+                seen.add(run.run_id)
+                out.append((variant.name, run))
+    return out
+
+
 def plan_runs(spec: SweepSpec) -> list[SweepRun]:
-    """Every run of ``spec`` in grid order (terrain, mapper, row), duplicates dropped."""
+    """Every distinct run of ``spec`` (base grid first, then the variants' own runs)."""
     runs: dict[str, SweepRun] = {}
-    for terrain in spec.terrains:
-        for grid in spec.mappers:
-            if terrain not in grid.terrains:
-                continue
-            for params in grid.rows:
-                run = SweepRun(terrain, spec.frames, spec.seed, grid.mapper, params,
-                               spec.voxel, spec.truth)
-                runs.setdefault(run.run_id, run)
+    for _, run in plan_variants(spec):
+        runs.setdefault(run.run_id, run)
     return list(runs.values())

@@ -24,8 +24,8 @@ __all__ = ["KEY_COLUMNS", "TIMING_COLUMNS", "finished_ids", "load_results", "wri
 
 #: Columns identifying a run (then ``p_<param>`` columns, then the metrics).
 KEY_COLUMNS = ("run_id", "terrain", "frames_requested", "seed", "mapper", "params_json")
-#: Wall-clock columns: the only ones that differ between repeated runs.
-TIMING_COLUMNS = ("elapsed_s", "wall_s")
+#: Timing columns: the only ones that differ between repeated runs.
+TIMING_COLUMNS = ("elapsed_s", "wall_s", "cpu_s")
 
 _PREFIX, _SUFFIX = "run-", ".parquet"
 
@@ -82,7 +82,7 @@ def load_results(out: str | os.PathLike[str], order: Iterable[str] | None = None
     if not files:
         return pd.DataFrame(columns=list(KEY_COLUMNS))
     table = pa.concat_tables([_read(p) for p in files], promote_options="permissive")
-    frame = table.to_pandas(types_mapper={pa.int64(): pd.Int64Dtype()}.get)
+    frame: pd.DataFrame = table.to_pandas(types_mapper={pa.int64(): pd.Int64Dtype()}.get)
     frame = frame[_ordered_columns(frame.columns)]
     if order is None:
         return frame.sort_values("run_id", kind="stable").reset_index(drop=True)

@@ -16,6 +16,7 @@ from matplotlib.collections import EllipseCollection
 from alte.errors import AlteError, MetricsError, ParameterError
 from alte.mappers.base import Cells
 from alte.metrics import TrueSurface
+from alte.pipeline import InputKind
 from alte.plot.landing import plot_landing_runs
 from alte.sim import SceneBuilder
 from alte.studies.landing import (
@@ -58,13 +59,13 @@ def _box_edge_distance(xy: np.ndarray, lo: float, hi: float) -> np.ndarray:
 
 # -- parameters ---------------------------------------------------------------------------
 @pytest.mark.parametrize(("field", "value", "match"), [
-    ("radius", 0.0, "radius=0.0: expected radius > 0"),
+    ("radius", 0.0, r"landing: radius=0.0 out of range \(radius > 0\)"),
     ("margin", -0.1, "margin=-0.1"),
     ("max_slope_deg", 90.0, "max_slope_deg"),
-    ("max_roughness", float("nan"), "max_roughness=nan: must be finite"),
-    ("step", 2.0, "step=2.0: expected 0 < step <= radius"),
-    ("max_sites", 1.5, "max_sites=1.5: expected an integer"),
-    ("clearance", "1", "clearance='1': expected a number"),
+    ("max_roughness", float("nan"), "max_roughness=nan must be finite"),
+    ("step", 2.0, r"step=2.0 out of range \(0 < step <= radius\)"),
+    ("max_sites", 1.5, "max_sites=1.5 must be an integer"),
+    ("clearance", "wide", "clearance='wide' is not a valid float"),
 ])
 def test_landing_params_are_validated(field, value, match):
     with pytest.raises(ParameterError, match=match):
@@ -75,7 +76,8 @@ def test_presets_per_terrain_and_overrides():
     sim, lab = landing_params("sim_lan_1"), landing_params("exp_lan_2", clearance=0.3)
     assert sim.radius == 1.0 and sim.keep_out == 2.0 and sim.disk == 1.5
     assert lab.radius < sim.radius and lab.clearance == 0.3 and lab.step < sim.step
-    with pytest.raises(ParameterError, match="unknown landing parameter wingspan"):
+    with pytest.raises(ParameterError,
+                       match=r"landing: unknown parameter\(s\) wingspan; valid: clearance"):
         landing_params("sim_lan_1", wingspan=2.0)
 
 
@@ -276,7 +278,8 @@ def test_ground_truth_scoring_on_a_tiny_simulated_terrain(tiny_lan):
 
 def test_without_ground_truth_only_detection_is_reported(tiny_lan):
     params = landing_params("sim_lan_1", step=0.5)
-    real = dataclasses.replace(tiny_lan, surface=None)
+    real = dataclasses.replace(tiny_lan, source=dataclasses.replace(tiny_lan.source,
+                                                               kind=InputKind.BAG))
     run = evaluate_landing(real, "quadtree", {"max_points": 200}, params)
     assert run.truth is None and set(run.scores) == {"sites", "chosen"}
     assert run.scores["sites"] >= 1

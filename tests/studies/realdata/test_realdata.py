@@ -219,13 +219,14 @@ def test_octomap_scan_and_vlp16_bag_are_mapped() -> None:
                "alte3d": {"max_res": 6, "min_pts": 5, "min_pts_split": 10,
                           "occupancy_level": 6}}
     vlp = realdata.vlp16_dataset(data)
-    assert vlp.info["frames"] == 4 and vlp.info["points"] == vlp.info["raw_points"] > 40_000
-    assert realdata.vlp16_dataset(data, frames=2).info["frames"] == 2
+    info = realdata.dataset_summary(vlp)
+    assert info["frames"] == 4 and info["points"] == info["raw_points"] > 40_000
+    assert len(realdata.vlp16_dataset(data, frames=2)) == 2
     table = realdata.map_table(realdata.map_runs(vlp, mappers, progress=False))
     assert table["mapper"].tolist() == ["octomap", "alte3d"]
     assert (table["basis_functions"] > table["occupied_cells"]).all()
     assert (table["occupied_cells"] > 0).all() and (table["memory_bytes"] > 0).all()
     assert (table["hd_m"] >= table["mhd_m"]).all() and (table["mhd_m"] < 0.5).all()
     scan = realdata.scan_dataset(data)
-    assert len(scan.cloud) == 88206 and scan.frames[0][1].tolist() == [0, 0, 0]
-    assert (scan.bounds[0] < scan.cloud.min(axis=0)).all()
+    assert len(scan.cloud) == 88206 and scan.frame(0).origin.tolist() == [0, 0, 0]
+    np.testing.assert_array_equal(scan.bounds().lo, scan.cloud.min(axis=0))

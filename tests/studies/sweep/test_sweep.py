@@ -103,11 +103,15 @@ def test_load_spec_reads_yaml(tmp_path):
     (_raw(frames=0), "frames: 0 must be an integer >= 1 or null"),
     (_raw(frames=True), "frames: True must be an integer"),
     (_raw(seed=-1), "seed: -1 must be an integer >= 0"),
+    (_raw(seeds=[0, -2]), "seeds: -2 must be an integer >= 0"),
+    (_raw(seeds=[]), r"seeds: \[\] must be a non-empty list"),
+    (_raw(seeds=3), "seeds: 3 must be a non-empty list"),
+    (_raw(seed=1, seeds=[1]), "seeds: give either seed or seeds, not both"),
     (_raw(voxel=-0.1), "voxel: -0.1 must be a positive number"),
     (_raw(truth=3), "truth: 3 must be a mapping"),
-    (_raw(truth={"samples": 3}), r"truth: unknown key\(s\) samples"),
-    (_raw(truth={"tolerance": 0}), "truth: .* must be > 0"),
-    (_raw(truth={"n_samples": "many"}), "truth: invalid literal"),
+    (_raw(truth={"samples": 3}), r"truth: unknown parameter\(s\) samples; valid: grid_step"),
+    (_raw(truth={"tolerance": 0}), r"truth: tolerance=0.0 out of range \(tolerance > 0\)"),
+    (_raw(truth={"n_samples": "many"}), "truth: n_samples='many' is not a valid int"),
 ])
 def test_bad_specs_name_the_key(raw, match):
     with pytest.raises(ParameterError, match=match):
@@ -133,6 +137,12 @@ def test_override():
         override(spec, frames=0)
     with pytest.raises(ParameterError, match="sweep override colour"):
         override(spec, colour=1)
+    assert override(spec, seed=3).seeds == (3,)
+    assert override(spec, seeds=[2, 1, 2], seed=None).seeds == (2, 1)
+    assert override(spec, seeds=None).seeds == spec.seeds == (0,)
+    for bad in ([], [-1], [True], "0"):
+        with pytest.raises(ParameterError, match=r"seeds=.*: expected a non-empty list"):
+            override(spec, seeds=bad)
 
 
 # -- store -------------------------------------------------------------------------------------
@@ -176,7 +186,8 @@ def test_serial_sweep_writes_rows_and_resumes(spec, tmp_path):
     assert table["frames"].eq(4).all() and table["frames_requested"].eq(4).all()
     assert table[["hd_m", "mhd_m", "basis_functions", "completeness"]].notna().all().all()
     assert (table["elapsed_s"] > 0).all() and (table["wall_s"] >= table["elapsed_s"]).all()
-    assert list(table.columns[-2:]) == list(TIMING_COLUMNS)
+    assert list(table.columns[-3:]) == list(TIMING_COLUMNS)
+    assert (table["cpu_s"] > 0).all()
     # max_res 4 refines more than max_res 3: more basis functions
     assert table["basis_functions"][1] > table["basis_functions"][0]
     again = run_sweep(spec, scheduler="none", output=out, progress=False)
@@ -190,19 +201,19 @@ def test_serial_sweep_writes_rows_and_resumes(spec, tmp_path):
 
 
 def test_failed_runs_are_reported_not_written_and_retried(spec, tmp_path, monkeypatch):
-    real = sweep_runner.run_mapper
+    real = sweep_runner.measure
 
-    def flaky(data, name, params, **kw):
+    def flaky(data, name, params=None, **kw):
         if name == "quadtree":
             raise MemoryError("boom")
         return real(data, name, params, **kw)
 
-    monkeypatch.setattr(sweep_runner, "run_mapper", flaky)
+    monkeypatch.setattr(sweep_runner, "measure", flaky)
     result = run_sweep(spec, scheduler="serial", output=tmp_path, progress=False)
     assert result.ran == 4 and len(result.table) == 4
     assert [(r.mapper, msg) for r, msg in result.failed] == [("quadtree", "MemoryError: boom")] * 2
     assert result.summary()["failed"][0]["params"] == {"max_points": 100}
-    monkeypatch.setattr(sweep_runner, "run_mapper", real)
+    monkeypatch.setattr(sweep_runner, "measure", real)
     retry = run_sweep(spec, scheduler="serial", output=tmp_path, progress=False)
     assert (retry.ran, retry.skipped, retry.failed) == (2, 4, [])
 

@@ -1,0 +1,121 @@
+"""Sets of voxel keys as 8x8x8 bit blocks: the per-scan key set of the native Octomap.
+
+A block is named by its Morton code (key >> 9) and holds 16 words: 8 of *free* bits,
+then 8 of *occupied* bits, bit ``i`` of the 512 being the voxel whose local Morton
+index (key & 511) is ``i``. An open-addressing hash table maps a block code to its row.
+A table is the tuple ``(slots, rows, bits, blocks)``; rows are added in arrival order.
+"""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+
+#: A block set: hash slots, their rows, bit rows (free, occupied) and block ids.
+Table = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+
+__all__ = ["EMPTY", "LOCAL", "WORDS", "find_slot", "keys_to_blocks", "new_table", "rehash",
+           "reserve", "row_of", "set_bit", "union"]
+
+EMPTY = np.uint64(0xFFFFFFFFFFFFFFFF)
+_GOLDEN = np.uint64(0x9E3779B97F4A7C15)
+#: Position of an axis' 3 low key bits in a block's 9-bit local Morton index (x; y and
+#: z are shifted left by 1 and 2).
+LOCAL = np.array([0, 1, 8, 9, 64, 65, 72, 73], dtype=np.int64)
+#: Words of free bits in a row; the occupied bits follow.
+WORDS = 8
+
+
+@numba.njit(cache=True, inline="always")
+def find_slot(slots: np.ndarray, block: np.uint64) -> int:
+    """Slot of ``block`` in an open-addressing table, or of the empty slot where it belongs."""
+    mask = np.uint64(slots.size - 1)
+    j = ((block * _GOLDEN) >> np.uint64(32)) & mask
+    while slots[j] != block and slots[j] != EMPTY:
+        j = (j + np.uint64(1)) & mask
+    return int(j)
+
+
+@numba.njit(cache=True)
+def rehash(slots: np.ndarray, blocks: np.ndarray, n_blocks: int,
+           size: int) -> tuple[np.ndarray, np.ndarray]:
+    """Hash table of ``size`` slots (a power of two) holding the first ``n_blocks`` blocks."""
+    new_slots = np.full(size, EMPTY, dtype=np.uint64)
+    new_rows = np.zeros(size, dtype=np.int64)
+    for r in range(n_blocks):
+        j = find_slot(new_slots, blocks[r])
+        new_slots[j] = blocks[r]
+        new_rows[j] = r
+    return new_slots, new_rows
+
+
+@numba.njit(cache=True)
+def new_table(capacity: int) -> Table:
+    """An empty table with room for ``capacity`` blocks."""
+    capacity = max(capacity, 16)
+    size = 1 << int(np.ceil(np.log2(2 * capacity)))
+    return (np.full(size, EMPTY, dtype=np.uint64), np.zeros(size, dtype=np.int64),
+            np.zeros((capacity, 2 * WORDS), dtype=np.uint64), np.zeros(capacity, dtype=np.uint64))
+
+
+@numba.njit(cache=True)
+def reserve(table: Table, n_blocks: int, need: int) -> Table:
+    """``table`` with room for ``need`` more blocks (rows doubled, hash kept half empty)."""
+    slots, rows, bits, blocks = table
+    if n_blocks + need > blocks.size:
+        cap = max(2 * blocks.size, n_blocks + need)
+        grown = np.zeros((cap, 2 * WORDS), dtype=np.uint64)
+        grown[:n_blocks] = bits[:n_blocks]
+        grown_blocks = np.zeros(cap, dtype=np.uint64)
+        grown_blocks[:n_blocks] = blocks[:n_blocks]
+        bits, blocks = grown, grown_blocks
+    if 2 * (n_blocks + need) > slots.size:
+        size = slots.size
+        while 2 * (n_blocks + need) > size:
+            size *= 2
+        slots, rows = rehash(slots, blocks, n_blocks, size)
+    return slots, rows, bits, blocks
+
+
+@numba.njit(cache=True, inline="always")
+def row_of(table: Table, block: np.uint64, n_blocks: int) -> tuple[int, int]:
+    """Row of ``block`` (added if new; room reserved by the caller); returns (row, n_blocks)."""
+    slots, rows, _, blocks = table
+    j = find_slot(slots, block)
+    if slots[j] == EMPTY:
+        slots[j] = block
+        rows[j] = n_blocks
+        blocks[n_blocks] = block
+        n_blocks += 1
+    return rows[j], n_blocks
+
+
+@numba.njit(cache=True, inline="always")
+def set_bit(bits: np.ndarray, row: int, word0: int, key: np.ndarray) -> None:
+    """Set the bit of ``key`` (kx, ky, kz) in its block's row, in the words from ``word0``."""
+    local = LOCAL[key[0] & 7] | (LOCAL[key[1] & 7] << 1) | (LOCAL[key[2] & 7] << 2)
+    bits[row, word0 + (local >> 6)] |= np.uint64(1) << np.uint64(local & 63)
+
+
+@numba.njit(cache=True)
+def keys_to_blocks(keys: np.ndarray, word0: int) -> tuple[np.ndarray, np.ndarray]:
+    """Blocks and bit rows of Morton ``keys``, set in the words from ``word0``."""
+    table = reserve(new_table(keys.size // 64), 0, keys.size)
+    n_blocks = 0
+    for key in keys:
+        row, n_blocks = row_of(table, key >> np.uint64(9), n_blocks)
+        local = key & np.uint64(511)
+        table[2][row, word0 + (local >> np.uint64(6))] |= np.uint64(1) << (local & np.uint64(63))
+    return table[3][:n_blocks], table[2][:n_blocks]
+
+
+@numba.njit(cache=True)
+def union(blocks: np.ndarray, bits: np.ndarray, capacity: int) -> tuple[Table, int]:
+    """Table of the rows ``bits`` (block codes ``blocks``, repeats OR-ed); (table, n_blocks)."""
+    table = reserve(new_table(capacity), 0, blocks.size)
+    n_blocks = 0
+    for r in range(blocks.size):
+        row, n_blocks = row_of(table, blocks[r], n_blocks)
+        for w in range(2 * WORDS):
+            table[2][row, w] |= bits[r, w]
+    return table, n_blocks

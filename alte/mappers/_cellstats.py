@@ -1,0 +1,259 @@
+"""Numba kernels of :class:`alte.mappers.levelstats.LevelStats`: sorting, aggregation, merges.
+
+The sums reproduce numpy's, bit for bit, so that a statistic does not depend on
+which kernel computed it: :func:`aggregate_points` sums every run of points as
+``np.add.reduceat`` does (first element plus numpy's pairwise sum of the rest) and
+:func:`combine` / :func:`merge_cells` keep the formulas (and evaluation order) of the
+former numpy code: Chan's parallel mean and ``M2`` update.
+
+A level's *index* finds a cell's storage row from its key without keeping the keys
+sorted. Where the level has few enough cells (``4**level``) it is *dense*: int32
+``row + 1`` at the key itself (0 = absent), one memory access per lookup, and the
+sorted keys of a frame read it in address order; deeper levels use an open-addressing
+table of ``key, row`` pairs (int64, key -1 = empty), key and row in one cache line.
+"""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+
+__all__ = ["aggregate_points", "combine", "fill_index", "merge_cells", "sort_keys"]
+
+_GOLDEN = np.uint64(0x9E3779B97F4A7C15)
+#: Below this many keys numba's merge sort beats the radix passes' fixed cost.
+_RADIX_MIN = 1 << 14
+
+
+@numba.njit(cache=True)
+def sort_keys(keys: np.ndarray, bits: int) -> tuple[np.ndarray, np.ndarray]:
+    """Stably sorted non-negative int64 ``keys`` below ``2**bits`` and their order (LSD
+    radix sort of key and index together, digits of at most 12 bits counted in one
+    pass; numba's merge sort for short arrays)."""
+    n = keys.size
+    if n < _RADIX_MIN:
+        order = np.argsort(keys, kind="mergesort")
+        return keys[order], order
+    passes = max(1, -(-bits // 12))
+    width = -(-max(bits, 1) // passes)
+    mask = (1 << width) - 1
+    count = np.zeros((passes, (1 << width) + 1), dtype=np.int64)
+    for i in range(n):
+        for p in range(passes):
+            count[p, ((keys[i] >> (p * width)) & mask) + 1] += 1
+    src_k, src_o = keys.copy(), np.arange(n)
+    dst_k, dst_o = np.empty(n, dtype=np.int64), np.empty(n, dtype=np.int64)
+    for p in range(passes):
+        at = count[p]
+        for d in range(1 << width):
+            at[d + 1] += at[d]
+        for i in range(n):
+            d = (src_k[i] >> (p * width)) & mask
+            dst_k[at[d]], dst_o[at[d]] = src_k[i], src_o[i]
+            at[d] += 1
+        src_k, dst_k, src_o, dst_o = dst_k, src_k, dst_o, src_o
+    return src_k, src_o
+
+
+@numba.njit(cache=True)
+def _pairwise(x: np.ndarray, j: int, a: int, n: int) -> float:
+    """numpy's pairwise sum of ``x[a:a + n, j]`` (8 accumulators, blocks of 128)."""
+    if n < 8:
+        res = -0.0
+        for i in range(a, a + n):
+            res += x[i, j]
+        return float(res)
+    if n <= 128:
+        r = x[a:a + 8, j].copy()
+        m = n - n % 8
+        for i in range(8, m, 8):
+            for q in range(8):
+                r[q] += x[a + i + q, j]
+        res = ((r[0] + r[1]) + (r[2] + r[3])) + ((r[4] + r[5]) + (r[6] + r[7]))
+        for i in range(m, n):
+            res += x[a + i, j]
+        return float(res)
+    half = n // 2
+    half -= half % 8
+    return _pairwise(x, j, a, half) + _pairwise(x, j, a + half, n - half)
+
+
+@numba.njit(cache=True, inline="always")
+def _run_total(x: np.ndarray, j: int, a: int, b: int) -> float:
+    """``np.add.reduceat`` of the run ``x[a:b, j]``."""
+    return float(x[a, j] + _pairwise(x, j, a + 1, b - a - 1) if b - a > 1 else x[a, j])
+
+
+@numba.njit(cache=True)
+def _run_starts(keys: np.ndarray, shift: int) -> np.ndarray:
+    """Start index of every run of equal ``keys >> shift`` in sorted ``keys``, then ``n``."""
+    n = keys.size
+    runs = 0
+    for i in range(n):
+        runs += i == 0 or (keys[i] >> shift) != (keys[i - 1] >> shift)
+    starts = np.empty(runs + 1, dtype=np.int64)
+    s = 0
+    for i in range(n):
+        if i == 0 or (keys[i] >> shift) != (keys[i - 1] >> shift):
+            starts[s] = i
+            s += 1
+    starts[runs] = n
+    return starts
+
+
+@numba.njit(cache=True, inline="always")
+def _cell_row(values: np.ndarray, run: tuple[int, int], out: np.ndarray, s: int,
+              dev: np.ndarray) -> None:
+    """Row ``s`` of ``out``: ``n, mean.., m2.., max..`` of the points ``values[a:b]``,
+    ``run = (a, b)`` (``np.add.reduceat``'s sums; ``dev``: scratch of the values' shape)."""
+    a, b = run
+    nv = values.shape[1]
+    out[s, 0] = count = np.float64(b - a)
+    for j in range(nv):
+        if b - a == 1:  # one point: the general formulas reduce to these
+            mean = values[a, j] / count
+            d = values[a, j] - mean
+            out[s, 1 + j], out[s, 1 + nv + j] = mean, d * d
+            out[s, 1 + 2 * nv + j] = values[a, j]
+            continue
+        mean = _run_total(values, j, a, b) / count
+        top = values[a, j]
+        for i in range(a, b):
+            d = values[i, j] - mean
+            dev[i, j] = d * d
+            top = max(top, values[i, j])
+        out[s, 1 + j], out[s, 1 + 2 * nv + j] = mean, top
+        out[s, 1 + nv + j] = _run_total(dev, j, a, b)
+
+
+@numba.njit(cache=True)
+def aggregate_points(keys: np.ndarray, values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Cells of sorted point ``keys`` and their rows ``n, mean.., m2.., max..``."""
+    starts = _run_starts(keys, 0)
+    out = np.empty((starts.size - 1, 1 + 3 * values.shape[1]))
+    cells = np.empty(starts.size - 1, dtype=np.int64)
+    dev = np.empty(values.shape)
+    for s in range(starts.size - 1):
+        cells[s] = keys[starts[s]]
+        _cell_row(values, (starts[s], starts[s + 1]), out, s, dev)
+    return cells, out
+
+
+@numba.njit(cache=True, inline="always")
+def _run_sum(x: np.ndarray, m: int) -> float:
+    """``x[0] + (x[1] + ... + x[m-1])``: the order of ``np.add.reduceat`` on short runs."""
+    if m == 1:
+        return float(x[0])
+    rest = x[1]
+    for i in range(2, m):
+        rest += x[i]
+    return float(x[0] + rest)
+
+
+@numba.njit(cache=True, inline="always")
+def _parent_row(rows: np.ndarray, run: tuple[int, int], out: np.ndarray, s: int,
+                term: np.ndarray) -> None:
+    """Row ``s`` of ``out``: Chan's merge of the (at most 4) child rows ``rows[a:b]``,
+    ``run = (a, b)``; ``term`` is scratch of 4 values."""
+    a, b = run
+    nv = (rows.shape[1] - 1) // 3
+    m = b - a
+    for i in range(m):
+        term[i] = rows[a + i, 0]
+    out[s, 0] = count = _run_sum(term, m)
+    for j in range(nv):
+        for i in range(m):
+            term[i] = rows[a + i, 0] * rows[a + i, 1 + j]
+        out[s, 1 + j] = mean = _run_sum(term, m) / count
+        top = rows[a, 1 + 2 * nv + j]
+        for i in range(m):
+            dev = rows[a + i, 1 + j] - mean
+            term[i] = rows[a + i, 1 + nv + j] + rows[a + i, 0] * dev * dev
+            top = max(top, rows[a + i, 1 + 2 * nv + j])
+        out[s, 1 + nv + j] = _run_sum(term, m)
+        out[s, 1 + 2 * nv + j] = top
+
+
+@numba.njit(cache=True)
+def combine(keys: np.ndarray, rows: np.ndarray, nv: int) -> tuple[np.ndarray, np.ndarray]:
+    """Parent cells (key >> 2) of sorted child ``keys`` with Chan's merge of their rows."""
+    starts = _run_starts(keys, 2)
+    out = np.empty((starts.size - 1, rows.shape[1]))
+    parents = np.empty(starts.size - 1, dtype=np.int64)
+    term = np.empty(4)
+    for s in range(starts.size - 1):
+        parents[s] = keys[starts[s]] >> 2
+        _parent_row(rows, (starts[s], starts[s + 1]), out, s, term)
+    return parents, out
+
+
+@numba.njit(cache=True, inline="always")
+def _locate(index: np.ndarray, key: int, dense: bool) -> int:
+    """Position of ``key`` in ``index``: the key itself (dense), else the slot holding it
+    or the empty slot where it belongs (hashed: pairs ``key, row``; key -1 = empty)."""
+    if dense:
+        return int(key)
+    mask = np.int64(index.size // 2 - 1)
+    j = np.int64((np.uint64(key) * _GOLDEN) >> np.uint64(32)) & mask
+    while index[2 * j] != -1 and index[2 * j] != key:
+        j = (j + 1) & mask
+    return int(j)
+
+
+@numba.njit(cache=True, inline="always")
+def _row(index: np.ndarray, j: int, key: int, dense: bool) -> int:
+    """Row stored at position ``j`` for ``key``; -1 when the key is absent."""
+    if dense:
+        return int(index[j]) - 1
+    return int(index[2 * j + 1]) if index[2 * j] == key else -1
+
+
+@numba.njit(cache=True, inline="always")
+def _set(index: np.ndarray, j: int, key: int, row: int, dense: bool) -> None:
+    if dense:
+        index[j] = row + 1
+    else:
+        index[2 * j], index[2 * j + 1] = key, row
+
+
+@numba.njit(cache=True)
+def fill_index(index: np.ndarray, keys: np.ndarray, n: int, dense: bool) -> None:
+    """Point ``index`` at the rows of the first ``n`` keys (an empty index, or one already
+    holding exactly these keys at other rows: the rows are rewritten in place)."""
+    for row in range(n):
+        _set(index, _locate(index, keys[row], dense), keys[row], row, dense)
+
+
+@numba.njit(cache=True)
+def merge_cells(store: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray], n: int,
+                cells: tuple[np.ndarray, np.ndarray], nv: int,
+                dense: bool) -> tuple[np.ndarray, int]:
+    """Merge ``cells`` = (keys, rows) into a level's ``store`` = (keys, rows, split, index)
+    holding ``n`` cells, capacity reserved; returns their rows and the new n.
+
+    Known cells get Chan's pairwise update in place; new ones are appended."""
+    skeys, srows, split, index = store
+    keys, agg = cells
+    touched = np.empty(keys.size, dtype=np.int64)
+    for i in range(keys.size):
+        j = _locate(index, keys[i], dense)
+        row = _row(index, j, keys[i], dense)
+        if row < 0:
+            skeys[n], split[n] = keys[i], False
+            for c in range(agg.shape[1]):
+                srows[n, c] = agg[i, c]
+            _set(index, j, keys[i], n, dense)
+            touched[i] = n
+            n += 1
+            continue
+        touched[i] = row
+        na, nb = srows[row, 0], agg[i, 0]
+        total = na + nb
+        for v in range(nv):
+            delta = agg[i, 1 + v] - srows[row, 1 + v]
+            srows[row, 1 + v] = srows[row, 1 + v] + delta * (nb / total)
+            srows[row, 1 + nv + v] = (srows[row, 1 + nv + v] + agg[i, 1 + nv + v]
+                                      + delta * delta * (na * nb / total))
+            srows[row, 1 + 2 * nv + v] = max(srows[row, 1 + 2 * nv + v], agg[i, 1 + 2 * nv + v])
+        srows[row, 0] = total
+    return touched, n

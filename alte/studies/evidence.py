@@ -1,0 +1,286 @@
+"""Verdicts on the thesis' claims from a trade-off table, with their evidence.
+
+Each check of a claim is measured per terrain, level and seed
+(:mod:`alte.studies.measures`); per (terrain, level) cell the mean over seeds gets a
+percentile-bootstrap interval (:mod:`alte.studies.uncertainty`). A cell *holds* when
+its interval lies wholly on the claim's side of the threshold, *does not hold* when it
+lies wholly on the other side, and is *inconclusive* otherwise (or with fewer than
+``min_seeds`` seeds). A check holds (does not hold) when every cell does; otherwise
+it *depends*, on the ``terrain``, the ``size`` or ``fidelity`` level, or on
+``uncertainty`` (intervals straddle the threshold). A conjunction (:class:`AllOf`)
+holds when all parts hold, does not hold when all parts do not, and otherwise depends
+on what tells the parts apart (``view``, ``metric``, ``mapper``, ``case``).
+Claims no map metric decides are ``not measurable``; checks the table cannot feed
+(missing rows, columns or settings) give ``no data``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, fields, replace
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from alte.studies.claims.types import AllOf, Check, Claim, NotMeasurable, Property
+from alte.studies.measures import Measured, NoDataError, measure
+from alte.studies.tradeoff import MAPPER_NAMES, METRICS, prepare
+from alte.studies.uncertainty import CONFIDENCE, bootstrap_ci
+
+__all__ = ["CELL_COLUMNS", "CLAIM_COLUMNS", "VERDICTS", "EvidenceOptions", "Finding",
+           "cells_table", "claims_table", "evaluate", "evaluate_all"]
+
+#: Every verdict a claim can get.
+VERDICTS = ("holds", "does not hold", "depends", "not measurable", "no data")
+#: Columns of :func:`claims_table` (the first four are the report's claims.csv schema).
+CLAIM_COLUMNS = ["claim", "section", "verdict", "evidence", "depends_on", "reading", "id"]
+#: Columns of :func:`cells_table`.
+CELL_COLUMNS = ["id", "part", "what", "terrain", "level", "seeds", "estimate", "low", "high",
+                "unit", "outcome"]
+_HOLDS, _FAILS, _DEPENDS = VERDICTS[:3]
+_DIMS = {"at": "view", "better": "mapper", "other": "mapper", "mapper": "mapper",
+         "case": "case", "x": "parameter", "param": "parameter"}
+_PRIORITY = ("metric", "view", "mapper", "case", "parameter")
+
+
+@dataclass(frozen=True)
+class EvidenceOptions:
+    """Interval level, bootstrap resamples and seed, the fewest seeds that make an
+    interval, and ``size``: a column replacing ``basis_functions`` in every check (the
+    ablation that counts Octomap's occupied cells only: ``size="occupied_cells"``)."""
+
+    level: float = CONFIDENCE
+    n_resamples: int = 2000
+    seed: int = 0
+    min_seeds: int = 2
+    size: str | None = None
+
+
+@dataclass(frozen=True)
+class Finding:
+    """A claim's verdict, what it depends on, the evidence text and the per-cell numbers."""
+
+    claim: Claim
+    verdict: str
+    depends_on: str
+    evidence: str
+    cells: pd.DataFrame
+
+
+def _number(value: float, ratio: bool) -> str:
+    """A statistic as text: log ratios as factors (x1.8), others signed (+0.12)."""
+    if not np.isfinite(value):
+        return "n/a"
+    return f"x{np.exp(value):.3g}" if ratio else f"{value:+.3g}"
+
+
+def _level_text(level: float, column: str) -> str:
+    if not np.isfinite(level):
+        return ""
+    value = f"{level:,.0f}" if abs(level) >= 100 else f"{level:.3g}"
+    name, unit = METRICS.get(column, (column, ""))
+    return f" at {value} {unit or name}"
+
+
+def _outcome(low: float, high: float, seeds: int, m: Measured, min_seeds: int) -> str:
+    if seeds < min_seeds or not (np.isfinite(low) and np.isfinite(high)):
+        return "inconclusive"
+    if m.relation == "undecided":
+        return _HOLDS if low <= 0 <= high else _FAILS
+    if m.relation == "similar":
+        if -m.band <= low and high <= m.band:
+            return _HOLDS
+        return _FAILS if low > m.band or high < -m.band else "inconclusive"
+    return _HOLDS if low > m.threshold else _FAILS if high < m.threshold else "inconclusive"
+
+
+def _cells(m: Measured, options: EvidenceOptions) -> pd.DataFrame:
+    rows = []
+    for (terrain, level), group in m.stats.groupby(["terrain", "level"], dropna=False,
+                                                   sort=True):
+        ci = bootstrap_ci(group["value"].to_numpy(), options.level, options.n_resamples,
+                          options.seed)
+        rows.append({"terrain": terrain, "level": level, "seeds": ci.seeds,
+                     "estimate": ci.estimate, "low": ci.low, "high": ci.high,
+                     "outcome": _outcome(ci.low, ci.high, ci.seeds, m, options.min_seeds)})
+    return pd.DataFrame(rows, columns=["terrain", "level", "seeds", "estimate", "low", "high",
+                                       "outcome"])
+
+
+def _cell_verdict(cells: pd.DataFrame, level_kind: str) -> tuple[str, str]:
+    outcomes = set(cells["outcome"])
+    if outcomes in ({_HOLDS}, {_FAILS}):
+        return outcomes.pop(), ""
+    decisive = cells[cells["outcome"] != "inconclusive"]
+    if decisive["outcome"].nunique() < 2:
+        return _DEPENDS, "uncertainty"
+    per_terrain = decisive.groupby("terrain")["outcome"].agg(lambda s: s.iloc[0]
+                                                             if s.nunique() == 1 else "mixed")
+    dims = [name for name, varies in (
+        ("terrain", per_terrain[per_terrain != "mixed"].nunique() > 1),
+        (level_kind or "setting", (per_terrain == "mixed").any())) if varies]
+    return _DEPENDS, ", ".join(dims) or "terrain"
+
+
+def _criterion(m: Measured) -> str:
+    unit = f" {m.unit}" if m.unit and not m.ratio else ""
+    if m.relation == "undecided":
+        return "the interval contains 0"
+    if m.relation == "similar":
+        return (f"the interval lies within {_number(-m.band, m.ratio)} .. "
+                f"{_number(m.band, m.ratio)}{unit}")
+    return f"the interval lies above {_number(m.threshold, m.ratio)}{unit}"
+
+
+def _check_text(m: Measured, cells: pd.DataFrame) -> str:
+    seeds = int(cells["seeds"].max())
+    unit = f" {m.unit}" if m.unit and not m.ratio else ""
+    parts = []
+    columns = ("terrain", "level", "seeds", "estimate", "low", "high")
+    for terrain, level, n, est, low, high in zip(*(cells[c].tolist() for c in columns),
+                                                 strict=True):
+        span = (f" [{_number(low, m.ratio)}, {_number(high, m.ratio)}]"
+                if n > 1 else " (one seed, no interval)")
+        fewer = f" ({n} seeds)" if 1 < n < seeds else ""
+        parts.append(f"{terrain}{_level_text(level, m.level_name)}: "
+                     f"{_number(est, m.ratio)}{span}{unit}{fewer}")
+    return (f"{m.what} ({seeds} seed{'s' if seeds != 1 else ''}; supports the claim where "
+            f"{_criterion(m)}): " + "; ".join(parts))
+
+
+def _property(p: Property) -> tuple[str, str]:
+    from alte.mappers import MAPPERS
+
+    values = {m: bool(getattr(MAPPERS[m], p.attribute)) for m in (*p.true, *p.false)}
+    wrong = [m for m in p.true if not values[m]] + [m for m in p.false if values[m]]
+    text = ", ".join(f"{MAPPER_NAMES.get(m, m)}: {p.attribute} = {values[m]}" for m in values)
+    return (_FAILS if wrong else _HOLDS), f"our implementations: {text}"
+
+
+def _one(check: Check, table: pd.DataFrame, options: EvidenceOptions
+         ) -> tuple[str, str, str, pd.DataFrame]:
+    """(verdict, depends_on, evidence, cells) of one check."""
+    if isinstance(check, NotMeasurable):
+        return "not measurable", "", check.reason, pd.DataFrame()
+    if isinstance(check, Property):
+        verdict, text = _property(check)
+        return verdict, "", text, pd.DataFrame()
+    try:
+        m = measure(check, table)
+    except NoDataError as err:
+        return "no data", "", f"not measured: {err}", pd.DataFrame()
+    cells = _cells(m, options)
+    cells = cells[cells["seeds"] > 0].reset_index(drop=True)
+    if cells.empty:
+        return "no data", "", f"{m.what}: no terrain and seed gives a value", cells
+    verdict, depends = _cell_verdict(cells, m.level_kind)
+    scale = np.exp if m.ratio else (lambda v: v)
+    shown = cells.assign(what=m.what, unit=m.unit, estimate=scale(cells["estimate"]),
+                         low=scale(cells["low"]), high=scale(cells["high"]))
+    return verdict, depends, _check_text(m, cells), shown
+
+
+def _part_dims(good: Sequence[Any], bad: Sequence[Any]) -> list[str]:
+    """What tells holding parts from failing ones: per pair the first of metric, view,
+    mapper, case, parameter that differs."""
+    dims = set()
+    for a, b in ((a, b) for a in good for b in bad):
+        differ = ({"metric"} if type(a) is not type(b) else
+                  {_DIMS.get(f.name, "metric") for f in fields(a)
+                   if getattr(a, f.name) != getattr(b, f.name)})
+        dims.add(next((d for d in _PRIORITY if d in differ), "metric"))
+    return sorted(dims, key=_PRIORITY.index)
+
+
+def _combine(parts: Sequence[Any], results: Sequence[tuple[str, str, str, pd.DataFrame]]
+             ) -> tuple[str, str]:
+    verdicts = [r[0] for r in results]
+    tested = [v for v in verdicts if v in (_HOLDS, _FAILS, _DEPENDS)]
+    if not tested:
+        return ("no data" if "no data" in verdicts else "not measurable"), ""
+    if set(tested) == {_FAILS}:
+        return _FAILS, ""
+    if set(verdicts) == {_HOLDS}:
+        return _HOLDS, ""
+    good = [p for p, v in zip(parts, verdicts, strict=True) if v == _HOLDS]
+    bad = [p for p, v in zip(parts, verdicts, strict=True) if v == _FAILS]
+    inner = [d for r in results for d in r[1].split(", ") if d]
+    untested = ["untested part"] if len(tested) < len(verdicts) else []
+    dims = _part_dims(good, bad) + inner + untested
+    return _DEPENDS, ", ".join(dict.fromkeys(dims)) or "uncertainty"
+
+
+def _resized(check: Check | AllOf, size: str | None) -> Check | AllOf:
+    """``check`` with every ``basis_functions`` column replaced by ``size``."""
+    if size is None:
+        return check
+    if isinstance(check, AllOf):
+        return AllOf(tuple(_resized_check(p, size) for p in check.parts))
+    return _resized_check(check, size)
+
+
+def _resized_check(check: Check, size: str) -> Check:
+    changes: dict[str, Any] = {f.name: size for f in fields(check)
+                               if getattr(check, f.name) == "basis_functions"}
+    return replace(check, **changes)
+
+
+Result = tuple[str, str, str, pd.DataFrame]
+
+
+def _evaluate(claim: Claim, table: pd.DataFrame, options: EvidenceOptions,
+              cache: dict[Any, Result] | None = None) -> Finding:
+    check = _resized(claim.check, options.size)
+    parts = check.parts if isinstance(check, AllOf) else (check,)
+    cache = {} if cache is None else cache
+    results = []
+    for part in parts:
+        if part not in cache:  # many claims share a check: measure it once per table
+            cache[part] = _one(part, table, options)
+        results.append(cache[part])
+    if len(parts) == 1:
+        verdict, depends, text, cells = results[0]
+    else:
+        verdict, depends = _combine(parts, results)
+        text = " ".join(f"({i}) {r[2]} -> {r[0]}{' (' + r[1] + ')' if r[1] else ''}."
+                        for i, r in enumerate(results, 1))
+        cells = pd.concat([r[3].assign(part=i) for i, r in enumerate(results, 1)
+                           if not r[3].empty] or [pd.DataFrame()], ignore_index=True)
+    if not cells.empty:
+        text = (f"Means over seeds with {options.level:.0%} percentile-bootstrap intervals. "
+                + text)
+    cells = cells.assign(id=claim.id) if not cells.empty else pd.DataFrame(columns=CELL_COLUMNS)
+    if "part" not in cells:
+        cells["part"] = 1
+    return Finding(claim, verdict, depends, text, cells.reindex(columns=CELL_COLUMNS))
+
+
+def evaluate(claim: Claim, table: pd.DataFrame,
+             options: EvidenceOptions | None = None) -> Finding:
+    """The verdict on ``claim`` from a trade-off table (see the module docstring)."""
+    return _evaluate(claim, prepare(table), options or EvidenceOptions())
+
+
+def evaluate_all(claims: Sequence[Claim], table: pd.DataFrame,
+                 options: EvidenceOptions | None = None) -> list[Finding]:
+    """:func:`evaluate` for every claim (the table is checked and prepared once)."""
+    prepared = prepare(table)
+    cache: dict[Any, Result] = {}
+    return [_evaluate(c, prepared, options or EvidenceOptions(), cache) for c in claims]
+
+
+def claims_table(findings: Sequence[Finding]) -> pd.DataFrame:
+    """The report's claims table: claim (the quote), section, verdict, evidence, then
+    depends_on, reading and id."""
+    return pd.DataFrame([{"claim": f.claim.quote, "section": f.claim.section,
+                          "verdict": f.verdict, "evidence": f.evidence,
+                          "depends_on": f.depends_on, "reading": f.claim.reading,
+                          "id": f.claim.id} for f in findings], columns=CLAIM_COLUMNS)
+
+
+def cells_table(findings: Sequence[Finding]) -> pd.DataFrame:
+    """Every measured cell of every claim (ratios shown as factors, unit ``x``)."""
+    frames = [f.cells for f in findings if not f.cells.empty]
+    return (pd.concat(frames, ignore_index=True) if frames
+            else pd.DataFrame(columns=CELL_COLUMNS))

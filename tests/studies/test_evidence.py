@@ -1,0 +1,160 @@
+"""Verdicts from trade-off tables: wins hold, losses do not, crossings and terrains depend."""
+
+from __future__ import annotations
+
+import pandas as pd
+import pytest
+from support.tradeoff import Curve, synthetic_tradeoff
+
+from alte.studies.claims import (
+    CLAIMS,
+    AllOf,
+    Claim,
+    Compare,
+    NotMeasurable,
+    Property,
+)
+from alte.studies.evidence import (
+    CELL_COLUMNS,
+    VERDICTS,
+    EvidenceOptions,
+    cells_table,
+    claims_table,
+    evaluate,
+    evaluate_all,
+)
+
+MHD_AT_SIZE = Compare("lan", "alte2d", "quadtree", "mhd_m", "equal_size")
+
+
+def _claim(check) -> Claim:
+    return Claim("test", "5.2.2 (Comparison)", "a quote", check)
+
+
+def test_a_clear_win_holds_and_the_evidence_names_numbers_units_and_intervals():
+    table = synthetic_tradeoff({"alte2d": Curve(scale=0.5)})
+    found = evaluate(_claim(MHD_AT_SIZE), table)
+    assert found.verdict == "holds" and found.depends_on == ""
+    text = found.evidence
+    assert "95% percentile-bootstrap intervals" in text and "3 seeds" in text
+    assert "MHD [m], Quadtree minus 2D-ALTE at equal basis functions" in text
+    assert "sim_lan_1 at " in text and " basis functions: +0." in text and "] m" in text
+    cells = found.cells
+    assert list(cells.columns) == CELL_COLUMNS and len(cells) == 6
+    assert (cells["outcome"] == "holds").all() and (cells["low"] > 0).all()
+
+
+def test_a_clear_loss_does_not_hold():
+    table = synthetic_tradeoff({"alte2d": Curve(scale=2.0)})
+    found = evaluate(_claim(MHD_AT_SIZE), table)
+    assert found.verdict == "does not hold"
+    assert (found.cells["high"] < 0).all()
+
+
+def test_crossing_curves_depend_on_size():
+    # equal at 3,000 basis functions: 2D-ALTE better below, worse above
+    table = synthetic_tradeoff({"alte2d": Curve(scale=1.0, slope=0.1, noise=0.0),
+                                "quadtree": Curve(scale=3**0.4, slope=0.5, noise=0.0)})
+    check = Compare("lan", "alte2d", "quadtree", "mhd_m", "equal_size", levels=(1500, 8000))
+    found = evaluate(_claim(check), table)
+    assert (found.verdict, found.depends_on) == ("depends", "size")
+    by_level = found.cells.groupby("level")["outcome"].first()
+    assert by_level[1500] == "holds" and by_level[8000] == "does not hold"
+
+
+def test_a_terrain_dependent_answer_depends_on_terrain():
+    lan1 = {"quadtree": ("sim_lan_1",), "alte2d": ("sim_lan_1",)}
+    lan2 = {"quadtree": ("sim_lan_2",), "alte2d": ("sim_lan_2",)}
+    table = pd.concat([synthetic_tradeoff({"alte2d": Curve(scale=0.5)}, terrains=lan1),
+                       synthetic_tradeoff({"alte2d": Curve(scale=2.0)}, terrains=lan2)])
+    found = evaluate(_claim(MHD_AT_SIZE), table)
+    assert (found.verdict, found.depends_on) == ("depends", "terrain")
+
+
+def test_seeds_that_disagree_or_a_single_seed_leave_it_uncertain():
+    wins = synthetic_tradeoff({"alte2d": Curve(scale=0.8)}, seeds=(0, 1))
+    loses = synthetic_tradeoff({"alte2d": Curve(scale=1.25)}, seeds=(2,))
+    found = evaluate(_claim(MHD_AT_SIZE), pd.concat([wins, loses]))
+    assert (found.verdict, found.depends_on) == ("depends", "uncertainty")
+    one = evaluate(_claim(MHD_AT_SIZE), synthetic_tradeoff({"alte2d": Curve(scale=0.5)},
+                                                           seeds=(0,)))
+    assert (one.verdict, one.depends_on) == ("depends", "uncertainty")
+    assert "one seed, no interval" in one.evidence
+    lenient = evaluate(_claim(MHD_AT_SIZE), synthetic_tradeoff({"alte2d": Curve(scale=0.5)},
+                                                               seeds=(0,)),
+                       EvidenceOptions(min_seeds=1))
+    assert lenient.verdict == "holds"
+
+
+def test_similar_within_the_band():
+    # 2D-ALTE's thesis setting has ~127 basis functions, Quadtree's (max_points=150) ~6,667
+    same_time = Curve(seconds=0.01 * 6667 / 127.4)
+    check = Compare("lan", "alte2d", "quadtree", "elapsed_s", "thesis_point", relation="similar")
+    assert evaluate(_claim(check), synthetic_tradeoff({"alte2d": same_time})).verdict == "holds"
+    assert evaluate(_claim(check), synthetic_tradeoff()).verdict == "does not hold"
+
+
+def test_undecided_holds_only_where_the_interval_contains_zero():
+    check = Compare("lan", "alte2d", "quadtree", "mhd_m", "equal_size", relation="undecided")
+    clear = synthetic_tradeoff({"alte2d": Curve(scale=0.5)})
+    assert evaluate(_claim(check), clear).verdict == "does not hold"
+    wins = synthetic_tradeoff({"alte2d": Curve(scale=0.8)}, seeds=(0, 1))
+    loses = synthetic_tradeoff({"alte2d": Curve(scale=1.25)}, seeds=(2,))
+    assert evaluate(_claim(check), pd.concat([wins, loses])).verdict == "holds"
+
+
+def test_conjunctions_depend_on_what_tells_the_parts_apart():
+    table = synthetic_tradeoff({"alte2d": Curve(scale=0.5)})
+    worse_time = Compare("lan", "quadtree", "alte2d", "elapsed_s", "equal_fidelity")
+    found = evaluate(_claim(AllOf((MHD_AT_SIZE, worse_time))), table)
+    assert (found.verdict, found.depends_on) == ("depends", "metric")
+    assert "(1) " in found.evidence and "-> holds" in found.evidence
+    assert "-> does not hold" in found.evidence
+    assert set(found.cells["part"]) == {1, 2}
+    at_point = Compare("lan", "alte2d", "quadtree", "mhd_m", "thesis_point")
+    views = evaluate(_claim(AllOf((MHD_AT_SIZE, at_point))), table)
+    assert (views.verdict, views.depends_on) == ("depends", "view")  # the thesis' pick loses
+    both = evaluate(_claim(AllOf((MHD_AT_SIZE, MHD_AT_SIZE))), table)
+    assert both.verdict == "holds"
+
+
+def test_unmeasurable_missing_and_property_checks():
+    table = synthetic_tradeoff()
+    found = evaluate(_claim(NotMeasurable("development is a judgement of code maturity")), table)
+    assert found.verdict == "not measurable" and "maturity" in found.evidence
+    assert found.cells.empty
+    missing = evaluate(_claim(Compare("lan", "alte2d", "quadtree", "mhd_m", "equal_size")),
+                       table[table["mapper"] != "alte2d"])
+    assert missing.verdict == "no data" and "no rows of alte2d" in missing.evidence
+    assert evaluate(_claim(Property("incremental", ("octomap",))), table).verdict == "holds"
+    refuted = evaluate(_claim(Property("incremental", (), ("octomap",))), table)
+    assert refuted.verdict == "does not hold" and "Octomap: incremental = True" in (
+        refuted.evidence)
+    partial = evaluate(_claim(AllOf((MHD_AT_SIZE, Compare("nav", "alte3d", "octomap",
+                                                          "mhd_m", "equal_size")))),
+                       synthetic_tradeoff({"alte2d": Curve(scale=0.5)}).query(
+                           "mapper != 'alte3d'"))
+    assert (partial.verdict, partial.depends_on) == ("depends", "untested part")
+
+
+def test_the_whole_catalogue_gets_verdicts_and_a_table_with_the_report_schema():
+    table = synthetic_tradeoff({"alte2d": Curve(scale=0.5), "alte3d": Curve(scale=0.5)})
+    findings = evaluate_all(CLAIMS, table)
+    out = claims_table(findings)
+    assert list(out.columns[:4]) == ["claim", "section", "verdict", "evidence"]
+    assert len(out) == len(CLAIMS) and set(out["verdict"]) <= set(VERDICTS)
+    by_id = out.set_index("id")
+    assert by_id.at["5.2.2-2d-mhd", "verdict"] == "depends"  # thesis' pick loses, curves win
+    assert by_id.at["6-quadtree-worse", "verdict"] == "holds"
+    assert by_id.at["t5.1-development", "verdict"] == "not measurable"
+    assert (out["verdict"] == "no data").sum() == 0
+    assert (out.loc[out["verdict"] == "depends", "depends_on"] != "").all()
+    cells = cells_table(findings)
+    assert list(cells.columns) == CELL_COLUMNS and set(cells["id"]) < set(out["id"])
+
+
+@pytest.mark.parametrize("level", [0.5, 0.99])
+def test_the_interval_level_is_stated(level):
+    table = synthetic_tradeoff({"alte2d": Curve(scale=0.5)})
+    found = evaluate(_claim(MHD_AT_SIZE), table, EvidenceOptions(level=level))
+    assert f"{level:.0%} percentile-bootstrap" in found.evidence
