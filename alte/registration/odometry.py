@@ -157,11 +157,14 @@ class _PlaneMap:
 class _DenseMap:
     """Refinement target: registered scans kept at ``voxel / 2``, matched point-to-plane
     (small_gicp) at ``voxel`` with normals from 20 neighbours; dense because many
-    scans from nearby poses fill the gaps between one scan's rings."""
+    scans from nearby poses fill the gaps between one scan's rings. The target (grid,
+    k-d tree, normals) is rebuilt every ``rebuild`` scans."""
 
-    def __init__(self, voxel: float, radius: float) -> None:
-        self.voxel, self.radius = voxel, radius
+    def __init__(self, voxel: float, radius: float, rebuild: int) -> None:
+        self.voxel, self.radius, self.rebuild = voxel, radius, rebuild
         self.points = np.empty((0, 3))
+        self.added = 0
+        self.target: Any = None
 
     def add(self, scan: np.ndarray, sensor: np.ndarray) -> None:
         """Add the scan (sensor frame) placed at ``sensor``; forget what is out of reach."""
@@ -172,14 +175,18 @@ class _DenseMap:
                                                num_threads=_THREADS)
         pts = np.asarray(merged.points())[:, :3]
         self.points = pts[np.linalg.norm(pts - sensor[:3, 3], axis=1) <= self.radius]
+        self.added += 1
+        if self.target is None or self.added % self.rebuild == 0:
+            target = small_gicp.voxelgrid_sampling(self.points, self.voxel, num_threads=_THREADS)
+            tree = small_gicp.KdTree(target, num_threads=_THREADS)
+            small_gicp.estimate_normals(target, tree, num_neighbors=20, num_threads=_THREADS)
+            self.target = (target, tree)
 
     def align(self, scan: np.ndarray, guess: np.ndarray) -> tuple[np.ndarray, float]:
         """The sensor pose placing ``scan`` on the map from ``guess``; inlier fraction."""
         import small_gicp
 
-        target = small_gicp.voxelgrid_sampling(self.points, self.voxel, num_threads=_THREADS)
-        tree = small_gicp.KdTree(target, num_threads=_THREADS)
-        small_gicp.estimate_normals(target, tree, num_neighbors=20, num_threads=_THREADS)
+        target, tree = self.target
         source = small_gicp.voxelgrid_sampling(scan, self.voxel, num_threads=_THREADS)
         result = small_gicp.align(target, source, tree, guess, registration_type="PLANE_ICP",
                                   max_correspondence_distance=6.0 * self.voxel,
@@ -284,7 +291,7 @@ def refine_frames(frames: Iterable[Frame], mount: Mount, *, counts: PoseCounts,
         counts.frames += 1
         if local is None:
             max_range, voxel = scene_scale(points, replace(params, method="plane"))
-            local = _DenseMap(voxel, max_range)
+            local = _DenseMap(voxel, max_range, params.rebuild)
         else:
             sensor = _refined(local, points, sensor, counts, params)
         local.add(points, sensor)
