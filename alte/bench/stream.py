@@ -133,14 +133,12 @@ class UfoPeer:
 
 def scan_peer(ctx: Context) -> list[Result]:
     """Row 11: native Octomap vs DUFOMap (UFOMap) integrating the same scans at 0.2 m."""
-    from numba import get_num_threads
-
     from alte.bench.maps import mapper_setup
     from alte.mappers import make_mapper
 
     params = mapper_setup(ctx, "octomap")
     voxel = 1.0 / float(params.get("resolution", 5.0))
-    threads = int(get_num_threads())
+    threads = len(os.sched_getaffinity(0))  # the cores numba's threads would use
     makers: dict[str, Callable[[], Any]] = {
         "native": lambda: make_mapper("octomap", **params),
         "dufomap": lambda: UfoPeer(voxel, threads)}

@@ -11,7 +11,7 @@ import json
 from pathlib import Path
 
 from alte.errors import BagError
-from alte.io.bag import BagInfo, inspect_bag
+from alte.io.baginfo import BagInfo, inspect_bag
 from alte.pipeline import InputKind, Source, open_input
 
 __all__ = ["add_parser", "format_info", "pose_source", "run"]

@@ -6,7 +6,8 @@
 
 from __future__ import annotations
 
-from alte.io.bag import BagInfo, FrameSet, inspect_bag, read_frames
+from alte.io.bag import FrameSet, read_frames
+from alte.io.baginfo import BagInfo, inspect_bag
 from alte.io.pointcloud2 import decode_pointcloud2, encode_pointcloud2
 from alte.io.pointfiles import read_points, write_points
 from alte.io.pose import PoseSamples, PoseTrack

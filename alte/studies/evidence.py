@@ -24,7 +24,7 @@ import numpy as np
 import pandas as pd
 
 from alte.studies.claims.types import AllOf, Check, Claim, NotMeasurable, Property
-from alte.studies.measures import Measured, NoDataError, measure
+from alte.studies.measures import CheckValues, NoDataError, measure_check
 from alte.studies.tradeoff import MAPPER_NAMES, METRICS, prepare
 from alte.studies.uncertainty import CONFIDENCE, bootstrap_ci
 
@@ -83,7 +83,7 @@ def _level_text(level: float, column: str) -> str:
     return f" at {value} {unit or name}"
 
 
-def _outcome(low: float, high: float, seeds: int, m: Measured, min_seeds: int) -> str:
+def _outcome(low: float, high: float, seeds: int, m: CheckValues, min_seeds: int) -> str:
     if seeds < min_seeds or not (np.isfinite(low) and np.isfinite(high)):
         return "inconclusive"
     if m.relation == "undecided":
@@ -95,7 +95,7 @@ def _outcome(low: float, high: float, seeds: int, m: Measured, min_seeds: int) -
     return _HOLDS if low > m.threshold else _FAILS if high < m.threshold else "inconclusive"
 
 
-def _cells(m: Measured, options: EvidenceOptions) -> pd.DataFrame:
+def _cells(m: CheckValues, options: EvidenceOptions) -> pd.DataFrame:
     rows = []
     for (terrain, level), group in m.stats.groupby(["terrain", "level"], dropna=False,
                                                    sort=True):
@@ -123,7 +123,7 @@ def _cell_verdict(cells: pd.DataFrame, level_kind: str) -> tuple[str, str]:
     return _DEPENDS, ", ".join(dims) or "terrain"
 
 
-def _criterion(m: Measured) -> str:
+def _criterion(m: CheckValues) -> str:
     unit = f" {m.unit}" if m.unit and not m.ratio else ""
     if m.relation == "undecided":
         return "the interval contains 0"
@@ -133,7 +133,7 @@ def _criterion(m: Measured) -> str:
     return f"the interval lies above {_number(m.threshold, m.ratio)}{unit}"
 
 
-def _check_text(m: Measured, cells: pd.DataFrame) -> str:
+def _check_text(m: CheckValues, cells: pd.DataFrame) -> str:
     seeds = int(cells["seeds"].max())
     unit = f" {m.unit}" if m.unit and not m.ratio else ""
     parts = []
@@ -167,7 +167,7 @@ def _one(check: Check, table: pd.DataFrame, options: EvidenceOptions
         verdict, text = _property(check)
         return verdict, "", text, pd.DataFrame()
     try:
-        m = measure(check, table)
+        m = measure_check(check, table)
     except NoDataError as err:
         return "no data", "", f"not measured: {err}", pd.DataFrame()
     cells = _cells(m, options)

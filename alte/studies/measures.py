@@ -1,7 +1,7 @@
 """Per-seed statistics of the claims' checks, measured on a prepared trade-off table.
 
-:func:`measure` turns one check (:mod:`alte.studies.claims.types`) into a
-:class:`Measured`: one value per (terrain, level, seed), oriented so that a value
+:func:`measure_check` turns one check (:mod:`alte.studies.claims.types`) into a
+:class:`CheckValues`: one value per (terrain, level, seed), oriented so that a value
 above ``threshold`` supports the claim (``relation="better"``), plus what it is and
 its unit. Ratios (sizes, times) are natural-log ratios, shown as factors. Terrains
 are those of the check's case: the table's ``case`` column when it has one, else
@@ -41,9 +41,9 @@ from alte.studies.tradeoff import (
     thesis_setting,
 )
 
-__all__ = ["STAT_COLUMNS", "Measured", "NoDataError", "measure"]
+__all__ = ["STAT_COLUMNS", "CheckValues", "NoDataError", "measure_check"]
 
-#: Columns of :attr:`Measured.stats`.
+#: Columns of :attr:`CheckValues.stats`.
 STAT_COLUMNS = ["terrain", "level", "seed", "value"]
 _RATIO_METRICS = (*SIZE_COLUMNS, "elapsed_s")
 
@@ -53,7 +53,7 @@ class NoDataError(ParameterError):
 
 
 @dataclass(frozen=True)
-class Measured:
+class CheckValues:
     """Per-seed values of one check and how to read them (see the module docstring).
 
     ``level_name`` is the column the levels are values of (equal-size or equal-fidelity
@@ -143,7 +143,7 @@ def _compare_what(c: Compare, ratio: bool) -> tuple[str, str]:
     return f"{head} {text}", level
 
 
-def _compare(c: Compare, table: pd.DataFrame) -> Measured:
+def _compare(c: Compare, table: pd.DataFrame) -> CheckValues:
     columns = [c.metric] + ([c.size] if c.at == "equal_size" else []) + (
         [c.fidelity] if c.at == "equal_fidelity" else [])
     rows = _case_rows(table, c.case, (c.better, c.other), columns)
@@ -164,7 +164,7 @@ def _compare(c: Compare, table: pd.DataFrame) -> Measured:
     what, level = _compare_what(c, ratio)
     band = float(np.log1p(c.tolerance)) if ratio else c.tolerance
     kind = {"equal_size": "size", "equal_fidelity": "fidelity"}.get(c.at, "")
-    return Measured(stats, what, "x" if ratio else _unit(c.metric), ratio,
+    return CheckValues(stats, what, "x" if ratio else _unit(c.metric), ratio,
                     float(np.log(c.factor)) if ratio else 0.0, c.relation, band, level, kind)
 
 
@@ -194,7 +194,7 @@ def _level_means(group: pd.DataFrame, x: str, metric: str) -> pd.Series:
     return group.groupby(x)[metric].mean().dropna().sort_index()
 
 
-def _trend(c: Trend, table: pd.DataFrame) -> Measured:
+def _trend(c: Trend, table: pd.DataFrame) -> CheckValues:
     rows = _case_rows(table, c.case, (c.mapper,), [c.metric, c.size])
     x = _xcol(rows, c.x)
 
@@ -207,10 +207,10 @@ def _trend(c: Trend, table: pd.DataFrame) -> Measured:
     over = "the larger half of " if c.largest_half else ""
     what = (f"Spearman rho of {label(c.metric)} with {label(c.x, False)} over {over}"
             f"{_name(c.mapper)}'s maps, times the stated sign ({c.sign:+d})")
-    return Measured(_per_seed(rows, rho), what, threshold=c.min_rho)
+    return CheckValues(_per_seed(rows, rho), what, threshold=c.min_rho)
 
 
-def _optimum(c: Optimum, table: pd.DataFrame) -> Measured:
+def _optimum(c: Optimum, table: pd.DataFrame) -> CheckValues:
     rows = _case_rows(table, c.case, (c.mapper,), [c.metric])
     x = _xcol(rows, c.x)
 
@@ -223,7 +223,7 @@ def _optimum(c: Optimum, table: pd.DataFrame) -> Measured:
 
     what = (f"{label(c.metric)} of {_name(c.mapper)} at the finest {c.x} minus the best "
             "interior setting")
-    return Measured(_per_seed(rows, gap), what, _unit(c.metric))
+    return CheckValues(_per_seed(rows, gap), what, _unit(c.metric))
 
 
 def _spread(group: pd.DataFrame, x: str, metric: str) -> float:
@@ -241,7 +241,7 @@ def _spread(group: pd.DataFrame, x: str, metric: str) -> float:
     return float(np.mean(ranges)) / overall
 
 
-def _effect(c: Effect, table: pd.DataFrame) -> Measured:
+def _effect(c: Effect, table: pd.DataFrame) -> CheckValues:
     rows = _case_rows(table, c.case, (c.mapper,), [c.metric])
     x = _xcol(rows, c.param)
     other = _xcol(rows, c.other) if c.other else None
@@ -254,10 +254,10 @@ def _effect(c: Effect, table: pd.DataFrame) -> Measured:
     what = (f"relative spread of {label(c.metric)} over {c.param} minus over {c.other}"
             if other else f"{limit:g} minus the relative spread of {label(c.metric)} over "
             f"{c.param}") + f" ({_name(c.mapper)})"
-    return Measured(_per_seed(rows, stat), what)
+    return CheckValues(_per_seed(rows, stat), what)
 
 
-def _agreement(c: Agreement, table: pd.DataFrame) -> Measured:
+def _agreement(c: Agreement, table: pd.DataFrame) -> CheckValues:
     columns = [c.metric, c.reference] + ([c.other] if c.other else [])
     rows = _case_rows(table, c.case, (c.mapper,), columns)
 
@@ -272,7 +272,7 @@ def _agreement(c: Agreement, table: pd.DataFrame) -> Measured:
     what = (f"agreement (Spearman rho) with {ref} of {label(c.metric)} minus that of "
             f"{label(c.other)}" if c.other else f"{c.min_rho:g} minus the agreement "
             f"(Spearman rho) of {label(c.metric)} with {ref}") + f", over {_name(c.mapper)}'s "
-    return Measured(_per_seed(rows, stat), what + "settings")
+    return CheckValues(_per_seed(rows, stat), what + "settings")
 
 
 def _aggregate(values: pd.Series, agg: str) -> float:
@@ -285,7 +285,7 @@ def _aggregate(values: pd.Series, agg: str) -> float:
     return float(data.std() / data.mean()) if data.size > 1 and data.mean() != 0 else np.nan
 
 
-def _summary(c: Summary, table: pd.DataFrame) -> Measured:
+def _summary(c: Summary, table: pd.DataFrame) -> CheckValues:
     mappers = (c.better,) + ((c.other,) if c.other else ())
     rows = _case_rows(table, c.case, mappers, [c.column])
     sign = 1.0 if c.higher_is_better else -1.0
@@ -302,15 +302,15 @@ def _summary(c: Summary, table: pd.DataFrame) -> Measured:
         first, second = second, first
     what = f"{agg} of {label(c.column)} over the settings, {first} minus {second}"
     unit = _unit(c.column) if c.agg == "median" else ""
-    return Measured(_per_seed(rows, stat), what, unit)
+    return CheckValues(_per_seed(rows, stat), what, unit)
 
 
-_MEASURES: dict[type, Callable[[Any, pd.DataFrame], Measured]] = {
+_MEASURES: dict[type, Callable[[Any, pd.DataFrame], CheckValues]] = {
     Compare: _compare, Trend: _trend, Optimum: _optimum, Effect: _effect,
     Agreement: _agreement, Summary: _summary}
 
 
-def measure(check: Check, table: pd.DataFrame) -> Measured:
+def measure_check(check: Check, table: pd.DataFrame) -> CheckValues:
     """Per-seed statistics of ``check`` on ``table`` (prepared by
     :func:`alte.studies.tradeoff.prepare`); :class:`NoDataError` when it cannot be measured."""
     try:

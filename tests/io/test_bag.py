@@ -10,7 +10,8 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from alte.errors import BagError, ParameterError, PoseError, TopicError
-from alte.io.bag import inspect_bag, read_frames
+from alte.io.bag import read_frames
+from alte.io.baginfo import inspect_bag
 from alte.types import Mount
 
 
