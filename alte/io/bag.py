@@ -12,12 +12,14 @@ from __future__ import annotations
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, TypedDict, Unpack
+from typing import TypedDict, Unpack, cast
 
 import numpy as np
+from rosbags.highlevel import AnyReader
 from tqdm.auto import tqdm
 
 from alte.errors import BagError, ParameterError, PoseError, TopicError
+from alte.io.messages import PointCloud2Msg, StampedMsg, VelodyneScanMsg
 from alte.io.pointcloud2 import decode_pointcloud2
 from alte.io.pose import POSE_TYPES, PoseTrack, header_stamp, pose_records, select_tf_child
 from alte.io.reader import (
@@ -82,7 +84,7 @@ class FrameSet:
 
 
 def _read_track(
-    reader: Any, topic: str, sensor: str | None, body: str | None, path: Path
+    reader: AnyReader, topic: str, sensor: str | None, body: str | None, path: Path
 ) -> PoseTrack:
     """All poses of ``topic`` as a :class:`PoseTrack` (one child frame for ``/tf``)."""
     records = [
@@ -114,12 +116,13 @@ def _resolve_mount(static: Mount | None, mount: Mount | None, notes: list[str]) 
     return Mount()
 
 
-def _decode(msg: Any, msgtype: str, topic: str, return_mode: str) -> tuple[np.ndarray, int]:
+def _decode(msg: object, msgtype: str, topic: str, return_mode: str) -> tuple[np.ndarray, int]:
+    """Points of one cloud-topic message; ``msgtype`` names the class rosbags built."""
     if msgtype == SCAN_TYPE:
         from alte.io.velodyne import decode_velodyne_scan
 
-        return decode_velodyne_scan(msg, return_mode), 0
-    return decode_pointcloud2(msg, topic)
+        return decode_velodyne_scan(cast(VelodyneScanMsg, msg), return_mode), 0
+    return decode_pointcloud2(cast(PointCloud2Msg, msg), topic)
 
 
 def evenly_spaced(total: int, limit: int | None) -> frozenset[int] | None:
@@ -219,7 +222,7 @@ def _pose_at(track: PoseTrack | None, stamp: int, max_gap_s: float,
             float(samples.angular_rate[0]))
 
 
-def _scan_frames(reader: Any, stream: FrameStream, counts: ReadCounts,
+def _scan_frames(reader: AnyReader, stream: FrameStream, counts: ReadCounts,
                  stamps: _StampRange) -> Iterator[Frame]:
     """Stream the cloud topic, yielding posed frames and counting what is dropped."""
     opts, topic = stream.options, stream.cloud_topic
@@ -230,7 +233,7 @@ def _scan_frames(reader: Any, stream: FrameStream, counts: ReadCounts,
             counts.scans_skipped += 1
             continue
         counts.scans_read += 1
-        stamp = header_stamp(msg.header, log_time)
+        stamp = header_stamp(cast(StampedMsg, msg).header, log_time)
         stamps.add(stamp)
         pose = _pose_at(stream.track, stamp, opts.max_gap_s, counts)
         if pose is None:
@@ -290,7 +293,7 @@ def read_frames(path: str | Path, **options: Unpack[StreamOptions]) -> FrameSet:
 
 
 def _sources(
-    reader: Any,
+    reader: AnyReader,
     bag: Path,
     names: tuple[str | None, str | None, str | None],
     *,

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
 
 from alte.errors import TopicError
 from alte.io.pose import POSE_TYPES
@@ -40,9 +39,9 @@ class BagInfo:
     mount: Mount | None = None
     notes: list[str] = field(default_factory=list)
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, object]:
         """JSON-ready form (topics as ``{name: {"type": ..., "count": ...}}``)."""
-        mount = None
+        mount: dict[str, list[float]] | None = None
         if self.mount is not None:
             mount = {
                 "translation": self.mount.translation.tolist(),

@@ -8,14 +8,24 @@ padding (``row_step > width * point_step``) are cut to their payload first.
 
 from __future__ import annotations
 
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 
 from alte.errors import BagError
+from alte.io.messages import PointCloud2Msg
 from alte.types import finite_rows
 
-__all__ = ["POINTFIELD_DTYPES", "decode_pointcloud2", "encode_pointcloud2", "make_header"]
+if TYPE_CHECKING:  # rosbags declares MsgType (its message classes' type) for checkers only
+    from rosbags.typesys.store import MsgType, Typestore
+
+__all__ = [
+    "POINTFIELD_DTYPES",
+    "CoordType",
+    "decode_pointcloud2",
+    "encode_pointcloud2",
+    "make_header",
+]
 
 #: ``sensor_msgs/PointField`` datatype code -> numpy scalar type.
 POINTFIELD_DTYPES: dict[int, np.dtype] = {
@@ -28,11 +38,13 @@ POINTFIELD_DTYPES: dict[int, np.dtype] = {
     7: np.dtype(np.float32),
     8: np.dtype(np.float64),
 }
+#: Storage type of x, y, z when encoding (float32 like real drivers, float64 lossless).
+CoordType = type[np.float32] | type[np.float64]
 _CODES = {dt: code for code, dt in POINTFIELD_DTYPES.items()}
 _XYZ = ("x", "y", "z")
 
 
-def _xyz_dtype(msg: Any, topic: str) -> np.dtype:
+def _xyz_dtype(msg: PointCloud2Msg, topic: str) -> np.dtype:
     """Structured dtype holding x, y, z at their offsets, ``itemsize == point_step``."""
     order: Literal[">", "<"] = ">" if msg.is_bigendian else "<"
     fields = {}
@@ -64,11 +76,11 @@ def _xyz_dtype(msg: Any, topic: str) -> np.dtype:
     )
 
 
-def _payload(msg: Any, topic: str) -> np.ndarray:
+def _payload(msg: PointCloud2Msg, topic: str) -> np.ndarray:
     """The point bytes without row padding, checked against width/height/steps."""
     width, height = int(msg.width), int(msg.height)
     point_step, row_step = int(msg.point_step), int(msg.row_step)
-    data = np.frombuffer(memoryview(msg.data), dtype=np.uint8)
+    data = np.frombuffer(msg.data, dtype=np.uint8)
     row_bytes = width * point_step
     if height > 1 or row_step:
         if row_step < row_bytes:
@@ -87,7 +99,7 @@ def _payload(msg: Any, topic: str) -> np.ndarray:
     return np.ascontiguousarray(data.reshape(height, row_step)[:, :row_bytes]).reshape(-1)
 
 
-def decode_pointcloud2(msg: Any, topic: str = "PointCloud2") -> tuple[np.ndarray, int]:
+def decode_pointcloud2(msg: PointCloud2Msg, topic: str = "PointCloud2") -> tuple[np.ndarray, int]:
     """Return the finite (N, 3) float64 x, y, z of ``msg`` and how many points were dropped.
 
     Points with a NaN or infinite coordinate (``is_dense = false`` clouds mark
@@ -113,11 +125,11 @@ def encode_pointcloud2(
     points: np.ndarray,
     stamp_ns: int,
     frame_id: str,
-    typestore: Any,
+    typestore: Typestore,
     *,
-    dtype: Any = np.float32,
+    dtype: CoordType = np.float32,
     extra_fields: dict[str, np.ndarray] | None = None,
-) -> Any:
+) -> MsgType:
     """Build an unorganized little-endian PointCloud2 message (x, y, z, then ``extra_fields``).
 
     ``dtype`` is the storage type of x, y, z (float32 like real drivers, float64
@@ -163,7 +175,7 @@ def encode_pointcloud2(
     )
 
 
-def make_header(stamp_ns: int, frame_id: str, typestore: Any) -> Any:
+def make_header(stamp_ns: int, frame_id: str, typestore: Typestore) -> MsgType:
     """A ``std_msgs/msg/Header`` for ``stamp_ns``."""
     sec, nanosec = divmod(int(stamp_ns), 1_000_000_000)
     stamp = typestore.types["builtin_interfaces/msg/Time"](sec=sec, nanosec=nanosec)

@@ -12,12 +12,21 @@ from __future__ import annotations
 import warnings
 from dataclasses import dataclass
 from functools import cached_property
-from typing import Any, NamedTuple
+from typing import NamedTuple, cast
 
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy.spatial.transform import Rotation, Slerp
 
 from alte.errors import PoseError
+from alte.io.messages import (
+    HeaderMsg,
+    OdometryMsg,
+    PoseMsg,
+    PoseStampedMsg,
+    TFMessageMsg,
+    TransformStampedMsg,
+)
 
 __all__ = [
     "POSE_TYPES",
@@ -80,7 +89,7 @@ class PoseTrack:
 
     @classmethod
     def from_samples(
-        cls, stamps: Any, positions: Any, quats: Any, source: str = "poses"
+        cls, stamps: ArrayLike, positions: ArrayLike, quats: ArrayLike, source: str = "poses"
     ) -> PoseTrack:
         """Sort, de-duplicate and check raw samples; ``source`` names them in errors.
 
@@ -117,7 +126,7 @@ class PoseTrack:
         dup = int(keep.size - np.count_nonzero(keep))
         return cls(t, p, q, source, dup, reordered)
 
-    def check_units(self, stamps_ns: Any) -> None:
+    def check_units(self, stamps_ns: ArrayLike) -> None:
         """Raise :class:`PoseError` when ``stamps_ns`` look like a different unit from the track."""
         s = np.asarray(stamps_ns, dtype=np.int64).reshape(-1)
         if s.size == 0 or ((s >= self.stamps[0]) & (s <= self.stamps[-1])).any():
@@ -132,7 +141,7 @@ class PoseTrack:
                         f"{int(self.stamps[-1])} ns): wrong stamp unit ({what})?"
                     )
 
-    def interpolate(self, stamps_ns: Any, max_gap_s: float = 0.5) -> PoseSamples:
+    def interpolate(self, stamps_ns: ArrayLike, max_gap_s: float = 0.5) -> PoseSamples:
         """Poses at ``stamps_ns``: linear position, slerp attitude, never extrapolated.
 
         Stamps outside [first, last] sample are ``outside``; stamps between two
@@ -195,7 +204,7 @@ class PoseTrack:
 
 
 def _as_arrays(
-    stamps: Any, positions: Any, quats: Any, source: str
+    stamps: ArrayLike, positions: ArrayLike, quats: ArrayLike, source: str
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Copies of the inputs as int64 (M,), float64 (M, 3) and (M, 4), shape-checked."""
     t = np.array(stamps, dtype=np.int64).reshape(-1)
@@ -211,53 +220,42 @@ def _as_arrays(
     return t, p, q
 
 
-def header_stamp(header: Any, log_time: int) -> int:
+def header_stamp(header: HeaderMsg, log_time: int) -> int:
     """Header stamp in ns, or the log time when the header stamp is zero."""
     ns = int(header.stamp.sec) * _NS + int(header.stamp.nanosec)
     return ns if ns else int(log_time)
 
 
-def _values(position: Any, orientation: Any) -> tuple[float, ...]:
-    o = orientation
-    return (position.x, position.y, position.z, o.x, o.y, o.z, o.w)
+def _pose_values(pose: PoseMsg) -> tuple[float, ...]:
+    p, o = pose.position, pose.orientation
+    return (p.x, p.y, p.z, o.x, o.y, o.z, o.w)
 
 
-def pose_records(msg: Any, msgtype: str, log_time: int) -> list[PoseRecord]:
+def _transform_record(tf: TransformStampedMsg, log_time: int) -> PoseRecord:
+    t, r = tf.transform.translation, tf.transform.rotation
+    return PoseRecord(tf.header.frame_id, tf.child_frame_id, header_stamp(tf.header, log_time),
+                      (t.x, t.y, t.z, r.x, r.y, r.z, r.w))
+
+
+def pose_records(msg: object, msgtype: str, log_time: int) -> list[PoseRecord]:
     """``(parent, child, stamp_ns, (x, y, z, qx, qy, qz, qw))`` for each pose in ``msg``.
 
-    PoseStamped has no child frame (``""``); a TFMessage yields one record per
-    transform.
+    ``msgtype`` (the bag connection's) says which of :data:`POSE_TYPES` ``msg`` is, as
+    rosbags built it from that definition. PoseStamped has no child frame (``""``); a
+    TFMessage yields one record per transform.
     """
     if msgtype == "geometry_msgs/msg/PoseStamped":
-        pose = msg.pose
-        return [
-            PoseRecord(
-                msg.header.frame_id,
-                "",
-                header_stamp(msg.header, log_time),
-                _values(pose.position, pose.orientation),
-            )
-        ]
+        stamped = cast(PoseStampedMsg, msg)
+        header = stamped.header
+        return [PoseRecord(header.frame_id, "", header_stamp(header, log_time),
+                           _pose_values(stamped.pose))]
     if msgtype == "nav_msgs/msg/Odometry":
-        pose = msg.pose.pose
-        return [
-            PoseRecord(
-                msg.header.frame_id,
-                msg.child_frame_id,
-                header_stamp(msg.header, log_time),
-                _values(pose.position, pose.orientation),
-            )
-        ]
+        odom = cast(OdometryMsg, msg)
+        header = odom.header
+        return [PoseRecord(header.frame_id, odom.child_frame_id, header_stamp(header, log_time),
+                           _pose_values(odom.pose.pose))]
     if msgtype == "tf2_msgs/msg/TFMessage":
-        return [
-            PoseRecord(
-                tf.header.frame_id,
-                tf.child_frame_id,
-                header_stamp(tf.header, log_time),
-                _values(tf.transform.translation, tf.transform.rotation),
-            )
-            for tf in msg.transforms
-        ]
+        return [_transform_record(tf, log_time) for tf in cast(TFMessageMsg, msg).transforms]
     raise PoseError(f"message type {msgtype} carries no pose (expected one of {POSE_TYPES})")
 
 

@@ -12,7 +12,7 @@ import sqlite3
 import struct
 from collections.abc import Iterator
 from pathlib import Path
-from typing import Any
+from typing import cast
 
 import apsw
 import numpy as np
@@ -24,6 +24,7 @@ from rosbags.typesys import Stores, get_typestore
 from rosbags.typesys.base import TypesysError
 
 from alte.errors import BagError, TopicError
+from alte.io.messages import StampedMsg
 from alte.io.pose import POSE_TYPES, pose_records
 from alte.types import Mount
 
@@ -121,11 +122,13 @@ def _register_extra_types(reader: AnyReader) -> None:
 
 def read_messages(
     reader: AnyReader, topic: str, path: str | Path, select: frozenset[int] | None = None
-) -> Iterator[tuple[int, str, Any]]:
+) -> Iterator[tuple[int, str, object]]:
     """Yield ``(log_time_ns, msgtype, message)`` of one topic, errors as :class:`BagError`.
 
-    With ``select`` only messages at those indices (in log-time order) are decoded; the
-    others are yielded as ``None`` without the cost of deserializing them.
+    ``message`` is rosbags' instance of the ``msgtype`` class (see :mod:`alte.io.messages`
+    for the shapes alte reads). With ``select`` only messages at those indices (in
+    log-time order) are decoded; the others are yielded as ``None`` without the cost of
+    deserializing them.
     """
     conns = [c for c in reader.connections if c.topic == topic]
     try:
@@ -209,7 +212,7 @@ def first_frame_id(reader: AnyReader, topic: str | None, path: Path) -> str | No
     if topic is None:
         return None
     for _, _, msg in read_messages(reader, topic, path):
-        return str(msg.header.frame_id)
+        return str(cast(StampedMsg, msg).header.frame_id)  # clouds and scans have headers
     return None
 
 

@@ -20,11 +20,15 @@ Everything is vectorized over packets, blocks and lasers.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from alte.errors import BagError, ParameterError
+from alte.io.messages import VelodyneScanMsg
+
+if TYPE_CHECKING:
+    from rosbags.typesys.store import Typestore
 
 __all__ = [
     "FRAMES",
@@ -63,7 +67,7 @@ _PACKET = np.dtype(
 )
 
 
-def register_velodyne_types(typestore: Any) -> None:
+def register_velodyne_types(typestore: Typestore) -> None:
     """Register ``velodyne_msgs/msg/VelodynePacket`` and ``VelodyneScan`` in a rosbags typestore.
 
     Bags do not store these definitions. Registering twice is harmless.
@@ -215,16 +219,19 @@ def decode_velodyne_packets(
 
 
 def decode_velodyne_scan(
-    msg: Any,
+    msg: VelodyneScanMsg,
     return_mode: str = "strongest",
     frame: str = "manual",
     min_range: float = 0.0,
     interpolation: str = "manual",
 ) -> np.ndarray:
-    """Decode one ``velodyne_msgs/msg/VelodyneScan`` message (all its packets) into (N, 3)."""
-    packets = getattr(msg, "packets", None)
-    if packets is None:
+    """Decode one ``velodyne_msgs/msg/VelodyneScan`` message (all its packets) into (N, 3).
+
+    Anything without packets (an untyped caller's wrong message) is a :class:`BagError`.
+    """
+    if not isinstance(msg, VelodyneScanMsg):
         raise BagError(f"{type(msg).__name__} is not a velodyne_msgs/msg/VelodyneScan")
+    packets = msg.packets
     if len(packets) == 0:
         data = np.empty((0, PACKET_SIZE), dtype=np.uint8)
     else:

@@ -10,18 +10,23 @@ clock or random data; only its version string enters the mcap header).
 from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, TypedDict, Unpack
+from typing import TYPE_CHECKING, TypedDict, Unpack
 
 import numpy as np
+from numpy.typing import ArrayLike
 from rosbags.rosbag2 import StoragePlugin, Writer
 from rosbags.typesys import Stores, get_typestore
 from tqdm.auto import tqdm
 
 from alte.errors import BagError, ParameterError
 from alte.fsutil import atomic_dir
-from alte.io.pointcloud2 import encode_pointcloud2, make_header
+from alte.io.pointcloud2 import CoordType, encode_pointcloud2, make_header
 from alte.types import Frame, Mount
+
+if TYPE_CHECKING:  # rosbags declares MsgType (its message classes' type) for checkers only
+    from rosbags.typesys.store import MsgType
 
 __all__ = ["STORAGES", "BagOptions", "write_bag", "write_frames"]
 
@@ -35,7 +40,7 @@ _Poses = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
 
 
 def _pose_arrays(
-    pose_stamps: Any, positions: Any, quaternions: Any
+    pose_stamps: ArrayLike, positions: ArrayLike, quaternions: ArrayLike
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     stamps = np.asarray(pose_stamps, dtype=np.int64).reshape(-1)
     pos = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
@@ -50,13 +55,15 @@ def _pose_arrays(
     return stamps, pos, quat
 
 
-def _pose_msg(types: Any, header: Any, position: np.ndarray, quat: np.ndarray) -> Any:
+def _pose_msg(header: MsgType, position: np.ndarray, quat: np.ndarray) -> MsgType:
+    types = _TYPESTORE.types
     point = types["geometry_msgs/msg/Point"](*map(float, position))
     orientation = types["geometry_msgs/msg/Quaternion"](*map(float, quat))
     return types[_POSE](header=header, pose=types["geometry_msgs/msg/Pose"](point, orientation))
 
 
-def _tf_static_msg(types: Any, mount: Mount, stamp: int, body: str, sensor: str) -> Any:
+def _tf_static_msg(mount: Mount, stamp: int, body: str, sensor: str) -> MsgType:
+    types = _TYPESTORE.types
     vector = types["geometry_msgs/msg/Vector3"](*map(float, mount.translation))
     rotation = types["geometry_msgs/msg/Quaternion"](*map(float, mount.quaternion))
     tf = types["geometry_msgs/msg/TransformStamped"](
@@ -67,10 +74,21 @@ def _tf_static_msg(types: Any, mount: Mount, stamp: int, body: str, sensor: str)
     return types[_TF](transforms=[tf])
 
 
+@dataclass(frozen=True)
+class _Names:
+    """Where scans and poses go: world and sensor frames, topics, coordinate type."""
+
+    world: str
+    sensor: str
+    cloud: str
+    pose: str
+    dtype: CoordType
+
+
 class _BagOut:
     """An open writer: its connections, frame names and the time-sorted poses."""
 
-    def __init__(self, writer: Writer, topics: dict[str, str], names: dict[str, Any]) -> None:
+    def __init__(self, writer: Writer, topics: dict[str, str], names: _Names) -> None:
         self.writer = writer
         self.names = names
         self.conns = {
@@ -79,7 +97,7 @@ class _BagOut:
         }
         self.next_pose = 0
 
-    def put(self, topic: str, stamp: int, msg: Any) -> None:
+    def put(self, topic: str, stamp: int, msg: object) -> None:
         data = _TYPESTORE.serialize_cdr(msg, self.conns[topic].msgtype)
         self.writer.write(self.conns[topic], int(stamp), data)
 
@@ -90,23 +108,19 @@ class _BagOut:
             until is None or stamps[order[self.next_pose]] <= until
         ):
             k = order[self.next_pose]
-            header = make_header(int(stamps[k]), self.names["world"], _TYPESTORE)
-            self.put(
-                self.names["pose"],
-                int(stamps[k]),
-                _pose_msg(_TYPESTORE.types, header, pos[k], quat[k]),
-            )
+            header = make_header(int(stamps[k]), self.names.world, _TYPESTORE)
+            self.put(self.names.pose, int(stamps[k]), _pose_msg(header, pos[k], quat[k]))
             self.next_pose += 1
 
     def clouds(
         self, clouds: Iterable[tuple[int, np.ndarray]], poses: _Poses, progress: bool
     ) -> None:
         """Write every scan, each preceded by the poses up to its stamp."""
-        topic = self.names["cloud"]
+        topic = self.names.cloud
         for stamp, points in tqdm(clouds, desc=topic, unit="scan", disable=not progress):
             self.poses_until(poses, int(stamp))
             msg = encode_pointcloud2(
-                points, int(stamp), self.names["sensor"], _TYPESTORE, dtype=self.names["dtype"]
+                points, int(stamp), self.names.sensor, _TYPESTORE, dtype=self.names.dtype
             )
             self.put(topic, int(stamp), msg)
         self.poses_until(poses, None)
@@ -126,7 +140,7 @@ def write_bag(  # noqa: PLR0917 - positional arrays as specified for the simulat
     world_frame: str = "map",
     body_frame: str = "base_link",
     sensor_frame: str = "velodyne",
-    dtype: type[np.floating[Any]] = np.float32,
+    dtype: CoordType = np.float32,
     overwrite: bool = False,
     progress: bool = False,
 ) -> Path:
@@ -143,13 +157,7 @@ def write_bag(  # noqa: PLR0917 - positional arrays as specified for the simulat
     topics = {cloud_topic: _PC2, pose_topic: _POSE}
     if mount is not None:
         topics["/tf_static"] = _TF
-    names = {
-        "world": world_frame,
-        "sensor": sensor_frame,
-        "cloud": cloud_topic,
-        "pose": pose_topic,
-        "dtype": dtype,
-    }
+    names = _Names(world_frame, sensor_frame, cloud_topic, pose_topic, dtype)
     plugin = STORAGES[storage]
     with (
         atomic_dir(target, overwrite=overwrite) as tmp,
@@ -158,7 +166,7 @@ def write_bag(  # noqa: PLR0917 - positional arrays as specified for the simulat
         out = _BagOut(writer, topics, names)
         if mount is not None:
             first = int(stamps[order[0]]) if stamps.size else 0
-            tf = _tf_static_msg(_TYPESTORE.types, mount, first, body_frame, sensor_frame)
+            tf = _tf_static_msg(mount, first, body_frame, sensor_frame)
             out.put("/tf_static", first, tf)
         out.clouds(clouds, (stamps, pos, quat, order), progress)
     return target
@@ -173,7 +181,7 @@ class BagOptions(TypedDict, total=False):
     world_frame: str
     body_frame: str
     sensor_frame: str
-    dtype: type[np.floating[Any]]
+    dtype: CoordType
     overwrite: bool
     progress: bool
 

@@ -8,8 +8,11 @@ the same small interface so the mapper and :func:`compare_backends` treat them a
 from __future__ import annotations
 
 import tempfile
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Protocol
 
 import numba
 import numpy as np
@@ -19,7 +22,11 @@ from alte.mappers._octree import Leaves, VoxelStore, prune, write_bt
 from alte.mappers._raycast import TREE_DEPTH, TREE_MAX_VAL, morton_decode, morton_encode
 from alte.mappers._scan import scan_blocks
 
-__all__ = ["NativeTree", "ReferenceTree", "SensorModel", "logodds", "tree_leaves", "voxel_keys"]
+if TYPE_CHECKING:
+    import pyoctomap
+
+__all__ = ["NativeTree", "OcTreeLike", "ReferenceTree", "SensorModel", "logodds", "tree_leaves",
+           "voxel_keys"]
 
 _THREE = np.uint64(3)
 
@@ -29,23 +36,62 @@ def logodds(p: float) -> np.float32:
     return np.float32(np.log(p / (1.0 - p)))
 
 
+@dataclass(frozen=True)
 class SensorModel:
-    """Hit/miss updates, clamping bounds and occupancy threshold as float32 log-odds."""
+    """OctoMap's sensor model: hit/miss probabilities, clamping bounds, occupancy threshold.
 
-    def __init__(self, params: dict[str, Any]) -> None:
-        self.hit = logodds(params["prob_hit"])
-        self.miss = logodds(params["prob_miss"])
-        self.clamp = (logodds(params["clamp_min"]), logodds(params["clamp_max"]))
-        self.occupied = logodds(params["occupancy_threshold"])
+    The trees work in float32 log-odds: :attr:`hit`, :attr:`miss`, :attr:`clamp` and
+    :attr:`occupied`.
+    """
+
+    prob_hit: float
+    prob_miss: float
+    clamp_min: float
+    clamp_max: float
+    occupancy_threshold: float
+
+    @cached_property
+    def hit(self) -> np.float32:
+        return logodds(self.prob_hit)
+
+    @cached_property
+    def miss(self) -> np.float32:
+        return logodds(self.prob_miss)
+
+    @cached_property
+    def clamp(self) -> tuple[np.float32, np.float32]:
+        return logodds(self.clamp_min), logodds(self.clamp_max)
+
+    @cached_property
+    def occupied(self) -> np.float32:
+        return logodds(self.occupancy_threshold)
+
+
+class _OcTreeNode(Protocol):
+    def getLogOdds(self) -> float: ...  # noqa: N802 - pyoctomap's (OctoMap's) names
+
+
+class _OcTreeLeaf(Protocol):
+    current_node: _OcTreeNode
+
+    def getCoordinate(self) -> Sequence[float]: ...  # noqa: N802
+    def getDepth(self) -> int: ...  # noqa: N802
+
+
+class OcTreeLike(Protocol):
+    """What :func:`tree_leaves` reads of a ``pyoctomap.OcTree`` (untyped library)."""
+
+    def begin_leafs(self) -> Iterable[_OcTreeLeaf]: ...
+    def getResolution(self) -> float: ...  # noqa: N802
 
 
 class NativeTree:
     """Per-voxel float32 log-odds in hashed 8x8x8 blocks (see ``_octree.VoxelStore``)."""
 
-    def __init__(self, params: dict[str, Any]) -> None:
-        self.voxel = 1.0 / params["resolution"]
-        self.max_range = params["max_range"]
-        self.model = SensorModel(params)
+    def __init__(self, voxel: float, max_range: float, model: SensorModel) -> None:
+        self.voxel = voxel
+        self.max_range = max_range
+        self.model = model
         self.store = VoxelStore()
         self._leaves: Leaves | None = None
         self._scan_blocks = 1024  # block count of the last scan: the next one's table size
@@ -103,15 +149,14 @@ class NativeTree:
 class ReferenceTree:
     """The C++ OctoMap (``pyoctomap.OcTree``) configured with the same sensor model."""
 
-    def __init__(self, params: dict[str, Any]) -> None:
+    def __init__(self, voxel: float, max_range: float, model: SensorModel) -> None:
         import pyoctomap
 
-        self.voxel = 1.0 / params["resolution"]
-        self.max_range = params["max_range"]
-        self.model = SensorModel(params)
-        self.params = params
+        self.voxel = voxel
+        self.max_range = max_range
+        self.model = model
         self.tree = pyoctomap.OcTree(self.voxel)
-        _configure(self.tree, params)
+        _configure(self.tree, model)
 
     def insert_scan(self, points: np.ndarray, origin: np.ndarray) -> None:
         self.tree.insertPointCloud(
@@ -142,16 +187,16 @@ class ReferenceTree:
             full = str(Path(tmp) / "copy.ot")
             self.tree.write(full)
             copy = self.tree.read(full)
-        _configure(copy, self.params)
+        _configure(copy, self.model)
         copy.writeBinary(str(path))
 
 
-def _configure(tree: Any, params: dict[str, Any]) -> None:
-    tree.setProbHit(params["prob_hit"])
-    tree.setProbMiss(params["prob_miss"])
-    tree.setClampingThresMin(params["clamp_min"])
-    tree.setClampingThresMax(params["clamp_max"])
-    tree.setOccupancyThres(params["occupancy_threshold"])
+def _configure(tree: pyoctomap.OcTree, model: SensorModel) -> None:
+    tree.setProbHit(model.prob_hit)
+    tree.setProbMiss(model.prob_miss)
+    tree.setClampingThresMin(model.clamp_min)
+    tree.setClampingThresMax(model.clamp_max)
+    tree.setOccupancyThres(model.occupancy_threshold)
 
 
 def voxel_keys(points: np.ndarray, voxel: float) -> np.ndarray:
@@ -162,7 +207,7 @@ def voxel_keys(points: np.ndarray, voxel: float) -> np.ndarray:
     return np.unique(morton_encode(keys[inside]))
 
 
-def tree_leaves(tree: Any) -> Leaves:
+def tree_leaves(tree: OcTreeLike) -> Leaves:
     """Leaves of a ``pyoctomap.OcTree`` as Morton prefixes, depths and float32 log-odds.
 
     pyoctomap only offers a leaf iterator, so this is one Python step per leaf

@@ -16,7 +16,7 @@ import time
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, ClassVar, Protocol
+from typing import ClassVar, Protocol
 
 import numpy as np
 
@@ -58,11 +58,12 @@ class _Backend(Protocol):
     def memory_bytes(self) -> int: ...
 
 
-_BACKENDS: dict[str, Callable[[dict[str, Any]], _Backend]] = {
+#: Backend by name, built from (voxel size, max range, sensor model).
+_BACKENDS: dict[str, Callable[[float, float, SensorModel], _Backend]] = {
     "native": NativeTree, "reference": ReferenceTree}
 
 
-def _prob(low: float, high: float) -> Any:
+def _prob(low: float, high: float) -> Callable[[float], bool]:
     return lambda v: low < v < high
 
 
@@ -89,12 +90,19 @@ class OctomapParams(Record):
         for name, value in SENSOR_MODELS[self.sensor_model].items():
             if getattr(self, name) is None:
                 object.__setattr__(self, name, value)
-        low, high, threshold = self.clamp_min, self.clamp_max, self.occupancy_threshold
-        assert low is not None and high is not None and threshold is not None  # filled above
-        if low >= threshold:
+        model = self.model()
+        if model.clamp_min >= model.occupancy_threshold:
             raise ParameterError("octomap: clamp_min must be below occupancy_threshold")
-        if high <= threshold:
+        if model.clamp_max <= model.occupancy_threshold:
             raise ParameterError("octomap: clamp_max must be above occupancy_threshold")
+
+    def model(self) -> SensorModel:
+        """The five probabilities (sensor-model defaults filled in) as a :class:`SensorModel`."""
+        hit, miss = self.prob_hit, self.prob_miss
+        low, high, threshold = self.clamp_min, self.clamp_max, self.occupancy_threshold
+        assert hit is not None and miss is not None, "filled by __post_init__"
+        assert low is not None and high is not None and threshold is not None, "filled too"
+        return SensorModel(hit, miss, low, high, threshold)
 
 
 class Octomap:
@@ -125,9 +133,12 @@ class Octomap:
             raise MapperError("octomap: its domain is the fixed key space of 2^16 voxels per "
                               "axis around 0; it takes no domain")
         self._record = OctomapParams.parse(given)
-        self._params = self._record.as_dict()
-        self._tree = _BACKENDS[self._params["backend"]](self._params)
+        self._tree = self._new_tree()
         self.points_outside = 0
+
+    def _new_tree(self) -> _Backend:
+        rec = self._record
+        return _BACKENDS[rec.backend](1.0 / rec.resolution, rec.max_range, rec.model())
 
     @property
     def params(self) -> Record:
@@ -161,7 +172,7 @@ class Octomap:
     def build(self, points: np.ndarray, origins: np.ndarray | None = None) -> None:
         """Rebuild from a cloud; see the class docstring for the meaning of ``origins``."""
         pts = check_points(points, "octomap")
-        self._tree = _BACKENDS[self._params["backend"]](self._params)
+        self._tree = self._new_tree()
         self.points_outside = 0
         self._count_outside(pts)
         if origins is None:
@@ -262,7 +273,7 @@ def read_bt(path: str | Path) -> Cells:
 
 
 def compare_backends(
-    scans: Iterable[tuple[np.ndarray, np.ndarray]], **params: Any
+    scans: Iterable[tuple[np.ndarray, np.ndarray]], **params: float | str
 ) -> dict[str, float]:
     """Insert the same scans into both backends; Jaccard of occupied voxels, leaves, times.
 
@@ -270,9 +281,9 @@ def compare_backends(
     the reference time) plus the final leaf count (native: pruning; reference: C++
     ``getNumLeafNodes``); numba compilation is excluded by a warm-up insert.
     """
-    native = Octomap(**{**params, "backend": "native"})
-    reference = Octomap(**{**params, "backend": "reference"})
-    warm = Octomap(**{**params, "backend": "native"})  # load the numba kernels untimed
+    native = Octomap(None, **{**params, "backend": "native"})
+    reference = Octomap(None, **{**params, "backend": "reference"})
+    warm = Octomap(None, **{**params, "backend": "native"})  # load the numba kernels untimed
     warm.insert(np.ones((1, 3)), np.zeros(3))
     _ = warm.basis_functions
     times = {"native": 0.0, "reference": 0.0}
