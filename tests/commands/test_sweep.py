@@ -70,10 +70,10 @@ def test_failed_runs_exit_1(spec_file, capsys, monkeypatch):
 
 
 @pytest.mark.parametrize(("args", "message"), [
-    (["--frames", "0"], "frames=0: expected a positive integer"),
+    (["--frames", "0"], "sweep: frames=0 out of range (frames >= 1)"),
     (["--scheduler", "mars"], "--scheduler 'mars': expected serial"),
     (["--workers", "0"], "--workers 0: must be at least 1"),
-    (["--seeds", "-1"], "seeds=[-1]: expected a non-empty list of integers >= 0"),
+    (["--seeds", "-1"], "sweep: seeds=[-1] out of range (a non-empty list of integers >= 0)"),
 ])
 def test_bad_options_are_one_line_errors(spec_file, capsys, args, message):
     assert main(["sweep", str(spec_file), "--no-progress", *args]) == 2

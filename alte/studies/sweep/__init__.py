@@ -25,6 +25,7 @@ from alte.studies.sweep.runner import (
 from alte.studies.sweep.spec import (
     MapperGrid,
     SweepRun,
+    SweepSettings,
     SweepSpec,
     load_spec,
     parse_spec,
@@ -48,6 +49,7 @@ __all__ = [
     "MapperGrid",
     "SweepResult",
     "SweepRun",
+    "SweepSettings",
     "SweepSpec",
     "Variant",
     "finished_ids",

@@ -28,7 +28,7 @@ from alte.errors import ParameterError, SimulationError
 from alte.pipeline import DomainPolicy, FrameSpec, MapSpec, Registered, open_input, prepare
 from alte.sim import ensure_terrain, terrain_folder
 from alte.studies.experiments import CACHE_DIR, measure
-from alte.studies.sweep.spec import SweepRun, SweepSpec, plan_runs, plan_variants
+from alte.studies.sweep.spec import SweepRun, SweepSettings, SweepSpec, plan_runs, plan_variants
 from alte.studies.sweep.store import finished_ids, load_results, write_row
 
 __all__ = ["SERIAL", "SweepResult", "override", "run_one", "run_sweep", "variant_table"]
@@ -200,34 +200,22 @@ def run_sweep(spec: SweepSpec, *, scheduler: str = "local", workers: int = 2,
     return SweepResult(out, table, len(todo) - len(failed), len(runs) - len(todo), failed)
 
 
-def _seeds(changes: dict[str, Any]) -> None:
-    """Fold ``seed`` (one) into ``seeds`` (several) and check them."""
-    seed = changes.pop("seed", None)
-    if seed is not None:
-        changes["seeds"] = [seed]
-    seeds = changes.get("seeds")
-    if seeds is None:
-        return
-    if not isinstance(seeds, list | tuple) or not seeds or any(
-            isinstance(s, bool) or not isinstance(s, int) or s < 0 for s in seeds):
-        raise ParameterError(f"seeds={seeds!r}: expected a non-empty list of integers >= 0")
-    changes["seeds"] = tuple(dict.fromkeys(seeds))
-
-
-def override(spec: SweepSpec, **changes: Any) -> SweepSpec:
+def override(spec: SweepSpec, **changes: object) -> SweepSpec:
     """``spec`` with other ``frames``/``data_dir``/``output``/``seed``/``seeds`` (CLI and
-    notebook); ``None`` keeps the spec's value, except for ``frames`` (the whole mission)."""
+    notebook), checked as :class:`SweepSettings`; ``None`` keeps the spec's value, except
+    for ``frames`` (the whole mission)."""
     allowed = ("frames", "data_dir", "output", "seed", "seeds")
     unknown = sorted(set(changes) - set(allowed))
     if unknown:
         raise ParameterError(f"sweep override {', '.join(unknown)}: valid: {', '.join(allowed)}")
-    frames = changes.get("frames")
-    if frames is not None and (isinstance(frames, bool) or not isinstance(frames, int)
-                               or frames < 1):
-        raise ParameterError(f"frames={frames!r}: expected a positive integer or None")
-    _seeds(changes)
-    return dataclasses.replace(spec, **{k: v for k, v in changes.items()
-                                        if k == "frames" or v is not None})
+    given = {k: v for k, v in changes.items() if k == "frames" or v is not None}
+    new = SweepSettings.parse(given)
+    return dataclasses.replace(
+        spec,
+        frames=new.frames if "frames" in given else spec.frames,
+        data_dir=new.data_dir if "data_dir" in given else spec.data_dir,
+        output=new.output or spec.output,
+        seeds=new.seed_list() if {"seed", "seeds"} & set(given) else spec.seeds)
 
 
 def variant_table(spec: SweepSpec, table: pd.DataFrame) -> pd.DataFrame:

@@ -3,7 +3,9 @@
 A spec names terrains, the scans kept per terrain (``frames``), the simulation
 ``seeds`` (or one ``seed``), where results go (``output``), per mapper a ``grid`` of
 parameter lists (their cartesian product) and/or explicit ``rows``, and optionally
-ablation ``variants`` (:mod:`alte.studies.sweep.variants`). Every run is a
+ablation ``variants`` (:mod:`alte.studies.sweep.variants`). The top-level scalars are a
+:class:`SweepSettings` parameter record, checked and coerced like mapper parameters
+(:mod:`alte.params`); errors name the spec and the key. Every run is a
 :class:`SweepRun` with a stable :attr:`SweepRun.run_id`: the sha256 of its canonical
 JSON, so a resumed sweep recognises runs it has already finished.
 """
@@ -18,21 +20,60 @@ import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar, TypeVar
 
 from alte.errors import AlteError, ParameterError
 from alte.mappers import make_mapper
 from alte.metrics.maps import TruthOptions
+from alte.params import Record, param
 from alte.sim import TERRAINS
 from alte.studies.sweep.variants import Variant, parse_variants
 
-__all__ = ["MapperGrid", "SweepRun", "SweepSpec", "load_spec", "parse_spec", "plan_runs",
-           "plan_variants"]
+__all__ = ["MapperGrid", "SweepRun", "SweepSettings", "SweepSpec", "load_spec", "parse_spec",
+           "plan_runs", "plan_variants"]
 
-_TOP_KEYS = ("name", "terrains", "frames", "seed", "seeds", "voxel", "data_dir", "output",
-             "truth", "mappers", "variants")
 _MAPPER_KEYS = ("grid", "rows", "terrains")
 _SCALARS = (bool, int, float, str)
+_R = TypeVar("_R", bound=Record)
+
+
+def _seed_list(value: object) -> bool:
+    return isinstance(value, list | tuple) and bool(value) and all(
+        isinstance(s, int) and not isinstance(s, bool) and s >= 0 for s in value)
+
+
+@dataclass(frozen=True)
+class SweepSettings(Record):
+    """The scalar settings of a sweep spec's top level (and of :func:`override`)."""
+
+    OWNER: ClassVar[str] = "sweep"
+    name: str | None = param(None, help="the sweep's name (default: the spec file's stem)")
+    frames: int | None = param(None, lambda v: v >= 1, "frames >= 1",
+                               "scans kept per terrain (None: every scan)")
+    seed: int | None = param(None, lambda v: v >= 0, "seed >= 0", "one simulation seed")
+    seeds: tuple[int, ...] | None = param(None, _seed_list, "a non-empty list of integers >= 0",
+                                          "several simulation seeds (not with seed)")
+    voxel: float | None = param(None, lambda v: v > 0, "voxel > 0",
+                                "voxel filter of the registered cloud (m; None: unfiltered)")
+    data_dir: str = param("data", help="folder of the simulated terrains")
+    output: str | None = param(None, help="results folder (default: reports/sweeps/NAME)")
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if self.seeds is None:
+            return
+        if self.seed is not None:
+            raise ParameterError(f"{self.OWNER}: seeds: give either seed or seeds, not both")
+        object.__setattr__(self, "seeds", tuple(dict.fromkeys(self.seeds)))  # distinct, in order
+
+    def seed_list(self) -> tuple[int, ...]:
+        """The seeds to run: ``seeds``, else ``seed`` alone, else seed 0."""
+        if self.seeds is not None:
+            return self.seeds
+        return (0 if self.seed is None else self.seed,)
+
+
+_TOP_KEYS = (*SweepSettings.names(), "terrains", "truth", "mappers", "variants")
 
 
 @dataclass(frozen=True)
@@ -105,15 +146,6 @@ def _check_keys(source: str, where: str, given: Mapping[str, Any], valid: Sequen
                     f"{', '.join(valid)}")
 
 
-def _int(source: str, key: str, value: Any, minimum: int, optional: bool = False) -> int | None:
-    if value is None and optional:
-        return None
-    if isinstance(value, bool) or not isinstance(value, int) or value < minimum:
-        extra = " or null" if optional else ""
-        raise _fail(source, key, f"{value!r} must be an integer >= {minimum}{extra}")
-    return value
-
-
 def _terrains(source: str, key: str, value: Any) -> tuple[str, ...]:
     names = [value] if isinstance(value, str) else value
     if not isinstance(names, list) or not names:
@@ -124,15 +156,21 @@ def _terrains(source: str, key: str, value: Any) -> tuple[str, ...]:
     return tuple(dict.fromkeys(names))
 
 
+def _record(source: str, record: type[_R], given: Mapping[str, object]) -> _R:
+    """``record`` parsed from ``given``; its errors (naming its owner and the key, as in
+    ``sweep: frames=0 out of range``) are prefixed with the spec's source."""
+    try:
+        return record.parse(given)
+    except ParameterError as err:
+        raise ParameterError(f"{source}: {err}") from err
+
+
 def _truth(source: str, value: Any) -> TruthOptions:
     if value is None:
         return TruthOptions()
     if not isinstance(value, Mapping):
         raise _fail(source, "truth", f"{value!r} must be a mapping")
-    try:
-        return TruthOptions.parse({str(k): v for k, v in value.items()})
-    except ParameterError as err:  # the record's message names "truth" and the key
-        raise ParameterError(f"{source}: {err}") from err
+    return _record(source, TruthOptions, {str(k): v for k, v in value.items()})
 
 
 def _grid_rows(source: str, key: str, grid: Any) -> list[dict[str, Any]]:
@@ -179,25 +217,6 @@ def _mapper(source: str, name: str, body: Any, terrains: tuple[str, ...]) -> Map
     return MapperGrid(name, tuple(coerced), own)
 
 
-def _optional_float(source: str, key: str, value: Any) -> float | None:
-    if value is None:
-        return None
-    if isinstance(value, bool) or not isinstance(value, int | float) or not value > 0:
-        raise _fail(source, key, f"{value!r} must be a positive number or null")
-    return float(value)
-
-
-def _seeds(source: str, raw: Mapping[str, Any]) -> tuple[int, ...]:
-    if "seed" in raw and "seeds" in raw:
-        raise _fail(source, "seeds", "give either seed or seeds, not both")
-    if "seeds" not in raw:
-        return (int(_int(source, "seed", raw.get("seed", 0), 0) or 0),)
-    given = raw["seeds"]
-    if not isinstance(given, list) or not given:
-        raise _fail(source, "seeds", f"{given!r} must be a non-empty list of integers >= 0")
-    return tuple(dict.fromkeys(int(_int(source, "seeds", s, 0) or 0) for s in given))
-
-
 def parse_spec(raw: Any, source: str = "spec") -> SweepSpec:
     """Validate a spec mapping (as read from YAML); errors name ``source`` and the key."""
     if not isinstance(raw, Mapping):
@@ -209,15 +228,14 @@ def parse_spec(raw: Any, source: str = "spec") -> SweepSpec:
     terrains = _terrains(source, "terrains", raw["terrains"])
     if not isinstance(raw["mappers"], Mapping) or not raw["mappers"]:
         raise _fail(source, "mappers", "must map mapper names to their grids")
-    name = str(raw.get("name") or Path(source).stem)
+    settings = _record(source, SweepSettings,
+                       {k: raw[k] for k in SweepSettings.names() if k in raw})
+    name = settings.name or Path(source).stem
     mappers = tuple(_mapper(source, str(m), body, terrains) for m, body in raw["mappers"].items())
     return SweepSpec(
-        name=name, terrains=terrains, mappers=mappers,
-        frames=_int(source, "frames", raw.get("frames"), 1, optional=True),
-        seeds=_seeds(source, raw),
-        voxel=_optional_float(source, "voxel", raw.get("voxel")),
-        data_dir=str(raw.get("data_dir", "data")),
-        output=str(raw.get("output") or f"reports/sweeps/{name}"),
+        name=name, terrains=terrains, mappers=mappers, frames=settings.frames,
+        seeds=settings.seed_list(), voxel=settings.voxel, data_dir=settings.data_dir,
+        output=settings.output or f"reports/sweeps/{name}",
         truth=_truth(source, raw.get("truth")), source=source,
         variants=parse_variants(source, raw.get("variants"), terrains,
                                 tuple(g.mapper for g in mappers)))

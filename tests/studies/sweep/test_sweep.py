@@ -8,6 +8,7 @@ import pytest
 from alte.errors import AlteError, ParameterError
 from alte.studies.sweep import (
     TIMING_COLUMNS,
+    SweepSettings,
     finished_ids,
     load_results,
     load_spec,
@@ -57,6 +58,16 @@ def test_spec_defaults_and_per_mapper_terrains():
     assert {r.terrain for r in runs if r.mapper == "alte2d"} == {"sim_lan_1", "sim_nav_1"}
 
 
+def test_top_level_settings_are_a_parameter_record():
+    # text values are coerced as for every parameter record (YAML strings, --set values)
+    spec = parse_spec(_raw(frames="3", seeds=[2, 1, 2], voxel="0.5", name=7, output="out"))
+    assert (spec.frames, spec.seeds, spec.voxel, spec.name, spec.output) == (3, (2, 1), 0.5,
+                                                                              "7", "out")
+    assert parse_spec(_raw(seed=5)).seeds == (5,) and parse_spec(_raw()).seeds == (0,)
+    assert SweepSettings.parse({"seeds": [3, 3]}).seeds == (3,)
+    assert "frames >= 1" in SweepSettings.help()["frames"]
+
+
 def test_run_id_is_stable_canonical_and_sensitive():
     one = plan_runs(parse_spec(_raw()))
     again = plan_runs(parse_spec(_raw(mappers={"alte2d": {"grid": {"max_res": [3, 4],
@@ -100,14 +111,19 @@ def test_load_spec_reads_yaml(tmp_path):
     (_raw(mappers={"moon": {"rows": [{}]}}), "mappers.moon: unknown mapper 'moon'"),
     (_raw(mappers={"alte2d": {"rows": [{}], "terrains": ["sim_nav_1"]}}),
      r"mappers.alte2d.terrains: \['sim_nav_1'\] not in the top-level"),
-    (_raw(frames=0), "frames: 0 must be an integer >= 1 or null"),
-    (_raw(frames=True), "frames: True must be an integer"),
-    (_raw(seed=-1), "seed: -1 must be an integer >= 0"),
-    (_raw(seeds=[0, -2]), "seeds: -2 must be an integer >= 0"),
-    (_raw(seeds=[]), r"seeds: \[\] must be a non-empty list"),
-    (_raw(seeds=3), "seeds: 3 must be a non-empty list"),
-    (_raw(seed=1, seeds=[1]), "seeds: give either seed or seeds, not both"),
-    (_raw(voxel=-0.1), "voxel: -0.1 must be a positive number"),
+    (_raw(frames=0), r"^bad.yaml: sweep: frames=0 out of range \(frames >= 1\)$"),
+    (_raw(frames=True), "bad.yaml: sweep: frames=True is not a valid int"),
+    (_raw(frames=2.5), "bad.yaml: sweep: frames=2.5 must be an integer"),
+    (_raw(seed=-1), r"bad.yaml: sweep: seed=-1 out of range \(seed >= 0\)"),
+    (_raw(seeds=[0, -2]), r"sweep: seeds=\[0, -2\] out of range \(a non-empty list of integers"),
+    (_raw(seeds=[]), r"sweep: seeds=\[\] out of range \(a non-empty list"),
+    (_raw(seeds=3), r"sweep: seeds=3 out of range \(a non-empty list"),
+    (_raw(seeds=[True]), r"sweep: seeds=\[True\] out of range"),
+    (_raw(seed=1, seeds=[1]), "bad.yaml: sweep: seeds: give either seed or seeds, not both"),
+    (_raw(voxel=-0.1), r"bad.yaml: sweep: voxel=-0.1 out of range \(voxel > 0\)"),
+    (_raw(voxel="fine"), "bad.yaml: sweep: voxel='fine' is not a valid float"),
+    (_raw(data_dir=None), "bad.yaml: sweep: data_dir=None is not a valid str"),
+    (_raw(output=["a"]), r"bad.yaml: sweep: output=\['a'\] is not a valid str"),
     (_raw(truth=3), "truth: 3 must be a mapping"),
     (_raw(truth={"samples": 3}), r"truth: unknown parameter\(s\) samples; valid: grid_step"),
     (_raw(truth={"tolerance": 0}), r"truth: tolerance=0.0 out of range \(tolerance > 0\)"),
@@ -133,7 +149,7 @@ def test_override():
     spec = parse_spec(_raw())
     assert override(spec, frames=None).frames is None
     assert override(spec, frames=7, data_dir=None).data_dir == spec.data_dir
-    with pytest.raises(ParameterError, match="frames=0"):
+    with pytest.raises(ParameterError, match=r"^sweep: frames=0 out of range \(frames >= 1\)$"):
         override(spec, frames=0)
     with pytest.raises(ParameterError, match="sweep override colour"):
         override(spec, colour=1)
@@ -141,8 +157,10 @@ def test_override():
     assert override(spec, seeds=[2, 1, 2], seed=None).seeds == (2, 1)
     assert override(spec, seeds=None).seeds == spec.seeds == (0,)
     for bad in ([], [-1], [True], "0"):
-        with pytest.raises(ParameterError, match=r"seeds=.*: expected a non-empty list"):
+        with pytest.raises(ParameterError, match=r"sweep: seeds=.* out of range \(a non-empty"):
             override(spec, seeds=bad)
+    with pytest.raises(ParameterError, match="sweep: seeds: give either seed or seeds"):
+        override(spec, seed=1, seeds=[2])
 
 
 # -- store -------------------------------------------------------------------------------------
