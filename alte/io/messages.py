@@ -2,9 +2,11 @@
 
 rosbags deserializes each message into a class generated from its definition, so a
 message is typed by the fields it has, not by a base class: these protocols name the
-fields the readers use (read-only, so any message class with those fields fits, as do
-the plain namespaces tests build). Reading code narrows rosbags' ``object`` to one of
-them by the connection's message type, which names the class rosbags built.
+fields the readers use, so any message class with those fields fits (as do the plain
+namespaces tests build): scalars are attributes, fields holding messages, lists or
+arrays read-only properties, which any class whose field has a fitting shape satisfies.
+Reading code narrows rosbags' ``object`` to one of them by the connection's message
+type, which names the class rosbags built.
 """
 
 from __future__ import annotations
@@ -35,19 +37,17 @@ __all__ = [
 class TimeMsg(Protocol):
     """``builtin_interfaces/msg/Time``."""
 
-    @property
-    def sec(self) -> int: ...
-    @property
-    def nanosec(self) -> int: ...
+    sec: int
+    nanosec: int
 
 
 class HeaderMsg(Protocol):
     """``std_msgs/msg/Header``: stamp and frame."""
 
+    frame_id: str
+
     @property
     def stamp(self) -> TimeMsg: ...
-    @property
-    def frame_id(self) -> str: ...
 
 
 class StampedMsg(Protocol):
@@ -60,19 +60,15 @@ class StampedMsg(Protocol):
 class XYZMsg(Protocol):
     """``geometry_msgs/msg/Point`` or ``Vector3``."""
 
-    @property
-    def x(self) -> float: ...
-    @property
-    def y(self) -> float: ...
-    @property
-    def z(self) -> float: ...
+    x: float
+    y: float
+    z: float
 
 
 class QuaternionMsg(XYZMsg, Protocol):
     """``geometry_msgs/msg/Quaternion`` (x, y, z, w)."""
 
-    @property
-    def w(self) -> float: ...
+    w: float
 
 
 class PoseMsg(Protocol):
@@ -84,25 +80,24 @@ class PoseMsg(Protocol):
     def orientation(self) -> QuaternionMsg: ...
 
 
-class PoseStampedMsg(StampedMsg, Protocol):
+class _WithPoseMsg(Protocol):
+    """A message holding a pose (``PoseStamped``, ``PoseWithCovariance``)."""
+
+    @property
+    def pose(self) -> PoseMsg: ...
+
+
+class PoseStampedMsg(StampedMsg, _WithPoseMsg, Protocol):
     """``geometry_msgs/msg/PoseStamped``."""
-
-    @property
-    def pose(self) -> PoseMsg: ...
-
-
-class _PoseWithCovarianceMsg(Protocol):
-    @property
-    def pose(self) -> PoseMsg: ...
 
 
 class OdometryMsg(StampedMsg, Protocol):
     """``nav_msgs/msg/Odometry`` (only its pose is read)."""
 
+    child_frame_id: str
+
     @property
-    def child_frame_id(self) -> str: ...
-    @property
-    def pose(self) -> _PoseWithCovarianceMsg: ...
+    def pose(self) -> _WithPoseMsg: ...
 
 
 class _TransformMsg(Protocol):
@@ -115,8 +110,8 @@ class _TransformMsg(Protocol):
 class TransformStampedMsg(StampedMsg, Protocol):
     """``geometry_msgs/msg/TransformStamped``."""
 
-    @property
-    def child_frame_id(self) -> str: ...
+    child_frame_id: str
+
     @property
     def transform(self) -> _TransformMsg: ...
 
@@ -131,31 +126,22 @@ class TFMessageMsg(Protocol):
 class PointFieldMsg(Protocol):
     """``sensor_msgs/msg/PointField``."""
 
-    @property
-    def name(self) -> str: ...
-    @property
-    def offset(self) -> int: ...
-    @property
-    def datatype(self) -> int: ...
-    @property
-    def count(self) -> int: ...
+    name: str
+    offset: int
+    datatype: int
+    count: int
 
 
 class PointCloud2Msg(StampedMsg, Protocol):
     """``sensor_msgs/msg/PointCloud2``: layout fields and the raw data buffer."""
 
-    @property
-    def height(self) -> int: ...
-    @property
-    def width(self) -> int: ...
+    height: int
+    width: int
     @property
     def fields(self) -> Sequence[PointFieldMsg]: ...
-    @property
-    def is_bigendian(self) -> bool: ...
-    @property
-    def point_step(self) -> int: ...
-    @property
-    def row_step(self) -> int: ...
+    is_bigendian: bool
+    point_step: int
+    row_step: int
     @property
     def data(self) -> NDArray[np.uint8] | bytes: ...
 

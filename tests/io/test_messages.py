@@ -1,4 +1,4 @@
-"""The message shapes name real fields: every property of each protocol is a field of the ROS
+"""The message shapes name real fields: every member of each protocol is a field of the ROS
 definition rosbags uses, nested shapes included, so a typo or a wrong nesting fails here."""
 
 from __future__ import annotations
@@ -17,13 +17,16 @@ STORE = get_typestore(Stores.ROS2_HUMBLE)
 register_velodyne_types(STORE)
 
 
-def _properties(shape: type) -> dict[str, object]:
-    """Property name -> annotated return type, inherited protocols included."""
+def _members(shape: type) -> dict[str, object]:
+    """Attribute or property name -> its type, inherited protocols included."""
     out: dict[str, object] = {}
     for klass in reversed(shape.__mro__):
+        if klass.__module__ != messages.__name__:
+            continue
+        out.update(typing.get_type_hints(klass))
         for name, value in vars(klass).items():
             if isinstance(value, property) and value.fget is not None:
-                out[name] = typing.get_type_hints(value.fget, vars(messages))["return"]
+                out[name] = typing.get_type_hints(value.fget)["return"]
     return out
 
 
@@ -31,7 +34,7 @@ def _check(shape: type, msgtype: str) -> int:
     """Assert ``shape``'s properties against ``msgtype``'s fields; count the fields checked."""
     fields = dict(STORE.fielddefs[msgtype][1])
     checked = 0
-    for name, annotated in _properties(shape).items():
+    for name, annotated in _members(shape).items():
         assert name in fields, f"{shape.__name__}.{name} is not a field of {msgtype}"
         node, spec = fields[name]
         checked += 1
