@@ -30,7 +30,7 @@ import numpy as np
 
 from alte.errors import MapperError
 from alte.mappers._octree import check_origin
-from alte.mappers.base import Cells, Feed, check_points
+from alte.mappers.base import CellCounts, Cells, Feed, check_points
 from alte.mappers.domain import Domain, DomainUse, check_domain
 from alte.params import Record, param
 from alte.types import Box
@@ -192,6 +192,10 @@ class Alte3D:
             counts.append(n[~split])
             cells = _children(cells[split], p["variant"])
         return leaves, counts
+
+    def cell_counts(self) -> CellCounts:
+        """Counts of :meth:`cells` (small maps: the table itself)."""
+        return CellCounts.of(self.cells())
 
     def cells(self) -> Cells:
         """Leaves: centre, size, point count, occupied flag and level."""

@@ -19,7 +19,7 @@ from alte.mappers.domain import Domain, DomainUse
 from alte.params import Record
 from alte.types import as_points
 
-__all__ = ["Cells", "Feed", "Mapper", "check_points"]
+__all__ = ["CellCounts", "Cells", "Feed", "Mapper", "check_points"]
 
 
 @dataclass(frozen=True)
@@ -50,6 +50,19 @@ class Cells:
             "occupied": self.occupied,
             "level": self.level,
         }
+
+
+@dataclass(frozen=True)
+class CellCounts:
+    """How many cells a map has and how many of them are occupied."""
+
+    cells: int
+    occupied: int
+
+    @classmethod
+    def of(cls, cells: Cells) -> CellCounts:
+        """The counts of a materialised :class:`Cells` table."""
+        return cls(len(cells), int(np.count_nonzero(cells.occupied)))
 
 
 class Feed(enum.Enum):
@@ -106,6 +119,11 @@ class Mapper(Protocol):
 
     def cells(self) -> Cells:
         """The map's leaves as arrays."""
+        ...
+
+    def cell_counts(self) -> CellCounts:
+        """``len(cells())`` and its occupied count, without building the arrays where the
+        map is large (an Octomap flight holds tens of millions of free leaves)."""
         ...
 
     @property

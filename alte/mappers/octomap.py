@@ -25,7 +25,7 @@ from alte.fsutil import atomic_path
 from alte.mappers._octomap_backends import NativeTree, ReferenceTree, SensorModel, tree_leaves
 from alte.mappers._octree import Leaves, check_origin, leaf_geometry
 from alte.mappers._raycast import TREE_DEPTH, TREE_MAX_VAL
-from alte.mappers.base import Cells, Feed, check_points
+from alte.mappers.base import CellCounts, Cells, Feed, check_points
 from alte.mappers.domain import Domain, DomainUse
 from alte.params import Record, param
 from alte.types import rows_all
@@ -197,6 +197,11 @@ class Octomap:
 
     def cells(self) -> Cells:
         return leaves_to_cells(self.leaves(), self.voxel_size, self._tree.model.occupied)
+
+    def cell_counts(self) -> CellCounts:
+        """Leaves and occupied leaves, from the leaf values alone (no centres or sizes)."""
+        value = self.leaves().value
+        return CellCounts(len(value), int(np.count_nonzero(value > self._tree.model.occupied)))
 
     @property
     def basis_functions(self) -> int:

@@ -23,7 +23,7 @@ from typing import ClassVar
 import numpy as np
 
 from alte.errors import MapperError
-from alte.mappers.base import Cells, Feed, check_points
+from alte.mappers.base import CellCounts, Cells, Feed, check_points
 from alte.mappers.domain import Domain, DomainUse, check_domain
 from alte.mappers.levelstats import LevelStats
 from alte.mappers.quadgrid import Square
@@ -163,6 +163,10 @@ class QuadMap:
             return
         self.points_inserted += kept
         self._update_splits(self.stats.add(keys, self._values(pts)))
+
+    def cell_counts(self) -> CellCounts:
+        """Counts of :meth:`cells` (small maps: the table itself)."""
+        return CellCounts.of(self.cells())
 
     def cells(self) -> Cells:
         """Leaves of the partition; unknown (empty) leaves have NaN height and value."""

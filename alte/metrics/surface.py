@@ -9,12 +9,15 @@ seeded numpy generator (uniform by area) so every metric is reproducible.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
-import open3d as o3d
 
 from alte.errors import MetricsError
 from alte.tensors import to_array, to_tensor
+
+if TYPE_CHECKING:  # open3d (~200 MB resident) is imported on first use, as everywhere else
+    import open3d as o3d
 
 __all__ = ["SurfaceSamples", "TrueSurface"]
 
@@ -64,6 +67,8 @@ class TrueSurface:
                                f"{self.triangles.shape[0]} triangles")
         self.labels = dict(labels or {})
         self.classes = dict(classes or {})
+        import open3d as o3d
+
         self._scene = o3d.t.geometry.RaycastingScene()
         mesh = o3d.t.geometry.TriangleMesh()
         mesh.vertex.positions = to_tensor(self.vertices)
@@ -113,6 +118,8 @@ class TrueSurface:
                                            o3d.t.geometry.RaycastingScene]]:
         """Per object: x/y bounds, top height and a raycasting scene of its triangles alone."""
         if self._objects is None:
+            import open3d as o3d
+
             self._objects = []
             for oid in np.unique(self.object_ids):
                 tris = self.triangles[self.object_ids == oid]

@@ -109,7 +109,7 @@ class MapRun:
 
     def summary(self) -> dict[str, object]:
         """The run as one JSON-ready object (what ``alte map --json`` prints)."""
-        cells = self.mapper.cells()
+        counts = self.mapper.cell_counts()
         info = self.info
         return {
             "input": info.input, "input_kind": info.kind.value, "mapper": info.mapper,
@@ -125,7 +125,7 @@ class MapRun:
             "points_outside": int(self.mapper.points_outside),
             "local_origin": list(info.local_origin), "elapsed_s": self.elapsed_s,
             "wall_s": self.wall_s, "basis_functions": int(self.mapper.basis_functions),
-            "cells": len(cells), "occupied_cells": int(np.count_nonzero(cells.occupied)),
+            "cells": counts.cells, "occupied_cells": counts.occupied,
             "memory_bytes": int(self.mapper.memory_bytes), "counts": self.counts.as_dict(),
         }
 

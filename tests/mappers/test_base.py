@@ -6,7 +6,17 @@ import numpy as np
 import pytest
 
 from alte.errors import MapperError
-from alte.mappers import MAPPERS, DomainUse, Feed, Mapper, check_export, make_mapper, mapper_class
+from alte.mappers import (
+    MAPPERS,
+    CellCounts,
+    Domain,
+    DomainUse,
+    Feed,
+    Mapper,
+    check_export,
+    make_mapper,
+    mapper_class,
+)
 from alte.mappers.base import check_points
 
 
@@ -49,3 +59,21 @@ def test_unknown_mapper_and_exports(tmp_path: Path):
         from alte.mappers import Domain
 
         make_mapper("octomap", domain=Domain(0, 0, 0, 1))
+
+
+@pytest.mark.parametrize("name", list(MAPPERS))
+def test_cell_counts_equal_the_cells_table(name):
+    """``cell_counts`` (what ``alte map --json`` prints) counts what ``cells()`` holds."""
+    rng = np.random.default_rng(3)
+    points = np.column_stack([rng.uniform(0, 20, (3000, 2)), rng.uniform(0, 2, 3000)])
+    points[:200, 2] += 4.0  # an obstacle, so some cells are occupied and some are not
+    params = {"octomap": {"resolution": 2.0},
+              "alte3d": {"min_pts": 2, "occupancy_level": 0}}.get(name, {})
+    text = {2: "0,0,20", 3: "0,0,-2,24"}[mapper_class(name).dims]
+    domain = None if name == "octomap" else Domain.parse(text)
+    mapper = make_mapper(name, params, domain=domain)
+    mapper.build(points, np.array([10.0, 10.0, 20.0]))
+    cells = mapper.cells()
+    counts = mapper.cell_counts()
+    assert counts == CellCounts(len(cells), int(np.count_nonzero(cells.occupied)))
+    assert 0 < counts.occupied <= counts.cells
