@@ -18,7 +18,7 @@ import numba
 import numpy as np
 
 from alte.mappers._blockset import WORDS, keys_to_blocks
-from alte.mappers._octree import Leaves, VoxelStore, prune, write_bt
+from alte.mappers._octree import Leaves, VoxelStore, prune_voxels, write_bt
 from alte.mappers._raycast import TREE_DEPTH, TREE_MAX_VAL, morton_decode, morton_encode
 from alte.mappers._scan import scan_blocks
 
@@ -128,9 +128,7 @@ class NativeTree:
     def leaves(self) -> Leaves:
         """Pruned leaves (cached until the next update)."""
         if self._leaves is None:
-            keys, log_odds = self.store.fold()
-            depth = np.full(keys.size, TREE_DEPTH, dtype=np.int64)
-            self._leaves = prune(Leaves(keys, depth, log_odds))
+            self._leaves = prune_voxels(*self.store.fold())
         return self._leaves
 
     @property

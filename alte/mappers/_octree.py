@@ -25,7 +25,8 @@ from alte.mappers._raycast import TREE_DEPTH, TREE_MAX_VAL, morton_decode
 #: The voxel store: hash slots, their rows, block ids and float32 log-odds pages.
 Store = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
 
-__all__ = ["PAGE", "Leaves", "VoxelStore", "check_origin", "leaf_geometry", "prune", "write_bt"]
+__all__ = ["PAGE", "Leaves", "VoxelStore", "check_origin", "leaf_geometry", "prune",
+           "prune_voxels", "write_bt"]
 
 _THREE = np.uint64(3)
 
@@ -215,6 +216,35 @@ def prune(leaves: Leaves) -> Leaves:
         np.concatenate([lv.depth for lv in out]).astype(np.int64),
         np.concatenate([lv.value for lv in out]),
     )
+
+
+def prune_voxels(keys: np.ndarray, values: np.ndarray) -> Leaves:
+    """:func:`prune` of sorted, unique depth-16 voxels (what the store folds to).
+
+    With no leaves above depth 16 the nodes of each depth are exactly the collapsed
+    parents of the depth below, already sorted: no per-depth concatenation or sort,
+    so the peak memory of pruning a flight's tens of millions of voxels stays a few
+    copies of the key array instead of a dozen.
+    """
+    prefixes, depths, kept = [], [], []
+    for depth in range(TREE_DEPTH, 0, -1):
+        if keys.size == 0:
+            break
+        parent = keys >> _THREE
+        starts = np.flatnonzero(np.r_[True, parent[1:] != parent[:-1]])
+        counts = np.diff(np.r_[starts, parent.size])
+        vmin = np.minimum.reduceat(values, starts)
+        collapse = (counts == 8) & (vmin == np.maximum.reduceat(values, starts))
+        keep = ~np.repeat(collapse, counts)
+        prefixes.append(keys[keep])
+        kept.append(values[keep])
+        depths.append(np.full(prefixes[-1].size, depth, dtype=np.int64))
+        keys, values = parent[starts[collapse]], vmin[collapse]
+        del parent, starts, counts, vmin, collapse, keep  # before the next depth's copies
+    prefixes.append(keys)
+    kept.append(values)
+    depths.append(np.zeros(keys.size, dtype=np.int64))
+    return Leaves(np.concatenate(prefixes), np.concatenate(depths), np.concatenate(kept))
 
 
 def leaf_geometry(leaves: Leaves, voxel: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

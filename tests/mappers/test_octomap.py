@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 from alte.errors import AlteError, MapperError, ParameterError
 from alte.mappers._blockset import WORDS, keys_to_blocks
 from alte.mappers._octomap_backends import logodds
-from alte.mappers._octree import PAGE, Leaves, VoxelStore, prune
+from alte.mappers._octree import PAGE, Leaves, VoxelStore, prune, prune_voxels
 from alte.mappers._raycast import morton_encode
 from alte.mappers.octomap import Octomap, compare_backends, read_bt
 from alte.paths import realdata_dir
@@ -165,6 +165,21 @@ def test_prune_collapses_identical_siblings_recursively():
     values[0] = 0.25
     mixed = prune(Leaves(keys, np.full(64, 16), values))
     assert sorted(mixed.depth.tolist()) == [15] * 7 + [16] * 8
+
+
+def test_pruning_voxels_directly_equals_the_general_prune():
+    """The store's fast path (sorted depth-16 voxels) gives the general prune's leaves."""
+    rng = np.random.default_rng(5)
+    cube = np.array([[x, y, z] for x in range(16) for y in range(16) for z in range(16)])
+    keys = np.unique(morton_encode(np.concatenate([cube + 64, rng.integers(0, 200, (3000, 3))])
+                                   .astype(np.int64)))
+    values = np.where(rng.random(keys.size) < 0.2, 0.85, -0.4).astype(np.float32)
+    values[keys < morton_encode(np.array([[80, 80, 80]]))[0]] = -0.4  # whole blocks agree
+    fast = prune_voxels(keys, values)
+    general = prune(Leaves(keys, np.full(keys.size, 16), values))
+    assert fast.depth.min() < 15  # collapses over several depths happened
+    for field in ("prefix", "depth", "value"):
+        np.testing.assert_array_equal(getattr(fast, field), getattr(general, field))
 
 
 def test_corners_of_one_occupied_voxel():
