@@ -184,6 +184,26 @@ def _collect(blocks: np.ndarray, pages: np.ndarray, n: int) -> tuple[np.ndarray,
     return keys, values
 
 
+def _collapse(keys: np.ndarray, values: np.ndarray, depth: int) -> tuple[Leaves, Leaves]:
+    """One depth of pruning over sorted ``keys``: the leaves kept at ``depth`` and the
+    parents (at ``depth - 1``) whose 8 children all hold the same value."""
+    parent = keys >> _THREE
+    starts = np.flatnonzero(np.r_[True, parent[1:] != parent[:-1]])
+    counts = np.diff(np.r_[starts, parent.size])
+    vmin = np.minimum.reduceat(values, starts)
+    collapse = (counts == 8) & (vmin == np.maximum.reduceat(values, starts))
+    keep = ~np.repeat(collapse, counts)
+    kept = keys[keep]
+    return (Leaves(kept, np.full(kept.size, depth, dtype=np.int64), values[keep]),
+            Leaves(parent[starts[collapse]], np.empty(0, np.int64), vmin[collapse]))
+
+
+def _joined(out: list[Leaves]) -> Leaves:
+    return Leaves(np.concatenate([lv.prefix for lv in out]),
+                  np.concatenate([lv.depth for lv in out]).astype(np.int64),
+                  np.concatenate([lv.value for lv in out]))
+
+
 def prune(leaves: Leaves) -> Leaves:
     """Collapse every node whose 8 children are leaves with equal values, bottom-up.
 
@@ -203,19 +223,9 @@ def prune(leaves: Leaves) -> Leaves:
             out.append(Leaves(keys, np.full(keys.size, depth), values))
             carry = Leaves(keys[:0], np.empty(0, np.int64), values[:0])
             continue
-        parent = keys >> _THREE
-        starts = np.flatnonzero(np.r_[True, parent[1:] != parent[:-1]])
-        counts = np.diff(np.r_[starts, parent.size])
-        vmin = np.minimum.reduceat(values, starts)
-        collapse = (counts == 8) & (vmin == np.maximum.reduceat(values, starts))
-        keep = ~np.repeat(collapse, counts)
-        out.append(Leaves(keys[keep], np.full(int(keep.sum()), depth), values[keep]))
-        carry = Leaves(parent[starts[collapse]], np.empty(0, np.int64), vmin[collapse])
-    return Leaves(
-        np.concatenate([lv.prefix for lv in out]),
-        np.concatenate([lv.depth for lv in out]).astype(np.int64),
-        np.concatenate([lv.value for lv in out]),
-    )
+        kept, carry = _collapse(keys, values, depth)
+        out.append(kept)
+    return _joined(out)
 
 
 def prune_voxels(keys: np.ndarray, values: np.ndarray) -> Leaves:
@@ -226,25 +236,15 @@ def prune_voxels(keys: np.ndarray, values: np.ndarray) -> Leaves:
     so the peak memory of pruning a flight's tens of millions of voxels stays a few
     copies of the key array instead of a dozen.
     """
-    prefixes, depths, kept = [], [], []
+    out = []
+    nodes = Leaves(keys, np.empty(0, np.int64), values)
     for depth in range(TREE_DEPTH, 0, -1):
-        if keys.size == 0:
+        if len(nodes) == 0:
             break
-        parent = keys >> _THREE
-        starts = np.flatnonzero(np.r_[True, parent[1:] != parent[:-1]])
-        counts = np.diff(np.r_[starts, parent.size])
-        vmin = np.minimum.reduceat(values, starts)
-        collapse = (counts == 8) & (vmin == np.maximum.reduceat(values, starts))
-        keep = ~np.repeat(collapse, counts)
-        prefixes.append(keys[keep])
-        kept.append(values[keep])
-        depths.append(np.full(prefixes[-1].size, depth, dtype=np.int64))
-        keys, values = parent[starts[collapse]], vmin[collapse]
-        del parent, starts, counts, vmin, collapse, keep  # before the next depth's copies
-    prefixes.append(keys)
-    kept.append(values)
-    depths.append(np.zeros(keys.size, dtype=np.int64))
-    return Leaves(np.concatenate(prefixes), np.concatenate(depths), np.concatenate(kept))
+        kept, nodes = _collapse(nodes.prefix, nodes.value, depth)
+        out.append(kept)
+    out.append(Leaves(nodes.prefix, np.zeros(len(nodes), np.int64), nodes.value))
+    return _joined(out)
 
 
 def leaf_geometry(leaves: Leaves, voxel: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
