@@ -4,13 +4,12 @@ Frames stream from the bag through registration into the map, so the peak reside
 set should be the map plus a few frames, whatever the bag's length. The long mission
 is the terrain's bag with its scans repeated (stamps shifted past the previous
 lap, poses repeated with them), written once beside the bench data. Each run is a
-fresh ``alte map`` process; its own peak RSS comes from ``os.wait4``. The peer of a
+fresh ``alte map`` process; its peak RSS is its own ``VmHWM`` (see :data:`_CHILD`). The peer of a
 long-mission row is the same mapper on the short mission, measured in the same run.
 """
 
 from __future__ import annotations
 
-import os
 import statistics
 import subprocess
 import sys
@@ -64,24 +63,44 @@ def long_mission(bag: Path, out: Path, laps: int = LAPS) -> Path:
     return write_bag(out, _laps(bag, laps, gap), shifted, positions, quaternions, stream.mount)
 
 
-def peak_rss_mb(argv: Sequence[str]) -> tuple[float, float]:
-    """Peak resident set (MB) and wall time (s) of one child process running ``argv``."""
+#: Runs ``alte`` with the given arguments and reports its own high-water mark on exit.
+#: ``os.wait4``'s ``ru_maxrss`` cannot be used: Linux folds the pre-``exec`` memory of a
+#: forked child (a copy of this, much larger, bench process) into it.
+_CHILD = """
+import sys
+from alte.cli import main
+try:
+    code = main(sys.argv[1:])
+finally:
+    with open("/proc/self/status") as status:
+        hwm = next(line.split()[1] for line in status if line.startswith("VmHWM:"))
+    sys.stderr.write(f"\\nVmHWM_kB {hwm}\\n")
+sys.exit(code)
+"""
+
+
+def peak_rss_mb(args: Sequence[str]) -> tuple[float, float]:
+    """Peak resident set (MB, the process's own ``VmHWM``) and wall time (s) of one
+    ``alte ARGS`` child process."""
     start = time.perf_counter()
-    child = subprocess.Popen(list(argv), stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
-    _, status, usage = os.wait4(child.pid, 0)
+    child = subprocess.run([sys.executable, "-c", _CHILD, *args], stdout=subprocess.DEVNULL,
+                           stderr=subprocess.PIPE, text=True, check=False)
     wall = time.perf_counter() - start
-    child.returncode = os.waitstatus_to_exitcode(status)
-    err = child.stderr.read().decode() if child.stderr else ""
     if child.returncode != 0:
-        raise RuntimeError(f"{' '.join(argv)} failed ({child.returncode}): {err.strip()}")
-    return usage.ru_maxrss / 1024.0, wall
+        raise RuntimeError(f"alte {' '.join(args)} failed ({child.returncode}): "
+                           f"{child.stderr.strip()[-2000:]}")
+    marks = [line.split()[1] for line in child.stderr.splitlines()
+             if line.startswith("VmHWM_kB ")]
+    if not marks:
+        raise RuntimeError(f"alte {' '.join(args)} reported no VmHWM: {child.stderr[-500:]}")
+    return int(marks[-1]) / 1024.0, wall
 
 
 def _median_rss(bag: Path, mapper: str, repeats: int,
                 frames: int | None) -> tuple[float, float]:
-    argv = [sys.executable, "-m", "alte.cli", "map", str(bag), "--mapper", mapper,
-            *MAPPER_SETS[mapper], "--json", *(() if frames is None else ("--frames", str(frames)))]
-    runs = [peak_rss_mb(argv) for _ in range(repeats)]
+    args = ["map", str(bag), "--mapper", mapper, *MAPPER_SETS[mapper], "--json",
+            *(() if frames is None else ("--frames", str(frames)))]
+    runs = [peak_rss_mb(args) for _ in range(repeats)]
     return statistics.median(r[0] for r in runs), statistics.median(r[1] for r in runs)
 
 
