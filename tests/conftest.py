@@ -1,0 +1,18 @@
+"""Run order for ``make test`` (``pytest -n 2 --dist loadfile``).
+
+xdist hands whole files to the two workers in collection order, so a long file that is
+collected last (the chapter notebooks come after ``tests/``) leaves one core idle
+while the other finishes it. Files holding a ``slow`` test and the notebooks go first;
+the many short files then fill both workers to the end. Within a file the order stays.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """Long files first (stable: files and their tests keep their relative order)."""
+    long_files = {item.path for item in items
+                  if item.get_closest_marker("slow") or item.path.suffix == ".ipynb"}
+    items.sort(key=lambda item: item.path not in long_files)
