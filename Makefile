@@ -28,7 +28,7 @@ lint: bootstrap
 	$(PY) -m mypy
 
 test: lint
-	$(PY) -m pytest -n 2 --dist loadfile tests notebooks --nbval-lax $(PYTEST_ARGS)
+	$(PY) -m pytest -n 2 --dist loadfile --no-loadscope-reorder tests notebooks --nbval-lax $(PYTEST_ARGS)
 
 bench: bootstrap
 	$(PY) -m alte bench

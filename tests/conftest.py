@@ -1,9 +1,11 @@
-"""Run order for ``make test`` (``pytest -n 2 --dist loadfile``).
+"""Run order for ``make test`` (``pytest -n 2 --dist loadfile --no-loadscope-reorder``).
 
-xdist hands whole files to the two workers in collection order, so a long file that is
-collected last (the chapter notebooks come after ``tests/``) leaves one core idle
-while the other finishes it. Files holding a ``slow`` test and the notebooks go first;
-the many short files then fill both workers to the end. Within a file the order stays.
+xdist hands whole files to the two workers, one at a time as each runs dry, in the
+collection order (``--no-loadscope-reorder``: its default orders files by their number
+of tests, which says little about time). A long file handed out last leaves one core
+idle while the other finishes it, so files holding a ``slow`` test and the notebooks go
+first; the many short files then fill both workers to the end. Within a file the order
+stays.
 """
 
 from __future__ import annotations
