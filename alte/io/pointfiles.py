@@ -12,6 +12,7 @@ shifted by :func:`local_origin` before centimetre cells are computed.
 
 from __future__ import annotations
 
+import datetime
 import os
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -190,10 +191,16 @@ def _write_text(tmp: Path, points: np.ndarray) -> None:
     pd.DataFrame(points).to_csv(tmp, sep=" ", header=False, index=False)
 
 
+#: The header's creation day: fixed, as numpy fixes the dates inside ``.npz`` files, so the
+#: same cloud gives the same bytes on any day.
+_LAS_DATE = datetime.date(1980, 1, 1)
+
+
 def _write_las(tmp: Path, points: np.ndarray, compress: bool) -> None:
     import laspy
 
     header = laspy.LasHeader(point_format=0, version="1.2")
+    header.creation_date = _LAS_DATE
     header.offsets = local_origin(points)
     header.scales = np.full(3, _LAS_SCALE)
     reach = np.abs(points - header.offsets).max() / _LAS_SCALE
