@@ -139,39 +139,40 @@ def aggregate_points(keys: np.ndarray, values: np.ndarray) -> tuple[np.ndarray, 
     return cells, out
 
 
-@numba.njit(cache=True, inline="always")
-def _run_sum(x: np.ndarray, m: int) -> float:
-    """``x[0] + (x[1] + ... + x[m-1])``: the order of ``np.add.reduceat`` on short runs."""
-    if m == 1:
-        return float(x[0])
-    rest = x[1]
-    for i in range(2, m):
-        rest += x[i]
-    return float(x[0] + rest)
-
-
-@numba.njit(cache=True, inline="always")
-def _parent_row(rows: np.ndarray, run: tuple[int, int], out: np.ndarray, s: int,
-                term: np.ndarray) -> None:
+@numba.njit(cache=True, inline="always", error_model="numpy")
+def _parent_row(rows: np.ndarray, run: tuple[int, int], out: np.ndarray, s: int) -> None:
     """Row ``s`` of ``out``: Chan's merge of the (at most 4) child rows ``rows[a:b]``,
-    ``run = (a, b)``; ``term`` is scratch of 4 values."""
+    ``run = (a, b)``, each sum in ``np.add.reduceat``'s order on short runs (``x[0] +
+    (x[1] + ... + x[m-1])``), in registers (no scratch; counts are >= 1, never 0)."""
     a, b = run
     nv = (rows.shape[1] - 1) // 3
-    m = b - a
-    for i in range(m):
-        term[i] = rows[a + i, 0]
-    out[s, 0] = count = _run_sum(term, m)
-    for j in range(nv):
-        for i in range(m):
-            term[i] = rows[a + i, 0] * rows[a + i, 1 + j]
-        out[s, 1 + j] = mean = _run_sum(term, m) / count
-        top = rows[a, 1 + 2 * nv + j]
-        for i in range(m):
-            dev = rows[a + i, 1 + j] - mean
-            term[i] = rows[a + i, 1 + nv + j] + rows[a + i, 0] * dev * dev
-            top = max(top, rows[a + i, 1 + 2 * nv + j])
-        out[s, 1 + nv + j] = _run_sum(term, m)
-        out[s, 1 + 2 * nv + j] = top
+    count = rows[a, 0]
+    if b - a > 1:
+        rest = rows[a + 1, 0]
+        for i in range(a + 2, b):
+            rest += rows[i, 0]
+        count = count + rest
+    out[s, 0] = count
+    for j in range(1, 1 + nv):
+        total, top = rows[a, 0] * rows[a, j], rows[a, 2 * nv + j]
+        if b - a > 1:
+            rest = rows[a + 1, 0] * rows[a + 1, j]
+            for i in range(a + 2, b):
+                rest += rows[i, 0] * rows[i, j]
+            total = total + rest
+        mean = total / count
+        dev = rows[a, j] - mean
+        total = rows[a, nv + j] + rows[a, 0] * dev * dev
+        if b - a > 1:
+            dev = rows[a + 1, j] - mean
+            rest = rows[a + 1, nv + j] + rows[a + 1, 0] * dev * dev
+            for i in range(a + 2, b):
+                dev = rows[i, j] - mean
+                rest += rows[i, nv + j] + rows[i, 0] * dev * dev
+            total = total + rest
+        for i in range(a + 1, b):
+            top = max(top, rows[i, 2 * nv + j])
+        out[s, j], out[s, nv + j], out[s, 2 * nv + j] = mean, total, top
 
 
 @numba.njit(cache=True)
@@ -180,10 +181,9 @@ def combine(keys: np.ndarray, rows: np.ndarray, nv: int) -> tuple[np.ndarray, np
     starts = _run_starts(keys, 2)
     out = np.empty((starts.size - 1, rows.shape[1]))
     parents = np.empty(starts.size - 1, dtype=np.int64)
-    term = np.empty(4)
     for s in range(starts.size - 1):
         parents[s] = keys[starts[s]] >> 2
-        _parent_row(rows, (starts[s], starts[s + 1]), out, s, term)
+        _parent_row(rows, (starts[s], starts[s + 1]), out, s)
     return parents, out
 
 

@@ -10,6 +10,11 @@ after the others (*pending*). Pending cells are sorted in only when a reader nee
 the sorted arrays, so an insertion costs O(frame x depth) whatever the map's size,
 with no copying of the map (storage grows rarely: doubling, from a generous first
 size that the OS pages in only as it is used).
+
+A first insertion into empty levels, and a build, walk the sorted points once
+(``_levelbuild``). A build whose cells split on their count alone keeps the tree of
+the partition only (:meth:`LevelStats.build_tree`) and the sorted points, from which
+:meth:`LevelStats.complete` fills in every other cell when an insertion needs them.
 """
 
 from __future__ import annotations
@@ -29,6 +34,7 @@ from alte.mappers._cellstats import (
     merge_cells,
     sort_keys,
 )
+from alte.mappers._levelbuild import Sorted, build_levels, sort_points
 
 __all__ = ["MAX_DEPTH", "LevelStats"]
 
@@ -104,6 +110,7 @@ class LevelStats:
         self._sorted = [0 for _ in levels]  # length of the sorted prefix
         self._index: list[np.ndarray | None] = [None for _ in levels]  # None: to rebuild
         self._defer = 0
+        self._source: tuple[Sorted, float] | None = None  # see build_tree
         self.keys = _PerLevel(self, self._k)
         self.rows = _PerLevel(self, self._r)
         self.split = _PerLevel(self, self._s)
@@ -127,10 +134,15 @@ class LevelStats:
         finally:
             self._defer -= 1
 
-    def add(self, fine_keys: np.ndarray, values: np.ndarray) -> list[np.ndarray] | None:
+    def add(self, fine_keys: np.ndarray, values: np.ndarray,
+            split_above: float = np.inf) -> list[np.ndarray] | None:
         """Add points given by finest-level keys and (N, nv) values; the rows touched per
-        level, or None when the map was empty (every row is new)."""
-        was_empty = not any(self._n)
+        level, or None when the map was empty (every row is new, and a cell above the
+        finest level is flagged to split when its ``n > split_above``)."""
+        if not any(self._n):
+            self._fill(sort_points(fine_keys, values, 2 * self.depth), split_above, tree=False)
+            return None
+        self.complete()
         keys, order = sort_keys(np.asarray(fine_keys, np.int64), 2 * self.depth)
         keys, agg = aggregate_points(keys, np.ascontiguousarray(values[order], float))
         touched: list[np.ndarray] = [np.empty(0, np.int64)] * (self.depth + 1)
@@ -138,14 +150,41 @@ class LevelStats:
             if level < self.depth:
                 keys, agg = combine(keys, agg, self.nv)
             touched[level] = self._merge(level, keys, agg)
-        return None if was_empty else touched
+        return touched
+
+    def build_tree(self, fine_keys: np.ndarray, values: np.ndarray, split_above: float) -> None:
+        """Fill empty levels with the cells of a partition that splits a cell when its
+        ``n > split_above``: the root and the children of split cells (``_treebuild``).
+
+        The sorted points are kept, so that :meth:`complete` can add the other cells
+        when an insertion or a shift of the root needs them."""
+        points = sort_points(fine_keys, values, 2 * self.depth)
+        self._fill(points, split_above, tree=True)
+        self._source = (points, split_above)
+
+    def complete(self) -> None:
+        """Every non-empty cell on every level (after :meth:`build_tree`, which keeps the
+        tree's cells only); the same rows and flags as :meth:`add` on the empty map."""
+        if self._source is not None:
+            points, split_above = self._source
+            self._source = None
+            self._fill(points, split_above, tree=False)
+
+    def _fill(self, points: Sorted, split_above: float, tree: bool) -> None:
+        """Every level's cells (or the tree's) from sorted points in one walk."""
+        for level, cells in enumerate(build_levels(points, self.depth, split_above, tree)):
+            self._set_level(level, *cells)
+
+    def _set_level(self, level: int, keys: np.ndarray, rows: np.ndarray,
+                   split: np.ndarray) -> None:
+        """Replace ``level``'s cells by sorted ``keys`` with their rows and split flags."""
+        self._k[level], self._r[level], self._s[level] = keys, rows, split
+        self._n[level] = self._sorted[level] = len(keys)
+        self._index[level] = None
 
     def _merge(self, level: int, keys: np.ndarray, agg: np.ndarray) -> np.ndarray:
-        if not self._n[level]:  # empty level (a build): take the arrays as they are
-            self._k[level], self._r[level] = keys, agg
-            self._s[level] = np.zeros(len(keys), bool)
-            self._n[level] = self._sorted[level] = len(keys)
-            self._index[level] = None
+        if not self._n[level]:  # empty level: take the arrays as they are
+            self._set_level(level, keys, agg, np.zeros(len(keys), bool))
             return np.arange(len(keys))
         index = self._reserve(level, len(keys))
         store = (self._k[level], self._r[level], self._s[level], index)
@@ -206,6 +245,7 @@ class LevelStats:
         Level ``l`` becomes level ``l + 1``; the new root has the old root's statistics
         and the old finest level is dropped (the depth limit is relative to the root).
         """
+        self.complete()
         for level in range(self.depth + 1):
             self.fold(level)
         for level in range(self.depth, 0, -1):
@@ -221,10 +261,15 @@ class LevelStats:
 
     @property
     def nbytes(self) -> int:
-        """Bytes of the cells' keys, rows and flags: the map itself, not the insertion's
-        growth slack or row index (up to 4 bytes per cell of a level's touched area)."""
+        """Bytes of the cells' keys, rows and flags, and of the points a tree build keeps:
+        the map itself, not the insertion's growth slack or row index (up to 4 bytes per
+        cell of a level's touched area)."""
         row = 8 * (1 + 3 * self.nv)
-        return sum(n * (8 + row + 1) for n in self._n)
+        kept = 0
+        if self._source is not None:
+            packed, _shift, values = self._source[0]
+            kept = packed.nbytes + values.nbytes
+        return sum(n * (8 + row + 1) for n in self._n) + kept
 
     def leaves(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Partition by the split flags: (level, key, row or -1 for an empty cell) per leaf."""

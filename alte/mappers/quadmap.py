@@ -75,6 +75,12 @@ class QuadMap:
     def _split(self, level: int, rows: np.ndarray | slice) -> np.ndarray:
         raise NotImplementedError
 
+    def _split_above(self) -> float | None:
+        """The count over which a cell splits, when :meth:`_split` is ``n > count`` above
+        the deepest level and nothing else: a build then flags cells as it writes them
+        (no pass over the levels). None: :meth:`_split` decides."""
+        return None
+
     def _update_splits(self, touched: list[np.ndarray] | None) -> None:
         """Recompute the split flags of the ``touched`` rows per level (None: all rows,
         as a slice: no gathering of whole columns).
@@ -134,7 +140,7 @@ class QuadMap:
             square = Square.bounding(pts[:, :2])
         self._reset(square)
         if len(pts):
-            self._add(pts)
+            self._add(pts, batch=True)
 
     def _grow(self, xy: np.ndarray) -> None:
         assert self.square is not None  # callers set the root square first
@@ -152,7 +158,7 @@ class QuadMap:
         assert self.square is not None, "insert and build set the root before adding points"
         return self.square
 
-    def _add(self, pts: np.ndarray) -> None:
+    def _add(self, pts: np.ndarray, batch: bool = False) -> None:
         keys, inside = self._root().locate(pts[:, :2], self.depth)
         kept = int(np.count_nonzero(inside))
         self.points_outside += len(pts) - kept
@@ -162,7 +168,13 @@ class QuadMap:
         if not kept:
             return
         self.points_inserted += kept
-        self._update_splits(self.stats.add(keys, self._values(pts)))
+        above = self._split_above()
+        if batch and above is not None:  # the partition's cells only (LevelStats.build_tree)
+            self.stats.build_tree(keys, self._values(pts), above)
+            return
+        touched = self.stats.add(keys, self._values(pts), np.inf if above is None else above)
+        if touched is not None or above is None:
+            self._update_splits(touched)
 
     def cell_counts(self) -> CellCounts:
         """Counts of :meth:`cells` (small maps: the table itself)."""
@@ -209,7 +221,8 @@ class QuadMap:
 
     @property
     def memory_bytes(self) -> int:
-        """Bytes of the per-level key, statistics and split-flag arrays."""
+        """Bytes of the per-level key, statistics and split-flag arrays (and of the points
+        a Quadtree build keeps)."""
         return self.stats.nbytes
 
     def corners(self) -> np.ndarray:

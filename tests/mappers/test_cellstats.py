@@ -74,6 +74,38 @@ def test_combine_groups_children_by_parent() -> None:
         assert row[0] == kids[:, 0].sum()
 
 
+def _ordered_sum(terms: list[float]) -> float:
+    """``x[0] + (x[1] + ... + x[m-1])``: np.add.reduceat's order on a short run."""
+    if len(terms) == 1:
+        return terms[0]
+    rest = terms[1]
+    for term in terms[2:]:
+        rest += term
+    return terms[0] + rest
+
+
+def test_combine_is_chans_merge_in_reduceat_order_bit_for_bit() -> None:
+    """Python floats (IEEE doubles) in the documented order give the kernel's rows exactly."""
+    rng = np.random.default_rng(8)
+    keys = np.unique(rng.integers(0, 1 << 12, 1500))
+    counts = rng.integers(1, 6, len(keys)).astype(np.float64)
+    rows = np.column_stack([counts, rng.normal(7.0, 3.0, (len(keys), 2)),
+                            rng.uniform(0.0, 2.0, (len(keys), 2))])  # n, means, m2 (nv 2)
+    rows = np.column_stack([rows, rows[:, 1:3] + 1.0])  # max
+    parents, merged = combine(keys, rows, 2)
+    for p, got in zip(parents, merged, strict=True):
+        kids = [list(map(float, r)) for r in rows[(keys >> 2) == p]]
+        count = _ordered_sum([k[0] for k in kids])
+        want = [count]
+        for j in (1, 2):
+            mean = _ordered_sum([k[0] * k[j] for k in kids]) / count
+            want.append(mean)
+            want.append(_ordered_sum([k[2 + j] + k[0] * (k[j] - mean) * (k[j] - mean)
+                                      for k in kids]))
+            want.append(max(k[4 + j] for k in kids))
+        assert got.tolist() == [want[0], want[1], want[4], want[2], want[5], want[3], want[6]]
+
+
 @pytest.mark.parametrize("dense", [True, False])
 def test_merge_cells_updates_known_and_appends_new(dense) -> None:
     rng = np.random.default_rng(9)

@@ -11,6 +11,7 @@ from support.maps import assert_partition, same_cells
 
 from alte.errors import MapperError, ParameterError
 from alte.mappers import levelstats
+from alte.mappers.alte2d import plane_height
 from alte.mappers.domain import Domain
 from alte.mappers.levelstats import LevelStats
 from alte.mappers.quadgrid import Square, morton_decode, morton_encode
@@ -62,9 +63,72 @@ def test_incremental_equals_batch_and_order_invariant(points, max_points, splits
     for chunk in np.array_split(points[order], splits):
         incr.insert(chunk, np.zeros(3))
     assert same_cells(batch.cells(), incr.cells())
+    batch.stats.complete()  # a build keeps the tree's cells; insertions keep every cell
     for level in range(7):  # the merged statistics (n, means, M2, max) match too
         assert np.array_equal(batch.stats.keys[level], incr.stats.keys[level])
         assert np.allclose(batch.stats.rows[level], incr.stats.rows[level], atol=1e-9)
+
+
+@settings(max_examples=30, deadline=None)
+@given(clouds, st.integers(1, 10), st.integers(0, 7))
+def test_build_keeps_the_trees_cells_bit_for_bit(points, max_points, max_depth) -> None:
+    """The tree of a build (root, children of split cells) holds the very rows, keys and
+    flags of those cells among every level's cells (insertion's first frame, complete)."""
+    built = Quadtree(max_points=max_points, max_depth=max_depth, domain=DOMAIN)
+    built.build(points)
+    tree = [(built.stats.keys[lv], built.stats.rows[lv], built.stats.split[lv])
+            for lv in range(max_depth + 1)]
+    cells, tree_bytes = built.cells(), built.memory_bytes
+    full = Quadtree(max_points=max_points, max_depth=max_depth, domain=DOMAIN)
+    full.insert(points, np.zeros(3))
+    for level, (keys, rows, split) in enumerate(tree):
+        parents = full.stats.keys[level - 1][full.stats.split[level - 1]] if level else [0]
+        kept = np.isin(full.stats.keys[level] >> (2 if level else 0), parents)
+        assert np.array_equal(full.stats.keys[level][kept], keys)
+        assert np.array_equal(full.stats.rows[level][kept], rows)
+        assert np.array_equal(full.stats.split[level][kept], split)
+    assert same_cells(cells, full.cells())
+    built.stats.complete()
+    for level in range(max_depth + 1):
+        assert np.array_equal(built.stats.rows[level], full.stats.rows[level])
+        assert np.array_equal(built.stats.split[level], full.stats.split[level])
+    assert built.memory_bytes == full.memory_bytes
+    # a cell: key, n, 3 statistics of 2 values, flag; a kept point: packed key, 2 values
+    assert tree_bytes == 65 * sum(len(keys) for keys, _, _ in tree) + 24 * len(points)
+
+
+def test_insert_after_build_equals_batch() -> None:
+    """Frames inserted into a built map (its levels completed first) give the batch map
+    of all points."""
+    pts = box_terrain(3000, seed=4)
+    later = box_terrain(1500, seed=5) * (1.5, 1.5, 1.0) - (2.0, 3.0, 0.0)  # some outside
+    qt = Quadtree(max_points=15, max_depth=9, domain=DOMAIN)
+    qt.build(pts)
+    for chunk in np.array_split(later, 4):
+        qt.insert(chunk, np.zeros(3))
+    batch = Quadtree(max_points=15, max_depth=9, domain=DOMAIN)
+    batch.build(np.vstack([pts, later]))
+    assert same_cells(qt.cells(), batch.cells())
+    assert qt.points_inserted == batch.points_inserted < len(pts) + len(later)
+
+
+def test_growth_after_build_sees_every_cell() -> None:
+    """A root that grows after a build (no domain) shifts the completed levels: the same
+    map, bit for bit, as when the build had kept every cell."""
+    pts = box_terrain(3000, seed=4)
+    later = np.array_split(box_terrain(1500, seed=5) * (1.5, 1.5, 1.0) - (2.0, 3.0, 0.0), 4)
+    lazy, eager = Quadtree(max_points=15, max_depth=9), Quadtree(max_points=15, max_depth=9)
+    lazy.build(pts)
+    eager.build(pts)
+    eager.stats.complete()
+    for chunk in later:
+        lazy.insert(chunk, np.zeros(3))
+        eager.insert(chunk, np.zeros(3))
+    assert lazy.square == eager.square and lazy.square.size > 2 * 16
+    for level in range(10):
+        assert np.array_equal(lazy.stats.keys[level], eager.stats.keys[level])
+        assert np.array_equal(lazy.stats.rows[level], eager.stats.rows[level])
+        assert np.array_equal(lazy.stats.split[level], eager.stats.split[level])
 
 
 def test_growth_without_domain_equals_batch_on_grown_root() -> None:
@@ -123,6 +187,15 @@ def test_ground_plane_and_fit() -> None:
     fitted.build(pts)
     assert not fitted.cells().occupied.any()
     assert np.allclose(fitted.plane[:3] / fitted.plane[2], [-0.1, 0, 1], atol=0.01)
+
+
+def test_heights_above_a_tilted_plane_are_numpys() -> None:
+    """The compiled values (z, height above the plane) are the numpy expression's, bit
+    for bit, so that maps do not depend on which computed them."""
+    pts = box_terrain(2000, seed=6) * (3.1, 0.7, 1.3)
+    qt = Quadtree(ground="0.13,-0.21,0.97,0.37")
+    above = pts[:, 2] - plane_height(qt.plane, pts[:, :2])
+    assert np.array_equal(qt._values(pts), np.column_stack([pts[:, 2], above]))
 
 
 def test_points_outside_fixed_domain_are_counted() -> None:

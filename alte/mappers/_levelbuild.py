@@ -1,0 +1,239 @@
+"""Numba kernels of a build: the cells of empty :class:`LevelStats` in one walk.
+
+An insertion into a map that holds cells aggregates the frame at the finest level and
+merges it upwards level by level (``_cellstats.combine``: a pass over each level and
+a fresh array per level). A build has no old cells to meet, so one walk over the
+sorted points does all levels: a finest cell closes where the next point's key
+differs, and with it every coarser cell whose key differs too; a closing parent
+merges its (at most 4) children, waiting in a small stack per level (in cache). The
+rows are those of the level-by-level path, bit for bit (same kernels, same order; a
+single point, or a parent of one single point, is that point's row).
+
+A closing cell writes its children out: all of them (every level's cells, for maps
+that insert later), or only when it splits on its count (``n > split_above``): the
+*tree* of a batch partition, its root and the children of split cells, a few per
+cent of all cells once levels are deep (sim_lan_2, ``max_points`` 25: 75 k of 1.49 M).
+
+The points are sorted by *packed* keys, ``key << shift | index``: one int64 array
+moved per radix pass, and the index makes the order stable. The hot loop is one
+function: numba passes arrays to a helper as structs of several words, and a call per
+cell (or its inlined copy's reference counting) costs more than the cell's arithmetic.
+"""
+
+from __future__ import annotations
+
+import itertools
+
+import numba
+import numpy as np
+
+from alte.mappers._cellstats import _cell_row, _parent_row, sort_keys
+
+__all__ = ["Sorted", "build_levels", "sort_points"]
+
+#: Below this many points numba's quicksort of the packed keys beats the radix passes.
+_RADIX_MIN = 1 << 14
+#: Points sorted for :func:`build_levels`: ``(packed, shift, values)``; ``shift`` 0
+#: when the keys alone are sorted and ``values`` are in their order.
+Sorted = tuple[np.ndarray, int, np.ndarray]
+#: Cells written by the walk: rows, keys, split flags, levels (for the tree; empty when
+#: every cell is written, each level at its own place) and the next place: per level
+#: (every cell), or one for all (the tree; counting on past the capacity).
+Out = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+
+
+@numba.njit(cache=True)
+def _sort_packed(keys: np.ndarray, bits: int, shift: int, scratch: np.ndarray,
+                 out: np.ndarray) -> np.ndarray:
+    """``keys << shift | index`` sorted (LSD radix on the key's ``bits``, digits of at
+    most 12 bits); the sorted array is ``out`` or ``scratch``."""
+    n = keys.size
+    passes = max(1, -(-bits // 12))
+    width = -(-max(bits, 1) // passes)
+    mask = (1 << width) - 1
+    count = np.zeros((passes, (1 << width) + 1), dtype=np.int64)
+    for i in range(n):
+        out[i] = (keys[i] << shift) | i
+        for p in range(passes):
+            count[p, ((keys[i] >> (p * width)) & mask) + 1] += 1
+    if n < _RADIX_MIN:
+        out[:] = np.sort(out)
+        return out
+    src, dst = out, scratch
+    for p in range(passes):
+        at = count[p]
+        for d in range(1 << width):
+            at[d + 1] += at[d]
+        for i in range(n):
+            d = (src[i] >> (shift + p * width)) & mask
+            dst[at[d]] = src[i]
+            at[d] += 1
+        src, dst = dst, src
+    return src
+
+
+@numba.njit(cache=True, inline="always")
+def _coarsest_change(a: int, b: int, depth: int) -> int:
+    """Coarsest level at which different finest keys ``a`` and ``b`` name different cells."""
+    x, bit = a ^ b, 0
+    for step in (32, 16, 8, 4, 2, 1):  # highest set bit, by halving
+        if x >> step:
+            x, bit = x >> step, bit + step
+    return depth - bit // 2
+
+
+@numba.njit(cache=True)
+def _level_counts(packed: np.ndarray, shift: int, depth: int) -> np.ndarray:
+    """Cells per level (``0..depth``) of the sorted points."""
+    closes = np.zeros(depth + 1, dtype=np.int64)  # finest-cell ends by coarsest level closed
+    for i in range(packed.size):
+        if i + 1 == packed.size:
+            closes[0] += 1
+        elif packed[i + 1] >> shift != packed[i] >> shift:
+            closes[_coarsest_change(packed[i] >> shift, packed[i + 1] >> shift, depth)] += 1
+    return np.cumsum(closes)
+
+
+@numba.njit(cache=True)
+def _run_row(points: Sorted, span: tuple[int, int], rows: np.ndarray, s: int) -> None:
+    """Row ``s``: the finest cell of the sorted points ``span = (i, j)``, two or more."""
+    packed, shift, values = points
+    i, j = span
+    run, dev = np.empty((j - i, values.shape[1])), np.empty((j - i, values.shape[1]))
+    for r in range(i, j):
+        p = r if shift == 0 else packed[r] & ((1 << shift) - 1)
+        run[r - i, :] = values[p]
+    _cell_row(run, (0, j - i), rows, s, dev)
+
+
+@numba.njit(cache=True)
+def _emit(stack: tuple[np.ndarray, np.ndarray], kids: tuple[int, int], level: int,
+          flags: tuple[int, float], out: Out) -> None:
+    """Write the stack's rows ``kids = (a, b)`` of ``level`` to ``out``, each flagged to
+    split when ``level < depth`` and ``n > split_above`` (``flags = (depth,
+    split_above)``); rows past the capacity are only counted."""
+    rows, keys = stack
+    table, cells, split, levels, at = out
+    cursor = level if at.size > 1 else 0
+    for k in range(kids[0], kids[1]):
+        u = at[cursor]
+        if u < table.shape[0]:
+            for c in range(rows.shape[1]):
+                table[u, c] = rows[k, c]
+            cells[u], split[u] = keys[k], level < flags[0] and rows[k, 0] > flags[1]
+            if levels.size:
+                levels[u] = level
+        at[cursor] = u + 1
+
+
+@numba.njit(cache=True)
+def _walk(points: Sorted, depth: int, rule: tuple[float, bool], out: Out) -> None:
+    """Write out the cells (``rule = (split_above, every cell)``) in the order they are
+    written: children of a cell together, by key; the root last.
+
+    A point alone in its cells from level ``top`` down (its neighbours differ there) has
+    that row on every one of them; unless every cell is written (or one point splits),
+    it enters the stack at ``top`` directly, skipping the chain of copies below."""
+    packed, shift, values = points
+    n, nv, mask = packed.size, values.shape[1], (1 << shift) - 1
+    rows, keys = np.empty((4 * depth + 4, 1 + 3 * nv)), np.empty(4 * depth + 4, np.int64)
+    count = np.zeros(depth + 1, np.int64)  # children waiting per level
+    i = before = 0  # ``before``: coarsest level where the previous point's cell differs
+    while i < n:
+        key, j = packed[i] >> shift, i + 1
+        while j < n and packed[j] >> shift == key:
+            j += 1
+        low = _coarsest_change(key, packed[j] >> shift, depth) if j < n else 0
+        top = depth if j - i > 1 or rule[1] or rule[0] < 1.0 else max(before, low)
+        s, before = 4 * top + count[top], low
+        if j - i > 1:
+            _run_row(points, (i, j), rows, s)
+        else:  # one point: _cell_row's values (v / 1 is v, M2 is 0 * 0)
+            rows[s, 0], p = 1.0, i if shift == 0 else packed[i] & mask
+            for c in range(nv):
+                rows[s, 1 + c], rows[s, 1 + nv + c], rows[s, 1 + 2 * nv + c] = \
+                    values[p, c], 0.0, values[p, c]
+        keys[s], count[top] = key >> (2 * (depth - top)), count[top] + 1
+        for level in range(top - 1, low - 1, -1):
+            m, s, kid = count[level + 1], 4 * level + count[level], 4 * level + 4
+            if m == 1 and rows[kid, 0] == 1.0:  # Chan's merge of one point: a copy
+                for c in range(1 + 3 * nv):
+                    rows[s, c] = rows[kid, c]
+            else:
+                _parent_row(rows, (kid, kid + m), rows, s)
+            keys[s], count[level], count[level + 1] = keys[kid] >> 2, count[level] + 1, 0
+            if rule[1] or rows[s, 0] > rule[0]:
+                _emit((rows, keys), (kid, kid + m), level + 1, (depth, rule[0]), out)
+        i = j
+    _emit((rows, keys), (0, 1), 0, (depth, rule[0]), out)
+
+
+def sort_points(keys: np.ndarray, values: np.ndarray, bits: int) -> Sorted:
+    """Points with finest ``keys`` (below ``2**bits``) and (N, nv) ``values``, stably
+    sorted by key: packed with their index when both fit in 63 bits, else by
+    ``_cellstats.sort_keys`` with the values put in that order."""
+    keys = np.asarray(keys, np.int64)
+    values = np.ascontiguousarray(values, np.float64)
+    shift = max(1, (keys.size - 1).bit_length())
+    if bits + shift > 63:
+        sorted_keys, order = sort_keys(keys, bits)
+        return sorted_keys, 0, values[order]
+    scratch, out = np.empty(keys.size, np.int64), np.empty(keys.size, np.int64)
+    return _sort_packed(keys, bits, shift, scratch, out), shift, values
+
+
+def build_levels(points: Sorted, depth: int, split_above: float, tree: bool,
+                 ) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """Per level ``0..depth``: sorted keys, rows ``n, mean.., m2.., max..`` and split
+    flags (``n > split_above`` above the finest level) of every non-empty cell of
+    :func:`sort_points`' points or, with ``tree``, of the root and the children of
+    split cells only (each level's arrays are views of one buffer per array)."""
+    packed, shift, values = points
+    if tree:
+        return _tree_levels(points, depth, split_above)
+    offsets = np.zeros(depth + 2, dtype=np.int64)
+    if len(packed):
+        offsets[1:] = np.cumsum(_level_counts(packed, shift, depth))
+    out = (np.empty((offsets[-1], 1 + 3 * values.shape[1])), np.empty(offsets[-1], np.int64),
+           np.zeros(offsets[-1], bool), np.empty(0, np.int64), offsets[:-1].copy())
+    if len(packed):
+        _walk(points, depth, (float(split_above), True), out)
+    return [(out[1][a:b], out[0][a:b], out[2][a:b]) for a, b in itertools.pairwise(offsets)]
+
+
+def _tree_levels(points: Sorted, depth: int, split_above: float,
+                 ) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """:func:`build_levels` of the tree: written in the order the walk closes cells,
+    then grouped by level."""
+    packed, values = points[0], points[2]
+    capacity = 64 + 8 * len(packed) // int(min(split_above + 1, max(len(packed), 1)))
+    for _ in range(2):  # a second walk when the first guess of the size was short
+        out = (np.empty((capacity, 1 + 3 * values.shape[1])), np.empty(capacity, np.int64),
+               np.empty(capacity, bool), np.empty(capacity, np.int64), np.zeros(1, np.int64))
+        if len(packed):
+            _walk(points, depth, (float(split_above), False), out)
+        used = int(out[4][0])
+        if used <= capacity:
+            break
+        capacity = used
+    offsets = np.zeros(depth + 2, np.int64)
+    offsets[1:] = np.cumsum(np.bincount(out[3][:used], minlength=depth + 1))
+    grouped = (np.empty((used, out[0].shape[1])), np.empty(used, np.int64), np.empty(used, bool))
+    _group(out, offsets[:-1].copy(), grouped)
+    return [(grouped[1][a:b], grouped[0][a:b], grouped[2][a:b])
+            for a, b in itertools.pairwise(offsets)]
+
+
+@numba.njit(cache=True)
+def _group(out: Out, at: np.ndarray, grouped: tuple[np.ndarray, np.ndarray, np.ndarray],
+           ) -> None:
+    """Copy the walk's cells to ``grouped`` (rows, keys, flags), level ``l`` from ``at[l]``
+    on, in the order written (a counting sort by level: keys stay sorted within)."""
+    table, cells, split, levels, used = out
+    rows, keys, flags = grouped
+    for u in range(used[0]):
+        d = at[levels[u]]
+        for c in range(table.shape[1]):
+            rows[d, c] = table[u, c]
+        keys[d], flags[d] = cells[u], split[u]
+        at[levels[u]] = d + 1
