@@ -1,18 +1,16 @@
-"""Numba kernels of a build: the cells of empty :class:`LevelStats` in one walk.
+"""Numba kernels of a build that keeps the partition's cells only, in one walk.
 
-An insertion into a map that holds cells aggregates the frame at the finest level and
-merges it upwards level by level (``_cellstats.combine``: a pass over each level and
-a fresh array per level). A build has no old cells to meet, so one walk over the
-sorted points does all levels: a finest cell closes where the next point's key
-differs, and with it every coarser cell whose key differs too; a closing parent
-merges its (at most 4) children, waiting in a small stack per level (in cache). The
-rows are those of the level-by-level path, bit for bit (same kernels, same order; a
-single point, or a parent of one single point, is that point's row).
-
-A closing cell writes its children out: all of them (every level's cells, for maps
-that insert later), or only when it splits on its count (``n > split_above``): the
-*tree* of a batch partition, its root and the children of split cells, a few per
-cent of all cells once levels are deep (sim_lan_2, ``max_points`` 25: 75 k of 1.49 M).
+An insertion aggregates a frame at the finest level and merges it upwards level by
+level (``_cellstats``: ``aggregate_points``, then ``combine`` per level), every cell of
+every level. A build whose cells split on their count alone (``n > split_above``)
+needs the partition's *tree*, its root and the children of split cells: a few per
+cent of all cells once levels are deep (sim_lan_2, ``max_points`` 25: 75 k of 1.49 M
+cells, 5 MB of the 97 MB). One walk over the sorted points finds them: a finest cell
+closes where the next point's key differs, and with it every coarser cell whose key
+differs too; a closing cell merges its (at most 4) children, waiting in a small stack
+per level, and writes them out when it splits. The rows are those of the
+level-by-level path, bit for bit: the same kernels in the same order (a point alone
+in its cells has its own row on each of them, so the walk skips that chain of copies).
 
 The points are sorted by *packed* keys, ``key << shift | index``: one int64 array
 moved per radix pass, and the index makes the order stable. The hot loop is one
@@ -30,16 +28,15 @@ from numba.cpython.unsafe.numbers import leading_zeros
 
 from alte.mappers._cellstats import _cell_row, _parent_row, sort_keys
 
-__all__ = ["Sorted", "build_levels", "sort_points"]
+__all__ = ["Sorted", "build_tree", "sort_points"]
 
 #: Below this many points numba's quicksort of the packed keys beats the radix passes.
 _RADIX_MIN = 1 << 14
-#: Points sorted for :func:`build_levels`: ``(packed, shift, values)``; ``shift`` 0
-#: when the keys alone are sorted and ``values`` are in their order.
+#: Points sorted by :func:`sort_points`: ``(packed, shift, values)``; ``shift`` 0 when
+#: the keys alone are sorted and ``values`` are in their order.
 Sorted = tuple[np.ndarray, int, np.ndarray]
-#: Cells written by the walk: rows, keys, split flags, levels (for the tree; empty when
-#: every cell is written, each level at its own place) and the next place: per level
-#: (every cell), or one for all (the tree; counting on past the capacity).
+#: The walk's output: rows, keys, split flags and levels of the cells in the order
+#: written, and how many were written (counting on past the capacity).
 Out = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]
 
 
@@ -81,18 +78,6 @@ def _coarsest_change(a: int, b: int, depth: int) -> int:
 
 
 @numba.njit(cache=True)
-def _level_counts(packed: np.ndarray, shift: int, depth: int) -> np.ndarray:
-    """Cells per level (``0..depth``) of the sorted points."""
-    closes = np.zeros(depth + 1, dtype=np.int64)  # finest-cell ends by coarsest level closed
-    for i in range(packed.size):
-        if i + 1 == packed.size:
-            closes[0] += 1
-        elif packed[i + 1] >> shift != packed[i] >> shift:
-            closes[_coarsest_change(packed[i] >> shift, packed[i + 1] >> shift, depth)] += 1
-    return np.cumsum(closes)
-
-
-@numba.njit(cache=True)
 def _run_row(points: Sorted, span: tuple[int, int], rows: np.ndarray, s: int) -> None:
     """Row ``s``: the finest cell of the sorted points ``span = (i, j)``, two or more."""
     packed, shift, values = points
@@ -111,39 +96,34 @@ def _emit(stack: tuple[np.ndarray, np.ndarray], kids: tuple[int, int], level: in
     split when ``level < depth`` and ``n > split_above`` (``flags = (depth,
     split_above)``); rows past the capacity are only counted."""
     rows, keys = stack
-    table, cells, split, levels, at = out
-    cursor = level if at.size > 1 else 0
+    table, cells, split, levels, used = out
     for k in range(kids[0], kids[1]):
-        u = at[cursor]
+        u = used[0]
         if u < table.shape[0]:
             for c in range(rows.shape[1]):
                 table[u, c] = rows[k, c]
-            cells[u], split[u] = keys[k], level < flags[0] and rows[k, 0] > flags[1]
-            if levels.size:
-                levels[u] = level
-        at[cursor] = u + 1
+            cells[u], levels[u] = keys[k], level
+            split[u] = level < flags[0] and rows[k, 0] > flags[1]
+        used[0] = u + 1
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _walk(points: Sorted, depth: int, rule: tuple[float, bool], out: Out) -> None:
-    """Write out the cells (``rule = (split_above, every cell)``) in the order they are
-    written: children of a cell together, by key; the root last.
-
-    A point alone in its cells from level ``top`` down (its neighbours differ there) has
-    that row on every one of them; unless every cell is written (or one point splits),
-    it enters the stack at ``top`` directly, skipping the chain of copies below."""
+def _walk(points: Sorted, depth: int, split_above: float, out: Out) -> None:
+    """Write out the tree's cells: children of a split cell together, by key; the root
+    last. A point alone in its cells from level ``top`` down (its neighbours differ
+    there) enters the stack at ``top``: no cell of one point splits (``split_above >=
+    1``), so the chain below holds nothing to write."""
     packed, shift, values = points
     n, nv, mask = packed.size, values.shape[1], (1 << shift) - 1
     rows, keys = np.empty((4 * depth + 4, 1 + 3 * nv)), np.empty(4 * depth + 4, np.int64)
     count = np.zeros(depth + 1, np.int64)  # children waiting per level
-    chains = not rule[1] and rule[0] >= 1.0  # a lone point's cells are not written out
     i = before = 0  # ``before``: coarsest level where the previous point's cell differs
     while i < n:
         key, j = packed[i] >> shift, i + 1
         while j < n and packed[j] >> shift == key:
             j += 1
         low = _coarsest_change(key, packed[j] >> shift, depth) if j < n else 0
-        top = max(before, low) if chains and j - i == 1 else depth
+        top = max(before, low) if j - i == 1 else depth
         s, before = 4 * top + count[top], low
         if j - i > 1:
             _run_row(points, (i, j), rows, s)
@@ -155,16 +135,12 @@ def _walk(points: Sorted, depth: int, rule: tuple[float, bool], out: Out) -> Non
         keys[s], count[top] = key >> (2 * (depth - top)), count[top] + 1
         for level in range(top - 1, low - 1, -1):
             m, s, kid = count[level + 1], 4 * level + count[level], 4 * level + 4
-            if m == 1 and rows[kid, 0] == 1.0:  # Chan's merge of one point: a copy
-                for c in range(1 + 3 * nv):
-                    rows[s, c] = rows[kid, c]
-            else:
-                _parent_row(rows, (kid, kid + m), rows, s)
+            _parent_row(rows, (kid, kid + m), rows, s)
             keys[s], count[level], count[level + 1] = keys[kid] >> 2, count[level] + 1, 0
-            if rule[1] or rows[s, 0] > rule[0]:
-                _emit((rows, keys), (kid, kid + m), level + 1, (depth, rule[0]), out)
+            if rows[s, 0] > split_above:
+                _emit((rows, keys), (kid, kid + m), level + 1, (depth, split_above), out)
         i = j
-    _emit((rows, keys), (0, 1), 0, (depth, rule[0]), out)
+    _emit((rows, keys), (0, 1), 0, (depth, split_above), out)
 
 
 def sort_points(keys: np.ndarray, values: np.ndarray, bits: int) -> Sorted:
@@ -181,36 +157,19 @@ def sort_points(keys: np.ndarray, values: np.ndarray, bits: int) -> Sorted:
     return _sort_packed(keys, bits, shift, scratch, out), shift, values
 
 
-def build_levels(points: Sorted, depth: int, split_above: float, tree: bool,
-                 ) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+def build_tree(points: Sorted, depth: int, split_above: float,
+               ) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
     """Per level ``0..depth``: sorted keys, rows ``n, mean.., m2.., max..`` and split
-    flags (``n > split_above`` above the finest level) of every non-empty cell of
-    :func:`sort_points`' points or, with ``tree``, of the root and the children of
-    split cells only (each level's arrays are views of one buffer per array)."""
-    packed, shift, values = points
-    if tree:
-        return _tree_levels(points, depth, split_above)
-    offsets = np.zeros(depth + 2, dtype=np.int64)
-    if len(packed):
-        offsets[1:] = np.cumsum(_level_counts(packed, shift, depth))
-    out = (np.empty((offsets[-1], 1 + 3 * values.shape[1])), np.empty(offsets[-1], np.int64),
-           np.zeros(offsets[-1], bool), np.empty(0, np.int64), offsets[:-1].copy())
-    if len(packed):
-        _walk(points, depth, (float(split_above), True), out)
-    return [(out[1][a:b], out[0][a:b], out[2][a:b]) for a, b in itertools.pairwise(offsets)]
-
-
-def _tree_levels(points: Sorted, depth: int, split_above: float,
-                 ) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
-    """:func:`build_levels` of the tree: written in the order the walk closes cells,
-    then grouped by level."""
+    flags (``n > split_above`` above the finest level) of the root and the children of
+    split cells of :func:`sort_points`' points (views of one buffer per array)."""
+    assert split_above >= 1.0, "the walk skips cells of one point: they must not split"
     packed, values = points[0], points[2]
     capacity = 64 + 8 * len(packed) // int(min(split_above + 1, max(len(packed), 1)))
     for _ in range(2):  # a second walk when the first guess of the size was short
         out = (np.empty((capacity, 1 + 3 * values.shape[1])), np.empty(capacity, np.int64),
                np.empty(capacity, bool), np.empty(capacity, np.int64), np.zeros(1, np.int64))
         if len(packed):
-            _walk(points, depth, (float(split_above), False), out)
+            _walk(points, depth, float(split_above), out)
         used = int(out[4][0])
         if used <= capacity:
             break

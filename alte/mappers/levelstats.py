@@ -11,10 +11,10 @@ the sorted arrays, so an insertion costs O(frame x depth) whatever the map's siz
 with no copying of the map (storage grows rarely: doubling, from a generous first
 size that the OS pages in only as it is used).
 
-A first insertion into empty levels, and a build, walk the sorted points once
-(``_levelbuild``). A build whose cells split on their count alone keeps the tree of
-the partition only (:meth:`LevelStats.build_tree`) and the sorted points, from which
-:meth:`LevelStats.complete` fills in every other cell when an insertion needs them.
+A build whose cells split on their count alone keeps the tree of the partition only
+(:meth:`LevelStats.build_tree`: one walk over the sorted points, ``_levelbuild``) and
+the sorted points, from which :meth:`LevelStats.complete` fills in every other cell
+when an insertion needs them.
 """
 
 from __future__ import annotations
@@ -34,7 +34,7 @@ from alte.mappers._cellstats import (
     merge_cells,
     sort_keys,
 )
-from alte.mappers._levelbuild import Sorted, build_levels, sort_points
+from alte.mappers._levelbuild import Sorted, build_tree, sort_points
 
 __all__ = ["MAX_DEPTH", "LevelStats"]
 
@@ -134,15 +134,11 @@ class LevelStats:
         finally:
             self._defer -= 1
 
-    def add(self, fine_keys: np.ndarray, values: np.ndarray,
-            split_above: float = np.inf) -> list[np.ndarray] | None:
+    def add(self, fine_keys: np.ndarray, values: np.ndarray) -> list[np.ndarray] | None:
         """Add points given by finest-level keys and (N, nv) values; the rows touched per
-        level, or None when the map was empty (every row is new, and a cell above the
-        finest level is flagged to split when its ``n > split_above``)."""
-        if not any(self._n):
-            self._fill(sort_points(fine_keys, values, 2 * self.depth), split_above, tree=False)
-            return None
+        level, or None when the map was empty (every row is new)."""
         self.complete()
+        was_empty = not any(self._n)
         keys, order = sort_keys(np.asarray(fine_keys, np.int64), 2 * self.depth)
         keys, agg = aggregate_points(keys, np.ascontiguousarray(values[order], float))
         touched: list[np.ndarray] = [np.empty(0, np.int64)] * (self.depth + 1)
@@ -150,30 +146,35 @@ class LevelStats:
             if level < self.depth:
                 keys, agg = combine(keys, agg, self.nv)
             touched[level] = self._merge(level, keys, agg)
-        return touched
+        return None if was_empty else touched
 
     def build_tree(self, fine_keys: np.ndarray, values: np.ndarray, split_above: float) -> None:
         """Fill empty levels with the cells of a partition that splits a cell when its
-        ``n > split_above``: the root and the children of split cells (``_treebuild``).
+        ``n > split_above``: the root and the children of split cells (``_levelbuild``),
+        with their split flags.
 
         The sorted points are kept, so that :meth:`complete` can add the other cells
         when an insertion or a shift of the root needs them."""
         points = sort_points(fine_keys, values, 2 * self.depth)
-        self._fill(points, split_above, tree=True)
+        for level, cells in enumerate(build_tree(points, self.depth, split_above)):
+            self._set_level(level, *cells)
         self._source = (points, split_above)
 
     def complete(self) -> None:
         """Every non-empty cell on every level (after :meth:`build_tree`, which keeps the
-        tree's cells only); the same rows and flags as :meth:`add` on the empty map."""
-        if self._source is not None:
-            points, split_above = self._source
-            self._source = None
-            self._fill(points, split_above, tree=False)
-
-    def _fill(self, points: Sorted, split_above: float, tree: bool) -> None:
-        """Every level's cells (or the tree's) from sorted points in one walk."""
-        for level, cells in enumerate(build_levels(points, self.depth, split_above, tree)):
-            self._set_level(level, *cells)
+        tree's cells only): :meth:`add` of the kept points to empty levels, flagged."""
+        if self._source is None:
+            return
+        (packed, shift, values), split_above = self._source
+        self._source = None
+        for level in range(self.depth + 1):
+            self._set_level(level, np.empty(0, np.int64), np.empty((0, 1 + 3 * self.nv)),
+                            np.empty(0, bool))
+        if shift:  # in their sorted order: the stable sort of add keeps it
+            values = values[packed & ((1 << shift) - 1)]
+        self.add(packed >> shift, values)
+        for level in range(self.depth):
+            self._s[level] = self._r[level][:, 0] > split_above
 
     def _set_level(self, level: int, keys: np.ndarray, rows: np.ndarray,
                    split: np.ndarray) -> None:

@@ -77,8 +77,8 @@ class QuadMap:
 
     def _split_above(self) -> float | None:
         """The count over which a cell splits, when :meth:`_split` is ``n > count`` above
-        the deepest level and nothing else: a build then flags cells as it writes them
-        (no pass over the levels). None: :meth:`_split` decides."""
+        the deepest level and nothing else: a build then keeps the partition's cells only
+        (:meth:`LevelStats.build_tree`). None: :meth:`_split` decides, on every cell."""
         return None
 
     def _update_splits(self, touched: list[np.ndarray] | None) -> None:
@@ -172,9 +172,7 @@ class QuadMap:
         if batch and above is not None:  # the partition's cells only (LevelStats.build_tree)
             self.stats.build_tree(keys, self._values(pts), above)
             return
-        touched = self.stats.add(keys, self._values(pts), np.inf if above is None else above)
-        if touched is not None or above is None:
-            self._update_splits(touched)
+        self._update_splits(self.stats.add(keys, self._values(pts)))
 
     def cell_counts(self) -> CellCounts:
         """Counts of :meth:`cells` (small maps: the table itself)."""
