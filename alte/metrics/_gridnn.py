@@ -4,13 +4,11 @@ The targets are counting-sorted into cubic cells of side ``h``. A query scans it
 cell (else rings of cells around it until one holds a target), then every cell that the
 ball through the best target so far reaches, skipping cells whose nearest wall is already
 no nearer. Walls and cell indices carry a tolerance far above their rounding, so no
-target that could be nearer is ever skipped: the result is the exact minimum over all
-targets. Squared distances are summed x, y, z in float64 and square-rooted, as pykdtree,
-scipy and open3d (nanoflann) do, so the distances are theirs to the last bit.
-
-Why not only a KD-tree: on terrain clouds and map corners (points on a surface, queries
-near it) a query here touches about three cells and two dozen points, about half the work
-of a KD-tree descent with backtracking (``environment.md`` has the measurements).
+target that could be nearer is skipped: the result is the exact minimum. Squared
+distances are summed x, y, z in float64 and square-rooted, as pykdtree, scipy and open3d
+(nanoflann) do, so the distances are theirs to the last bit. On terrain clouds and map
+corners a query touches about three cells and two dozen points, about half the work of a
+KD-tree descent with backtracking (``environment.md`` has the measurements).
 
 The first grid has the smallest cells keeping it within :data:`CELLS_PER_TARGET` cells
 per target (linear build, little memory). A query with no target within :data:`RINGS`
@@ -27,8 +25,8 @@ import numba
 import numpy as np
 from pykdtree.kdtree import KDTree
 
-__all__ = ["CELLS_PER_TARGET", "COARSER", "MAX_LOAD", "RINGS", "Grid", "bounds", "build_grid",
-           "first_side", "nearest_distances", "query_grid"]
+__all__ = ["CELLS_PER_TARGET", "COARSER", "MAX_LOAD", "PARALLEL_MIN", "RINGS", "Grid", "bounds",
+           "build_grid", "first_side", "nearest_distances", "query_grid"]
 
 #: Grid cells allowed per target point: the dense cell index costs O(cells + points);
 #: fewer, fuller cells were faster on the benchmark's clouds than emptier ones.
@@ -40,6 +38,8 @@ COARSER = 4.0
 #: Largest mean number of targets sharing a target's cell; a more crowded grid (each
 #: query would scan whole clusters) leaves the remaining queries to the KD-tree.
 MAX_LOAD = 256.0
+#: Fewer queries than this run on one thread: waking a second one costs more than it saves.
+PARALLEL_MIN = 4096
 #: Tolerance on cell walls, relative to the coordinates (far above their rounding).
 _TOL = 1e-9
 #: Coordinates are clamped to this many cells from the grid before the integer cast.
@@ -58,7 +58,7 @@ class Grid:
     """Targets sorted by cell: cell ``c`` holds ``points[start[c]:start[c + 1]]``.
 
     ``load`` is the mean number of targets in a target's cell (the cost of scanning one);
-    ``scale`` the largest absolute target coordinate (for the certificate's tolerance).
+    ``scale`` the largest absolute target coordinate (for the walls' tolerance).
     """
 
     lo: np.ndarray
@@ -244,8 +244,6 @@ def _side_for_cells(extent: np.ndarray, cells: float, smallest: float) -> float:
         return float(np.prod(np.maximum(np.ceil(extent / h), 1)))
 
     lo, hi = max(top / (cells + 1), smallest), top
-    if count(lo) <= cells:
-        return lo
     for _ in range(60):
         mid = np.sqrt(lo) * np.sqrt(hi)
         lo, hi = (mid, hi) if count(mid) > cells else (lo, mid)
@@ -271,8 +269,14 @@ def build_grid(points: np.ndarray, h: float, box: tuple[np.ndarray, np.ndarray])
 def query_grid(grid: Grid, queries: np.ndarray, rings: int) -> tuple[np.ndarray, np.ndarray]:
     """(distance to the nearest target, settled) for every query (M, 3): exact where
     settled, inf where no target lies within ``rings`` rings of the query's cell."""
-    return _query(queries, grid.lo, grid.h, grid.dims, grid.start, grid.points, rings,
-                  grid.scale)
+    threads = numba.get_num_threads()
+    if len(queries) < PARALLEL_MIN:
+        numba.set_num_threads(1)
+    try:
+        return _query(queries, grid.lo, grid.h, grid.dims, grid.start, grid.points, rings,
+                      grid.scale)
+    finally:
+        numba.set_num_threads(threads)
 
 
 def _kdtree(queries: np.ndarray, targets: np.ndarray) -> np.ndarray:

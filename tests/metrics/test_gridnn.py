@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import numba
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -112,4 +113,6 @@ lattice_sets = st.integers(1, 40).flatmap(
 @settings(max_examples=80, deadline=None)
 @given(lattice_sets, lattice_sets)
 def test_small_lattice_sets_with_ties_equal_the_kdtree(queries, targets):
+    threads = numba.get_num_threads()
     assert np.array_equal(nearest_distances(queries, targets), _reference(queries, targets))
+    assert numba.get_num_threads() == threads  # one thread for a small set, then restored
