@@ -85,11 +85,16 @@ def morton_decode(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return (_compact1by1(k).astype(np.int64), _compact1by1(k >> np.uint64(1)).astype(np.int64))
 
 
+@numba.njit(cache=True)
 def _extent(xy: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Per-column minimum and maximum of (N, 2) points (column by column: numpy reduces
-    an (N, 2) array along axis 0 two values at a time, many times slower)."""
-    return (np.array([xy[:, 0].min(), xy[:, 1].min()]),
-            np.array([xy[:, 0].max(), xy[:, 1].max()]))
+    """Per-column minimum and maximum of (N >= 1, 2) finite points, in one pass (numpy
+    reduces an (N, 2) array along axis 0 two values at a time, and a strided column
+    at a time reads every row's cache line)."""
+    lo, hi = xy[0].copy(), xy[0].copy()
+    for i in range(1, xy.shape[0]):
+        for c in range(2):
+            lo[c], hi[c] = min(lo[c], xy[i, c]), max(hi[c], xy[i, c])
+    return lo, hi
 
 
 @dataclass(frozen=True)
