@@ -12,7 +12,7 @@ with no copying of the map (storage grows rarely: doubling, from a generous firs
 size that the OS pages in only as it is used).
 
 A build whose cells split on their count alone keeps the tree of the partition only
-(:meth:`LevelStats.build_tree`: one walk over the sorted points, ``_levelbuild``) and
+(:meth:`LevelStats.build_tree`: one walk over the sorted points, ``_treebuild``) and
 the sorted points, from which :meth:`LevelStats.complete` fills in every other cell
 when an insertion needs them.
 """
@@ -34,7 +34,7 @@ from alte.mappers._cellstats import (
     merge_cells,
     sort_keys,
 )
-from alte.mappers._levelbuild import Sorted, build_tree, sort_points
+from alte.mappers._treebuild import Sorted, sort_points, tree_cells
 
 __all__ = ["MAX_DEPTH", "LevelStats"]
 
@@ -150,13 +150,13 @@ class LevelStats:
 
     def build_tree(self, fine_keys: np.ndarray, values: np.ndarray, split_above: float) -> None:
         """Fill empty levels with the cells of a partition that splits a cell when its
-        ``n > split_above``: the root and the children of split cells (``_levelbuild``),
+        ``n > split_above``: the root and the children of split cells (``_treebuild``),
         with their split flags.
 
         The sorted points are kept, so that :meth:`complete` can add the other cells
         when an insertion or a shift of the root needs them."""
         points = sort_points(fine_keys, values, 2 * self.depth)
-        for level, cells in enumerate(build_tree(points, self.depth, split_above)):
+        for level, cells in enumerate(tree_cells(points, self.depth, split_above)):
             self._set_level(level, *cells)
         self._source = (points, split_above)
 

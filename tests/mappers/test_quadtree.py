@@ -69,11 +69,10 @@ def test_incremental_equals_batch_and_order_invariant(points, max_points, splits
         assert np.allclose(batch.stats.rows[level], incr.stats.rows[level], atol=1e-9)
 
 
-@settings(max_examples=30, deadline=None)
-@given(clouds, st.integers(1, 10), st.integers(0, 7))
-def test_build_keeps_the_trees_cells_bit_for_bit(points, max_points, max_depth) -> None:
-    """The tree of a build (root, children of split cells) holds the very rows, keys and
-    flags of those cells among every level's cells (insertion's first frame, complete)."""
+def assert_tree_of_every_cell(points: np.ndarray, max_points: int, max_depth: int) -> None:
+    """The tree a build keeps (root, children of split cells) holds the very rows, keys
+    and flags of those cells among every level's cells (an insertion's); completed, the
+    built map holds every cell, bit for bit; memory counts what is held."""
     built = Quadtree(max_points=max_points, max_depth=max_depth, domain=DOMAIN)
     built.build(points)
     tree = [(built.stats.keys[lv], built.stats.rows[lv], built.stats.split[lv])
@@ -95,6 +94,19 @@ def test_build_keeps_the_trees_cells_bit_for_bit(points, max_points, max_depth) 
     assert built.memory_bytes == full.memory_bytes
     # a cell: key, n, 3 statistics of 2 values, flag; a kept point: packed key, 2 values
     assert tree_bytes == 65 * sum(len(keys) for keys, _, _ in tree) + 24 * len(points)
+
+
+@settings(max_examples=30, deadline=None)
+@given(clouds, st.integers(1, 10), st.integers(0, 7))
+def test_build_keeps_the_trees_cells_bit_for_bit(points, max_points, max_depth) -> None:
+    assert_tree_of_every_cell(points, max_points, max_depth)
+
+
+def test_build_of_a_tree_larger_than_guessed() -> None:
+    """Pairs of equal points under max_points 1 split down to max_depth: more tree cells
+    than the walk's first guess of its output, so it walks again into the right size."""
+    pairs = np.repeat(np.random.default_rng(1).uniform(0, 16, (300, 3)), 2, axis=0)
+    assert_tree_of_every_cell(pairs, 1, 12)
 
 
 def test_insert_after_build_equals_batch() -> None:

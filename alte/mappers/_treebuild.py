@@ -28,7 +28,7 @@ from numba.cpython.unsafe.numbers import leading_zeros
 
 from alte.mappers._cellstats import _cell_row, _parent_row, sort_keys
 
-__all__ = ["Sorted", "build_tree", "sort_points"]
+__all__ = ["Sorted", "sort_points", "tree_cells"]
 
 #: Below this many points numba's quicksort of the packed keys beats the radix passes.
 _RADIX_MIN = 1 << 14
@@ -157,7 +157,7 @@ def sort_points(keys: np.ndarray, values: np.ndarray, bits: int) -> Sorted:
     return _sort_packed(keys, bits, shift, scratch, out), shift, values
 
 
-def build_tree(points: Sorted, depth: int, split_above: float,
+def tree_cells(points: Sorted, depth: int, split_above: float,
                ) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
     """Per level ``0..depth``: sorted keys, rows ``n, mean.., m2.., max..`` and split
     flags (``n > split_above`` above the finest level) of the root and the children of
