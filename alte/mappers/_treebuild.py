@@ -11,6 +11,8 @@ differs too; a closing cell merges its (at most 4) children, waiting in a small 
 per level, and writes them out when it splits. The rows are those of the
 level-by-level path, bit for bit: the same kernels in the same order (a point alone
 in its cells has its own row on each of them, so the walk skips that chain of copies).
+A first, top-down pass counts the tree's cells per level (binary searches in the
+split cells' ranges of sorted keys), so the walk writes each level in place, once.
 
 The points are sorted by *packed* keys, ``key << shift | index``: one int64 array
 moved per radix pass, and the index makes the order stable. The hot loop is one
@@ -35,9 +37,9 @@ _RADIX_MIN = 1 << 14
 #: Points sorted by :func:`sort_points`: ``(packed, shift, values)``; ``shift`` 0 when
 #: the keys alone are sorted and ``values`` are in their order.
 Sorted = tuple[np.ndarray, int, np.ndarray]
-#: The walk's output: rows, keys, split flags and levels of the cells in the order
-#: written, and how many were written (counting on past the capacity).
-Out = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+#: The walk's output: rows, keys and split flags of every level's cells, level ``l``
+#: from ``offsets[l]``, and the next place per level.
+Out = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
 
 
 @numba.njit(cache=True)
@@ -92,27 +94,51 @@ def _run_row(points: Sorted, span: tuple[int, int], rows: np.ndarray, s: int) ->
 @numba.njit(cache=True)
 def _emit(stack: tuple[np.ndarray, np.ndarray], kids: tuple[int, int], level: int,
           flags: tuple[int, float], out: Out) -> None:
-    """Write the stack's rows ``kids = (a, b)`` of ``level`` to ``out``, each flagged to
-    split when ``level < depth`` and ``n > split_above`` (``flags = (depth,
-    split_above)``); rows past the capacity are only counted."""
+    """Write the stack's rows ``kids = (a, b)`` at ``level``'s next places in ``out``,
+    each flagged to split when ``level < depth`` and ``n > split_above`` (``flags =
+    (depth, split_above)``)."""
     rows, keys = stack
-    table, cells, split, levels, used = out
+    table, cells, split, at = out
     for k in range(kids[0], kids[1]):
-        u = used[0]
-        if u < table.shape[0]:
-            for c in range(rows.shape[1]):
-                table[u, c] = rows[k, c]
-            cells[u], levels[u] = keys[k], level
-            split[u] = level < flags[0] and rows[k, 0] > flags[1]
-        used[0] = u + 1
+        u = at[level]
+        for c in range(rows.shape[1]):
+            table[u, c] = rows[k, c]
+        cells[u], split[u] = keys[k], level < flags[0] and rows[k, 0] > flags[1]
+        at[level] = u + 1
+
+
+@numba.njit(cache=True)
+def _tree_counts(packed: np.ndarray, shift: int, depth: int, split_above: float) -> np.ndarray:
+    """Cells per level of the tree (the root, the non-empty children of cells with ``n >
+    split_above``), top down: a cell is a range of the sorted keys, its children the
+    runs of their next two bits, found by binary search (no pass over every point)."""
+    counts = np.zeros(depth + 1, np.int64)
+    lo, hi = np.zeros(1, np.int64), np.full(1, packed.size, np.int64)
+    counts[0] = packed.size > 0
+    for level in range(depth):
+        wide = np.flatnonzero(hi - lo > split_above)
+        kids_lo, kids_hi, m = np.empty(4 * wide.size, np.int64), np.empty(4 * wide.size,
+                                                                          np.int64), 0
+        bit = shift + 2 * (depth - level - 1)  # the children's lowest key bit, packed
+        for c in wide:
+            a, b = lo[c], hi[c]
+            while a < b:  # the first key of the next child, by bisection
+                first, end, bound = a + 1, b, ((packed[a] >> bit) + 1) << bit
+                while first < end:
+                    mid = (first + end) >> 1
+                    first, end = (mid + 1, end) if packed[mid] < bound else (first, mid)
+                kids_lo[m], kids_hi[m], m, a = a, first, m + 1, first
+        lo, hi, counts[level + 1] = kids_lo[:m], kids_hi[:m], m
+    return counts
 
 
 @numba.njit(cache=True, error_model="numpy")
 def _walk(points: Sorted, depth: int, split_above: float, out: Out) -> None:
-    """Write out the tree's cells: children of a split cell together, by key; the root
-    last. A point alone in its cells from level ``top`` down (its neighbours differ
-    there) enters the stack at ``top``: no cell of one point splits (``split_above >=
-    1``), so the chain below holds nothing to write."""
+    """Write the tree's cells to ``out``, each level's in key order (the children of a
+    split cell together, as it closes; the root last). A point alone in its cells from
+    level ``top`` down (its neighbours differ there) enters the stack at ``top``: no
+    cell of one point splits (``split_above >= 1``), so the chain below holds nothing
+    to write."""
     packed, shift, values = points
     n, nv, mask = packed.size, values.shape[1], (1 << shift) - 1
     rows, keys = np.empty((4 * depth + 4, 1 + 3 * nv)), np.empty(4 * depth + 4, np.int64)
@@ -163,35 +189,12 @@ def tree_cells(points: Sorted, depth: int, split_above: float,
     flags (``n > split_above`` above the finest level) of the root and the children of
     split cells of :func:`sort_points`' points (views of one buffer per array)."""
     assert split_above >= 1.0, "the walk skips cells of one point: they must not split"
-    packed, values = points[0], points[2]
-    capacity = 64 + 8 * len(packed) // int(min(split_above + 1, max(len(packed), 1)))
-    for _ in range(2):  # a second walk when the first guess of the size was short
-        out = (np.empty((capacity, 1 + 3 * values.shape[1])), np.empty(capacity, np.int64),
-               np.empty(capacity, bool), np.empty(capacity, np.int64), np.zeros(1, np.int64))
-        if len(packed):
-            _walk(points, depth, float(split_above), out)
-        used = int(out[4][0])
-        if used <= capacity:
-            break
-        capacity = used
+    packed, shift, values = points
     offsets = np.zeros(depth + 2, np.int64)
-    offsets[1:] = np.cumsum(np.bincount(out[3][:used], minlength=depth + 1))
-    grouped = (np.empty((used, out[0].shape[1])), np.empty(used, np.int64), np.empty(used, bool))
-    _group(out, offsets[:-1].copy(), grouped)
-    return [(grouped[1][a:b], grouped[0][a:b], grouped[2][a:b])
-            for a, b in itertools.pairwise(offsets)]
-
-
-@numba.njit(cache=True)
-def _group(out: Out, at: np.ndarray, grouped: tuple[np.ndarray, np.ndarray, np.ndarray],
-           ) -> None:
-    """Copy the walk's cells to ``grouped`` (rows, keys, flags), level ``l`` from ``at[l]``
-    on, in the order written (a counting sort by level: keys stay sorted within)."""
-    table, cells, split, levels, used = out
-    rows, keys, flags = grouped
-    for u in range(used[0]):
-        d = at[levels[u]]
-        for c in range(table.shape[1]):
-            rows[d, c] = table[u, c]
-        keys[d], flags[d] = cells[u], split[u]
-        at[levels[u]] = d + 1
+    offsets[1:] = np.cumsum(_tree_counts(packed, shift, depth, float(split_above)))
+    out = (np.empty((offsets[-1], 1 + 3 * values.shape[1])), np.empty(offsets[-1], np.int64),
+           np.empty(offsets[-1], bool), offsets[:-1].copy())
+    if len(packed):
+        _walk(points, depth, float(split_above), out)
+    assert (out[3] == offsets[1:]).all(), "the walk wrote the cells the count found"
+    return [(out[1][a:b], out[0][a:b], out[2][a:b]) for a, b in itertools.pairwise(offsets)]

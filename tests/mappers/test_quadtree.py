@@ -102,9 +102,9 @@ def test_build_keeps_the_trees_cells_bit_for_bit(points, max_points, max_depth) 
     assert_tree_of_every_cell(points, max_points, max_depth)
 
 
-def test_build_of_a_tree_larger_than_guessed() -> None:
-    """Pairs of equal points under max_points 1 split down to max_depth: more tree cells
-    than the walk's first guess of its output, so it walks again into the right size."""
+def test_build_of_equal_pairs_splits_to_max_depth() -> None:
+    """Pairs of equal points under max_points 1: every cell holding a pair splits, down
+    to max_depth (a tree of long chains, more cells than points)."""
     pairs = np.repeat(np.random.default_rng(1).uniform(0, 16, (300, 3)), 2, axis=0)
     assert_tree_of_every_cell(pairs, 1, 12)
 
