@@ -17,14 +17,18 @@ from alte.mappers._lanes import prefetch
 
 __all__ = ["PAGE", "VoxelStore"]
 
-#: Blocks per page of log-odds (1024 x 512 float32 = 2 MiB): the map grows a page at a
-#: time, so no insert ever copies the map.
-PAGE = 1024
-_PAGE_SHIFT = 10
+#: Blocks per page of log-odds (2048 x 512 float32 = 4 MiB): the map grows a page at a
+#: time, so no insert ever copies the map. numpy asks Linux for huge pages for arrays
+#: from 4 MiB on, which halves the cost of a new page (fewer faults) and spares the
+#: updates most TLB misses.
+PAGE = 2048
+_PAGE_SHIFT = 11
 
 
 def _page() -> np.ndarray:
-    return np.full((PAGE, 512), np.nan, dtype=np.float32)
+    """Room for PAGE blocks, untouched: a block's row is set to NaN when the block is made,
+    so the cost of fresh memory is spread over the scans that add blocks."""
+    return np.empty((PAGE, 512), dtype=np.float32)
 
 
 class VoxelStore:
@@ -145,6 +149,7 @@ def _apply(store: tuple[np.ndarray, np.ndarray, np.ndarray], pages: np.ndarray, 
         j = find_slot(slots, scan_blocks[r])
         if slots[j] == EMPTY:
             slots[j], rows[j], blocks[n] = scan_blocks[r], n, scan_blocks[r]
+            pages[n >> _PAGE_SHIFT][n & (PAGE - 1)] = np.nan
             n += 1
         at[r] = rows[j]
     order = _page_order(at, len(pages))
