@@ -24,10 +24,17 @@ from alte.mappers._blockset import WORDS, local_index, new_table, reserve, row_o
 from alte.mappers._lanes import walk_lanes
 from alte.mappers._raycast import Ray, flat_starts, morton, prepare, walk_hashed
 
-__all__ = ["DENSE_MAX_WORDS", "ScanWork", "scan_blocks"]
+__all__ = ["DENSE_ANY_WORDS", "DENSE_MAX_WORDS", "WORDS_PER_STEP", "ScanWork", "scan_blocks"]
 
-#: Largest flat bit grid (uint64 words; 2^21 = 16 MiB) before the hashed set is used.
-DENSE_MAX_WORDS = 1 << 21
+#: Largest flat bit grid (uint64 words; 2^24 = 128 MiB, of which only the pages the rays
+#: cross are ever written) before the hashed set is used.
+DENSE_MAX_WORDS = 1 << 24
+#: A flat grid above this size (2^21 words = 16 MiB) is used only while it has at most
+#: WORDS_PER_STEP words per ray step: the passes over the grid after the walk cost about
+#: a step's hashing per few words (sim_nav_1's full-range scans at 0.1 m: flat twice as
+#: fast as hashed).
+DENSE_ANY_WORDS = 1 << 21
+WORDS_PER_STEP = 8
 
 
 class ScanWork:
@@ -67,6 +74,17 @@ def _box(okey: np.ndarray, ekeys: np.ndarray) -> np.ndarray:
     size = hi - lo + 3
     size[0] = (size[0] + 7) // 8 * 8
     return np.concatenate((lo - 1, size))
+
+
+@numba.njit(cache=True)
+def _steps(okey: np.ndarray, ekeys: np.ndarray) -> int:
+    """Voxel steps of the scan's walks (|dk|_1 of the valid ray ends)."""
+    steps = 0
+    for i in range(ekeys.shape[0]):
+        if ekeys[i, 0] >= 0:
+            steps += abs(ekeys[i, 0] - okey[0]) + abs(ekeys[i, 1] - okey[1]) + \
+                abs(ekeys[i, 2] - okey[2])
+    return steps
 
 
 @numba.njit(cache=True, inline="always")
@@ -193,10 +211,10 @@ def _dense(rays: Ray, res: float, box: np.ndarray, work: tuple[np.ndarray, np.nd
     buffers (grown when the box needs more)."""
     grid, cell, flags = work
     cells = box[3] * box[4] * box[5]
-    if grid.size <= 8 * cells:
-        grid = np.zeros(max(8 * cells + 1, 2 * grid.size), dtype=np.uint64)
+    if grid.size <= 8 * cells:  # a quarter more than this box needs: boxes vary a little
+        grid = np.zeros(10 * cells + 1, dtype=np.uint64)
     if cell.size < cells:
-        cell = np.full(max(cells, 2 * cell.size), -1, dtype=np.int64)
+        cell = np.full(cells + cells // 4 // 8 * 8, -1, dtype=np.int64)
         flags = np.zeros(cell.size // 8, dtype=np.uint64)
     corner = 8 * box[:3]
     strides = np.array([corner[0], corner[1], corner[2], 8 * box[3], 64 * box[3] * box[4]])
@@ -250,15 +268,17 @@ def _finish(blocks: np.ndarray, bits: np.ndarray, ekeys: np.ndarray,
 @numba.njit(cache=True)
 def _scan(cloud: tuple[np.ndarray, np.ndarray], res: float, max_range: float,
           work: tuple[np.ndarray, np.ndarray, np.ndarray],
-          sizes: tuple[int, int]) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray,
-                                           np.ndarray]:
+          sizes: tuple[int, int, int, int]) -> tuple[np.ndarray, np.ndarray, np.ndarray,
+                                                     np.ndarray, np.ndarray]:
     """:func:`scan_blocks` of ``cloud`` (points, origin) in one compiled call; ``sizes``
-    is the hashed set's first capacity and the largest flat grid (words). Also returns
-    the work buffers."""
-    (points, origin), (capacity, dense_max) = cloud, sizes
+    is the hashed set's first capacity and the flat grid's limits (DENSE_MAX_WORDS,
+    DENSE_ANY_WORDS, WORDS_PER_STEP). Also returns the work buffers."""
+    (points, origin), (capacity, most, anyway, per_step) = cloud, sizes
     okey, ends, ekeys, hit = prepare(points, origin, res, max_range)
     box = _box(okey, ekeys)
-    if okey.min() >= 0 and 8 * box[3] * box[4] * box[5] <= dense_max:
+    words = 8 * box[3] * box[4] * box[5]
+    if okey.min() >= 0 and words <= most and (
+            words <= anyway or words <= per_step * _steps(okey, ekeys)):
         return _dense((origin, okey, ends, ekeys), res, box, work, hit)
     blocks, bits = np.empty(0, np.uint64), np.empty((0, 2 * WORDS), np.uint64)
     if okey.min() >= 0:
@@ -280,6 +300,6 @@ def scan_blocks(points: np.ndarray, origin: np.ndarray, res: float, max_range: f
     work = work or ScanWork()
     blocks, bits, work.grid, work.cell, work.flags = _scan(
         (points, origin), res, max_range, (work.grid, work.cell, work.flags),
-        (work.blocks + 64, DENSE_MAX_WORDS))
+        (work.blocks + 64, DENSE_MAX_WORDS, DENSE_ANY_WORDS, WORDS_PER_STEP))
     work.blocks = blocks.size + blocks.size // 4
     return blocks, bits

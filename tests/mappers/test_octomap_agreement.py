@@ -47,3 +47,19 @@ def test_lane_walk_and_hashed_scans_give_the_same_keys(tmp_path_factory, monkeyp
             patch.setattr(_scan, "DENSE_MAX_WORDS", 0)  # every scan takes the hashed path
             hashed = _sorted(*_scan.scan_blocks(*args, _scan.ScanWork()))
         assert all(np.array_equal(a, b) for a, b in zip(dense, hashed, strict=True))
+
+
+@pytest.mark.slow
+def test_large_flat_grids_follow_the_words_per_step_rule(tmp_path_factory, monkeypatch):
+    folder = ensure_terrain("sim_nav_1", tmp_path_factory.mktemp("data"), frames=3)
+    monkeypatch.setattr(_scan, "DENSE_ANY_WORDS", 0)  # every grid counts as large
+    for frame in prepare(open_input(folder)).frames():
+        args = (np.array(frame.points, np.float32), frame.origin.astype(np.float32), 0.1, 100.0)
+        runs = {}
+        for per_step in (0, 10**6):  # no grid is cheap enough / every grid is
+            monkeypatch.setattr(_scan, "WORDS_PER_STEP", per_step)
+            work = _scan.ScanWork()
+            runs[per_step] = _sorted(*_scan.scan_blocks(*args, work))
+            assert (work.grid.size > 1) == (per_step > 0)  # the flat grid was used or not
+        assert runs[0][0].size > 100
+        assert all(np.array_equal(a, b) for a, b in zip(runs[0], runs[10**6], strict=True))
