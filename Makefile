@@ -27,7 +27,11 @@ lint: bootstrap
 	$(PY) -m ruff check alte tests bench
 	$(PY) -m mypy
 
-test: lint
+# mypy and the compilation of the mappers' numba kernels (`alte warmup`, cached for every
+# later process) run side by side on the two cores, then the tests.
+test: bootstrap
+	$(PY) -m ruff check alte tests bench
+	@$(PY) -m alte warmup & warm=$$!; $(PY) -m mypy; typed=$$?; wait $$warm && exit $$typed
 	$(PY) -m pytest -n 2 --dist loadfile --no-loadscope-reorder tests notebooks --nbval-lax $(PYTEST_ARGS)
 
 bench: bootstrap

@@ -28,6 +28,7 @@ COMMANDS: dict[str, str] = {
     "simulate": "alte.commands.simulate",
     "bench": "alte.commands.bench",
     "sweep": "alte.commands.sweep",
+    "warmup": "alte.commands.warmup",
 }
 
 

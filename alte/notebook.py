@@ -185,10 +185,17 @@ def save_results(out_dir: str | os.PathLike[str], results: Mapping[str, Any]) ->
 
 
 def save_figure(fig: Any, out_dir: str | os.PathLike[str], name: str) -> Path:
-    """Save a matplotlib figure as ``out_dir/figures/name.png`` (atomic, overwrites)."""
+    """Save a matplotlib figure as ``out_dir/figures/name.png`` (atomic, overwrites).
+
+    A figure with constrained layout already fits its canvas; trimming it to a tight box
+    as well would draw it twice (the layout solved each time), so only others are trimmed.
+    """
+    from matplotlib.layout_engine import ConstrainedLayoutEngine
+
     path = Path(out_dir) / "figures" / f"{name}.png"
+    tight = not isinstance(fig.get_layout_engine(), ConstrainedLayoutEngine)
     with atomic_path(path, overwrite=True) as tmp:
-        fig.savefig(tmp, format="png", dpi=110, bbox_inches="tight",
+        fig.savefig(tmp, format="png", dpi=110, bbox_inches="tight" if tight else None,
                     metadata={"Software": None})
     return path
 

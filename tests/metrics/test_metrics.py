@@ -94,6 +94,20 @@ def test_hausdorff_rejects_bad_sets(a, b, match):
         hausdorff(a, b)
 
 
+@pytest.mark.parametrize(
+    ("source", "target", "match"),
+    [
+        (np.zeros((0, 3)), np.zeros((2, 3)), "set source is empty"),
+        (np.zeros((2, 3)), np.zeros((0, 3)), "set target is empty"),
+        (np.zeros(3), np.zeros((2, 3)), r"set source must have shape \(N, 3\)"),
+        (np.zeros((2, 3)), np.array([[0.0, np.inf, 0.0]]), "set target contains NaN or inf"),
+    ],
+)
+def test_directed_distances_rejects_bad_sets(source, target, match):
+    with pytest.raises(MetricsError, match=match):
+        directed_distances(source, target)
+
+
 def test_distance_to_boxes_matches_brute_force():
     rng = np.random.default_rng(3)
     centers = rng.uniform(0, 5, (40, 3))

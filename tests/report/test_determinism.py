@@ -38,7 +38,7 @@ def test_ch5_tables_identical_across_runs_but_for_timing(tmp_path: Path) -> None
         pytest.skip("notebooks/ch5_analysis.ipynb absent")
     runs = build_plan(PLAN, quick=True, notebooks_dir=ROOT / "notebooks", only=["ch5_analysis"],
                       overrides={"FRAMES": 10, "ROWS": [0, 1], "OVERHANGS": False,
-                                 "N_SAMPLES": 5000, "GRID_SEEDS": [0]})
+                                 "N_SAMPLES": 5000, "GRID_SEEDS": [0], "GRID_FRAMES": 4})
     reports = [run_report(runs, tmp_path / "reports", tmp_path / "data", quick=True,
                           progress=False) for _ in range(2)]
     assert all(not r.failed for r in reports), [r.error for r in reports[0].results]
