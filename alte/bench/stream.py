@@ -15,11 +15,10 @@ its wall time (CPU <= wall shows that no second core helped). Per-frame latency
 sensor's 100 ms.
 
 Row 11 is the peer beyond liboctomap: DUFOMap's scan integration (Python bindings of
-DUFOMap, built on UFOMap: rays cast into an octree at the same 0.2 m, one thread as the
-native Octomap uses) against the native Octomap on the same scans, fresh maps,
-alternating pass by pass. The maps
-differ in kind (DUFOMap keeps seen / void / hit states for dynamic-point removal, not
-OctoMap's log-odds), so only the time is compared.
+DUFOMap, built on UFOMap: rays cast into an octree at the same 0.2 m, on one thread as
+the native Octomap) against the native Octomap on the same scans, fresh maps,
+alternating pass by pass. The maps differ in kind (DUFOMap keeps seen / void / hit
+states for dynamic-point removal, not OctoMap's log-odds), so only the time is compared.
 """
 
 from __future__ import annotations
