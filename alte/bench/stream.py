@@ -8,14 +8,17 @@ from the first byte read to the last map update. The peer is the mission's own
 duration (scans x their period): ``wall / mission <= 0.1`` is 10x faster than real
 time. Each mapper runs with the terrain's chapter 4 parameters where the thesis gives
 them (its defaults otherwise); runs of all mappers of a terrain alternate round by
-round. Per-frame latency (reading, registering, inserting: ``MapRun.log.latency_s``)
-is reported beside the sensor's 100 ms.
+round. The row runs on one core: every thread of the process is pinned to one CPU
+(:func:`alte.bench.timing.one_core`), and each run's process CPU time is kept beside
+its wall time (CPU <= wall shows that no second core helped). Per-frame latency
+(reading, registering, inserting: ``MapRun.log.latency_s``) is reported beside the
+sensor's 100 ms.
 
 Row 11 is the peer beyond liboctomap: DUFOMap's scan integration (Python bindings of
-DUFOMap, built on UFOMap: rays cast into an octree at the same 0.2 m) against the
-native Octomap on the same scans, fresh maps, alternating pass by pass. The maps
-differ in kind (DUFOMap keeps seen / void / hit states for dynamic-point removal, not
-OctoMap's log-odds), so only the time is compared.
+DUFOMap, built on UFOMap: rays cast into an octree at the same 0.2 m, on one thread as
+the native Octomap) against the native Octomap on the same scans, fresh maps,
+alternating pass by pass. The maps differ in kind (DUFOMap keeps seen / void / hit
+states for dynamic-point removal, not OctoMap's log-odds), so only the time is compared.
 """
 
 from __future__ import annotations
@@ -31,7 +34,7 @@ from tqdm.auto import tqdm
 
 from alte.bench.core import LIMITS, Context, Result
 from alte.bench.maps import LAN, NAV, ROTATION_S, interleaved_passes
-from alte.bench.timing import interleave
+from alte.bench.timing import interleave, one_core
 from alte.bench.workload import QUICK_FRAMES, workload_dir
 
 __all__ = ["STREAM_MAPPERS", "UfoPeer", "mission_seconds", "scan_peer", "streaming_chain"]
@@ -59,12 +62,13 @@ def _bag(ctx: Context, terrain: str) -> Path:
     return source.bag
 
 
-def _one_run(bag: Path, spec: Any) -> tuple[float, Any]:
+def _one_run(bag: Path, spec: Any) -> tuple[float, float, Any]:
+    """Wall and process CPU seconds of one ``run`` of ``spec`` on ``bag``, and the run."""
     from alte.pipeline import run
 
-    start = time.perf_counter()
+    start, used = time.perf_counter(), time.process_time()
     result = run(bag, spec)
-    return time.perf_counter() - start, result
+    return time.perf_counter() - start, time.process_time() - used, result
 
 
 def _quantiles_ms(seconds: list[np.ndarray]) -> dict[str, float]:
@@ -73,11 +77,13 @@ def _quantiles_ms(seconds: list[np.ndarray]) -> dict[str, float]:
             for name, q in (("p50", 50), ("p99", 99), ("max", 100))}
 
 
-def _chain_result(terrain: str, name: str, walls: list[float], runs: list[Any]) -> Result:
-    log = runs[-1].log
+def _chain_result(terrain: str, name: str, times: tuple[list[float], list[float]],
+                  runs: list[Any], cpu: int | None) -> Result:
+    log, walls = runs[-1].log, times[0]
     mission = mission_seconds(log.stamps)
     wall = float(np.median(walls))
-    detail = {"rtf": mission / wall, "wall_s": walls, "mission_s": mission,
+    detail = {"rtf": mission / wall, "wall_s": walls, "cpu_s": times[1], "pinned_cpu": cpu,
+              "mission_s": mission,
               "frames": len(log.stamps), "points_per_frame": float(np.mean(log.points)),
               "latency_ms": _quantiles_ms([r.log.latency_s for r in runs]),
               "insert_ms": _quantiles_ms([r.log.insert_s for r in runs]),
@@ -101,16 +107,18 @@ def streaming_chain(ctx: Context) -> list[Result]:
         params = mapper_params(terrain)
         specs = {name: MapSpec(name, dict(params.get(name, {})), DomainPolicy.AUTO,
                                Feed.FRAMES) for name in STREAM_MAPPERS}
-        walls: dict[str, list[float]] = {name: [] for name in specs}
+        times: dict[str, tuple[list[float], list[float]]] = {name: ([], []) for name in specs}
         runs: dict[str, list[Any]] = {name: [] for name in specs}
         rounds = list(interleave(list(specs), cfg.warmup + cfg.repeats))
-        for r, name in tqdm(rounds, desc=f"alte map {terrain}", unit="run",
-                            disable=not cfg.progress, leave=False):
-            wall, result = _one_run(bag, specs[name])
-            if r >= cfg.warmup:
-                walls[name].append(wall)
-                runs[name].append(result)
-        out.extend(_chain_result(terrain, name, walls[name], runs[name]) for name in specs)
+        with one_core() as cpu:
+            for r, name in tqdm(rounds, desc=f"alte map {terrain}", unit="run",
+                                disable=not cfg.progress, leave=False):
+                wall, used, result = _one_run(bag, specs[name])
+                if r >= cfg.warmup:
+                    times[name][0].append(wall)
+                    times[name][1].append(used)
+                    runs[name].append(result)
+        out.extend(_chain_result(terrain, name, times[name], runs[name], cpu) for name in specs)
     return out
 
 
@@ -138,7 +146,7 @@ def scan_peer(ctx: Context) -> list[Result]:
 
     params = mapper_setup(ctx, "octomap")
     voxel = 1.0 / float(params.get("resolution", 5.0))
-    threads = len(os.sched_getaffinity(0))  # the cores numba's threads would use
+    threads = 1  # the native Octomap walks a scan's rays on one thread
     makers: dict[str, Callable[[], Any]] = {
         "native": lambda: make_mapper("octomap", **params),
         "dufomap": lambda: UfoPeer(voxel, threads)}

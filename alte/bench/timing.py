@@ -12,7 +12,8 @@ import os
 import platform
 import resource
 import time
-from collections.abc import Callable, Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass
 from importlib import metadata
 from typing import Any
@@ -22,7 +23,7 @@ import numpy as np
 from alte.errors import ParameterError
 
 __all__ = ["Sample", "fit_exponent", "interleave", "machine_info", "measure", "nlogn_exponent",
-           "peak_rss_bytes"]
+           "one_core", "peak_rss_bytes"]
 
 
 @dataclass(frozen=True)
@@ -91,6 +92,39 @@ def nlogn_exponent(sizes: Sequence[float] | np.ndarray) -> float:
     """The slope :func:`fit_exponent` gives for exact n log n over ``sizes`` (about 1.1)."""
     n = np.asarray(sizes, float)
     return fit_exponent(n, n * np.log(n))
+
+
+def _threads() -> list[int]:
+    try:
+        return [int(tid) for tid in os.listdir("/proc/self/task")]
+    except OSError:
+        return [0]
+
+
+@contextmanager
+def one_core() -> Iterator[int | None]:
+    """Run the block on one CPU: every thread of the process (and so every thread started
+    in the block) is pinned to the lowest CPU it may use; the masks are restored after.
+    Yields that CPU, or None where affinity cannot be set (not Linux)."""
+    if not hasattr(os, "sched_setaffinity"):
+        yield None
+        return
+    cpu = min(os.sched_getaffinity(0))
+    saved: dict[int, set[int]] = {}
+    for tid in _threads():
+        try:
+            saved[tid] = os.sched_getaffinity(tid)
+            os.sched_setaffinity(tid, {cpu})
+        except OSError:  # the thread ended meanwhile
+            saved.pop(tid, None)
+    try:
+        yield cpu
+    finally:
+        for tid, mask in saved.items():
+            try:
+                os.sched_setaffinity(tid, mask)
+            except OSError:
+                continue
 
 
 def peak_rss_bytes() -> int:

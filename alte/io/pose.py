@@ -164,14 +164,20 @@ class PoseTrack:
         else:
             i0 = np.clip(right - 1, 0, len(t) - 2)
             span = t[i0 + 1] - t[i0]
-            rel = Rotation.from_quat(self.quaternions[i0]).inv() * Rotation.from_quat(
-                self.quaternions[i0 + 1]
-            )
-            rate = np.linalg.norm(rel.as_rotvec(), axis=1) / (span / _NS)
+            rate = self._rates[i0]
         in_gap = ~outside & ~hit & (span > max_gap_s * _NS)
         valid = ~outside & ~in_gap
         pos, quat = self._at(s, valid, hit, right)
         return PoseSamples(pos, quat, nearest / _NS, rate, valid, outside, in_gap)
+
+    @cached_property
+    def _rates(self) -> np.ndarray:
+        """Rotation rate (rad/s) between each sample and the next (once per track: a
+        stream asks for one scan's pose at a time)."""
+        q = self.quaternions
+        rel = Rotation.from_quat(q[:-1]).inv() * Rotation.from_quat(q[1:])
+        rates: np.ndarray = np.linalg.norm(rel.as_rotvec(), axis=1) / (np.diff(self.stamps) / _NS)
+        return rates
 
     @cached_property
     def _slerp(self) -> Slerp:

@@ -1,8 +1,10 @@
 """Sets of voxel keys as 8x8x8 bit blocks: the per-scan key set of the native Octomap.
 
 A block is named by its Morton code (key >> 9) and holds 16 words: 8 of *free* bits,
-then 8 of *occupied* bits, bit ``i`` of the 512 being the voxel whose local Morton
-index (key & 511) is ``i``. An open-addressing hash table maps a block code to its row.
+then 8 of *occupied* bits, bit ``x + 8 y + 64 z`` of the 512 being the voxel whose
+per-axis key ends in (x, y, z) (:func:`local_index`), so each byte is an x row: the
+layout of the flat grid a scan's rays are walked in. An open-addressing hash table
+maps a block code to its row.
 A table is the tuple ``(slots, rows, bits, blocks)``; rows are added in arrival order.
 """
 
@@ -14,16 +16,31 @@ import numpy as np
 #: A block set: hash slots, their rows, bit rows (free, occupied) and block ids.
 Table = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
 
-__all__ = ["EMPTY", "LOCAL", "WORDS", "find_slot", "keys_to_blocks", "new_table", "rehash",
-           "reserve", "row_of", "set_bit", "union"]
+__all__ = ["EMPTY", "MORTON_BIT", "WORDS", "find_slot", "keys_to_blocks", "local_index",
+           "new_table", "rehash", "reserve", "row_of", "set_bit", "union"]
 
 EMPTY = np.uint64(0xFFFFFFFFFFFFFFFF)
 _GOLDEN = np.uint64(0x9E3779B97F4A7C15)
-#: Position of an axis' 3 low key bits in a block's 9-bit local Morton index (x; y and
-#: z are shifted left by 1 and 2).
-LOCAL = np.array([0, 1, 8, 9, 64, 65, 72, 73], dtype=np.int64)
 #: Words of free bits in a row; the occupied bits follow.
 WORDS = 8
+
+
+def _morton_bits() -> np.ndarray:
+    m = np.arange(512, dtype=np.int64)
+    x = (m & 1) | (m >> 2 & 2) | (m >> 4 & 4)
+    y = (m >> 1 & 1) | (m >> 3 & 2) | (m >> 5 & 4)
+    z = (m >> 2 & 1) | (m >> 4 & 2) | (m >> 6 & 4)
+    return x | y << 3 | z << 6
+
+
+#: Block bit of each local Morton index (key & 511).
+MORTON_BIT = _morton_bits()
+
+
+@numba.njit(cache=True, inline="always")
+def local_index(kx: int, ky: int, kz: int) -> int:
+    """Bit of voxel key (kx, ky, kz) in its block: x + 8 y + 64 z of the keys' low 3 bits."""
+    return int((kx & 7) | ((ky & 7) << 3) | ((kz & 7) << 6))
 
 
 @numba.njit(cache=True, inline="always")
@@ -93,7 +110,7 @@ def row_of(table: Table, block: np.uint64, n_blocks: int) -> tuple[int, int]:
 @numba.njit(cache=True, inline="always")
 def set_bit(bits: np.ndarray, row: int, word0: int, key: np.ndarray) -> None:
     """Set the bit of ``key`` (kx, ky, kz) in its block's row, in the words from ``word0``."""
-    local = LOCAL[key[0] & 7] | (LOCAL[key[1] & 7] << 1) | (LOCAL[key[2] & 7] << 2)
+    local = local_index(key[0], key[1], key[2])
     bits[row, word0 + (local >> 6)] |= np.uint64(1) << np.uint64(local & 63)
 
 
@@ -104,8 +121,8 @@ def keys_to_blocks(keys: np.ndarray, word0: int) -> tuple[np.ndarray, np.ndarray
     n_blocks = 0
     for key in keys:
         row, n_blocks = row_of(table, key >> np.uint64(9), n_blocks)
-        local = key & np.uint64(511)
-        table[2][row, word0 + (local >> np.uint64(6))] |= np.uint64(1) << (local & np.uint64(63))
+        local = MORTON_BIT[key & np.uint64(511)]
+        table[2][row, word0 + (local >> 6)] |= np.uint64(1) << np.uint64(local & 63)
     return table[3][:n_blocks], table[2][:n_blocks]
 
 

@@ -14,13 +14,13 @@ from functools import cached_property
 from pathlib import Path
 from typing import TYPE_CHECKING, Protocol
 
-import numba
 import numpy as np
 
 from alte.mappers._blockset import WORDS, keys_to_blocks
-from alte.mappers._octree import Leaves, VoxelStore, prune_voxels, write_bt
+from alte.mappers._octree import Leaves, prune_voxels, write_bt
 from alte.mappers._raycast import TREE_DEPTH, TREE_MAX_VAL, morton_decode, morton_encode
-from alte.mappers._scan import scan_blocks
+from alte.mappers._scan import ScanWork, scan_blocks
+from alte.mappers._voxelstore import VoxelStore
 
 if TYPE_CHECKING:
     import pyoctomap
@@ -86,7 +86,7 @@ class OcTreeLike(Protocol):
 
 
 class NativeTree:
-    """Per-voxel float32 log-odds in hashed 8x8x8 blocks (see ``_octree.VoxelStore``)."""
+    """Per-voxel float32 log-odds in hashed 8x8x8 blocks (see ``_voxelstore.VoxelStore``)."""
 
     def __init__(self, voxel: float, max_range: float, model: SensorModel) -> None:
         self.voxel = voxel
@@ -94,16 +94,13 @@ class NativeTree:
         self.model = model
         self.store = VoxelStore()
         self._leaves: Leaves | None = None
-        self._scan_blocks = 1024  # block count of the last scan: the next one's table size
+        self._work = ScanWork()
 
     def insert_scan(self, points: np.ndarray, origin: np.ndarray) -> None:
-        """OctoMap ``insertPointCloud``: each voxel updated once, occupied beats free.
-
-        Rays are walked by as many threads as numba may use (``NUMBA_NUM_THREADS``)."""
+        """OctoMap ``insertPointCloud``: each voxel updated once, occupied beats free (one
+        thread: the rays are walked four at a time in vector registers)."""
         blocks, bits = scan_blocks(points.astype(np.float32), origin.astype(np.float32),
-                                   self.voxel, self.max_range, capacity=self._scan_blocks + 64,
-                                   threads=int(numba.config.NUMBA_NUM_THREADS))  # type: ignore[attr-defined]  # set at import by numba
-        self._scan_blocks = blocks.size + blocks.size // 4
+                                   self.voxel, self.max_range, self._work)
         self._update(blocks, bits)
 
     def insert_hits(self, points: np.ndarray) -> None:

@@ -4,20 +4,17 @@ Everything here reproduces the OctoMap library that ``pyoctomap`` 1.2 ships (its
 ``computeRayKeys`` keeps the ray length as float and casts the half-voxel step to
 float; checked ray by ray against it) bit for bit: points and origins are float32
 (``point3d``), keys are ``floor(coord / res) + 32768`` per axis for a tree of depth 16,
-:func:`walk_dense` / :func:`walk_hashed` step along each ray exactly like
-``OcTreeBaseImpl::computeRayKeys`` (Amanatides & Woo, with OctoMap's float/double
-mix), and :func:`prepare` truncates rays at the maximum range like ``computeUpdate``.
-Keys are 48-bit Morton codes (x in the lowest bit of each triple), so sorting them
-puts the eight children of every octree node next to each other. ``_scan`` drives
-the walks over a scan and de-duplicates the keys.
+:func:`walk_hashed` and the lock-step walk of ``_lanes`` (started by :func:`flat_starts`)
+step along each ray exactly like ``OcTreeBaseImpl::computeRayKeys`` (Amanatides & Woo,
+with OctoMap's float/double mix), and :func:`prepare` truncates rays at the maximum
+range like ``computeUpdate``. Keys are 48-bit Morton codes (x in the lowest bit of
+each triple), so sorting them puts the eight children of every octree node next to
+each other. ``_scan`` drives the walks over a scan and de-duplicates the keys.
 
-A walk keeps its voxel in scalars: its key and its local Morton index in the 8x8x8
-block, kept per axis in dilated form (x on bits 0, 3, 6; y and z shifted by 1 and 2)
-and moved by one add that also tells when the walk leaves the block. The key can
-equal the end key only after exactly |dk|_1 steps (each axis moves monotonically),
-so it is compared then alone. The step limit |dk|_1 + 5 only stops a ray that float
-round-off carries past its end voxel, so a walk strays at most 4 voxels from the box
-of its origin and end keys.
+The key can equal the end key only after exactly |dk|_1 steps (each axis moves
+monotonically), so :func:`walk_hashed` compares it then alone. The step limit
+|dk|_1 + 5 only stops a ray that float round-off carries past its end voxel, so a walk
+strays at most 4 voxels from the box of its origin and end keys.
 """
 
 from __future__ import annotations
@@ -25,15 +22,15 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from alte.mappers._blockset import LOCAL, Table, row_of
+from alte.mappers._blockset import Table, local_index, row_of
 
 #: A ray (or rays): origin, origin key, end(s), end key(s).
 Ray = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
 #: Per-axis (step, tMax, tDelta) of a voxel walk.
 Axis = tuple[int, float, float]
 
-__all__ = ["TREE_DEPTH", "TREE_MAX_VAL", "morton", "morton_decode", "morton_encode", "prepare",
-           "walk_dense", "walk_hashed"]
+__all__ = ["TREE_DEPTH", "TREE_MAX_VAL", "flat_starts", "morton", "morton_decode",
+           "morton_encode", "prepare", "walk_hashed"]
 
 TREE_DEPTH = 16
 TREE_MAX_VAL = 32768
@@ -157,15 +154,6 @@ def _axis(delta: np.float32, lf: np.float32, okey: int, origin: np.float32,
 
 
 @numba.njit(cache=True, inline="always")
-def _dilated(step: int, mask: int) -> tuple[int, int]:
-    """(fill, wrap) of one axis' dilated local index: ``((l | fill) + step) & mask`` moves
-    it one voxel, and it equals ``wrap`` exactly when the walk left the block."""
-    if step > 0:
-        return 511 & ~mask, 0
-    return 0, mask
-
-
-@numba.njit(cache=True, inline="always")
 def _start(ray: Ray, res: float) -> tuple[Axis, Axis, Axis, float, int]:
     """Per-axis (step, tMax, tDelta), the float ray length and the steps to the end key."""
     origin, okey, end, ekey = ray
@@ -177,50 +165,36 @@ def _start(ray: Ray, res: float) -> tuple[Axis, Axis, Axis, float, int]:
 
 
 @numba.njit(cache=True)
-def walk_dense(ray: Ray, res: float, limit: int, grid: np.ndarray, box: np.ndarray) -> None:
-    """Set the bits of the free keys of ``computeRayKeys(origin, end)`` in a dense array;
-    ``ray`` is (origin, origin key, end, end key).
+def flat_starts(rays: Ray, res: float, grid: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Start data of the walkable rays in a flat bit grid (for :func:`_lanes.walk_lanes`):
+    per ray tMax, tDelta, length and bit index, bit steps, end bit, step limit - 1.
 
-    ``grid`` has 8 uint64 words per 8x8x8 block of the block box ``box`` (x0, y0, z0,
-    nbx, nby, nbz; x fastest), so entering a block adds a fixed jump to the word offset.
+    ``rays`` is (origin, origin key, ends, end keys); ``grid`` is the grid's first voxel
+    key and its bit strides along y and z (x is 1). A ray is walked when its end key is
+    valid and differs from the origin's.
     """
-    (sx, tx, ddx), (sy, ty, ddy), (sz, tz, ddz), length, last = _start(ray, res)
-    okey, ekey = ray[1], ray[3]
-    cx, cy, cz = okey[0], okey[1], okey[2]
-    lx, ly, lz = LOCAL[cx & 7], LOCAL[cy & 7] << 1, LOCAL[cz & 7] << 2
-    fx, wx = _dilated(sx, 73)
-    fy, wy = _dilated(sy, 146)
-    fz, wz = _dilated(sz, 292)
-    nbx, nbxy = box[3], box[3] * box[4]
-    base = 8 * ((cx >> 3) - box[0] + nbx * ((cy >> 3) - box[1]) + nbxy * ((cz >> 3) - box[2]))
-    jx, jy, jz = 8 * sx, 8 * sy * nbx, 8 * sz * nbxy
-    local = lx | ly | lz
-    grid[base + (local >> 6)] |= np.uint64(1) << np.uint64(local & 63)
-    for s in range(1, limit):
-        if tx < ty and tx < tz:
-            cx += sx
-            tx += ddx
-            lx = ((lx | fx) + sx) & 73
-            if lx == wx:
-                base += jx
-        elif ty < tz and not tx < ty:
-            cy += sy
-            ty += ddy
-            ly = ((ly | fy) + (sy << 1)) & 146
-            if ly == wy:
-                base += jy
-        else:
-            cz += sz
-            tz += ddz
-            lz = ((lz | fz) + (sz << 2)) & 292
-            if lz == wz:
-                base += jz
-        if s == last and cx == ekey[0] and cy == ekey[1] and cz == ekey[2]:
-            break
-        if min(tx, ty, tz) > length:
-            break
-        local = lx | ly | lz
-        grid[base + (local >> 6)] |= np.uint64(1) << np.uint64(local & 63)
+    origin, okey, ends, ekeys = rays
+    n = ends.shape[0]
+    floats, ints = np.empty((n, 7)), np.empty((n, 6), dtype=np.int64)
+    strides = np.array([1, grid[3], grid[4]])
+    first = 0
+    for a in range(3):
+        first += (okey[a] - grid[a]) * strides[a]
+    m = 0
+    for i in range(n):
+        k = ekeys[i]
+        if k[0] < 0 or (k[0] == okey[0] and k[1] == okey[1] and k[2] == okey[2]):
+            continue
+        (sx, tx, ddx), (sy, ty, ddy), (sz, tz, ddz), length, last = _start(
+            (origin, okey, ends[i], k), res)
+        floats[m, 0], floats[m, 1], floats[m, 2] = tx, ty, tz
+        floats[m, 3], floats[m, 4], floats[m, 5], floats[m, 6] = ddx, ddy, ddz, length
+        ints[m, 0], ints[m, 1], ints[m, 2], ints[m, 3] = first, sx, sy * grid[3], sz * grid[4]
+        ints[m, 4] = first + (k[0] - okey[0]) + (k[1] - okey[1]) * grid[3] \
+            + (k[2] - okey[2]) * grid[4]
+        ints[m, 5] = last + 4  # the step limit |dk|_1 + 5, less the origin's voxel
+        m += 1
+    return floats[:m], ints[:m]
 
 
 @numba.njit(cache=True)
@@ -229,46 +203,37 @@ def walk_hashed(ray: Ray, res: float, limit: int, table: Table, n_blocks: int) -
     set (``_blockset``; room reserved by the caller); return the new block count;
     ``ray`` is (origin, origin key, end, end key).
 
-    Entering a block costs a hash probe, so this serves scans too wide for a dense array.
+    Entering a block costs a hash probe, so this serves scans too wide for a flat grid.
     """
     (sx, tx, ddx), (sy, ty, ddy), (sz, tz, ddz), length, last = _start(ray, res)
     okey, ekey = ray[1], ray[3]
     cx, cy, cz = okey[0], okey[1], okey[2]
-    lx, ly, lz = LOCAL[cx & 7], LOCAL[cy & 7] << 1, LOCAL[cz & 7] << 2
-    fx, wx = _dilated(sx, 73)
-    fy, wy = _dilated(sy, 146)
-    fz, wz = _dilated(sz, 292)
+    edge_x, edge_y, edge_z = (0 if sx > 0 else 7), (0 if sy > 0 else 7), (0 if sz > 0 else 7)
     row, n_blocks = row_of(table, morton(cx >> 3, cy >> 3, cz >> 3), n_blocks)
-    grid = table[2].reshape(-1)
-    base = 16 * row
-    local = lx | ly | lz
-    grid[base + (local >> 6)] |= np.uint64(1) << np.uint64(local & 63)
+    bits = table[2]
+    local = local_index(cx, cy, cz)
+    bits[row, local >> 6] |= np.uint64(1) << np.uint64(local & 63)
     for s in range(1, limit):
-        moved = False
         if tx < ty and tx < tz:
             cx += sx
             tx += ddx
-            lx = ((lx | fx) + sx) & 73
-            moved = lx == wx
+            moved = (cx & 7) == edge_x
         elif ty < tz and not tx < ty:
             cy += sy
             ty += ddy
-            ly = ((ly | fy) + (sy << 1)) & 146
-            moved = ly == wy
+            moved = (cy & 7) == edge_y
         else:
             cz += sz
             tz += ddz
-            lz = ((lz | fz) + (sz << 2)) & 292
-            moved = lz == wz
+            moved = (cz & 7) == edge_z
         if s == last and cx == ekey[0] and cy == ekey[1] and cz == ekey[2]:
             break
         if min(tx, ty, tz) > length:
             break
         if moved:
             row, n_blocks = row_of(table, morton(cx >> 3, cy >> 3, cz >> 3), n_blocks)
-            base = 16 * row
-        local = lx | ly | lz
-        grid[base + (local >> 6)] |= np.uint64(1) << np.uint64(local & 63)
+        local = local_index(cx, cy, cz)
+        bits[row, local >> 6] |= np.uint64(1) << np.uint64(local & 63)
     return n_blocks
 
 

@@ -1,37 +1,52 @@
 """One scan of the native Octomap: OctoMap's ``computeUpdate`` as blocks of key bits.
 
-Every ray of the scan is walked (``_raycast.walk_dense`` or ``walk_hashed``) into a set of
-8x8x8 bit blocks, which de-duplicates the keys as OctoMap's ``KeySet`` does. When
-the scan's block box (origin and ray ends, padded by one block) is small, as for a
-LiDAR scan (0.4-1.2 MiB of bits for sim_nav_1 at 0.2 m), the bits live in a dense
-array over that box: entering a block is an add, with no hashing; a larger box
-falls back to a hash table of blocks (``_blockset``). The scan leaves as the touched
-blocks with 8 words of free and 8 of occupied bits each, which the map applies
-block by block (``_octree.VoxelStore``) with no sort.
+Every ray of the scan is walked into a set of voxel bits, which de-duplicates the keys
+as OctoMap's ``KeySet`` does. When the scan's block box (origin and ray ends, padded by
+one block) is small, as for a LiDAR scan (0.4-3 MiB of bits for sim_nav_1 at 0.2 m),
+the bits live in a flat grid over that box, x rows of 64-bit words, and the rays are
+walked four at a time by ``_lanes.walk_lanes``; the set bits are then gathered into
+8x8x8 blocks. A larger box falls back to a hash table of blocks walked ray by ray
+(``_raycast.walk_hashed``, ``_blockset``). The scan leaves as the touched blocks with
+8 words of free and 8 of occupied bits each, which the map applies block by block
+(``_voxelstore.VoxelStore``) with no sort.
 
-Rays are independent, so with ``threads`` > 1 they are walked in chunks by a thread
-pool (the kernels release the GIL), each chunk into its own set; the union of the
-sets does not depend on the split.
+The grid and the box's block-to-row table are reused from scan to scan
+(:class:`ScanWork`): a scan leaves them cleared, so none is allocated or zeroed per scan.
 """
 
 from __future__ import annotations
 
-import itertools
-from concurrent.futures import ThreadPoolExecutor
-
 import numba
 import numpy as np
+from numba.cpython.unsafe.numbers import trailing_zeros
 
-from alte.mappers._blockset import WORDS, new_table, reserve, row_of, set_bit, union
-from alte.mappers._raycast import Ray, morton, prepare, walk_dense, walk_hashed
+from alte.mappers._blockset import WORDS, local_index, new_table, reserve, row_of, set_bit, union
+from alte.mappers._lanes import walk_lanes
+from alte.mappers._raycast import Ray, flat_starts, morton, prepare, walk_hashed
 
-__all__ = ["DENSE_MAX_WORDS", "scan_blocks"]
+__all__ = ["DENSE_ANY_WORDS", "DENSE_MAX_WORDS", "WORDS_PER_STEP", "ScanWork", "scan_blocks"]
 
-#: Largest dense bit box (uint64 words; 2^21 = 16 MiB) before the hashed set is used.
-DENSE_MAX_WORDS = 1 << 21
-#: Rays per chunk below which a scan is walked in the calling thread.
-_MIN_CHUNK = 256
-_POOLS: dict[int, ThreadPoolExecutor] = {}
+#: Largest flat bit grid (uint64 words; 2^24 = 128 MiB, of which only the pages the rays
+#: cross are ever written) before the hashed set is used.
+DENSE_MAX_WORDS = 1 << 24
+#: A flat grid above this size (2^21 words = 16 MiB) is used only while it has at most
+#: WORDS_PER_STEP words per ray step: the passes over the grid after the walk cost about
+#: a step's hashing per few words (sim_nav_1's full-range scans at 0.1 m: flat twice as
+#: fast as hashed).
+DENSE_ANY_WORDS = 1 << 21
+WORDS_PER_STEP = 8
+
+
+class ScanWork:
+    """Buffers reused by the scans of one map: the flat bit grid and the cell flags (all
+    zero between scans), the box cell -> row table (all -1) and the last scan's block
+    count (the hashed set's first size)."""
+
+    def __init__(self) -> None:
+        self.grid = np.zeros(1, dtype=np.uint64)
+        self.cell = np.full(8, -1, dtype=np.int64)
+        self.flags = np.zeros(1, dtype=np.uint64)
+        self.blocks = 1024
 
 
 @numba.njit(cache=True, inline="always")
@@ -48,48 +63,177 @@ def _limit(okey: np.ndarray, k: np.ndarray) -> int:
 @numba.njit(cache=True)
 def _box(okey: np.ndarray, ekeys: np.ndarray) -> np.ndarray:
     """Block box of the origin and the valid ray ends, padded by one block: (x0, y0, z0,
-    nbx, nby, nbz). A walk strays at most 4 voxels from its own box, so it stays inside."""
+    nbx, nby, nbz), nbx rounded up to whole grid words (8 blocks). A walk strays at most
+    4 voxels from its own box, so it stays inside."""
     lo, hi = okey >> 3, okey >> 3
     for i in range(ekeys.shape[0]):
         if ekeys[i, 0] >= 0:
             for a in range(3):
                 lo[a] = min(lo[a], ekeys[i, a] >> 3)
                 hi[a] = max(hi[a], ekeys[i, a] >> 3)
-    return np.concatenate((lo - 1, hi - lo + 3))
+    size = hi - lo + 3
+    size[0] = (size[0] + 7) // 8 * 8
+    return np.concatenate((lo - 1, size))
 
 
-@numba.njit(cache=True, nogil=True)
-def _rays_dense(rays: Ray, res: float, box: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Blocks and bit rows of ``rays`` (origin, its key, ends, their keys), walked into a
-    dense bit array over ``box``."""
-    origin, okey, ends, ekeys = rays
-    nbx, nby, nbz = box[3], box[4], box[5]
-    grid = np.zeros(WORDS * nbx * nby * nbz, dtype=np.uint64)
-    for i in range(ends.shape[0]):
-        if not _skip(okey, ekeys[i]):
-            ray = (origin, okey, ends[i], ekeys[i])
-            walk_dense(ray, res, _limit(okey, ekeys[i]), grid, box)
-    used = np.empty(nbx * nby * nbz, dtype=np.int64)
-    n_used = 0
-    for b in range(used.size):
-        for w in range(WORDS):
-            if grid[WORDS * b + w]:
-                used[n_used] = b
-                n_used += 1
-                break
-    blocks = np.empty(n_used, dtype=np.uint64)
-    bits = np.zeros((n_used, 2 * WORDS), dtype=np.uint64)
-    for r in range(n_used):
-        iz, rest = divmod(used[r], nbx * nby)
-        iy, ix = divmod(rest, nbx)
-        blocks[r] = morton(box[0] + ix, box[1] + iy, box[2] + iz)
-        bits[r, :WORDS] = grid[WORDS * used[r]:WORDS * used[r] + WORDS]
-    return blocks, bits
+@numba.njit(cache=True)
+def _steps(okey: np.ndarray, ekeys: np.ndarray) -> int:
+    """Voxel steps of the scan's walks (|dk|_1 of the valid ray ends)."""
+    steps = 0
+    for i in range(ekeys.shape[0]):
+        if ekeys[i, 0] >= 0:
+            steps += abs(ekeys[i, 0] - okey[0]) + abs(ekeys[i, 1] - okey[1]) + \
+                abs(ekeys[i, 2] - okey[2])
+    return steps
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, inline="always")
+def _cell(box: np.ndarray, k: np.ndarray) -> int:
+    """Box cell (block index, x fastest) of voxel key ``k``."""
+    return int((((k[2] >> 3) - box[2]) * box[4] + (k[1] >> 3) - box[1]) * box[3]
+               + (k[0] >> 3) - box[0])
+
+
+@numba.njit(cache=True)
+def _mark(grid: np.ndarray, box: np.ndarray, flags: np.ndarray, ekeys: np.ndarray,
+          hit: np.ndarray) -> None:
+    """Flag the box cells holding set bits or occupied ends: bit 8j of ``flags[c >> 3]``
+    for cell ``c`` with ``c & 7 == j`` (a grid word spans the x rows of 8 cells)."""
+    nwx, nby = box[3] // 8, box[4]
+    low = np.uint64(0x0101010101010101)
+    for f in range(nwx * nby * box[5]):
+        rest, xw = divmod(f, nwx)
+        bz, by = divmod(rest, nby)
+        w = np.uint64(0)
+        for zz in range(8):
+            first = ((8 * bz + zz) * 8 * nby + 8 * by) * nwx + xw
+            for yy in range(8):
+                w |= grid[first + yy * nwx]
+        w |= w >> np.uint64(4)
+        w |= w >> np.uint64(2)
+        flags[f] = (w | (w >> np.uint64(1))) & low
+    for r in range(ekeys.shape[0]):
+        if ekeys[r, 0] >= 0 and hit[r]:
+            c = _cell(box, ekeys[r])
+            flags[c >> 3] |= np.uint64(1) << np.uint64(8 * (c & 7))
+
+
+@numba.njit(cache=True)
+def _rows(box: np.ndarray, flags: np.ndarray, cell: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """A row per flagged cell (``cell[c]`` = its row): block codes and each row's cell."""
+    nwx, nby = box[3] // 8, box[4]
+    count = 0
+    for f in range(nwx * nby * box[5]):
+        t = flags[f]
+        while t:
+            t &= t - np.uint64(1)
+            count += 1
+    blocks, where = np.empty(count, dtype=np.uint64), np.empty(count, dtype=np.int64)
+    n = 0
+    for f in range(nwx * nby * box[5]):
+        t = flags[f]
+        while t:
+            j = int(trailing_zeros(t)) >> 3  # type: ignore[call-arg]  # numba intrinsic
+            t &= t - np.uint64(1)
+            rest, xw = divmod(f, nwx)
+            bz, by = divmod(rest, nby)
+            cell[8 * f + j] = n
+            blocks[n], where[n] = morton(box[0] + 8 * xw + j, box[1] + by, box[2] + bz), 8 * f + j
+            n += 1
+    return blocks, where
+
+
+@numba.njit(cache=True, inline="always")
+def _swap(rows: np.ndarray, a: int, b: int, shift: int, mask: np.uint64) -> None:
+    """Swap the ``mask`` lanes of ``rows[b]`` with the lanes ``shift`` bits up in ``rows[a]``."""
+    t = ((rows[a] >> np.uint64(shift)) ^ rows[b]) & mask
+    rows[a] ^= t << np.uint64(shift)
+    rows[b] ^= t
+
+
+@numba.njit(cache=True, inline="always")
+def _transpose(rows: np.ndarray) -> None:
+    """Transpose 8 words as an 8x8 byte matrix: byte j of word i <-> byte i of word j."""
+    for i in range(4):
+        _swap(rows, i, i + 4, 32, np.uint64(0x00000000FFFFFFFF))
+    for i in (0, 1, 4, 5):
+        _swap(rows, i, i + 2, 16, np.uint64(0x0000FFFF0000FFFF))
+    for i in (0, 2, 4, 6):
+        _swap(rows, i, i + 1, 8, np.uint64(0x00FF00FF00FF00FF))
+
+
+@numba.njit(cache=True)
+def _gather(grid: np.ndarray, box: np.ndarray, cell: np.ndarray, flags: np.ndarray,
+            bits: np.ndarray) -> None:
+    """Copy the grid's x rows (bytes) into the free words of their cells' rows (row
+    ``bits.shape[0] - 1`` takes the unflagged cells' zeros), flagged groups of 8 cells at
+    a time: the 8 y rows of a z slice are 8 words whose byte transpose gives each cell's
+    word of that slice. Clears the grid and the flags."""
+    nwx, nby, spare = box[3] // 8, box[4], bits.shape[0] - 1
+    rows, words = np.empty(8, dtype=np.int64), np.empty(8, dtype=np.uint64)
+    for f in range(nwx * nby * box[5]):
+        if flags[f] == 0:
+            continue
+        flags[f] = 0
+        rest, xw = divmod(f, nwx)
+        bz, by = divmod(rest, nby)
+        for j in range(8):
+            rows[j] = spare if cell[8 * f + j] < 0 else cell[8 * f + j]
+        for zz in range(8):
+            first = ((8 * bz + zz) * 8 * nby + 8 * by) * nwx + xw
+            for yy in range(8):
+                words[yy] = grid[first + yy * nwx]
+                grid[first + yy * nwx] = 0
+            _transpose(words)
+            for j in range(8):
+                bits[rows[j], zz] = words[j]
+
+
+@numba.njit(cache=True)
+def _hits(bits: np.ndarray, box: np.ndarray, cell: np.ndarray, ekeys: np.ndarray,
+          hit: np.ndarray) -> None:
+    """Set the occupied end voxels in their rows' occupied words (occupied beats free)."""
+    for i in range(ekeys.shape[0]):
+        k = ekeys[i]
+        if k[0] >= 0 and hit[i]:
+            local = local_index(k[0], k[1], k[2])
+            bit = np.uint64(1) << np.uint64(local & 63)
+            r = cell[_cell(box, k)]
+            bits[r, local >> 6] &= ~bit
+            bits[r, WORDS + (local >> 6)] |= bit
+
+
+@numba.njit(cache=True)
+def _dense(rays: Ray, res: float, box: np.ndarray, work: tuple[np.ndarray, np.ndarray,
+                                                               np.ndarray],
+           hit: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Blocks and bit rows of ``rays`` walked in the flat grid over ``box``, and the work
+    buffers (grown when the box needs more)."""
+    grid, cell, flags = work
+    cells = box[3] * box[4] * box[5]
+    if grid.size <= 8 * cells:  # a quarter more than this box needs: boxes vary a little
+        grid = np.zeros(10 * cells + 1, dtype=np.uint64)
+    if cell.size < cells:
+        cell = np.full(cells + cells // 4 // 8 * 8, -1, dtype=np.int64)
+        flags = np.zeros(cell.size // 8, dtype=np.uint64)
+    corner = 8 * box[:3]
+    strides = np.array([corner[0], corner[1], corner[2], 8 * box[3], 64 * box[3] * box[4]])
+    floats, ints = flat_starts(rays, res, strides)
+    walk_lanes(floats, ints, grid, 64 * 8 * cells)
+    grid[8 * cells] = 0  # the spare word of stopped and parked lanes
+    _mark(grid, box, flags, rays[3], hit)
+    blocks, where = _rows(box, flags, cell)
+    bits = np.zeros((blocks.size + 1, 2 * WORDS), dtype=np.uint64)
+    _gather(grid, box, cell, flags, bits)
+    _hits(bits, box, cell, rays[3], hit)
+    cell[where] = -1
+    return blocks, bits[:-1], grid, cell, flags
+
+
+@numba.njit(cache=True)
 def _rays_hashed(rays: Ray, res: float, capacity: int) -> tuple[np.ndarray, np.ndarray]:
-    """Blocks and bit rows of ``rays`` (as :func:`_rays_dense`), walked into a hash table."""
+    """Blocks and bit rows of ``rays`` (origin, its key, ends, their keys), walked into a
+    hash table."""
     origin, okey, ends, ekeys = rays
     table, n_blocks = new_table(capacity), 0
     for i in range(ends.shape[0]):
@@ -121,38 +265,41 @@ def _finish(blocks: np.ndarray, bits: np.ndarray, ekeys: np.ndarray,
     return table[3][:n_blocks], out
 
 
-def _pool(workers: int) -> ThreadPoolExecutor:
-    if workers not in _POOLS:
-        _POOLS[workers] = ThreadPoolExecutor(workers, thread_name_prefix="alte-raycast")
-    return _POOLS[workers]
+@numba.njit(cache=True)
+def _scan(cloud: tuple[np.ndarray, np.ndarray], res: float, max_range: float,
+          work: tuple[np.ndarray, np.ndarray, np.ndarray],
+          sizes: tuple[int, int, int, int]) -> tuple[np.ndarray, np.ndarray, np.ndarray,
+                                                     np.ndarray, np.ndarray]:
+    """:func:`scan_blocks` of ``cloud`` (points, origin) in one compiled call; ``sizes``
+    is the hashed set's first capacity and the flat grid's limits (DENSE_MAX_WORDS,
+    DENSE_ANY_WORDS, WORDS_PER_STEP). Also returns the work buffers."""
+    (points, origin), (capacity, most, anyway, per_step) = cloud, sizes
+    okey, ends, ekeys, hit = prepare(points, origin, res, max_range)
+    box = _box(okey, ekeys)
+    words = 8 * box[3] * box[4] * box[5]
+    if okey.min() >= 0 and words <= most and (
+            words <= anyway or words <= per_step * _steps(okey, ekeys)):
+        return _dense((origin, okey, ends, ekeys), res, box, work, hit)
+    blocks, bits = np.empty(0, np.uint64), np.empty((0, 2 * WORDS), np.uint64)
+    if okey.min() >= 0:
+        blocks, bits = _rays_hashed((origin, okey, ends, ekeys), res, capacity)
+    blocks, bits = _finish(blocks, bits, ekeys, hit)
+    return blocks, bits, work[0], work[1], work[2]
 
 
-def scan_blocks(points: np.ndarray, origin: np.ndarray, res: float, max_range: float, *,
-                capacity: int = 1024, threads: int = 1) -> tuple[np.ndarray, np.ndarray]:
+def scan_blocks(points: np.ndarray, origin: np.ndarray, res: float, max_range: float,
+                work: ScanWork | None = None) -> tuple[np.ndarray, np.ndarray]:
     """One scan's update as (block codes, rows of 8 free + 8 occupied words).
 
     Free bits: every voxel a ray crosses before its end voxel; occupied bits: end
     voxels of rays within ``max_range``; occupied beats free, so they are disjoint.
     ``points`` (N, 3) and ``origin`` (3,) are float32; rays whose origin or end lies
-    outside the key space are skipped, as OctoMap does. ``capacity`` guesses the block
-    count of a hashed set; ``threads`` > 1 walks 2 x ``threads`` chunks in a pool.
+    outside the key space are skipped, as OctoMap does. ``work`` keeps the buffers of
+    a map's scans (fresh ones without).
     """
-    okey, ends, ekeys, hit = prepare(points, origin, res, max_range)
-    if okey.min() < 0:
-        return _finish(np.empty(0, np.uint64), np.empty((0, 2 * WORDS), np.uint64), ekeys, hit)
-    box = _box(okey, ekeys)
-    dense = WORDS * box[3] * box[4] * box[5] <= DENSE_MAX_WORDS
-
-    def rays(a: int, b: int) -> tuple[np.ndarray, np.ndarray]:
-        if dense:
-            return _rays_dense((origin, okey, ends[a:b], ekeys[a:b]), res, box)
-        return _rays_hashed((origin, okey, ends[a:b], ekeys[a:b]), res, capacity)
-
-    chunks = min(2 * threads, len(ends) // _MIN_CHUNK) if threads > 1 else 1
-    if chunks <= 1:
-        return _finish(*rays(0, len(ends)), ekeys, hit)
-    cuts = [len(ends) * i // chunks for i in range(chunks + 1)]
-    jobs = [_pool(threads).submit(rays, a, b) for a, b in itertools.pairwise(cuts)]
-    parts = [job.result() for job in jobs]
-    return _finish(np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts]),
-                   ekeys, hit)
+    work = work or ScanWork()
+    blocks, bits, work.grid, work.cell, work.flags = _scan(
+        (points, origin), res, max_range, (work.grid, work.cell, work.flags),
+        (work.blocks + 64, DENSE_MAX_WORDS, DENSE_ANY_WORDS, WORDS_PER_STEP))
+    work.blocks = blocks.size + blocks.size // 4
+    return blocks, bits

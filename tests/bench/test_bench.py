@@ -2,6 +2,8 @@
 
 import json
 import math
+import os
+import threading
 
 import numpy as np
 import pytest
@@ -9,7 +11,14 @@ import pytest
 from alte.bench import ROWS, BenchConfig, Context, Result, run_bench, select_rows, write_outputs
 from alte.bench.output import format_value, miss_note, render_markdown
 from alte.bench.scaling import predicted_seconds, whole_scans
-from alte.bench.timing import fit_exponent, interleave, machine_info, measure, nlogn_exponent
+from alte.bench.timing import (
+    fit_exponent,
+    interleave,
+    machine_info,
+    measure,
+    nlogn_exponent,
+    one_core,
+)
 from alte.bench.wall import report_wall_time, stage_shares, thesis_total_s
 from alte.bench.workload import tile_points
 from alte.cli import main
@@ -25,6 +34,28 @@ def test_measure_interleaves_alternating_and_drops_the_warmup():
     assert [len(s.times) for s in samples.values()] == [3, 3]
     assert samples["a"].median >= 0 and samples["a"].as_dict()["repeats"] == 3
     assert list(interleave(["x", "y"], 2)) == [(0, "x"), (0, "y"), (1, "y"), (1, "x")]
+
+
+@pytest.mark.skipif(not hasattr(os, "sched_setaffinity"), reason="CPU affinity is Linux only")
+def test_one_core_pins_every_thread_and_restores_the_masks():
+    before = os.sched_getaffinity(0)
+    waiting, seen = threading.Event(), {}
+
+    def later() -> None:  # a thread that exists before the block, asks inside it
+        waiting.wait()
+        seen["older"] = os.sched_getaffinity(0)
+
+    older = threading.Thread(target=later)
+    older.start()
+    with one_core() as cpu:
+        assert cpu == min(before) and os.sched_getaffinity(0) == {cpu}
+        waiting.set()
+        older.join()
+        newer = threading.Thread(target=lambda: seen.update(newer=os.sched_getaffinity(0)))
+        newer.start()
+        newer.join()
+    assert seen == {"older": {cpu}, "newer": {cpu}}  # started before or inside the block
+    assert os.sched_getaffinity(0) == before
 
 
 @pytest.mark.parametrize(("repeats", "warmup", "match"),

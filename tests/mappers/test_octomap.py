@@ -12,8 +12,9 @@ from hypothesis import strategies as st
 from alte.errors import AlteError, MapperError, ParameterError
 from alte.mappers._blockset import WORDS, keys_to_blocks
 from alte.mappers._octomap_backends import logodds
-from alte.mappers._octree import PAGE, Leaves, VoxelStore, prune, prune_voxels
+from alte.mappers._octree import Leaves, prune, prune_voxels
 from alte.mappers._raycast import morton_encode
+from alte.mappers._voxelstore import PAGE, VoxelStore
 from alte.mappers.octomap import Octomap, compare_backends, read_bt
 from alte.paths import realdata_dir
 

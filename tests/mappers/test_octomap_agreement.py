@@ -3,7 +3,7 @@
 Frame by frame, same origins, thesis (MATLAB) sensor model, 100 m max range: the
 occupied voxel sets must be identical (Jaccard 1.0) and so must the leaf counts.
 A reduced mission keeps the test to seconds; ``alte bench`` runs the full one. The
-scan kernels' paths (dense or hashed key sets, one thread or a pool) must give the
+scan kernels' paths (the lane walk in a flat grid or the hashed block set) must give the
 very same key sets.
 """
 
@@ -34,18 +34,32 @@ def _sorted(blocks: np.ndarray, bits: np.ndarray) -> tuple[np.ndarray, np.ndarra
 
 
 @pytest.mark.slow
-def test_dense_hashed_and_threaded_scans_give_the_same_keys(tmp_path_factory, monkeypatch):
+def test_lane_walk_and_hashed_scans_give_the_same_keys(tmp_path_factory, monkeypatch):
     folder = ensure_terrain("sim_nav_1", tmp_path_factory.mktemp("data"), frames=6)
+    work = _scan.ScanWork()  # reused by every scan, as a map does: left clean by each
     for frame in prepare(open_input(folder)).frames():
         points, origin = np.array(frame.points), frame.origin
         args = (points.astype(np.float32), origin.astype(np.float32), 0.2, 100.0)
-        dense = _sorted(*_scan.scan_blocks(*args))
+        dense = _sorted(*_scan.scan_blocks(*args, work))
         assert dense[0].size > 100 and (dense[1][:, :WORDS] & dense[1][:, WORDS:] == 0).all()
-        for threads in (2, 3):
-            threaded = _sorted(*_scan.scan_blocks(*args, threads=threads))
-            assert all(np.array_equal(a, b) for a, b in zip(dense, threaded, strict=True))
+        assert not work.grid.any() and (work.cell == -1).all()
         with monkeypatch.context() as patch:
             patch.setattr(_scan, "DENSE_MAX_WORDS", 0)  # every scan takes the hashed path
-            for threads in (1, 2):
-                hashed = _sorted(*_scan.scan_blocks(*args, capacity=16, threads=threads))
-                assert all(np.array_equal(a, b) for a, b in zip(dense, hashed, strict=True))
+            hashed = _sorted(*_scan.scan_blocks(*args, _scan.ScanWork()))
+        assert all(np.array_equal(a, b) for a, b in zip(dense, hashed, strict=True))
+
+
+@pytest.mark.slow
+def test_large_flat_grids_follow_the_words_per_step_rule(tmp_path_factory, monkeypatch):
+    folder = ensure_terrain("sim_nav_1", tmp_path_factory.mktemp("data"), frames=3)
+    monkeypatch.setattr(_scan, "DENSE_ANY_WORDS", 0)  # every grid counts as large
+    for frame in prepare(open_input(folder)).frames():
+        args = (np.array(frame.points, np.float32), frame.origin.astype(np.float32), 0.1, 100.0)
+        runs = {}
+        for per_step in (0, 10**6):  # no grid is cheap enough / every grid is
+            monkeypatch.setattr(_scan, "WORDS_PER_STEP", per_step)
+            work = _scan.ScanWork()
+            runs[per_step] = _sorted(*_scan.scan_blocks(*args, work))
+            assert (work.grid.size > 1) == (per_step > 0)  # the flat grid was used or not
+        assert runs[0][0].size > 100
+        assert all(np.array_equal(a, b) for a, b in zip(runs[0], runs[10**6], strict=True))
