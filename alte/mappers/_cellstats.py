@@ -55,24 +55,32 @@ def sort_keys(keys: np.ndarray, bits: int) -> tuple[np.ndarray, np.ndarray]:
     return src_k, src_o
 
 
-@numba.njit(cache=True)
-def _pairwise(x: np.ndarray, j: int, a: int, n: int) -> float:
-    """numpy's pairwise sum of ``x[a:a + n, j]`` (8 accumulators, blocks of 128)."""
+@numba.njit(cache=True, inline="always")
+def _pairwise_block(x: np.ndarray, j: int, a: int, n: int) -> float:
+    """numpy's pairwise sum of ``x[a:a + n, j]`` for ``n <= 128``: a plain loop below 8,
+    else 8 accumulators (scalars: no scratch array per call)."""
+    res = -0.0
     if n < 8:
-        res = -0.0
         for i in range(a, a + n):
             res += x[i, j]
         return float(res)
+    r0, r1, r2, r3 = x[a, j], x[a + 1, j], x[a + 2, j], x[a + 3, j]
+    r4, r5, r6, r7 = x[a + 4, j], x[a + 5, j], x[a + 6, j], x[a + 7, j]
+    m = n - n % 8
+    for i in range(a + 8, a + m, 8):
+        r0, r1, r2, r3 = r0 + x[i, j], r1 + x[i + 1, j], r2 + x[i + 2, j], r3 + x[i + 3, j]
+        r4, r5, r6, r7 = r4 + x[i + 4, j], r5 + x[i + 5, j], r6 + x[i + 6, j], r7 + x[i + 7, j]
+    res = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
+    for i in range(a + m, a + n):
+        res += x[i, j]
+    return float(res)
+
+
+@numba.njit(cache=True)
+def _pairwise(x: np.ndarray, j: int, a: int, n: int) -> float:
+    """numpy's pairwise sum of ``x[a:a + n, j]`` (8 accumulators, blocks of 128)."""
     if n <= 128:
-        r = x[a:a + 8, j].copy()
-        m = n - n % 8
-        for i in range(8, m, 8):
-            for q in range(8):
-                r[q] += x[a + i + q, j]
-        res = ((r[0] + r[1]) + (r[2] + r[3])) + ((r[4] + r[5]) + (r[6] + r[7]))
-        for i in range(m, n):
-            res += x[a + i, j]
-        return float(res)
+        return _pairwise_block(x, j, a, n)
     half = n // 2
     half -= half % 8
     return _pairwise(x, j, a, half) + _pairwise(x, j, a + half, n - half)
@@ -81,7 +89,9 @@ def _pairwise(x: np.ndarray, j: int, a: int, n: int) -> float:
 @numba.njit(cache=True, inline="always")
 def _run_total(x: np.ndarray, j: int, a: int, b: int) -> float:
     """``np.add.reduceat`` of the run ``x[a:b, j]``."""
-    return float(x[a, j] + _pairwise(x, j, a + 1, b - a - 1) if b - a > 1 else x[a, j])
+    if b - a <= 129:  # the usual short run: no call
+        return float(x[a, j] + _pairwise_block(x, j, a + 1, b - a - 1) if b - a > 1 else x[a, j])
+    return float(x[a, j] + _pairwise(x, j, a + 1, b - a - 1))
 
 
 @numba.njit(cache=True)
@@ -101,21 +111,34 @@ def _run_starts(keys: np.ndarray, shift: int) -> np.ndarray:
     return starts
 
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=True)
+def _point_row(values: np.ndarray, a: int, out: np.ndarray, s: int) -> None:
+    """Row ``s`` of ``out`` for the one point ``values[a]``: :func:`_cell_row`'s formulas
+    with ``n = 1`` (``v / 1`` is ``v``, ``M2`` is ``0 * 0``), the usual finest cell."""
+    nv = values.shape[1]
+    out[s, 0] = 1.0
+    for j in range(nv):
+        mean = values[a, j] / 1.0
+        d = values[a, j] - mean
+        out[s, 1 + j], out[s, 1 + nv + j] = mean, d * d
+        out[s, 1 + 2 * nv + j] = values[a, j]
+
+
+@numba.njit(cache=True)
 def _cell_row(values: np.ndarray, run: tuple[int, int], out: np.ndarray, s: int,
               dev: np.ndarray) -> None:
     """Row ``s`` of ``out``: ``n, mean.., m2.., max..`` of the points ``values[a:b]``,
-    ``run = (a, b)`` (``np.add.reduceat``'s sums; ``dev``: scratch of the values' shape)."""
+    ``run = (a, b)`` (``np.add.reduceat``'s sums; ``dev``: scratch of the values' shape).
+    A plain function: numba's ``inline="always"`` adds reference counting of the arrays
+    per call, which costs more than a one-point row (callers test ``b - a == 1`` first
+    and call :func:`_point_row`, which LLVM inlines)."""
     a, b = run
+    if b - a == 1:
+        _point_row(values, a, out, s)
+        return
     nv = values.shape[1]
     out[s, 0] = count = np.float64(b - a)
     for j in range(nv):
-        if b - a == 1:  # one point: the general formulas reduce to these
-            mean = values[a, j] / count
-            d = values[a, j] - mean
-            out[s, 1 + j], out[s, 1 + nv + j] = mean, d * d
-            out[s, 1 + 2 * nv + j] = values[a, j]
-            continue
         mean = _run_total(values, j, a, b) / count
         top = values[a, j]
         for i in range(a, b):
@@ -135,11 +158,14 @@ def aggregate_points(keys: np.ndarray, values: np.ndarray) -> tuple[np.ndarray, 
     dev = np.empty(values.shape)
     for s in range(starts.size - 1):
         cells[s] = keys[starts[s]]
-        _cell_row(values, (starts[s], starts[s + 1]), out, s, dev)
+        if starts[s + 1] - starts[s] == 1:
+            _point_row(values, starts[s], out, s)
+        else:
+            _cell_row(values, (starts[s], starts[s + 1]), out, s, dev)
     return cells, out
 
 
-@numba.njit(cache=True, inline="always", error_model="numpy")
+@numba.njit(cache=True, error_model="numpy")
 def _parent_row(rows: np.ndarray, run: tuple[int, int], out: np.ndarray, s: int) -> None:
     """Row ``s`` of ``out``: Chan's merge of the (at most 4) child rows ``rows[a:b]``,
     ``run = (a, b)``, each sum in ``np.add.reduceat``'s order on short runs (``x[0] +

@@ -28,12 +28,16 @@ import numba
 import numpy as np
 from numba.cpython.unsafe.numbers import leading_zeros
 
-from alte.mappers._cellstats import _cell_row, _parent_row, sort_keys
+from alte._numba import CLOUD_MIN
+from alte.mappers._cellstats import _cell_row, _parent_row, _run_starts, sort_keys
 
 __all__ = ["Sorted", "sort_points", "tree_cells"]
 
 #: Below this many points numba's quicksort of the packed keys beats the radix passes.
 _RADIX_MIN = 1 << 14
+#: From ``CLOUD_MIN`` points on, the cells of this level are walked side by side, one
+#: contiguous group of them per thread, and the levels above from their rows.
+_SPLIT_LEVEL = 3
 #: Points sorted by :func:`sort_points`: ``(packed, shift, values)``; ``shift`` 0 when
 #: the keys alone are sorted and ``values`` are in their order.
 Sorted = tuple[np.ndarray, int, np.ndarray]
@@ -80,14 +84,17 @@ def _coarsest_change(a: int, b: int, depth: int) -> int:
 
 
 @numba.njit(cache=True)
-def _run_row(points: Sorted, span: tuple[int, int], rows: np.ndarray, s: int) -> None:
-    """Row ``s``: the finest cell of the sorted points ``span = (i, j)``, two or more."""
+def _run_row(points: Sorted, span: tuple[int, int], rows: np.ndarray, s: int,
+             scratch: tuple[np.ndarray, np.ndarray]) -> None:
+    """Row ``s``: the finest cell of the sorted points ``span = (i, j)``, two or more
+    (``scratch``: two arrays of at least ``j - i`` rows)."""
     packed, shift, values = points
     i, j = span
-    run, dev = np.empty((j - i, values.shape[1])), np.empty((j - i, values.shape[1]))
+    run, dev = scratch
     for r in range(i, j):
         p = r if shift == 0 else packed[r] & ((1 << shift) - 1)
-        run[r - i, :] = values[p]
+        for c in range(values.shape[1]):
+            run[r - i, c] = values[p, c]
     _cell_row(run, (0, j - i), rows, s, dev)
 
 
@@ -108,13 +115,16 @@ def _emit(stack: tuple[np.ndarray, np.ndarray], kids: tuple[int, int], level: in
 
 
 @numba.njit(cache=True)
-def _tree_counts(packed: np.ndarray, shift: int, depth: int, split_above: float) -> np.ndarray:
+def _tree_counts(packed: np.ndarray, shift: int, depth: int,
+                 split_above: float) -> tuple[np.ndarray, np.ndarray]:
     """Cells per level of the tree (the root, the non-empty children of cells with ``n >
-    split_above``), top down: a cell is a range of the sorted keys, its children the
-    runs of their next two bits, found by binary search (no pass over every point)."""
+    split_above``) and each cell's first sorted point, levels one after the other, top
+    down: a cell is a range of the sorted keys, its children the runs of their next two
+    bits, found by binary search (no pass over every point)."""
     counts = np.zeros(depth + 1, np.int64)
     lo, hi = np.zeros(1, np.int64), np.full(1, packed.size, np.int64)
     counts[0] = packed.size > 0
+    firsts = [lo[:counts[0]].copy()]
     for level in range(depth):
         wide = np.flatnonzero(hi - lo > split_above)
         kids_lo, kids_hi, m = np.empty(4 * wide.size, np.int64), np.empty(4 * wide.size,
@@ -129,30 +139,40 @@ def _tree_counts(packed: np.ndarray, shift: int, depth: int, split_above: float)
                     first, end = (mid + 1, end) if packed[mid] < bound else (first, mid)
                 kids_lo[m], kids_hi[m], m, a = a, first, m + 1, first
         lo, hi, counts[level + 1] = kids_lo[:m], kids_hi[:m], m
-    return counts
+        firsts.append(lo.copy())
+    joined, at = np.empty(counts.sum(), np.int64), 0
+    for level_firsts in firsts:
+        joined[at:at + level_firsts.size] = level_firsts
+        at += level_firsts.size
+    return counts, joined
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _walk(points: Sorted, depth: int, split_above: float, out: Out) -> None:
-    """Write the tree's cells to ``out``, each level's in key order (the children of a
-    split cell together, as it closes; the root last). A point alone in its cells from
-    level ``top`` down (its neighbours differ there) enters the stack at ``top``: no
-    cell of one point splits (``split_above >= 1``), so the chain below holds nothing
-    to write."""
+def _walk(points: Sorted, span: tuple[int, int, int], flags: tuple[int, float], out: Out,
+          root: tuple[np.ndarray, np.ndarray, int]) -> None:
+    """Write the cells below level ``floor`` of the points ``i..end`` (``span = (i, end,
+    floor)``: those of one cell at ``floor``; all of them for floor 0) to ``out``, each
+    level's in key order (the children of a split cell together, as it closes), and put
+    that cell's row and key in ``root = (rows, keys, t)`` at ``t``. A point alone in its
+    cells from level ``top`` down (its neighbours differ there) enters the stack at
+    ``top``: no cell of one point splits (``split_above >= 1``), so the chain below
+    holds nothing to write."""
     packed, shift, values = points
-    n, nv, mask = packed.size, values.shape[1], (1 << shift) - 1
+    depth, split_above = flags
+    (i, end, floor), nv, mask = span, values.shape[1], (1 << shift) - 1
     rows, keys = np.empty((4 * depth + 4, 1 + 3 * nv)), np.empty(4 * depth + 4, np.int64)
+    scratch = (np.empty((end - i, nv)), np.empty((end - i, nv)))
     count = np.zeros(depth + 1, np.int64)  # children waiting per level
-    i = before = 0  # ``before``: coarsest level where the previous point's cell differs
-    while i < n:
+    before = floor  # coarsest level where the previous point's cell differs
+    while i < end:
         key, j = packed[i] >> shift, i + 1
-        while j < n and packed[j] >> shift == key:
+        while j < end and packed[j] >> shift == key:
             j += 1
-        low = _coarsest_change(key, packed[j] >> shift, depth) if j < n else 0
+        low = max(floor, _coarsest_change(key, packed[j] >> shift, depth)) if j < end else floor
         top = max(before, low) if j - i == 1 else depth
         s, before = 4 * top + count[top], low
         if j - i > 1:
-            _run_row(points, (i, j), rows, s)
+            _run_row(points, (i, j), rows, s, scratch)
         else:  # one point: _cell_row's values (v / 1 is v, M2 is 0 * 0)
             rows[s, 0], p = 1.0, i if shift == 0 else packed[i] & mask
             for c in range(nv):
@@ -164,9 +184,52 @@ def _walk(points: Sorted, depth: int, split_above: float, out: Out) -> None:
             _parent_row(rows, (kid, kid + m), rows, s)
             keys[s], count[level], count[level + 1] = keys[kid] >> 2, count[level] + 1, 0
             if rows[s, 0] > split_above:
-                _emit((rows, keys), (kid, kid + m), level + 1, (depth, split_above), out)
+                _emit((rows, keys), (kid, kid + m), level + 1, flags, out)
         i = j
-    _emit((rows, keys), (0, 1), 0, (depth, split_above), out)
+    root[0][root[2]], root[1][root[2]] = rows[4 * floor], keys[4 * floor]
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _walk_top(cells: tuple[np.ndarray, np.ndarray], floor: int, flags: tuple[int, float],
+              out: Out) -> None:
+    """The levels ``0..floor`` from the rows and keys of the non-empty cells at
+    ``floor`` in key order, merged, split and written as :func:`_walk` does (a cell of
+    one point enters where its neighbours differ, as that point would have)."""
+    cell_rows, cell_keys = cells
+    rows = np.empty((4 * floor + 4, cell_rows.shape[1]))
+    keys = np.empty(4 * floor + 4, np.int64)
+    count = np.zeros(floor + 1, np.int64)
+    before = 0
+    for t in range(cell_keys.size):
+        key = cell_keys[t]
+        low = _coarsest_change(key, cell_keys[t + 1], floor) if t + 1 < cell_keys.size else 0
+        top = max(before, low) if cell_rows[t, 0] == 1.0 else floor
+        s, before = 4 * top + count[top], low
+        rows[s, :] = cell_rows[t]
+        keys[s], count[top] = key >> (2 * (floor - top)), count[top] + 1
+        for level in range(top - 1, low - 1, -1):
+            m, s, kid = count[level + 1], 4 * level + count[level], 4 * level + 4
+            _parent_row(rows, (kid, kid + m), rows, s)
+            keys[s], count[level], count[level + 1] = keys[kid] >> 2, count[level] + 1, 0
+            if rows[s, 0] > flags[1]:
+                _emit((rows, keys), (kid, kid + m), level + 1, flags, out)
+    _emit((rows, keys), (0, 1), 0, flags, out)
+
+
+@numba.njit(cache=True, parallel=True)
+def _walk_groups(points: Sorted, cuts: tuple[np.ndarray, np.ndarray, int],
+                 flags: tuple[int, float], out: Out,
+                 cells: tuple[np.ndarray, np.ndarray]) -> None:
+    """:func:`_walk` of every cell at level ``floor`` (``cuts = (spans, groups, floor)``;
+    ``spans``: the cells' first points, then ``n``), group ``g`` of them (``groups[g]..
+    groups[g + 1]``) on a thread of its own; ``out[3]`` holds each cell's next places per
+    level (a row per cell)."""
+    spans, groups, floor = cuts
+    table, keys, split, places = out
+    for g in numba.prange(groups.size - 1):
+        for t in range(groups[g], groups[g + 1]):
+            _walk(points, (spans[t], spans[t + 1], floor), flags,
+                  (table, keys, split, places[t]), (cells[0], cells[1], t))
 
 
 def sort_points(keys: np.ndarray, values: np.ndarray, bits: int) -> Sorted:
@@ -183,18 +246,50 @@ def sort_points(keys: np.ndarray, values: np.ndarray, bits: int) -> Sorted:
     return _sort_packed(keys, bits, shift, scratch, out), shift, values
 
 
-def tree_cells(points: Sorted, depth: int, split_above: float,
+def _places(spans: np.ndarray, firsts: np.ndarray, offsets: np.ndarray,
+            floor: int) -> np.ndarray:
+    """Each floor cell's first place per level below ``floor`` in the output: the
+    level's offset plus the tree cells of the floor cells before it (by first point)."""
+    places = np.zeros((spans.size - 1, offsets.size - 1), np.int64)
+    for level in range(floor + 1, offsets.size - 1):
+        owner = np.searchsorted(spans, firsts[offsets[level]:offsets[level + 1]], "right") - 1
+        held = np.bincount(owner, minlength=spans.size - 1)
+        places[:, level] = offsets[level] + np.cumsum(held) - held
+    return places
+
+
+def tree_cells(points: Sorted, depth: int, split_above: float, threads: int | None = None,
                ) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
     """Per level ``0..depth``: sorted keys, rows ``n, mean.., m2.., max..`` and split
     flags (``n > split_above`` above the finest level) of the root and the children of
-    split cells of :func:`sort_points`' points (views of one buffer per array)."""
+    split cells of :func:`sort_points`' points (views of one buffer per array).
+
+    Large inputs are walked on ``threads`` (default: numba's) side by side, one group of
+    the cells of level ``_SPLIT_LEVEL`` each, with the same rows bit for bit."""
     assert split_above >= 1.0, "the walk skips cells of one point: they must not split"
     packed, shift, values = points
+    flags = (depth, float(split_above))
+    counts, firsts = _tree_counts(packed, shift, depth, flags[1])
     offsets = np.zeros(depth + 2, np.int64)
-    offsets[1:] = np.cumsum(_tree_counts(packed, shift, depth, float(split_above)))
-    out = (np.empty((offsets[-1], 1 + 3 * values.shape[1])), np.empty(offsets[-1], np.int64),
-           np.empty(offsets[-1], bool), offsets[:-1].copy())
-    if len(packed):
-        _walk(points, depth, float(split_above), out)
-    assert (out[3] == offsets[1:]).all(), "the walk wrote the cells the count found"
+    offsets[1:] = np.cumsum(counts)
+    width, at = 1 + 3 * values.shape[1], offsets[:-1].copy()
+    out = (np.empty((offsets[-1], width)), np.empty(offsets[-1], np.int64),
+           np.empty(offsets[-1], bool), at)
+    threads = numba.get_num_threads() if threads is None else threads
+    floor = min(_SPLIT_LEVEL, depth) if threads > 1 and len(packed) >= CLOUD_MIN else 0
+    if floor:  # the floor cells' subtrees in parallel, then the levels above
+        spans = _run_starts(packed, shift + 2 * (depth - floor))
+        size = spans.size - 1
+        groups = np.r_[0, np.searchsorted(spans[:-1], np.arange(1, threads) * len(packed)
+                                          / threads), size]
+        cells = (np.empty((size, width)), np.empty(size, np.int64))
+        places = _places(spans, firsts, offsets, floor)
+        _walk_groups(points, (spans, groups, floor), flags, (*out[:3], places), cells)
+        _walk_top(cells, floor, flags, out)
+        at[floor + 1:] = places[-1, floor + 1:]
+    elif len(packed):
+        cells = (np.empty((1, width)), np.empty(1, np.int64))
+        _walk(points, (0, len(packed), 0), flags, out, (*cells, 0))
+        _emit(cells, (0, 1), 0, flags, out)
+    assert (at == offsets[1:]).all(), "the walk wrote the cells the count found"
     return [(out[1][a:b], out[0][a:b], out[2][a:b]) for a, b in itertools.pairwise(offsets)]

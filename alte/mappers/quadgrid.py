@@ -22,6 +22,7 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
+from alte._numba import CLOUD_MIN, threads_for
 from alte.types import rows_all
 
 __all__ = ["Square", "morton_decode", "morton_encode"]
@@ -57,14 +58,15 @@ def _spread(v: int) -> int:
     return (v | (v << 1)) & 0x5555555555555555
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, parallel=True)
 def _locate(xy: np.ndarray, corner: tuple[float, float], size: float,
             cells: int) -> tuple[np.ndarray, np.ndarray]:
     """Morton keys of ``xy``'s cells (clipped to the grid) and whether each point lies in
-    the closed square: :meth:`Square.keys` and :meth:`Square.contains` in one pass."""
+    the closed square: :meth:`Square.keys` and :meth:`Square.contains` in one pass (on
+    every thread for a whole cloud: ``alte._numba.CLOUD_MIN``)."""
     keys = np.empty(xy.shape[0], dtype=np.int64)
     inside = np.empty(xy.shape[0], dtype=np.bool_)
-    for i in range(xy.shape[0]):
+    for i in numba.prange(xy.shape[0]):
         rx, ry = (xy[i, 0] - corner[0]) / size, (xy[i, 1] - corner[1]) / size
         inside[i] = rx >= 0.0 and rx <= 1.0 and ry >= 0.0 and ry <= 1.0
         ix = min(max(np.floor(rx * cells), 0.0), cells - 1.0)
@@ -89,12 +91,13 @@ def morton_decode(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 def _extent(xy: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Per-column minimum and maximum of (N >= 1, 2) finite points, in one pass (numpy
     reduces an (N, 2) array along axis 0 two values at a time, and a strided column
-    at a time reads every row's cache line)."""
-    lo, hi = xy[0].copy(), xy[0].copy()
+    at a time reads every row's cache line); the four bounds stay in registers."""
+    x0 = x1 = xy[0, 0]
+    y0 = y1 = xy[0, 1]
     for i in range(1, xy.shape[0]):
-        for c in range(2):
-            lo[c], hi[c] = min(lo[c], xy[i, c]), max(hi[c], xy[i, c])
-    return lo, hi
+        x, y = xy[i, 0], xy[i, 1]
+        x0, x1, y0, y1 = min(x0, x), max(x1, x), min(y0, y), max(y1, y)
+    return np.array([x0, y0]), np.array([x1, y1])
 
 
 @dataclass(frozen=True)
@@ -130,8 +133,9 @@ class Square:
 
     def locate(self, xy: np.ndarray, level: int) -> tuple[np.ndarray, np.ndarray]:
         """:meth:`keys` and :meth:`contains` (closed) of ``xy`` (N, 2), computed together."""
-        found: tuple[np.ndarray, np.ndarray] = _locate(
-            np.asarray(xy, dtype=np.float64), (self.xmin, self.ymin), self.size, 1 << level)
+        with threads_for(len(xy), CLOUD_MIN):
+            found: tuple[np.ndarray, np.ndarray] = _locate(
+                np.asarray(xy, dtype=np.float64), (self.xmin, self.ymin), self.size, 1 << level)
         return found
 
     def keys(self, xy: np.ndarray, level: int) -> np.ndarray:

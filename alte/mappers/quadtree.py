@@ -43,6 +43,7 @@ from typing import ClassVar
 import numba
 import numpy as np
 
+from alte._numba import CLOUD_MIN, threads_for
 from alte.errors import AlteError, MapperError
 from alte.mappers.alte2d import plane_height
 from alte.mappers.base import Feed
@@ -66,12 +67,12 @@ def parse_ground(text: str) -> np.ndarray | None:
     return values
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, parallel=True)
 def _z_and_above(points: np.ndarray, plane: np.ndarray, out: np.ndarray) -> None:
     """``out[i] = z, z - plane_height(plane, xy)`` of every point, in one pass (the same
-    arithmetic, in the same order, as the numpy expression)."""
+    arithmetic, in the same order, as the numpy expression; every thread for a cloud)."""
     a, b, c, d = plane[0], plane[1], plane[2], plane[3]
-    for i in range(points.shape[0]):
+    for i in numba.prange(points.shape[0]):
         out[i, 0] = points[i, 2]
         out[i, 1] = points[i, 2] - -(a * points[i, 0] + b * points[i, 1] + d) / c
 
@@ -144,7 +145,8 @@ class Quadtree(QuadMap):
     def _values(self, points: np.ndarray) -> np.ndarray:
         assert self.plane is not None  # insert and build refuse to go on without one
         values = np.empty((len(points), 2))
-        _z_and_above(points, self.plane, values)
+        with threads_for(len(points), CLOUD_MIN):
+            _z_and_above(points, self.plane, values)
         return values
 
     def _split(self, level: int, rows: np.ndarray | slice) -> np.ndarray:

@@ -18,12 +18,13 @@ targets crowd the cells (:data:`MAX_LOAD`) a pykdtree KD-tree answers the rest.
 
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass
 
 import numba
 import numpy as np
 from pykdtree.kdtree import KDTree
+
+from alte._numba import threads_for
 
 __all__ = ["CELLS_PER_TARGET", "COARSER", "MAX_LOAD", "PARALLEL_MIN", "RINGS", "Grid", "bounds",
            "build_grid", "first_side", "nearest_distances", "query_grid"]
@@ -46,12 +47,6 @@ _TOL = 1e-9
 _FAR = 2.0**40
 #: Cell index ranges (first, last along x, then y, then z).
 Range = tuple[int, int, int, int, int, int]
-
-if "NUMBA_THREADING_LAYER_PRIORITY" not in os.environ:
-    # OpenMP first: thread-safe, and already loaded by pykdtree and open3d; numba would try
-    # TBB first and warn (to no one's benefit) when the machine's TBB is too old.
-    numba.config.THREADING_LAYER_PRIORITY = ["omp", "tbb", "workqueue"]  # type: ignore[attr-defined]
-
 
 @dataclass(frozen=True)
 class Grid:
@@ -269,14 +264,9 @@ def build_grid(points: np.ndarray, h: float, box: tuple[np.ndarray, np.ndarray])
 def query_grid(grid: Grid, queries: np.ndarray, rings: int) -> tuple[np.ndarray, np.ndarray]:
     """(distance to the nearest target, settled) for every query (M, 3): exact where
     settled, inf where no target lies within ``rings`` rings of the query's cell."""
-    threads = numba.get_num_threads()
-    if len(queries) < PARALLEL_MIN:
-        numba.set_num_threads(1)
-    try:
+    with threads_for(len(queries), PARALLEL_MIN):
         return _query(queries, grid.lo, grid.h, grid.dims, grid.start, grid.points, rings,
                       grid.scale)
-    finally:
-        numba.set_num_threads(threads)
 
 
 def _kdtree(queries: np.ndarray, targets: np.ndarray) -> np.ndarray:

@@ -306,3 +306,9 @@ def test_split_flags_need_one_per_cell() -> None:
     assert stats.split[2].tolist() == [True, False, True]
     with pytest.raises(MapperError, match=r"level 2: .* for 3 cells"):
         stats.split[2] = np.zeros(2, bool)
+
+
+def test_build_of_a_whole_cloud_keeps_the_trees_cells_bit_for_bit() -> None:
+    """A cloud large enough for the build's per-point kernels and walk to run on every
+    thread (``alte._numba.CLOUD_MIN``) keeps the insertion's cells as a small one does."""
+    assert_tree_of_every_cell(box_terrain(80_000, seed=3), 25, 10)
