@@ -14,6 +14,11 @@ in its cells has its own row on each of them, so the walk skips that chain of co
 A first, top-down pass counts the tree's cells per level (binary searches in the
 split cells' ranges of sorted keys), so the walk writes each level in place, once.
 
+The cells of level 3 hold disjoint runs of the sorted points, so a whole cloud is
+walked on every thread, one contiguous group of those cells each, up to level 3; their
+rows then go through the same walk for levels 3..0. Each cell's places per level come
+from the counting pass, so the output is the single walk's, bit for bit.
+
 The points are sorted by *packed* keys, ``key << shift | index``: one int64 array
 moved per radix pass, and the index makes the order stable. The hot loop is one
 function: numba passes arrays to a helper as structs of several words, and a call per
