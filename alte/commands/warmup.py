@@ -6,7 +6,9 @@ update of the package) would otherwise spend tens of seconds compiling inside it
 scans, far over a 100 ms sensor period. This command maps a two-scan simulated flight
 with every mapper and feed, through the same pipeline as ``alte map``, and measures HD/MHD
 once (the grid search of ``alte map --metrics``, about 10 s to compile), so each kernel is
-compiled and written to the cache; later processes load it in milliseconds.
+compiled and written to the cache; later processes load it in milliseconds. The 2D maps
+also build a synthetic cloud of ``CLOUD_MIN`` points: a whole cloud takes kernels a scan
+never reaches (the Quadtree's tree walk on every thread).
 """
 
 from __future__ import annotations
@@ -16,7 +18,10 @@ import tempfile
 import time
 from pathlib import Path
 
-from alte.mappers import MAPPERS, Feed, Mapper
+import numpy as np
+
+from alte._numba import CLOUD_MIN
+from alte.mappers import MAPPERS, Feed, Mapper, make_mapper
 from alte.metrics.hausdorff import hausdorff
 from alte.pipeline import MapSpec, run
 from alte.sim import ensure_terrain
@@ -57,6 +62,12 @@ def warm_kernels() -> dict[str, int]:
                 cells[f"{name}/{feed.value}"] = _touch(result.mapper)
     corners = result.mapper.corners()
     hausdorff(corners, corners[::3])
+    cloud = np.random.default_rng(0).uniform((0.0, 0.0, -1.0), (50.0, 50.0, 3.0), (CLOUD_MIN, 3))
+    for name, kind in MAPPERS.items():
+        if kind.dims == 2:
+            mapper = make_mapper(name)
+            mapper.build(cloud)
+            cells[f"{name}/cloud"] = _touch(mapper)
     return cells
 
 

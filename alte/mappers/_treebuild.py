@@ -33,7 +33,7 @@ import numba
 import numpy as np
 from numba.cpython.unsafe.numbers import leading_zeros
 
-from alte._numba import CLOUD_MIN
+from alte._numba import CLOUD_MIN, threads_for
 from alte.mappers._cellstats import _cell_row, _parent_row, _run_starts, sort_keys
 
 __all__ = ["Sorted", "sort_points", "tree_cells"]
@@ -51,34 +51,66 @@ Sorted = tuple[np.ndarray, int, np.ndarray]
 Out = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
 
 
+@numba.njit(cache=True, parallel=True)
+def _pack(keys: np.ndarray, shift: int, out: np.ndarray, scratch: np.ndarray) -> None:
+    """``out[i] = keys[i] << shift | i`` (``out`` may be ``keys``) and ``scratch`` touched,
+    on every thread: a fresh array costs a page fault per 4 KiB at its first touch."""
+    for i in numba.prange(keys.size):
+        out[i] = (keys[i] << shift) | i
+        scratch[i] = 0
+
+
 @numba.njit(cache=True)
-def _sort_packed(keys: np.ndarray, bits: int, shift: int, scratch: np.ndarray,
-                 out: np.ndarray) -> np.ndarray:
-    """``keys << shift | index`` sorted (LSD radix on the key's ``bits``, digits of at
-    most 12 bits); the sorted array is ``out`` or ``scratch``."""
-    n = keys.size
+def _radix(buffers: tuple[np.ndarray, np.ndarray], span: tuple[int, int],
+           digits: tuple[int, int]) -> bool:
+    """Stable LSD radix sort of ``src[lo:hi]`` (``buffers = (src, dst)``, ``span = (lo,
+    hi)``) by ``bits`` bits of the values from bit ``low`` (``digits = (low, bits)``),
+    digits of at most 12 bits; True when the sorted run ended in ``dst``."""
+    src, dst = buffers
+    (lo, hi), (low, bits) = span, digits
     passes = max(1, -(-bits // 12))
     width = -(-max(bits, 1) // passes)
     mask = (1 << width) - 1
     count = np.zeros((passes, (1 << width) + 1), dtype=np.int64)
-    for i in range(n):
-        out[i] = (keys[i] << shift) | i
+    for i in range(lo, hi):
         for p in range(passes):
-            count[p, ((keys[i] >> (p * width)) & mask) + 1] += 1
-    if n < _RADIX_MIN:
-        out[:] = np.sort(out)
-        return out
-    src, dst = out, scratch
+            count[p, ((src[i] >> (low + p * width)) & mask) + 1] += 1
     for p in range(passes):
         at = count[p]
         for d in range(1 << width):
             at[d + 1] += at[d]
-        for i in range(n):
-            d = (src[i] >> (shift + p * width)) & mask
-            dst[at[d]] = src[i]
+        for i in range(lo, hi):
+            d = (src[i] >> (low + p * width)) & mask
+            dst[lo + at[d]] = src[i]
             at[d] += 1
         src, dst = dst, src
-    return src
+    return passes % 2 == 1
+
+
+@numba.njit(cache=True, parallel=True)
+def _radix_split(out: np.ndarray, scratch: np.ndarray, shift: int, bits: int) -> None:
+    """:func:`_radix` of all of ``out`` by the key's top 6 bits into ``scratch`` (the 64
+    runs of the walk's split level), then of each run by the other bits on every thread
+    (``out`` the other buffer)."""
+    top = shift + bits - 6
+    _radix((out, scratch), (0, out.size), (top, 6))
+    starts = np.searchsorted(scratch, np.arange(65) << top)  # runs in order of their bits
+    starts[64] = out.size
+    for b in numba.prange(64):
+        _radix((scratch, out), (starts[b], starts[b + 1]), (shift, bits - 6))
+
+
+def _sort_packed(out: np.ndarray, bits: int, shift: int, scratch: np.ndarray) -> np.ndarray:
+    """Packed keys ``out`` (:func:`_pack`) sorted; the sorted array is ``out`` or
+    ``scratch``. Small inputs: numpy's sort; a cloud: the top 6 bits first, then their
+    runs side by side; else one radix sort."""
+    if out.size < _RADIX_MIN:
+        out.sort()
+        return out
+    if out.size >= CLOUD_MIN and bits > 6 and numba.get_num_threads() > 1:
+        _radix_split(out, scratch, shift, bits)
+        return scratch if -(-(bits - 6) // 12) % 2 == 0 else out
+    return scratch if _radix((out, scratch), (0, out.size), (shift, bits)) else out
 
 
 @numba.njit(cache=True, inline="always")
@@ -166,7 +198,7 @@ def _walk(points: Sorted, span: tuple[int, int, int], flags: tuple[int, float], 
     depth, split_above = flags
     (i, end, floor), nv, mask = span, values.shape[1], (1 << shift) - 1
     rows, keys = np.empty((4 * depth + 4, 1 + 3 * nv)), np.empty(4 * depth + 4, np.int64)
-    scratch = (np.empty((end - i, nv)), np.empty((end - i, nv)))
+    scratch = (np.empty((64, nv)), np.empty((64, nv)))  # grown for a longer run
     count = np.zeros(depth + 1, np.int64)  # children waiting per level
     before = floor  # coarsest level where the previous point's cell differs
     while i < end:
@@ -176,6 +208,8 @@ def _walk(points: Sorted, span: tuple[int, int, int], flags: tuple[int, float], 
         low = max(floor, _coarsest_change(key, packed[j] >> shift, depth)) if j < end else floor
         top = max(before, low) if j - i == 1 else depth
         s, before = 4 * top + count[top], low
+        if j - i > scratch[0].shape[0]:
+            scratch = (np.empty((2 * (j - i), nv)), np.empty((2 * (j - i), nv)))
         if j - i > 1:
             _run_row(points, (i, j), rows, s, scratch)
         else:  # one point: _cell_row's values (v / 1 is v, M2 is 0 * 0)
@@ -237,18 +271,30 @@ def _walk_groups(points: Sorted, cuts: tuple[np.ndarray, np.ndarray, int],
                   (table, keys, split, places[t]), (cells[0], cells[1], t))
 
 
-def sort_points(keys: np.ndarray, values: np.ndarray, bits: int) -> Sorted:
+def sort_points(keys: np.ndarray, values: np.ndarray, bits: int, *,
+                reuse_keys: bool = False) -> Sorted:
     """Points with finest ``keys`` (below ``2**bits``) and (N, nv) ``values``, stably
     sorted by key: packed with their index when both fit in 63 bits, else by
-    ``_cellstats.sort_keys`` with the values put in that order."""
+    ``_cellstats.sort_keys`` with the values put in that order. ``reuse_keys``: the
+    caller gives up ``keys`` (int64, contiguous), whose buffer then holds packed keys."""
     keys = np.asarray(keys, np.int64)
     values = np.ascontiguousarray(values, np.float64)
     shift = max(1, (keys.size - 1).bit_length())
     if bits + shift > 63:
         sorted_keys, order = sort_keys(keys, bits)
         return sorted_keys, 0, values[order]
-    scratch, out = np.empty(keys.size, np.int64), np.empty(keys.size, np.int64)
-    return _sort_packed(keys, bits, shift, scratch, out), shift, values
+    own = reuse_keys and keys.flags.c_contiguous and keys.flags.writeable
+    out, scratch = keys if own else np.empty(keys.size, np.int64), np.empty(keys.size, np.int64)
+    with threads_for(keys.size, CLOUD_MIN):
+        _pack(keys, shift, out, scratch)
+    return _sort_packed(out, bits, shift, scratch), shift, values
+
+
+@numba.njit(cache=True)
+def _output(cells: int, width: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The walk's rows, keys and flags, allocated by numba: numpy asks the kernel for huge
+    pages from 4 MiB on, whose first touch (zeroing, compaction) costs more than a walk."""
+    return np.empty((cells, width)), np.empty(cells, np.int64), np.empty(cells, np.bool_)
 
 
 def _places(spans: np.ndarray, firsts: np.ndarray, offsets: np.ndarray,
@@ -278,8 +324,7 @@ def tree_cells(points: Sorted, depth: int, split_above: float, threads: int | No
     offsets = np.zeros(depth + 2, np.int64)
     offsets[1:] = np.cumsum(counts)
     width, at = 1 + 3 * values.shape[1], offsets[:-1].copy()
-    out = (np.empty((offsets[-1], width)), np.empty(offsets[-1], np.int64),
-           np.empty(offsets[-1], bool), at)
+    out = (*_output(int(offsets[-1]), width), at)
     threads = numba.get_num_threads() if threads is None else threads
     floor = min(_SPLIT_LEVEL, depth) if threads > 1 and len(packed) >= CLOUD_MIN else 0
     if floor:  # the floor cells' subtrees in parallel, then the levels above

@@ -154,8 +154,9 @@ class LevelStats:
         with their split flags.
 
         The sorted points are kept, so that :meth:`complete` can add the other cells
-        when an insertion or a shift of the root needs them."""
-        points = sort_points(fine_keys, values, 2 * self.depth)
+        when an insertion or a shift of the root needs them. ``fine_keys`` is consumed:
+        its buffer holds the sorted points' packed keys."""
+        points = sort_points(fine_keys, values, 2 * self.depth, reuse_keys=True)
         for level, cells in enumerate(tree_cells(points, self.depth, split_above)):
             self._set_level(level, *cells)
         self._source = (points, split_above)

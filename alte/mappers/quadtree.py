@@ -68,13 +68,17 @@ def parse_ground(text: str) -> np.ndarray | None:
 
 
 @numba.njit(cache=True, parallel=True)
-def _z_and_above(points: np.ndarray, plane: np.ndarray, out: np.ndarray) -> None:
-    """``out[i] = z, z - plane_height(plane, xy)`` of every point, in one pass (the same
-    arithmetic, in the same order, as the numpy expression; every thread for a cloud)."""
+def _z_and_above(points: np.ndarray, plane: np.ndarray) -> np.ndarray:
+    """``z, z - plane_height(plane, xy)`` of every point, in one pass (the same arithmetic,
+    in the same order, as the numpy expression; every thread for a cloud). Allocated
+    here: numpy asks the kernel for huge pages for arrays from 4 MiB, and on this kind
+    of machine their first touch (zeroing, compaction) costs more than the pass itself."""
     a, b, c, d = plane[0], plane[1], plane[2], plane[3]
+    out = np.empty((points.shape[0], 2))
     for i in numba.prange(points.shape[0]):
         out[i, 0] = points[i, 2]
         out[i, 1] = points[i, 2] - -(a * points[i, 0] + b * points[i, 1] + d) / c
+    return out
 
 
 def _ground_ok(text: str) -> bool:
@@ -144,9 +148,8 @@ class Quadtree(QuadMap):
 
     def _values(self, points: np.ndarray) -> np.ndarray:
         assert self.plane is not None  # insert and build refuse to go on without one
-        values = np.empty((len(points), 2))
         with threads_for(len(points), CLOUD_MIN):
-            _z_and_above(points, self.plane, values)
+            values: np.ndarray = _z_and_above(points, self.plane)
         return values
 
     def _split(self, level: int, rows: np.ndarray | slice) -> np.ndarray:

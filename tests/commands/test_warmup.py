@@ -5,7 +5,7 @@ from __future__ import annotations
 import re
 
 from alte.cli import main
-from alte.mappers import MAPPERS, Feed
+from alte.mappers import MAPPERS, Feed, _treebuild
 from alte.metrics import _gridnn
 
 
@@ -14,6 +14,9 @@ def test_every_mapper_and_feed_maps_the_flight(capsys):
     out = capsys.readouterr().out
     assert out.startswith(f"compiled and cached the kernels of {len(MAPPERS)} mappers in ")
     cells = dict(re.findall(r"(\w+/\w+) (\d+)", out))
-    assert set(cells) == {f"{name}/{feed.value}" for name in MAPPERS for feed in Feed}
+    flights = {f"{name}/{feed.value}" for name in MAPPERS for feed in Feed}
+    clouds = {f"{name}/cloud" for name, kind in MAPPERS.items() if kind.dims == 2}
+    assert set(cells) == flights | clouds
     assert all(int(n) > 0 for n in cells.values()), cells
     assert _gridnn._query.signatures  # the grid search of HD/MHD is compiled too
+    assert _treebuild._walk_groups.signatures  # and the tree walk of a whole cloud

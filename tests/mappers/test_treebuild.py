@@ -46,3 +46,18 @@ def test_walk_of_one_cell_below_the_split_level() -> None:
     keys, values = clustered_points(70_000, 8)
     points = sort_points(keys, values, 24)
     assert same(tree_cells(points, 12, 3.0, threads=2), tree_cells(points, 12, 3.0, threads=1))
+
+
+@pytest.mark.parametrize(("n", "bits"), [(100, 24), (20_000, 24), (70_000, 24), (70_000, 7),
+                                         (70_000, 40), (70_000, 13)])
+def test_sort_points_is_numpys_stable_sort(n: int, bits: int) -> None:
+    """Small inputs, one radix sort, and a cloud's split by its top 6 bits: the packed
+    keys in stable key order, with the values they index."""
+    keys, values = clustered_points(n, bits, seed=n + bits)
+    packed, shift, kept = sort_points(keys.copy(), values, bits)
+    order = np.argsort(keys, kind="stable")
+    assert shift and kept is not None
+    assert np.array_equal(packed >> shift, keys[order])
+    assert np.array_equal(packed & ((1 << shift) - 1), order)
+    again, _, _ = sort_points(keys.copy(), values, bits, reuse_keys=True)
+    assert np.array_equal(again, packed)

@@ -136,8 +136,10 @@ def _executor(scheduler: str, workers: int) -> Iterator[MapUnordered]:
     if scheduler == "local":
         if workers < 1:
             raise ParameterError(f"--workers {workers}: must be at least 1")
+        # One thread per worker, numba's kernels included: the workers are the parallelism.
         with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                          dashboard_address=None) as cluster, Client(cluster) as client:
+                          dashboard_address=None, env={"NUMBA_NUM_THREADS": "1"},
+                          ) as cluster, Client(cluster) as client:
             yield _dask_map(client)
         return
     if "://" not in scheduler:
