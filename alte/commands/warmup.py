@@ -7,8 +7,9 @@ scans, far over a 100 ms sensor period. This command maps a two-scan simulated f
 with every mapper and feed, through the same pipeline as ``alte map``, and measures HD/MHD
 once (the grid search of ``alte map --metrics``, about 10 s to compile), so each kernel is
 compiled and written to the cache; later processes load it in milliseconds. The 2D maps
-also build a synthetic cloud of ``CLOUD_MIN`` points: a whole cloud takes kernels a scan
-never reaches (the Quadtree's tree walk on every thread).
+also build a synthetic cloud of ``CLOUD_MIN`` points, writeable and read-only: a whole
+cloud takes kernels a scan never reaches (the Quadtree's tree walk on every thread), and
+numba compiles a kernel once per array type.
 """
 
 from __future__ import annotations
@@ -65,8 +66,10 @@ def warm_kernels() -> dict[str, int]:
     cloud = np.random.default_rng(0).uniform((0.0, 0.0, -1.0), (50.0, 50.0, 3.0), (CLOUD_MIN, 3))
     for name, kind in MAPPERS.items():
         if kind.dims == 2:
-            mapper = make_mapper(name)
-            mapper.build(cloud)
+            for writeable in (True, False):  # a cached, memory-mapped cloud is read-only
+                cloud.setflags(write=writeable)
+                mapper = make_mapper(name)
+                mapper.build(cloud)
             cells[f"{name}/cloud"] = _touch(mapper)
     return cells
 
