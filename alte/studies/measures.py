@@ -14,18 +14,15 @@ is judged on what does not:
   ``cost`` (:class:`alte.mappers.Cost`), and measured again on its CPU time as a
   cross-check (:attr:`CheckValues.crosscheck`);
 * between mappers (different cost units), on the mapper's CPU time (``map_cpu_s``),
-  each value known only within the time's spread
-  (:func:`alte.studies.uncertainty.time_spreads`): the per-seed ``low`` and ``high``.
-
-Where the thesis' rule picks (``at="rule"``) and cannot separate rows within the times'
-spreads (:func:`alte.studies.tables.rule_picks`), a seed's value is the mean over the
-tie and its bounds span the tie.
+  each value known only within the time's spread: the per-seed ``low`` and ``high`` of
+  a comparison (:mod:`alte.studies.comparisons`, which also reads the thesis' rule with
+  its ties).
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass, fields, replace
+from collections.abc import Callable
+from dataclasses import fields, replace
 from typing import Any
 
 import numpy as np
@@ -34,8 +31,16 @@ from scipy.stats import spearmanr
 
 from alte.errors import ParameterError
 from alte.mappers import mapper_class
+from alte.studies.checks import (
+    ELAPSED,
+    STAT_COLUMNS,
+    CheckValues,
+    NoDataError,
+    case_rows,
+    name,
+    unit,
+)
 from alte.studies.claims.types import (
-    SIZE_COLUMNS,
     Agreement,
     Check,
     Compare,
@@ -44,205 +49,11 @@ from alte.studies.claims.types import (
     Summary,
     Trend,
 )
-from alte.studies.tables import TIME_COLUMN, rule_criteria, rule_picks
-from alte.studies.thesis import TERRAIN_CASE
-from alte.studies.tradeoff import (
-    MAPPER_NAMES,
-    METRICS,
-    equal_fidelity,
-    equal_size,
-    label,
-    matching,
-    thesis_setting,
-)
-from alte.studies.uncertainty import time_spreads
+from alte.studies.comparisons import measure_compare
+from alte.studies.tables import TIME_COLUMN
+from alte.studies.tradeoff import label
 
 __all__ = ["STAT_COLUMNS", "CheckValues", "NoDataError", "measure_check"]
-
-#: Columns of :attr:`CheckValues.stats` (``low`` and ``high`` only where a seed's value is
-#: known within bounds: a time, a tie of the rule).
-STAT_COLUMNS = ["terrain", "level", "seed", "value"]
-#: The time a claim names: the thesis' elapsed time.
-ELAPSED = "elapsed_s"
-_RATIO_METRICS = (*SIZE_COLUMNS, ELAPSED, TIME_COLUMN, "cost")
-
-
-class NoDataError(ParameterError):
-    """The table cannot measure a check (missing rows, columns or settings)."""
-
-
-@dataclass(frozen=True)
-class CheckValues:
-    """Per-seed values of one check and how to read them (see the module docstring).
-
-    ``level_name`` is the column the levels are values of (equal-size or equal-fidelity
-    reads), ``level_kind`` ``"size"`` or ``"fidelity"`` (empty without levels).
-    ``time``: how a time was read (``"cost"``: judged on the machine-independent cost,
-    with ``crosscheck`` the same statistic on the CPU time; ``"cpu"``: the CPU time
-    within its spread; empty: no time).
-    """
-
-    stats: pd.DataFrame
-    what: str
-    unit: str = ""
-    ratio: bool = False
-    threshold: float = 0.0
-    relation: str = "better"
-    band: float = 0.0
-    level_name: str = ""
-    level_kind: str = ""
-    time: str = ""
-    crosscheck: CheckValues | None = None
-
-
-def _name(mapper: str) -> str:
-    return MAPPER_NAMES.get(mapper, mapper)
-
-
-def _unit(metric: str) -> str:
-    return METRICS.get(metric, ("", ""))[1]
-
-
-def _case_rows(table: pd.DataFrame, case: str, mappers: Sequence[str],
-               columns: Sequence[str]) -> pd.DataFrame:
-    if "case" in table:
-        in_case = table["case"] == case
-    else:
-        in_case = table["terrain"].map(TERRAIN_CASE) == case
-    rows = table[in_case & table["mapper"].isin(mappers)]
-    absent = [m for m in mappers if m not in set(rows["mapper"])]
-    if absent:
-        raise NoDataError(f"no rows of {', '.join(absent)} on the {case} terrains")
-    missing = [c for c in columns if c not in rows or not rows[c].notna().any()]
-    if missing:
-        raise NoDataError(f"no values in column(s) {', '.join(missing)}")
-    return rows
-
-
-def _bounded(chosen: pd.DataFrame, metric: str) -> tuple[float, float, float]:
-    """Mean, least and largest of ``metric`` over ``chosen`` rows (a time within its
-    spread)."""
-    values = chosen[metric].to_numpy(dtype=np.float64)
-    low = high = values
-    if metric == TIME_COLUMN:
-        spread = time_spreads(chosen)
-        low, high = values * np.exp(-spread), values * np.exp(spread)
-    if not np.isfinite(values).any():
-        return np.nan, np.nan, np.nan
-    return float(np.nanmean(values)), float(np.nanmin(low)), float(np.nanmax(high))
-
-
-def _picked(group: pd.DataFrame, c: Compare) -> pd.DataFrame | None:
-    """The rows of one mapper, terrain and seed the view reads (None: none can)."""
-    if c.at != "rule":
-        return group
-    criteria = rule_criteria(group)
-    if group[list(criteria)].notna().all(axis=1).sum() == 0:
-        return None
-    return group.iloc[rule_picks(group, criteria)]
-
-
-def _point_values(rows: pd.DataFrame, c: Compare, metric: str) -> pd.DataFrame:
-    """(terrain, level, seed, mapper, value, low, high) at the thesis' settings or the
-    rule's pick (a tie: the mean, and bounds over it)."""
-    out = []
-    for mapper in (c.better, c.other):
-        mine = rows[rows["mapper"] == mapper]
-        if c.at == "thesis_point":
-            setting = thesis_setting(mapper)
-            if setting is None:
-                raise NoDataError(f"the thesis chose no {mapper} map")
-            mine = mine[matching(mine, setting)]
-            if mine.empty:
-                text = ", ".join(f"{k}={v}" for k, v in setting.items())
-                raise NoDataError(f"the table lacks the thesis' setting {mapper} {text}")
-        for (terrain, seed), group in mine.groupby(["terrain", "seed"], sort=True):
-            chosen = _picked(group, c)
-            if chosen is None:
-                continue
-            value, low, high = _bounded(chosen, metric)
-            out.append({"terrain": terrain, "level": np.nan, "seed": seed, "mapper": mapper,
-                        "value": value, "low": low, "high": high})
-    return pd.DataFrame(out, columns=["terrain", "level", "seed", "mapper", "value", "low",
-                                      "high"])
-
-
-def _read_bounds(reads: pd.DataFrame, table: pd.DataFrame, metric: str) -> pd.DataFrame:
-    """Front reads with bounds: a time read off a front moves at most as far (in log) as
-    the most uncertain time of the mapper's maps on that terrain and seed."""
-    if metric != TIME_COLUMN or reads.empty:
-        return reads.assign(low=reads["value"], high=reads["value"])
-    worst = table.assign(_spread=time_spreads(table)).groupby(
-        ["terrain", "seed", "mapper"])["_spread"].max().rename("_u").reset_index()
-    out = reads.merge(worst, on=["terrain", "seed", "mapper"], how="left")
-    factor = np.exp(out.pop("_u").to_numpy(dtype=np.float64))
-    return out.assign(low=out["value"] / factor, high=out["value"] * factor)
-
-
-def _compare_values(c: Compare, table: pd.DataFrame, metric: str) -> pd.DataFrame:
-    pair = (c.better, c.other)
-    if c.at == "equal_size":
-        reads = equal_size(table, pair, metric, size=c.size, levels=c.levels or None,
-                           higher_is_better=c.higher_is_better)
-    elif c.at == "equal_fidelity":
-        reads = equal_fidelity(table, pair, metric, fidelity=c.fidelity,
-                               levels=c.levels or None,
-                               spread="map_cpu_spread" if metric == TIME_COLUMN else None)
-    else:
-        return _point_values(table, c, metric)
-    return _read_bounds(reads, table, metric)
-
-
-def _compare_what(c: Compare, metric: str, ratio: bool) -> tuple[str, str]:
-    sign = "/" if ratio else "minus"
-    first, second = ((c.better, c.other) if c.relation == "similar" or
-                     (c.higher_is_better and not ratio) else (c.other, c.better))
-    head = f"{label(metric)}, {_name(first)} {sign} {_name(second)}"
-    where = {"thesis_point": ("at the thesis' chosen settings", ""),
-             "rule": ("at the settings the thesis' rule picks from our sweep", ""),
-             "equal_size": (f"at equal {label(c.size, False)}", c.size),
-             "equal_fidelity": (f"for equal {label(c.fidelity)}", c.fidelity)}
-    text, level = where[c.at]
-    return f"{head} {text}", level
-
-
-def _oriented(wide: pd.DataFrame, ratio: bool, sign: float) -> pd.DataFrame:
-    """Per seed: the statistic (log ratio or difference, times ``sign``) of the better
-    and the other mapper's values, and its bounds from theirs."""
-    b, o, lo_b, hi_b, lo_o, hi_o = (wide[k].to_numpy(float) for k in (
-        "value_b", "value_o", "low_b", "high_b", "low_o", "high_o"))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        if ratio:
-            value, low, high = np.log(b / o), np.log(lo_b / hi_o), np.log(hi_b / lo_o)
-        else:
-            value, low, high = b - o, lo_b - hi_o, hi_b - lo_o
-    if sign < 0:
-        low, high = -high, -low
-    return wide[["terrain", "level", "seed"]].assign(value=sign * value, low=low, high=high)
-
-
-def _compare(c: Compare, table: pd.DataFrame) -> CheckValues:
-    metric = TIME_COLUMN if c.metric == ELAPSED else c.metric
-    columns = [metric] + ([c.size] if c.at == "equal_size" else []) + (
-        [c.fidelity] if c.at == "equal_fidelity" else [])
-    rows = _case_rows(table, c.case, (c.better, c.other), columns)
-    values = _compare_values(c, rows, metric)
-    keys = ["terrain", "level", "seed"]
-    wide = values[values["mapper"] == c.better].merge(
-        values[values["mapper"] == c.other], on=keys, suffixes=("_b", "_o"))
-    wide = wide[wide[["value_b", "value_o"]].notna().all(axis=1)]
-    if wide.empty:
-        raise NoDataError(f"{_name(c.better)} and {_name(c.other)} share no terrain and "
-                          "size range")
-    ratio = metric in _RATIO_METRICS
-    sign = 1.0 if c.relation == "similar" or c.higher_is_better else -1.0
-    stats = _oriented(wide, ratio, sign)
-    what, level = _compare_what(c, metric, ratio)
-    band = float(np.log1p(c.tolerance)) if ratio else c.tolerance
-    kind = {"equal_size": "size", "equal_fidelity": "fidelity"}.get(c.at, "")
-    return CheckValues(stats, what, "x" if ratio else _unit(metric), ratio,
-                       float(np.log(c.factor)) if ratio else 0.0, c.relation, band, level, kind,
-                       "cpu" if metric == TIME_COLUMN else "")
 
 
 def _rho(x: np.ndarray, y: np.ndarray) -> float:
@@ -272,7 +83,7 @@ def _level_means(group: pd.DataFrame, x: str, metric: str) -> pd.Series:
 
 
 def _trend(c: Trend, table: pd.DataFrame) -> CheckValues:
-    rows = _case_rows(table, c.case, (c.mapper,), [c.metric, c.size])
+    rows = case_rows(table, c.case, (c.mapper,), [c.metric, c.size])
     x = _xcol(rows, c.x)
 
     def rho(group: pd.DataFrame) -> float:
@@ -283,12 +94,12 @@ def _trend(c: Trend, table: pd.DataFrame) -> CheckValues:
 
     over = "the larger half of " if c.largest_half else ""
     what = (f"Spearman rho of {label(c.metric)} with {label(c.x, False)} over {over}"
-            f"{_name(c.mapper)}'s maps, times the stated sign ({c.sign:+d})")
+            f"{name(c.mapper)}'s maps, times the stated sign ({c.sign:+d})")
     return CheckValues(_per_seed(rows, rho), what, threshold=c.min_rho)
 
 
 def _optimum(c: Optimum, table: pd.DataFrame) -> CheckValues:
-    rows = _case_rows(table, c.case, (c.mapper,), [c.metric])
+    rows = case_rows(table, c.case, (c.mapper,), [c.metric])
     x = _xcol(rows, c.x)
 
     def gap(group: pd.DataFrame) -> float:
@@ -298,9 +109,9 @@ def _optimum(c: Optimum, table: pd.DataFrame) -> CheckValues:
         finest = means.iloc[0] if c.finest == "low" else means.iloc[-1]
         return float(finest - means.iloc[1:-1].min())
 
-    what = (f"{label(c.metric)} of {_name(c.mapper)} at the finest {c.x} minus the best "
+    what = (f"{label(c.metric)} of {name(c.mapper)} at the finest {c.x} minus the best "
             "interior setting")
-    return CheckValues(_per_seed(rows, gap), what, _unit(c.metric))
+    return CheckValues(_per_seed(rows, gap), what, unit(c.metric))
 
 
 def _spread(group: pd.DataFrame, x: str, metric: str) -> float:
@@ -319,7 +130,7 @@ def _spread(group: pd.DataFrame, x: str, metric: str) -> float:
 
 
 def _effect(c: Effect, table: pd.DataFrame) -> CheckValues:
-    rows = _case_rows(table, c.case, (c.mapper,), [c.metric])
+    rows = case_rows(table, c.case, (c.mapper,), [c.metric])
     x = _xcol(rows, c.param)
     other = _xcol(rows, c.other) if c.other else None
     limit = c.max_spread if c.max_spread is not None else 0.0
@@ -330,13 +141,13 @@ def _effect(c: Effect, table: pd.DataFrame) -> CheckValues:
 
     what = (f"relative spread of {label(c.metric)} over {c.param} minus over {c.other}"
             if other else f"{limit:g} minus the relative spread of {label(c.metric)} over "
-            f"{c.param}") + f" ({_name(c.mapper)})"
+            f"{c.param}") + f" ({name(c.mapper)})"
     return CheckValues(_per_seed(rows, stat), what)
 
 
 def _agreement(c: Agreement, table: pd.DataFrame) -> CheckValues:
     columns = [c.metric, c.reference] + ([c.other] if c.other else [])
-    rows = _case_rows(table, c.case, (c.mapper,), columns)
+    rows = case_rows(table, c.case, (c.mapper,), columns)
 
     def agree(group: pd.DataFrame, metric: str) -> float:
         return c.sign * _rho(group[metric].to_numpy(float), group[c.reference].to_numpy(float))
@@ -348,7 +159,7 @@ def _agreement(c: Agreement, table: pd.DataFrame) -> CheckValues:
     ref = label(c.reference)
     what = (f"agreement (Spearman rho) with {ref} of {label(c.metric)} minus that of "
             f"{label(c.other)}" if c.other else f"{c.min_rho:g} minus the agreement "
-            f"(Spearman rho) of {label(c.metric)} with {ref}") + f", over {_name(c.mapper)}'s "
+            f"(Spearman rho) of {label(c.metric)} with {ref}") + f", over {name(c.mapper)}'s "
     return CheckValues(_per_seed(rows, stat), what + "settings")
 
 
@@ -364,7 +175,7 @@ def _aggregate(values: pd.Series, agg: str) -> float:
 
 def _summary(c: Summary, table: pd.DataFrame) -> CheckValues:
     mappers = (c.better,) + ((c.other,) if c.other else ())
-    rows = _case_rows(table, c.case, mappers, [c.column])
+    rows = case_rows(table, c.case, mappers, [c.column])
     sign = 1.0 if c.higher_is_better else -1.0
 
     def stat(group: pd.DataFrame) -> float:
@@ -374,16 +185,16 @@ def _summary(c: Summary, table: pd.DataFrame) -> CheckValues:
         return sign * (mine - base)
 
     agg = "median" if c.agg == "median" else "coefficient of variation"
-    first, second = (_name(c.better), _name(c.other) if c.other else f"{c.threshold:g}")
+    first, second = (name(c.better), name(c.other) if c.other else f"{c.threshold:g}")
     if not c.higher_is_better:
         first, second = second, first
     what = f"{agg} of {label(c.column)} over the settings, {first} minus {second}"
-    unit = _unit(c.column) if c.agg == "median" else ""
-    return CheckValues(_per_seed(rows, stat), what, unit)
+    shown = unit(c.column) if c.agg == "median" else ""
+    return CheckValues(_per_seed(rows, stat), what, shown)
 
 
 _MEASURES: dict[type, Callable[[Any, pd.DataFrame], CheckValues]] = {
-    Compare: _compare, Trend: _trend, Optimum: _optimum, Effect: _effect,
+    Compare: measure_compare, Trend: _trend, Optimum: _optimum, Effect: _effect,
     Agreement: _agreement, Summary: _summary}
 
 
