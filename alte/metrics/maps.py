@@ -80,7 +80,7 @@ class TruthMetrics:
 
 @dataclass(frozen=True)
 class MapMetrics:
-    """One map's time (:class:`~alte.metrics.timing.Timing`: the medians ``elapsed_s``
+    """One map's time (:class:`~alte.metrics.timing.Timing`: the least ``elapsed_s``
     and ``map_cpu_s`` over ``time_repeats`` runs, with their spreads) and its
     machine-independent ``cost`` (in its mapper's ``cost_unit``), size, thesis fidelity
     metrics (set A = cloud, set B = corners) and truth."""

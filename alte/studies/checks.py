@@ -37,7 +37,9 @@ class CheckValues:
     reads), ``level_kind`` ``"size"`` or ``"fidelity"`` (empty without levels).
     ``time``: how a time was read (``"cost"``: judged on the machine-independent cost,
     with ``crosscheck`` the same statistic on the CPU time; ``"cpu"``: the CPU time
-    within its spread; empty: no time).
+    within its spread; empty: no time). ``read_from_times``: which values are read
+    depends on time readings (a CPU time, or the rows the thesis' rule picks), so which
+    cells a run decides does too.
     """
 
     stats: pd.DataFrame
@@ -51,6 +53,7 @@ class CheckValues:
     level_kind: str = ""
     time: str = ""
     crosscheck: CheckValues | None = None
+    read_from_times: bool = False
 
 
 def name(mapper: str) -> str:

@@ -4,9 +4,10 @@ The values are read at the thesis' chosen settings, at the rows the thesis' rule
 from our sweep (every row of a tie: :func:`alte.studies.tables.rule_picks`) or off the
 Pareto fronts at equal size or equal fidelity. Each seed's value carries bounds: a tie
 spans its rows, and a time (the mapper's CPU time, for the thesis' elapsed time) its
-spread (:func:`alte.studies.uncertainty.time_spreads`); the statistic's bounds follow
-(log ratio or difference, :func:`oriented`), so a comparison is decided only where the
-difference exceeds them.
+spread (:func:`alte.studies.uncertainty.time_spreads`; a time for a fidelity:
+:mod:`alte.studies.timefronts`, where a censored read is an upper bound); the
+statistic's bounds follow (log ratio or difference, :func:`oriented`), so a comparison
+is decided only where the difference exceeds them.
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ import pandas as pd
 from alte.studies.checks import ELAPSED, CheckValues, NoDataError, case_rows, name, unit
 from alte.studies.claims.types import SIZE_COLUMNS, Compare
 from alte.studies.tables import TIME_COLUMN, rule_criteria, rule_picks
+from alte.studies.timefronts import time_at_fidelity
 from alte.studies.tradeoff import equal_fidelity, equal_size, label, matching, thesis_setting
 from alte.studies.uncertainty import time_spreads
 
@@ -91,10 +93,11 @@ def _compare_values(c: Compare, table: pd.DataFrame, metric: str) -> pd.DataFram
     if c.at == "equal_size":
         reads = equal_size(table, pair, metric, size=c.size, levels=c.levels or None,
                            higher_is_better=c.higher_is_better)
+    elif c.at == "equal_fidelity" and metric == TIME_COLUMN:
+        return time_at_fidelity(table, pair, metric, fidelity=c.fidelity, levels=c.levels)
     elif c.at == "equal_fidelity":
         reads = equal_fidelity(table, pair, metric, fidelity=c.fidelity,
-                               levels=c.levels or None,
-                               spread="map_cpu_spread" if metric == TIME_COLUMN else None)
+                               levels=c.levels or None)
     else:
         return _point_values(table, c, metric)
     return _read_bounds(reads, table, metric)
@@ -148,6 +151,7 @@ def measure_compare(c: Compare, table: pd.DataFrame) -> CheckValues:
     what, level = _compare_what(c, metric, ratio)
     band = float(np.log1p(c.tolerance)) if ratio else c.tolerance
     kind = {"equal_size": "size", "equal_fidelity": "fidelity"}.get(c.at, "")
+    timed = metric == TIME_COLUMN
     return CheckValues(stats, what, "x" if ratio else unit(metric), ratio,
                        float(np.log(c.factor)) if ratio else 0.0, c.relation, band, level, kind,
-                       "cpu" if metric == TIME_COLUMN else "")
+                       "cpu" if timed else "", read_from_times=timed or c.at == "rule")

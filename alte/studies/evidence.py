@@ -20,7 +20,10 @@ only within the times' spreads, so its interval runs from the bootstrap low of t
 seeds' lower bounds to the bootstrap high of their upper bounds (as for a tie of the
 thesis' rule). A verdict thus never rests on a difference smaller than a time's spread.
 ``time_check`` says how (``cost``, or ``CPU time``); for the cost, the evidence ends with
-the same statistic on the CPU time and the cells where it decides the other way.
+the same statistic on the CPU time and the cells where it decides the other way. A check
+whose values are read from times (a CPU time, the rule's picks) and leaves a cell
+undecided depends on ``uncertainty`` alone: which of its cells a run decides moves with
+the readings, so they name no terrain or size.
 """
 
 from __future__ import annotations
@@ -87,7 +90,10 @@ class Finding:
 
 
 def _number(value: float, ratio: bool) -> str:
-    """A statistic as text: log ratios as factors (x1.8), others signed (+0.12)."""
+    """A statistic as text: log ratios as factors (x1.8), others signed (+0.12); an
+    unbounded end of an interval (a censored read) as such."""
+    if np.isinf(value):
+        return "unbounded"
     if not np.isfinite(value):
         return "n/a"
     return f"x{np.exp(value):.3g}" if ratio else f"{value:+.3g}"
@@ -102,7 +108,7 @@ def _level_text(level: float, column: str) -> str:
 
 
 def _outcome(low: float, high: float, seeds: int, m: CheckValues, min_seeds: int) -> str:
-    if seeds < min_seeds or not (np.isfinite(low) and np.isfinite(high)):
+    if seeds < min_seeds or np.isnan(low) or np.isnan(high):  # inf: an unbounded side
         return "inconclusive"
     if m.relation == "undecided":
         return _HOLDS if low <= 0 <= high else _FAILS
@@ -232,6 +238,8 @@ def _one(check: Check, table: pd.DataFrame, options: EvidenceOptions) -> Result:
     if cells.empty:
         return "no data", "", f"{m.what}: no terrain and seed gives a value", cells, ""
     verdict, depends = _cell_verdict(cells, m.level_kind)
+    if m.read_from_times and (cells["outcome"] == "inconclusive").any():
+        depends = "uncertainty"  # which of its cells are decided moves with the readings
     scale = np.exp if m.ratio else (lambda v: v)
     shown = cells.assign(what=m.what, unit=m.unit, estimate=scale(cells["estimate"]),
                          low=scale(cells["low"]), high=scale(cells["high"]))

@@ -7,7 +7,7 @@ once and cached under ``DATA_DIR/.cache``) -> :func:`measure` (one map through
 quantity (:class:`alte.metrics.timing.Timing`): the first map of each mapper and feed in
 a process is made once untimed (numba loads its kernels on first use: 0.2-0.7 s of CPU,
 a hundred times a small map), and a map whose first timed run takes under
-:data:`REPEAT_BELOW_S` CPU seconds is made :data:`REPEATS` times, its time the median.
+:data:`REPEAT_BELOW_S` CPU seconds is made :data:`REPEATS` times, its time the least.
 Each mapper is fed as its protocol says (``Mapper.default_feed``: Quadtree once on the
 final cloud, the others frame by frame), over the control volume's cube.
 """
@@ -45,8 +45,8 @@ __all__ = ["CACHE_DIR", "REPEATS", "REPEAT_BELOW_S", "Measured", "ground_truth",
 
 #: Where registrations are cached, inside the data folder (``DATA_DIR/.cache``).
 CACHE_DIR = ".cache"
-#: Runs of a cheap map (the median is its time; three give a spread and outvote one
-#: reading that another process disturbed).
+#: Runs of a cheap map (the least reading is its time: other processes only add to it;
+#: three give a spread).
 REPEATS = 3
 #: A map whose first timed run takes less CPU than this is repeated (a whole mission's
 #: map, seconds long, is timed once: its repeats would cost more than the rest of its row).

@@ -120,11 +120,14 @@ def _spread(group: pd.DataFrame, x: str, metric: str) -> float:
     to the mean of ``metric`` (so rows added off a balanced grid confound nothing)."""
     others = [c for c in group.columns if c.startswith("p_") and c != x
               and group[c].notna().all() and group[c].nunique() > 1]
-    sets = group.groupby(others, dropna=False) if others else [((), group)]
-    ranges = [float(means.max() - means.min()) for _, part in sets
-              if len(means := _level_means(part, x, metric)) > 1]
+    means = group.groupby([*others, x], sort=True)[metric].mean().dropna()
+    per_set = means.groupby(level=list(range(len(others)))) if others else None
+    if per_set is None:
+        ranges = np.array([means.max() - means.min()] if len(means) > 1 else [])
+    else:
+        ranges = (per_set.max() - per_set.min())[per_set.size() > 1].to_numpy(float)
     overall = abs(float(group[metric].mean()))
-    if not ranges or not overall > 0:
+    if not len(ranges) or not overall > 0:
         return float("nan")
     return float(np.mean(ranges)) / overall
 

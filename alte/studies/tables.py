@@ -10,7 +10,7 @@ but not the other three: the thesis' tables are not consistent with any one rule
 2D-ALTE pick, row 4 of table 5.9, is beaten by row 1 on time and basis functions at
 equal HD and MHD). :func:`comparison_table` prints both choices side by side.
 
-On our maps the time is the mapper's CPU seconds (``map_cpu_s``, the median of repeated
+On our maps the time is the mapper's CPU seconds (``map_cpu_s``, the least of repeated
 runs; :func:`rule_criteria`), and it is known only within its spread
 (:func:`alte.studies.uncertainty.time_spreads`). :func:`rule_picks` keeps every row that
 no other row beats whatever the times within their spreads: one row, or a *tie* of rows
@@ -42,7 +42,7 @@ __all__ = ["COMPARISON_TRENDS", "SWEEP_TRENDS", "THESIS_CRITERIA", "TIME_COLUMN"
 
 #: The criteria of the comparison rule, all lower-is-better, equally weighted.
 THESIS_CRITERIA: tuple[str, ...] = ("elapsed_s", "basis_functions", "mhd_m", "hd_minus_mhd_m")
-#: The time of our maps the rule weighs: the mapper's CPU seconds, median of repeats.
+#: The time of our maps the rule weighs: the mapper's CPU seconds, least of repeats.
 TIME_COLUMN = "map_cpu_s"
 _TIMES = ("elapsed_s", TIME_COLUMN)
 

@@ -25,7 +25,7 @@ import pandas as pd
 
 from alte.errors import ParameterError
 from alte.studies.thesis import COMPARISONS, SWEEPS
-from alte.studies.uncertainty import CONFIDENCE, bootstrap_ci, time_spreads
+from alte.studies.uncertainty import CONFIDENCE, bootstrap_ci
 
 __all__ = ["MAPPER_NAMES", "METRICS", "OPTIONAL_COLUMNS", "REQUIRED_COLUMNS", "equal_fidelity",
            "equal_size", "fronts", "interval_table", "label", "matching", "pareto_front",
@@ -209,33 +209,18 @@ def _levels(lo: float, hi: float, log: bool) -> list[float]:
     return sorted({r if lo <= r <= hi else v for r, v in zip(rounded, values, strict=True)})
 
 
-#: A front: its x and (signed) y, sorted by x; the largest x made; and the highest y it
-#: can be read at (its first point's, or lower where the fastest map is uncertain).
-Curve = tuple[np.ndarray, np.ndarray, float, float]
+Curve = tuple[np.ndarray, np.ndarray, float]
 
 
-def _top(xv: np.ndarray, yv: np.ndarray, spreads: np.ndarray) -> float:
-    """The least (signed) error among the maps that could be the fastest, their times
-    within ``spreads``: a level it reaches is censored (:func:`equal_fidelity`)."""
-    ok = np.isfinite(xv) & (xv > 0) & np.isfinite(yv)
-    x, y, u = xv[ok], yv[ok], spreads[ok]
-    could = x * np.exp(-u) <= np.min(x * np.exp(u))
-    return float(y[could].min())
-
-
-def _curves(part: pd.DataFrame, x: str, y: str, sign: float,
-            spread: str | None = None) -> dict[tuple[str, Any], Curve]:
-    """Each (mapper, seed)'s front on one terrain (y times ``sign``), its largest x and
-    the highest y it can be read at (:func:`_top` with an uncertain x)."""
+def _curves(part: pd.DataFrame, x: str, y: str, sign: float) -> dict[tuple[str, Any], Curve]:
+    """Each (mapper, seed)'s front on one terrain (y times ``sign``) and its largest x."""
     curves = {}
     for (mapper, seed), group in part.groupby(["mapper", "seed"], sort=True):
         xv = group[x].to_numpy(dtype=np.float64)
         yv = sign * group[y].to_numpy(dtype=np.float64)
         idx = pareto_front(np.where(xv > 0, xv, np.nan), yv)
         if idx.size:
-            top = float(yv[idx][0]) if spread is None else _top(
-                xv, yv, time_spreads(group, spread))
-            curves[(str(mapper), seed)] = (xv[idx], yv[idx], float(np.nanmax(xv)), top)
+            curves[(str(mapper), seed)] = (xv[idx], yv[idx], float(np.nanmax(xv)))
     return curves
 
 
@@ -243,15 +228,14 @@ def _span(curves: Sequence[Curve], by_size: bool) -> tuple[float, float]:
     """The range of sizes (signed errors) every curve can be read at."""
     if by_size:
         return max(float(c[0][0]) for c in curves), min(c[2] for c in curves)
-    return max(float(c[1][-1]) for c in curves), min(c[3] for c in curves)
+    return max(float(c[1][-1]) for c in curves), min(float(c[1][0]) for c in curves)
 
 
 def _front_reads(table: pd.DataFrame, mappers: Sequence[str], axes: tuple[str, str], *,
-                 sign: float, levels: Levels | None, by_size: bool,
-                 spread: str | None = None) -> pd.DataFrame:
+                 sign: float, levels: Levels | None, by_size: bool) -> pd.DataFrame:
     rows = []
     for terrain, part in table[table["mapper"].isin(mappers)].groupby("terrain", sort=True):
-        curves = _curves(part, *axes, sign, spread)
+        curves = _curves(part, *axes, sign)
         if {m for m, _ in curves} != set(mappers):
             continue
         lo, hi = _span(list(curves.values()), by_size)
@@ -260,10 +244,9 @@ def _front_reads(table: pd.DataFrame, mappers: Sequence[str], axes: tuple[str, s
         wanted = list(levels) if levels is not None and len(levels) else _levels(lo, hi,
                                                                                log=by_size)
         at = np.asarray(wanted, dtype=np.float64)
-        for (mapper, seed), (xs, ys, x_max, top) in curves.items():
+        for (mapper, seed), (xs, ys, x_max) in curves.items():
             values = (sign * read_at_size(xs, ys, at, x_max) if by_size
-                      else np.where(sign * at > top, np.nan, size_for_fidelity(xs, ys,
-                                                                                sign * at)))
+                      else size_for_fidelity(xs, ys, sign * at))
             rows += [{"terrain": terrain, "seed": seed, "level": lv, "mapper": mapper,
                       "value": v} for lv, v in zip(wanted, values, strict=True)]
     return pd.DataFrame(rows, columns=["terrain", "seed", "level", "mapper", "value"])
@@ -283,20 +266,14 @@ def equal_size(table: pd.DataFrame, mappers: Sequence[str], metric: str = "mhd_m
 
 def equal_fidelity(table: pd.DataFrame, mappers: Sequence[str],
                    metric: str = "basis_functions", *, fidelity: str = "mhd_m",
-                   levels: Levels | None = None, higher_is_better: bool = False,
-                   spread: str | None = None) -> pd.DataFrame:
+                   levels: Levels | None = None,
+                   higher_is_better: bool = False) -> pd.DataFrame:
     """The ``metric`` (a size or the time) each mapper needs to reach ``fidelity`` levels,
-    read off its (metric, fidelity) front; same columns as :func:`equal_size`.
-
-    A level the front's first (smallest, fastest) map already reaches is censored (a
-    smaller map might reach it too). ``spread`` names the column of the metric's spread
-    (a time, :func:`~alte.studies.uncertainty.time_spreads`): then a level is censored
-    when any map that could be the fastest within the spreads reaches it, so which map
-    a reading put first never decides which levels are read."""
+    read off its (metric, fidelity) front; same columns as :func:`equal_size`."""
     _need(table, ["terrain", "mapper", "seed", metric, fidelity])
     sign = -1.0 if higher_is_better else 1.0
     return _front_reads(table, mappers, (metric, fidelity), sign=sign, levels=levels,
-                        by_size=False, spread=spread)
+                        by_size=False)
 
 
 def interval_table(reads: pd.DataFrame, level: float = CONFIDENCE, seed: int = 0) -> pd.DataFrame:

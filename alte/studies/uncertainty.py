@@ -85,16 +85,22 @@ def bootstrap_columns(values: np.ndarray, level: float = CONFIDENCE, n_resamples
 def bootstrap_bounds(values: np.ndarray | list[float], low: np.ndarray | list[float],
                      high: np.ndarray | list[float], *, level: float = CONFIDENCE,
                      n_resamples: int = 2000, seed: int = 0) -> Interval:
-    """Mean of ``values`` over the seeds where all three are finite, with an interval from
-    the bootstrap interval of the mean of ``low`` (its low end) and of ``high`` (its high
-    end): each seed's value known only within [low, high]."""
+    """Mean of the finite ``values`` (over the seeds with both bounds), with an interval
+    from the bootstrap interval of the mean of ``low`` (its low end) and of ``high`` (its
+    high end): each seed's value known only within [low, high]. An unbounded side (a
+    censored read: -inf or +inf) leaves that end of the interval unbounded."""
     data = np.column_stack([np.asarray(a, dtype=np.float64) for a in (values, low, high)])
-    data = data[np.isfinite(data).all(axis=1)]
+    data = data[np.isfinite(data[:, 0]) & ~np.isnan(data[:, 1:]).any(axis=1)]
     if data.size == 0:
         return Interval(np.nan, np.nan, np.nan, 0, level)
-    lower = bootstrap_ci(data[:, 1], level, n_resamples, seed)
-    upper = bootstrap_ci(data[:, 2], level, n_resamples, seed)
-    return Interval(float(data[:, 0].mean()), lower.low, upper.high, len(data), level)
+    ends = []
+    for column, side in ((data[:, 1], 0), (data[:, 2], 1)):
+        if not np.isfinite(column).all():
+            ends.append(-np.inf if side == 0 else np.inf)
+            continue
+        ci = bootstrap_ci(column, level, n_resamples, seed)
+        ends.append(ci.high if side else ci.low)
+    return Interval(float(data[:, 0].mean()), float(ends[0]), float(ends[1]), len(data), level)
 
 
 def time_spreads(table: pd.DataFrame, spread: str = "map_cpu_spread") -> np.ndarray:

@@ -177,3 +177,25 @@ def test_the_interval_level_is_stated(level):
     table = synthetic_tradeoff({"alte2d": Curve(scale=0.5)})
     found = evaluate(_claim(MHD_AT_SIZE), table, EvidenceOptions(level=level))
     assert f"{level:.0%} percentile-bootstrap" in found.evidence
+
+
+def test_a_time_comparison_left_undecided_somewhere_depends_on_uncertainty_alone():
+    # at the thesis' settings (2D-ALTE ~127 basis functions, Quadtree ~6,667) 2D-ALTE 10x
+    # faster on sim_lan_1, 10x slower on sim_lan_2: decided both ways, on the terrain
+    same = 0.01 * 6667 / 127.4
+    fast = synthetic_tradeoff({"alte2d": Curve(seconds=same / 10)}, terrains={
+        "alte2d": ("sim_lan_1",)})
+    slow = synthetic_tradeoff({"alte2d": Curve(seconds=same * 10)}, terrains={
+        "alte2d": ("sim_lan_2",)})
+    table = pd.concat([fast, slow[slow["mapper"] == "alte2d"]], ignore_index=True)
+    check = Compare("lan", "alte2d", "quadtree", "elapsed_s", "thesis_point")
+    found = evaluate(_claim(check), table)
+    assert (found.verdict, found.depends_on) == ("depends", "terrain")
+    # 1.1x slower on sim_lan_2, within the times' spreads: undecided there, so the
+    # terrain it would name moves with the readings: uncertainty alone
+    close = synthetic_tradeoff({"alte2d": Curve(seconds=same * 1.1)}, terrains={
+        "alte2d": ("sim_lan_2",)})
+    table = pd.concat([fast, close[close["mapper"] == "alte2d"]], ignore_index=True)
+    found = evaluate(_claim(check), table)
+    assert (found.verdict, found.depends_on) == ("depends", "uncertainty")
+    assert found.time_check.startswith("CPU time")
