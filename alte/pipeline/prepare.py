@@ -26,6 +26,7 @@ from alte.fsutil import atomic_dir
 from alte.io.bag import ReadCounts
 from alte.pipeline.source import Source, StreamCounts, stream_frames
 from alte.pipeline.spec import FrameSpec
+from alte.registration.deskew import DeskewCounts
 from alte.registration.grid import GridAccumulator
 from alte.registration.odometry import PoseCounts
 from alte.registration.register import RegistrationCounts, empty_reason
@@ -124,8 +125,9 @@ def _counts(raw: dict[str, Any]) -> StreamCounts:
     read = ReadCounts(**raw["read"])
     reg = RegistrationCounts(**raw["registration"])
     poses = PoseCounts(**raw.get("poses", {}))
+    deskew = DeskewCounts(**raw.get("deskew", {}))
     return StreamCounts(read, reg, int(raw["scans"]), int(raw["selected"]), list(raw["notes"]),
-                        poses)
+                        poses, deskew)
 
 
 def _load(folder: Path, source: Source, spec: FrameSpec, key: str) -> Registered:

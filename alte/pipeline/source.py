@@ -26,6 +26,7 @@ from alte.errors import BagError, ParameterError, PointFileError, TopicError
 from alte.io.bag import NO_POSE_NOTE, FrameStream, ReadCounts
 from alte.io.pose import POSE_TYPES
 from alte.pipeline.spec import FrameSpec, PoseSource
+from alte.registration.deskew import DeskewCounts, deskew_frames
 from alte.registration.grid import GridAccumulator, grid_average
 from alte.registration.odometry import PoseCounts, odometry_frames, refine_frames
 from alte.registration.register import RegistrationCounts, crop_mask, register_frames
@@ -123,12 +124,13 @@ class StreamCounts:
     selected: int = 0
     notes: list[str] = field(default_factory=list)
     poses: PoseCounts = field(default_factory=PoseCounts)
+    deskew: DeskewCounts = field(default_factory=DeskewCounts)
 
     def as_dict(self) -> dict[str, object]:
         """JSON-ready form."""
         return {"scans": self.scans, "selected": self.selected, "read": self.read.as_dict(),
                 "registration": self.registration.as_dict(), "notes": list(self.notes),
-                "poses": self.poses.as_dict()}
+                "poses": self.poses.as_dict(), "deskew": self.deskew.as_dict()}
 
 
 def _open(source: Source, spec: FrameSpec, pose_topic: str | None, progress: bool,
@@ -158,9 +160,19 @@ def _odometry(stream: FrameStream, probe: FrameStream, spec: FrameSpec,
                                params=spec.odometry, start=start)
 
 
-def _posed(source: Source, spec: FrameSpec, counts: PoseCounts,
-           progress: bool) -> tuple[FrameStream, Iterator[Frame]]:
+def _deskewed(stream: FrameStream, spec: FrameSpec, counts: DeskewCounts) -> Iterator[Frame]:
+    """The stream's frames, deskewed along its pose track when ``spec.deskew`` (clouds
+    with per-point time), else as read (their time dropped: registered as taken)."""
+    if spec.deskew and stream.track is not None:
+        return deskew_frames(iter(stream), stream.track, stream.mount, counts=counts,
+                             max_gap_s=stream.options.max_gap_s)
+    return (replace(f, times=None) for f in stream)
+
+
+def _posed(source: Source, spec: FrameSpec, counts: PoseCounts, progress: bool,
+           deskew: DeskewCounts | None = None) -> tuple[FrameStream, Iterator[Frame]]:
     """The scan stream and its frames posed as ``spec.poses`` says (:class:`PoseSource`)."""
+    deskew = DeskewCounts() if deskew is None else deskew
     choice = spec.poses
     counts.source = choice.value
     if choice is PoseSource.IDENTITY:
@@ -173,13 +185,13 @@ def _posed(source: Source, spec: FrameSpec, counts: PoseCounts,
                          f"{probe.cloud_topic}; use --poses odometry (LiDAR odometry) or "
                          "--poses identity (static sensor)")
     if choice is PoseSource.RECORDED:
-        return probe, iter(probe)
+        return probe, _deskewed(probe, spec, deskew)
     if choice is PoseSource.REFINE:
-        return probe, refine_frames(iter(probe), probe.mount, counts=counts,
+        return probe, refine_frames(_deskewed(probe, spec, deskew), probe.mount, counts=counts,
                                     params=spec.odometry)
     if choice is PoseSource.AUTO and probe.track is not None:
         counts.source = PoseSource.RECORDED.value
-        return probe, iter(probe)
+        return probe, _deskewed(probe, spec, deskew)
     counts.source = PoseSource.ODOMETRY.value
     stream = probe if probe.track is None else _open(source, spec, "", progress)
     stream.notes[:] = [n for n in stream.notes if n != NO_POSE_NOTE]
@@ -188,7 +200,7 @@ def _posed(source: Source, spec: FrameSpec, counts: PoseCounts,
 
 def _bag_frames(source: Source, spec: FrameSpec, counts: StreamCounts,
                 merge: GridAccumulator | None, progress: bool) -> Iterator[RegisteredFrame]:
-    stream, posed = _posed(source, spec, counts.poses, progress)
+    stream, posed = _posed(source, spec, counts.poses, progress, counts.deskew)
     counts.scans, counts.selected, counts.notes = stream.scans, stream.selected, stream.notes
     frames = register_frames(posed, stream.mount, voxel=spec.voxel,
                              crop_box=None if spec.crop is None else spec.crop.values(),

@@ -102,7 +102,7 @@ def _pose_stream(terrain: Terrain, traj: Trajectory, seed: int, stamps: np.ndarr
     if not isinstance(platform, Cart):
         if pose_hz > 0:
             step = round(1e9 / pose_hz)
-            stamps = START_NS + step * np.arange(int(traj.duration * 1e9) // step + 1)
+            stamps = START_NS + step * np.arange(int((traj.duration + 0.1) * 1e9) // step + 1)
         pos, rot = traj.pose((stamps - START_NS) / 1e9)
         return stamps.astype(np.int64), pos, rot.as_quat(canonical=False)
     step = round(1e9 / platform.mocap_hz)
