@@ -75,6 +75,8 @@ def _sensor_poses(track: PoseTrack, stamps: np.ndarray, mount: Mount,
     samples = track.interpolate(stamps, max_gap_s)
     valid = samples.valid
     pos, quat = samples.positions, samples.quaternions
+    if not valid.any():
+        return Rotation.identity(len(stamps)), np.zeros((len(stamps), 3)), ~valid
     if not valid.all():
         good = np.flatnonzero(valid)
         nearest = good[np.abs(good[None, :] - np.arange(len(stamps))[:, None]).argmin(axis=1)]
