@@ -25,7 +25,7 @@ def test_imu_round_trip_with_its_mount(tmp_path):
     n = 50
     rng = np.random.default_rng(0)
     samples = ImuSamples(STAMP + 5_000_000 * np.arange(n), rng.normal(size=(n, 3)),
-                         rng.normal(size=(n, 3)) + [0, 0, 9.81], "imu_link",
+                         rng.normal(size=(n, 3)) + np.array([0.0, 0.0, 9.81]), "imu_link",
                          Mount(np.array([0.0, 0.0, 0.03])), 0.005, 0.06)
     bag = _bag(tmp_path / "bag", samples)
     assert imu_topic(bag) == "/imu"
