@@ -14,7 +14,7 @@ from alte.commands.options import parse_box
 from alte.commands.register import format_counts
 from alte.errors import ParameterError
 from alte.io import read_frames, write_frames
-from alte.io.bag import ReadCounts
+from alte.io.bag import ReadCounts, ReadOptions
 from alte.io.pointfiles import read_points
 from alte.paths import realdata_dir
 from alte.pipeline import InputKind, Source
@@ -63,6 +63,7 @@ def fake_io(monkeypatch):
             self.notes: list[str] = []
             self.counts = ReadCounts(scans_read=len(frames))
             self.track = object()  # a recorded pose stream: the frames keep their poses
+            self.options = ReadOptions()  # read as FrameStream reads (deskew's gap limit)
 
         def __iter__(self):
             return iter(frames)
