@@ -9,8 +9,15 @@ A known pixel of a height raster (NaN = unknown) is **landable** when
   ground is the MSAC plane of the known pixels (``ground=plane``, thesis 2.1.4: one
   plane for the whole map) or the raster's grey opening over a square of side
   ``ground_window`` (``ground=local``: the lowest surface that objects narrower than
-  the window stand on, as in the progressive morphological filters of airborne
-  LiDAR; it follows hills that a single plane cannot).
+  the window stand on, as in the morphological ground filters of airborne LiDAR; it
+  follows hills that a single plane cannot). An opening also shaves the top of a
+  convex slope (a crest, a hill top, a ramp at the map's edge) by up to the grade
+  times half the window, so the allowance grows by ``g * ground_window / 2``, with
+  ``g`` the mean grade (tangent of the window-plane slope, each capped at
+  ``max_slope_deg``) over the ground window: the slope tolerance of the progressive
+  morphological filter (Zhang et al. 2003), measured around each pixel. On flat ground
+  a roof or a box keeps nearly the bare ``obstacle_height``; only the ring its own
+  edges tilt adds to it.
 
 :func:`classify_surface` applies it to every pixel at once (image filters, one
 vectorised pass); the landing study (:mod:`alte.studies.landing`) tests site centres
@@ -53,8 +60,8 @@ class SurfaceRule(Record):
     max_roughness: float = param(0.1, lambda v: v > 0, "max_roughness > 0",
                                  "largest residual std about the local plane (m)")
     obstacle_height: float = param(0.3, lambda v: v > 0, "obstacle_height > 0",
-                                   "height step above or below the ground that makes an "
-                                   "obstacle (m)")
+                                   "height above the ground (or below a plane ground) "
+                                   "that makes an obstacle (m)")
     ground: Literal["plane", "local"] = param(
         "local", rule="plane|local",
         help="ground reference: one MSAC plane, or the local grey opening")
@@ -171,24 +178,35 @@ def ground_obstacles(height: np.ndarray, centres: np.ndarray, obstacle_height: f
 
 def local_ground(height: np.ndarray, step: float, window: float) -> np.ndarray:
     """Grey opening of the known heights over a square of side ``window`` (m, odd pixel
-    count, at least 3): erosion ignores unknown pixels; NaN where no known pixel is near."""
+    count, at least 3); unknown pixels and the outside of the raster take no part; NaN
+    where no known pixel is near."""
     size = max(2 * round(window / step / 2) + 1, 3)
     known = np.isfinite(height)
-    low = ndimage.minimum_filter(np.where(known, height, np.inf), size=size, mode="nearest")
+    low = ndimage.minimum_filter(np.where(known, height, np.inf), size=size, mode="constant",
+                                 cval=np.inf)
     low = np.where(np.isfinite(low), low, -np.inf)
-    ground = ndimage.maximum_filter(low, size=size, mode="nearest")
+    ground = ndimage.maximum_filter(low, size=size, mode="constant", cval=-np.inf)
     return np.where(np.isfinite(ground), ground, np.nan)
 
 
 def _obstacles(height: np.ndarray, origin: tuple[float, float] | np.ndarray, step: float,
-               rule: SurfaceRule, seed: int) -> np.ndarray:
+               rule: SurfaceRule, slope_deg: np.ndarray, *, seed: int) -> np.ndarray:
+    """Obstacle pixels: off the MSAC plane, or above the local ground by more than
+    ``obstacle_height`` plus the rise the terrain's slope explains over half the ground
+    window (module docstring)."""
     if rule.ground == "plane":
         return ground_obstacles(height, pixel_centres(origin, step, height.shape),
                                 rule.obstacle_height, seed=seed)
     ground = local_ground(height, step, rule.ground_window)
-    with np.errstate(invalid="ignore"):
-        step_up: np.ndarray = np.isfinite(height) & \
-            (np.nan_to_num(height - ground) > rule.obstacle_height)
+    known = np.isfinite(height) & np.isfinite(slope_deg)
+    grade = np.tan(np.radians(np.minimum(np.where(known, slope_deg, 0.0), rule.max_slope_deg)))
+    size = max(2 * round(rule.ground_window / step / 2) + 1, 3)
+    weight = ndimage.uniform_filter(known.astype(np.float64), size=size, mode="constant")
+    with np.errstate(invalid="ignore", divide="ignore"):
+        mean_grade = np.where(weight > 1e-6, ndimage.uniform_filter(
+            grade, size=size, mode="constant") / weight, 0.0)
+        allowed = rule.obstacle_height + mean_grade * rule.ground_window / 2
+        step_up: np.ndarray = np.isfinite(height) & (np.nan_to_num(height - ground) > allowed)
     return step_up
 
 
@@ -203,6 +221,6 @@ def classify_surface(height: np.ndarray, origin: tuple[float, float] | np.ndarra
     height = np.asarray(height, dtype=np.float64)
     known = np.isfinite(height)
     feats = plane_features(height, step, rule.window)
-    obstacle = _obstacles(height, origin, step, rule, seed) & known
+    obstacle = _obstacles(height, origin, step, rule, feats.slope_deg, seed=seed) & known
     free = known & planar(feats, rule) & ~obstacle
     return Surface(free, known & ~free, feats.slope_deg, feats.roughness, obstacle)
