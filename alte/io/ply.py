@@ -87,8 +87,9 @@ def read_ply(path: Path) -> tuple[np.ndarray, Fields, dict[str, Any]]:
     """A point-cloud PLY (one vertex element) read with numpy, every property kept (red,
     green, blue as ``colors``); other PLYs through open3d's tensor reader."""
     fmt, start, lines = _check_ply_complete(path)
-    about = {"format": "PLY", "encoding": fmt,
-             "properties": [" ".join(w[1:]) for w in lines if w[0] == "property"]}
+    about = {"format": "PLY", "encoding": fmt, "fields": [
+        {"name": w[-1], "type": " ".join(w[1:-1]), "count": 1}
+        for w in lines if w[0] == "property"]}
     dtype = _vertex_dtype(fmt, lines)
     if dtype is None:
         return (*_read_ply_open3d(path), about)

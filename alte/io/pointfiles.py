@@ -45,6 +45,7 @@ __all__ = [
     "WRITE_SUFFIXES",
     "PointFileInfo",
     "PointTable",
+    "describe_points",
     "local_origin",
     "read_point_table",
     "read_points",
@@ -134,6 +135,21 @@ def read_points_info(path: str | os.PathLike[str]) -> PointFileInfo:
     kept = np.ascontiguousarray(points[finite], dtype=np.float64)
     fields = {k: v[finite] for k, v in table.fields.items()}
     return PointFileInfo(kept, len(points), int(len(points) - len(kept)), fields)
+
+
+def describe_points(path: str | os.PathLike[str]) -> dict[str, Any]:
+    """What a point file holds (``alte info FILE``): format, encoding, fields, rows,
+    finite points, non-finite rows, the finite points' bounds, and per field its range."""
+    table = read_point_table(path)
+    finite = np.isfinite(table.points).all(axis=1)
+    kept = table.points[finite]
+    bounds = [kept.min(axis=0).tolist(), kept.max(axis=0).tolist()] if len(kept) else None
+    ranges = {k: [float(np.min(v)), float(np.max(v))] for k, v in table.fields.items()
+              if v.size and v.dtype.kind in "biuf"}
+    return {"file": str(path), **table.about, "rows": len(table.points),
+            "points": int(finite.sum()), "nonfinite": int((~finite).sum()),
+            "nan": int(np.isnan(table.points).any(axis=1).sum()), "bounds": bounds,
+            "field_ranges": ranges}
 
 
 def read_points(path: str | os.PathLike[str]) -> np.ndarray:

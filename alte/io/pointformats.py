@@ -65,10 +65,11 @@ def read_las(path: Path) -> tuple[np.ndarray, Fields, dict[str, Any]]:
             fields["colors"] = (rgb >> 8 if rgb.max() > 255 else rgb).astype(np.uint8)
     for name in las.point_format.extra_dimension_names:
         fields[name] = np.asarray(las[name])
-    about = {"format": f"LAS {las.header.version}", "encoding": "LAZ" if
-             path.suffix.lower() == ".laz" else "LAS",
-             "point_format": int(las.header.point_format.id),
-             "dimensions": list(las.point_format.dimension_names)}
+    about = {"format": f"LAS {las.header.version} point format {las.header.point_format.id}",
+             "encoding": "laz" if path.suffix.lower() == ".laz" else "las",
+             "fields": [{"name": d.name, "type": str(d.dtype) if d.dtype is not None
+                         else f"{d.num_bits} bit", "count": 1}
+                        for d in las.point_format.dimensions]}
     return points, fields, about
 
 
@@ -115,8 +116,9 @@ def read_npz(path: Path) -> tuple[np.ndarray, Fields, dict[str, Any]]:
         points = np.asarray(archive["points"], dtype=np.float64)
         fields = {k: archive[k] for k in archive.files if k != "points"
                   and archive[k].ndim >= 1 and len(archive[k]) == len(points)}
-    return points, fields, {"format": "npz", "encoding": "zip",
-                            "arrays": sorted(["points", *fields])}
+    about = {"format": "npz", "encoding": "zip", "fields": [
+        {"name": "points", "type": "float64", "count": 3}, *_describe(fields)]}
+    return points, fields, about
 
 
 def write_npz(tmp: Path, points: np.ndarray, fields: Fields) -> None:
@@ -130,7 +132,9 @@ def read_text(path: Path) -> tuple[np.ndarray, Fields, dict[str, Any]]:
     if table.shape[1] < 3:
         raise PointFileError(f"{path}: {table.shape[1]} column(s); expected x y z per line")
     about = {"format": "text", "encoding": "bzip2" if path.suffix.lower() == ".bz2" else "ascii",
-             "columns": int(table.shape[1])}
+             "fields": [{"name": c, "type": "text", "count": 1} for c in "xyz"]
+             + [{"name": f"column {k + 1} (ignored)", "type": "text", "count": 1}
+                for k in range(3, table.shape[1])]}
     return table.iloc[:, :3].to_numpy(np.float64), {}, about
 
 
