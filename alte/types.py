@@ -157,13 +157,15 @@ class Frame:
 @dataclass(frozen=True, eq=False)
 class RegisteredFrame:
     """One scan after registration: inertial ``points`` (N, 3) and the sensor ``origin`` (3,),
-    with the scan's stamp (ns) and the body pose it was registered with."""
+    with the scan's stamp (ns) and the body pose it was registered with; ``fields``: the
+    points' other values by name (a point file's intensity, colours, ...), when kept."""
 
     stamp: int
     points: np.ndarray
     origin: np.ndarray
     position: np.ndarray
     quaternion: np.ndarray
+    fields: dict[str, np.ndarray] | None = None
 
 
 @dataclass(frozen=True, eq=False)

@@ -215,7 +215,8 @@ def _bag_frames(source: Source, spec: FrameSpec, counts: StreamCounts,
 
 def _file_frames(source: Source, spec: FrameSpec, counts: StreamCounts,
                  merge: GridAccumulator | None) -> Iterator[RegisteredFrame]:
-    """A point file as one frame: finite, cropped, grid-averaged, seen from ``spec.origin``."""
+    """A point file as one frame: finite, cropped, grid-averaged, seen from ``spec.origin``;
+    the file's other fields ride along while every point is kept (no voxel)."""
     from alte.io.pointfiles import read_points_info
 
     if spec.poses in (PoseSource.ODOMETRY, PoseSource.REFINE):
@@ -226,12 +227,12 @@ def _file_frames(source: Source, spec: FrameSpec, counts: StreamCounts,
     reg = counts.registration
     counts.scans = counts.selected = counts.read.scans_read = counts.read.frames = 1
     counts.read.points_nonfinite = info.nonfinite
-    points = info.points
+    points, fields = info.points, info.fields
     reg.frames_in, reg.points_in = 1, len(points)
     if spec.crop is not None:
         inside = crop_mask(points, spec.crop.values())
         reg.points_dropped_crop = int(len(points) - np.count_nonzero(inside))
-        points = points[inside]
+        points, fields = points[inside], {k: v[inside] for k, v in fields.items()}
     if len(points) == 0:
         reg.frames_dropped_empty = 1
         return
@@ -239,9 +240,13 @@ def _file_frames(source: Source, spec: FrameSpec, counts: StreamCounts,
         merge.add(points)
     if spec.voxel is not None:
         points = grid_average(points, spec.voxel)
+        if fields:
+            counts.notes.append(f"fields {', '.join(fields)} not kept: --voxel averages the "
+                                "points into cells")
     reg.frames_kept, reg.points_registered = 1, len(points)
     origin = np.array(spec.origin)
-    yield RegisteredFrame(0, points, origin, origin.copy(), np.array([0.0, 0.0, 0.0, 1.0]))
+    yield RegisteredFrame(0, points, origin, origin.copy(), np.array([0.0, 0.0, 0.0, 1.0]),
+                          fields if spec.voxel is None else None)
 
 
 def stream_frames(source: Source, spec: FrameSpec, counts: StreamCounts, *,
