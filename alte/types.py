@@ -116,7 +116,8 @@ class Frame:
     ``points`` are in the sensor frame; ``position`` and ``quaternion`` (x, y, z, w)
     give the body pose in the inertial frame. ``pose_offset_s`` is the time from the
     scan stamp to the nearest pose sample and ``angular_rate`` the body rate (rad/s)
-    there; the fast-manoeuvre filter of thesis ch. 4 uses both.
+    there; the fast-manoeuvre filter of thesis ch. 4 uses both. ``times`` (N,) is each
+    point's time in seconds from ``stamp`` when the scan carries one (deskewing), else None.
     """
 
     stamp: int
@@ -126,6 +127,7 @@ class Frame:
     pose_offset_s: float = 0.0
     angular_rate: float = 0.0
     dropped_points: int = 0
+    times: np.ndarray | None = None
 
     @property
     def time(self) -> float:

@@ -15,7 +15,7 @@ from alte.io.pointfiles import WRITE_SUFFIXES, write_points
 from alte.pipeline import StreamCounts, merged_cloud, open_input, prepare
 from alte.registration import RegistrationCounts
 
-__all__ = ["add_parser", "format_counts", "run"]
+__all__ = ["add_parser", "format_counts", "pose_line", "run"]
 
 
 def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -49,6 +49,22 @@ def format_counts(counts: RegistrationCounts) -> list[str]:
     ]
 
 
+def pose_line(counts: StreamCounts) -> str:
+    """Where the poses came from, with the backend, its settings and refinement's counts."""
+    poses = counts.poses
+    if poses.method == "refine":
+        kept = ", ".join(f"{n} {r}" for r, n in sorted(poses.kept.items()))
+        return (f"refine ({poses.corrected} corrected, {poses.frames - poses.corrected} kept"
+                + (f": {kept})" if kept else ")"))
+    if poses.method:
+        from alte.registration.odometry import OdometryParams, odometry_label
+
+        label = odometry_label(OdometryParams.parse(poses.settings))
+        return f"{poses.source} ({label}, {1e3 * poses.seconds / max(poses.frames, 1):.0f} " \
+               "ms per scan)"
+    return poses.source
+
+
 def _reader_line(counts: StreamCounts) -> str:
     parts = ", ".join(f"{k.replace('_', ' ')} {v}" for k, v in counts.read.as_dict().items())
     return f"bag: {parts}" if parts else "bag: read"
@@ -77,7 +93,7 @@ def run(args: argparse.Namespace) -> int:
     print(_reader_line(counts))
     for line in format_counts(counts.registration):
         print(line)
-    print(f"poses: {counts.poses.source}")
+    print(f"poses: {pose_line(counts)}")
     print(f"wrote {len(cloud)} points to {args.out}")
     if args.mcap is not None:
         print(f"wrote {sum(topics.values())} messages to {args.mcap}: "

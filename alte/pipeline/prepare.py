@@ -34,7 +34,7 @@ from alte.types import Box, RegisteredFrame, Trajectory
 __all__ = ["Registered", "cache_key", "merged_cloud", "prepare"]
 
 #: Bump when the registered output of the same input and spec changes.
-CACHE_VERSION = 1
+CACHE_VERSION = 2
 _POINTS, _ARRAYS, _META = "points.f64", "arrays.npz", "meta.json"
 
 
