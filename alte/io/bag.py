@@ -272,7 +272,8 @@ def _raise_empty(stream: FrameStream, counts: ReadCounts, stamps: _StampRange) -
         f"{stamps.high} ns, pose stamps {int(track.stamps[0])}..{int(track.stamps[-1])} ns "
         f"({counts.scans_outside_poses} outside the pose track, "
         f"{counts.scans_in_pose_gap} in gaps > {stream.options.max_gap_s} s, "
-        f"{counts.scans_empty} without points): different clocks?"
+        f"{counts.scans_empty} without points): different clocks? Use --poses odometry to "
+        "pose the scans without it, or --pose-topic / --pose-file for poses on the scans' clock"
     )
 
 

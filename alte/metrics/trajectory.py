@@ -1,7 +1,8 @@
 """How far estimated poses are from reference poses, as ``evo`` reports it.
 
 * ATE: RMSE of the position error after the rigid (SE(3), no scale) Umeyama alignment
-  of the estimate onto the reference (``evo_ape --align``).
+  of the estimate onto the reference (``evo_ape --align``); on a straight path, where
+  that alignment is undefined, after aligning the first poses (``--align_origin``).
 * RPE over segments of ``delta_m`` metres of the reference path (``evo_rpe --delta 1
   --delta_unit m --all_pairs``): the mean translation error as a percentage of the
   segment length and the mean rotation error in degrees per metre. RPE needs no
@@ -72,6 +73,7 @@ def trajectory_errors(stamps: np.ndarray, positions: np.ndarray, quaternions: np
     import copy
 
     from evo.core import metrics
+    from evo.core.geometry import GeometryException
     from evo.core.metrics import PoseRelation
 
     if len(stamps) < 3 or np.shape(positions) != np.shape(reference_positions):
@@ -80,7 +82,10 @@ def trajectory_errors(stamps: np.ndarray, positions: np.ndarray, quaternions: np
     reference = _trajectory(stamps, reference_positions, reference_quaternions)
     estimate = _trajectory(stamps, positions, quaternions)
     aligned = copy.deepcopy(estimate)
-    aligned.align(reference, correct_scale=False)  # type: ignore[attr-defined]
+    try:
+        aligned.align(reference, correct_scale=False)  # type: ignore[attr-defined]
+    except GeometryException:  # a straight path: the turn about it is unobservable
+        aligned.align_origin(reference)  # type: ignore[attr-defined]
     ape = metrics.APE(PoseRelation.translation_part)
     ape.process_data((reference, aligned))
     ate = float(ape.get_statistic(metrics.StatisticsType.rmse))

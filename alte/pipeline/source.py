@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from alte.errors import BagError, ParameterError, PointFileError, TopicError
+from alte.errors import BagError, ParameterError, PointFileError, PoseError, TopicError
 from alte.io.bag import NO_POSE_NOTE, FrameStream, ReadCounts
 from alte.io.pose import POSE_TYPES
 from alte.pipeline.spec import FrameSpec, PoseSource
@@ -145,6 +145,17 @@ def _open(source: Source, spec: FrameSpec, pose_topic: str | None, progress: boo
                        frames=spec.frames, progress=progress, pose_file=pose_file)
 
 
+def _start(probe: FrameStream, stamp: int) -> tuple[np.ndarray, np.ndarray] | None:
+    """The recorded pose at the first scan, or None (no track, or one on another clock)."""
+    if probe.track is None:
+        return None
+    try:
+        at = probe.track.interpolate([stamp], probe.options.max_gap_s)
+    except PoseError:  # stamps in another unit: odometry does without the anchor
+        return None
+    return (at.positions[0], at.quaternions[0]) if at.valid[0] else None
+
+
 def _odometry(stream: FrameStream, probe: FrameStream, spec: FrameSpec,
               counts: PoseCounts) -> Iterator[Frame]:
     """KISS-ICP poses, anchored at the recorded pose of the first scan when there is one."""
@@ -152,11 +163,7 @@ def _odometry(stream: FrameStream, probe: FrameStream, spec: FrameSpec,
     first = next(frames, None)
     if first is None:
         return
-    start = None
-    if probe.track is not None:
-        at = probe.track.interpolate([first.stamp], probe.options.max_gap_s)
-        if at.valid[0]:
-            start = (at.positions[0], at.quaternions[0])
+    start = _start(probe, first.stamp)
     anchor = f"the recorded pose of the first scan ({probe.pose_topic})" if start is not None \
         else "the first scan's body frame"
     stream.notes.append(f"poses from LiDAR odometry ({odometry_label(spec.odometry)}), "

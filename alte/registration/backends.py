@@ -40,13 +40,14 @@ def scene_scale(points: np.ndarray, params: OdometryParams) -> tuple[float, floa
     return max_range, params.voxel or max(typical / 70, 0.01)
 
 
-def kiss_config(points: np.ndarray, params: OdometryParams) -> Any:
-    """KISS-ICP's configuration for ``params`` (unset values: KISS-ICP's own defaults)."""
+def kiss_config(points: np.ndarray, params: OdometryParams, timed: bool = False) -> Any:
+    """KISS-ICP's configuration for ``params`` (unset values: KISS-ICP's own defaults);
+    deskewing only for scans with per-point time (``timed``)."""
     from kiss_icp.config import KISSConfig
 
     max_range, voxel = scene_scale(points, params)
     config = KISSConfig()
-    config.data.deskew = params.deskew
+    config.data.deskew = params.deskew and timed
     config.data.max_range = max_range
     config.data.min_range = params.min_range
     config.mapping.voxel_size = voxel
@@ -61,11 +62,11 @@ def kiss_config(points: np.ndarray, params: OdometryParams) -> Any:
 class Kiss:
     """KISS-ICP's own pipeline, with the sparse-sensor switches (module docstring)."""
 
-    def __init__(self, points: np.ndarray, params: OdometryParams) -> None:
+    def __init__(self, points: np.ndarray, params: OdometryParams, timed: bool) -> None:
         from kiss_icp.kiss_icp import KissICP
         from kiss_icp.voxelization import voxel_down_sample
 
-        self.config = config = kiss_config(points, params)
+        self.config = config = kiss_config(points, params, timed)
         self.pipeline = KissICP(config)
         if params.single_downsample:
             voxel = config.mapping.voxel_size
@@ -76,11 +77,15 @@ class Kiss:
 
             self.pipeline.voxelize = single
 
+    def deskews(self, times: np.ndarray | None) -> bool:
+        """Whether a scan with these per-point ``times`` is deskewed (they must vary)."""
+        return bool(times is not None and self.config.data.deskew and len(times)
+                    and np.ptp(times) > 0)
+
     def step(self, points: np.ndarray, times: np.ndarray | None) -> np.ndarray:
         """The sensor pose of this scan in the first scan's sensor frame (deskewed with
         ``times`` when given and ``deskew`` is on)."""
-        stamps = times if times is not None and self.config.data.deskew else \
-            np.zeros(len(points))
+        stamps = times if times is not None and self.deskews(times) else np.zeros(len(points))
         self.pipeline.register_frame(points, stamps)
         return np.asarray(self.pipeline.last_pose)
 

@@ -128,7 +128,8 @@ def odometry_label(params: OdometryParams) -> str:
 @dataclass
 class PoseCounts:
     """Where the poses came from, what odometry / refinement did and how long it took
-    (``seconds``: the pose step alone); ``scans``: refinement's decision per scan."""
+    (``seconds``: the pose step alone, wall; ``cpu_seconds``: its thread's CPU time);
+    ``scans``: refinement's decision per scan."""
 
     source: str = "recorded"
     method: str = ""
@@ -141,6 +142,7 @@ class PoseCounts:
     max_correction_m: float = 0.0
     max_correction_deg: float = 0.0
     seconds: float = 0.0
+    cpu_seconds: float = 0.0
     scans: list[dict[str, object]] = field(default_factory=list)
 
     def as_dict(self) -> dict[str, object]:
@@ -178,15 +180,16 @@ def odometry_frames(frames: Iterable[Frame], mount: Mount, *, counts: PoseCounts
     previous: Frame | None = None
     for frame in frames:
         points = np.asarray(frame.points, dtype=np.float64)
-        began = time.perf_counter()
+        began, cpu = time.perf_counter(), time.thread_time()
         if odometry is None:
-            odometry = Kiss(points, params) if params.method == "kiss" \
+            odometry = Kiss(points, params, frame.times is not None) \
+                if params.method == "kiss" \
                 else Plane(points, params, counts)
         body = anchor @ odometry.step(points, frame.times) @ sensor_body
         counts.seconds += time.perf_counter() - began
+        counts.cpu_seconds += time.thread_time() - cpu
         counts.frames += 1
-        counts.deskewed += int(frame.times is not None and params.deskew
-                               and params.method == "kiss")
+        counts.deskewed += int(isinstance(odometry, Kiss) and odometry.deskews(frame.times))
         quaternion = Rotation.from_matrix(body[:3, :3]).as_quat()
         previous = replace(frame, position=body[:3, 3].copy(), quaternion=quaternion,
                            pose_offset_s=0.0,

@@ -198,7 +198,7 @@ def refine_frames(frames: Iterable[Frame], mount: Mount, *, counts: PoseCounts,
         points = np.asarray(frame.points, dtype=np.float64)
         sensor = pose_matrix(frame.position, frame.quaternion) @ body_sensor
         counts.frames += 1
-        began = time.perf_counter()
+        began, cpu = time.perf_counter(), time.thread_time()
         if local is None:
             max_range, voxel = scene_scale(points, replace(params, method="plane"))
             local = DenseMap(params.voxel or voxel, max_range, params.rebuild, params.threads)
@@ -210,6 +210,7 @@ def refine_frames(frames: Iterable[Frame], mount: Mount, *, counts: PoseCounts,
                                        stamp=frame.stamp)
         local.add(points, sensor)
         counts.seconds += time.perf_counter() - began
+        counts.cpu_seconds += time.thread_time() - cpu
         _count(counts, decision)
         body = sensor @ sensor_body
         yield replace(frame, position=body[:3, 3].copy(),

@@ -8,7 +8,8 @@ registration cache). Each pose source (``recorded``, LiDAR odometry with each ba
 the same scans, and the registered cloud's median / p90 distance to the cloud registered
 with the reference poses (a grid five times finer than the source clouds' voxel), plus,
 on a terrain, the mean distance to the true mesh. ``ms_per_scan`` is the time the pose
-step itself took (odometry or refinement; reading and registering are not counted).
+step itself took (odometry or refinement; reading and registering are not counted), wall
+and CPU (the machine may be shared: CPU time is the steadier figure).
 
 Odometry's poses and cloud are moved so that its first scan sits at the reference pose
 of that scan (the pipeline anchors odometry at the recorded pose of the first scan, or
@@ -35,8 +36,8 @@ from alte.registration.odometry import OdometryParams
 from alte.studies.experiments import CACHE_DIR
 from alte.studies.tables import write_csv
 
-__all__ = ["COLUMNS", "SOURCES", "BenchInput", "bench_input", "odometry_table", "pose_benchmark",
-           "write_odometry_table"]
+__all__ = ["COLUMNS", "REAL_SEQUENCE", "SOURCES", "BenchInput", "bench_input", "odometry_table",
+           "pose_benchmark", "realdata_table", "write_odometry_table"]
 
 #: Pose sources in table order: name -> (pose source, odometry backend or None).
 SOURCES: dict[str, tuple[PoseSource, str | None]] = {
@@ -47,7 +48,7 @@ BAG_VOXEL = 0.05
 #: The table's columns (units in the names).
 COLUMNS = ("input", "source", "settings", "frames", "path_m", "ate_m", "rpe_trans_pct",
            "rpe_rot_deg_m", "cloud_median_m", "cloud_p90_m", "mesh_mean_m", "ms_per_scan",
-           "corrected", "kept")
+           "cpu_ms_per_scan", "corrected", "kept")
 
 
 @dataclass(frozen=True)
@@ -89,6 +90,9 @@ def bench_input(what: str | os.PathLike[str], *, reference: str | os.PathLike[st
                                  "poses are the reference")
         made = _terrain_input(str(what), Path(data_dir), frames, seed)
         return made if voxel is None else replace(made, voxel=voxel)
+    if not Path(what).exists():
+        raise ParameterError(f"{what}: neither a simulated terrain ({', '.join(TERRAINS)}) "
+                             "nor a bag or terrain folder")
     source = open_input(Path(what))
     if reference is not None and not Path(reference).is_file():
         raise ParameterError(f"--reference {reference}: no such TUM file")
@@ -153,6 +157,7 @@ def _score(item: BenchInput, key: str, reg: Registered, reference: Registered,
             "cloud_median_m": cloud.median_m, "cloud_p90_m": cloud.p90_m,
             "mesh_mean_m": _mesh_mean(item, points),
             "ms_per_scan": 1e3 * poses.seconds / max(poses.frames, 1),
+            "cpu_ms_per_scan": 1e3 * poses.cpu_seconds / max(poses.frames, 1),
             "corrected": poses.corrected if key == "refine" else 0,
             "kept": poses.frames - poses.corrected if key == "refine" else 0}
 
@@ -217,6 +222,22 @@ def odometry_table(inputs: Sequence[str | os.PathLike[str]] | None = None, *,
         tables.append(pose_benchmark(item, sources, settings=settings, cache=cache,
                                      progress=progress))
     return pd.concat(tables, ignore_index=True)
+
+
+#: The real sequence of the benchmark, under the real-data folder.
+REAL_SEQUENCE = ("balm_seq", "bag")
+
+
+def realdata_table(root: Path | None, terrains: Sequence[str] = (), *,
+                   sources: Sequence[str] = tuple(SOURCES),
+                   data_dir: str | os.PathLike[str] = "data",
+                   progress: bool = False) -> pd.DataFrame:
+    """The benchmark on the real sequence under ``root`` (its pose topic as the reference),
+    then on ``terrains``; an empty table when ``root`` is None (no real data)."""
+    if root is None:
+        return pd.DataFrame(columns=list(COLUMNS))
+    inputs = [str(Path(root).joinpath(*REAL_SEQUENCE)), *terrains]
+    return odometry_table(inputs, data_dir=data_dir, sources=sources, progress=progress)
 
 
 def write_odometry_table(table: pd.DataFrame, out_dir: str | os.PathLike[str],
