@@ -76,9 +76,9 @@ class OdometryParams(Record):
     min_fitness: float = param(0.3, _fraction, "0..1",
                                "plane, refine: fewest inliers (fraction of the scan) for an "
                                "alignment to count")
-    min_constraint: float = param(0.01, _fraction, "0..1",
+    min_constraint: float = param(0.002, _fraction, "0..1",
                                   "refine: smallest / largest Hessian eigenvalue to accept")
-    min_gain: float = param(0.25, _fraction, "0..1",
+    min_gain: float = param(0.1, _fraction, "0..1",
                             "refine: least drop of the alignment cost to accept a correction")
     max_correction: float = param(0.5, _positive, "> 0",
                                   "m; refine: a larger correction is not applied")

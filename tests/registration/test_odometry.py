@@ -75,8 +75,8 @@ def test_refine_improves_a_desynchronised_mission(tmp_path: Path) -> None:
     refined, counts = merged_cloud(source, FrameSpec(poses=PoseSource.REFINE))
     before = mesh_distance(recorded, scene).mean()
     after = mesh_distance(refined, scene).mean()
-    assert after < 0.8 * before
-    assert counts.poses.source == "refine" and counts.poses.corrected > 20
+    assert after < 0.9 * before
+    assert counts.poses.source == "refine" and counts.poses.corrected > 10
     assert counts.registration.frames_kept == plain.registration.frames_kept  # none dropped
 
 
