@@ -29,7 +29,7 @@ __all__ = ["CloudDistance", "TrajectoryErrors", "cloud_distance", "trajectory_er
 @dataclass(frozen=True)
 class TrajectoryErrors:
     """ATE (m), RPE translation (% of ``delta_m``) and rotation (deg/m); NaN RPE when the
-    reference path is shorter than one segment."""
+    reference path is shorter than one segment or no two scans are one segment apart."""
 
     ate_m: float
     rpe_trans_pct: float
@@ -73,6 +73,7 @@ def trajectory_errors(stamps: np.ndarray, positions: np.ndarray, quaternions: np
     import copy
 
     from evo.core import metrics
+    from evo.core.filters import FilterException
     from evo.core.geometry import GeometryException
     from evo.core.metrics import PoseRelation
 
@@ -92,8 +93,11 @@ def trajectory_errors(stamps: np.ndarray, positions: np.ndarray, quaternions: np
     steps = np.linalg.norm(np.diff(np.asarray(reference_positions), axis=0), axis=1)
     if steps.sum() < 1.5 * delta_m:
         return TrajectoryErrors(ate, float("nan"), float("nan"), delta_m, 0)
-    trans, pairs = _rpe(reference, estimate, PoseRelation.translation_part, delta_m)
-    rot, _ = _rpe(reference, estimate, PoseRelation.rotation_angle_deg, delta_m)
+    try:
+        trans, pairs = _rpe(reference, estimate, PoseRelation.translation_part, delta_m)
+        rot, _ = _rpe(reference, estimate, PoseRelation.rotation_angle_deg, delta_m)
+    except FilterException:  # scans further apart than a segment: no pair delta_m apart
+        return TrajectoryErrors(ate, float("nan"), float("nan"), delta_m, 0)
     return TrajectoryErrors(ate, 100.0 * trans / delta_m, rot / delta_m, delta_m, pairs)
 
 
