@@ -24,10 +24,9 @@ from scipy.spatial.transform import Rotation
 
 from alte.io.bag import FrameStream
 from alte.io.imu import ImuSamples, read_imu
+from alte.metrics.trajectory import trajectory_errors
 from alte.registration.odometry import pose_matrix
 from alte.sim import get_terrain, true_poses
-from alte.studies.odometry import ate
-from alte.studies.sensor import rpe
 from alte.types import Mount
 
 
@@ -94,9 +93,11 @@ def main(folder: str, name: str, package: str) -> None:
     est = np.array([p[:3, 3] for _, p in poses])
     quat = Rotation.from_matrix(np.array([p[:3, :3] for _, p in poses])).as_quat()
     path = float(np.linalg.norm(np.diff(truth.positions, axis=0), axis=1).sum())
+    errors = trajectory_errors(stamps, est, quat, truth.positions[index],
+                               truth.quaternions[index])
     print(f"{package} {name}: {len(poses)}/{stream.scans} scans, {ms:.1f} ms/scan, "
-          f"ATE {ate(est, truth.positions[index]):.2f} m on a {path:.0f} m path, "
-          f"RPE {100 * rpe(est, quat, truth.positions[index], truth.quaternions[index]):.1f} %")
+          f"ATE {errors.ate_m:.2f} m on a {path:.0f} m path, "
+          f"RPE {errors.rpe_trans_pct:.1f} %")
 
 
 if __name__ == "__main__":

@@ -41,7 +41,10 @@ def pose_source(info: BagInfo) -> str:
     """What ``alte map``/``register`` use for poses by default (``--poses`` unset)."""
     if info.pose_topic:
         return f"recorded ({info.pose_topic})"
-    return "odometry (no pose topic: LiDAR odometry, in the first scan's body frame)"
+    from alte.registration.odometry import OdometryParams, odometry_label
+
+    return (f"odometry (no pose topic: LiDAR odometry, {odometry_label(OdometryParams())} "
+            "unless --odometry says otherwise, in the first scan's body frame)")
 
 
 def format_info(info: BagInfo) -> list[str]:

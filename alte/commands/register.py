@@ -19,7 +19,7 @@ from alte.io.pointfiles import WRITE_SUFFIXES, storable, write_points
 from alte.pipeline import InputKind, StreamCounts, merge_frames, open_input, prepare
 from alte.registration import RegistrationCounts
 
-__all__ = ["add_parser", "format_counts", "format_file_counts", "run"]
+__all__ = ["add_parser", "format_counts", "format_file_counts", "pose_line", "run"]
 
 
 def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -51,6 +51,22 @@ def format_counts(counts: RegistrationCounts) -> list[str]:
         f"{c.points_dropped_crop} (outside crop box); {c.points_registered} after "
         f"per-frame down-sampling, {c.points_out} out",
     ]
+
+
+def pose_line(counts: StreamCounts) -> str:
+    """Where the poses came from, with the backend, its settings and refinement's counts."""
+    poses = counts.poses
+    if poses.method == "refine":
+        kept = ", ".join(f"{n} {r}" for r, n in sorted(poses.kept.items()))
+        return (f"refine ({poses.corrected} corrected, {poses.frames - poses.corrected} kept"
+                + (f": {kept})" if kept else ")"))
+    if poses.method:
+        from alte.registration.odometry import OdometryParams, odometry_label
+
+        label = odometry_label(OdometryParams.parse(poses.settings))
+        return f"{poses.source} ({label}, {1e3 * poses.seconds / max(poses.frames, 1):.0f} " \
+               "ms per scan)"
+    return poses.source
 
 
 def _reader_line(counts: StreamCounts) -> str:
@@ -105,7 +121,7 @@ def run(args: argparse.Namespace) -> int:
         lines = format_file_counts(source.path, counts) + ([line] if fields else [])
     else:
         lines = [_reader_line(counts), *format_counts(counts.registration),
-                 f"poses: {counts.poses.source}"]
+                 f"poses: {pose_line(counts)}"]
     print("\n".join([*lines, *(f"note: {n}" for n in counts.notes)]))
     print(f"wrote {len(cloud)} points to {args.out}")
     if args.mcap is not None:

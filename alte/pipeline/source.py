@@ -22,13 +22,19 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from alte.errors import BagError, ParameterError, PointFileError, TopicError
+from alte.errors import BagError, ParameterError, PointFileError, PoseError, TopicError
 from alte.io.bag import NO_POSE_NOTE, FrameStream, ReadCounts
 from alte.io.pose import POSE_TYPES
 from alte.pipeline.spec import FrameSpec, PoseSource
 from alte.registration.deskew import DeskewCounts, deskew_frames
 from alte.registration.grid import GridAccumulator, grid_average
-from alte.registration.odometry import PoseCounts, odometry_frames, refine_frames
+from alte.registration.odometry import (
+    KEYS,
+    PoseCounts,
+    odometry_frames,
+    odometry_label,
+    refine_frames,
+)
 from alte.registration.register import RegistrationCounts, crop_mask, register_frames
 from alte.types import Box, Frame, RegisteredFrame
 
@@ -135,9 +141,21 @@ class StreamCounts:
 
 def _open(source: Source, spec: FrameSpec, pose_topic: str | None, progress: bool,
           allow_no_pose: bool = True) -> FrameStream:
+    pose_file = spec.pose_file if pose_topic != "" else None
     return FrameStream(source.bag or source.path, cloud_topic=spec.cloud_topic,
                        pose_topic=pose_topic, mount=spec.mount, allow_no_pose=allow_no_pose,
-                       frames=spec.frames, progress=progress)
+                       frames=spec.frames, progress=progress, pose_file=pose_file)
+
+
+def _start(probe: FrameStream, stamp: int) -> tuple[np.ndarray, np.ndarray] | None:
+    """The recorded pose at the first scan, or None (no track, or one on another clock)."""
+    if probe.track is None:
+        return None
+    try:
+        at = probe.track.interpolate([stamp], probe.options.max_gap_s)
+    except PoseError:  # stamps in another unit: odometry does without the anchor
+        return None
+    return (at.positions[0], at.quaternions[0]) if at.valid[0] else None
 
 
 def _odometry(stream: FrameStream, probe: FrameStream, spec: FrameSpec,
@@ -147,15 +165,11 @@ def _odometry(stream: FrameStream, probe: FrameStream, spec: FrameSpec,
     first = next(frames, None)
     if first is None:
         return
-    start = None
-    if probe.track is not None:
-        at = probe.track.interpolate([first.stamp], probe.options.max_gap_s)
-        if at.valid[0]:
-            start = (at.positions[0], at.quaternions[0])
+    start = _start(probe, first.stamp)
     anchor = f"the recorded pose of the first scan ({probe.pose_topic})" if start is not None \
         else "the first scan's body frame"
-    method = "point-to-plane" if spec.odometry.method == "plane" else "kiss-icp"
-    stream.notes.append(f"poses from LiDAR odometry ({method}), anchored at {anchor}")
+    stream.notes.append(f"poses from LiDAR odometry ({odometry_label(spec.odometry)}), "
+                        f"anchored at {anchor}")
     yield from odometry_frames(itertools.chain([first], frames), stream.mount, counts=counts,
                                params=spec.odometry, start=start)
 
@@ -187,6 +201,8 @@ def _posed(source: Source, spec: FrameSpec, counts: PoseCounts, progress: bool,
     if choice is PoseSource.RECORDED:
         return probe, _deskewed(probe, spec, deskew)
     if choice is PoseSource.REFINE:
+        counts.method = "refine"
+        counts.settings = {k: spec.odometry.as_dict()[k] for k in KEYS["refine"]}
         return probe, refine_frames(_deskewed(probe, spec, deskew), probe.mount, counts=counts,
                                     params=spec.odometry)
     if choice is PoseSource.AUTO and probe.track is not None:

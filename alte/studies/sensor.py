@@ -3,9 +3,9 @@
 For each UAV mission (or any terrain) the ``uav`` sensor profile's bag is registered
 with recorded poses as taken, recorded poses + deskew and LiDAR-only odometry, beside
 the thesis profile's bag with recorded poses (the chapters' reference), and scored
-against the simulator's truth: ATE (RMSE of body positions after rigid alignment), RPE
-(translation error of the relative motion over 1 s, per metre travelled in it) and the
-merged cloud's mean distance to the true mesh, with the time per scan.
+against the simulator's truth: ATE and RPE (translation, % of 1 m segments) as evo reports
+them (:mod:`alte.metrics.trajectory`) and the merged cloud's mean distance to the true
+mesh, with the time per scan.
 """
 
 from __future__ import annotations
@@ -17,12 +17,11 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
-from scipy.spatial.transform import Rotation
 
+from alte.metrics.trajectory import trajectory_errors
 from alte.pipeline import FrameSpec, PoseSource, open_input, prepare
-from alte.studies.odometry import ate
 
-__all__ = ["RUNS", "rpe", "sensor_row", "sensor_table"]
+__all__ = ["RUNS", "sensor_row", "sensor_table"]
 
 #: Column key -> (profile, pose source, deskew).
 RUNS: dict[str, tuple[str, PoseSource, bool]] = {
@@ -33,25 +32,10 @@ RUNS: dict[str, tuple[str, PoseSource, bool]] = {
 }
 
 
-def rpe(positions: np.ndarray, quaternions: np.ndarray, truth_pos: np.ndarray,
-        truth_quat: np.ndarray, step: int = 10) -> float:
-    """Relative pose error: mean translation error of the motion over ``step`` scans,
-    expressed in the first scan's body frame, per metre travelled (a fraction)."""
-    def rel(p: np.ndarray, q: np.ndarray) -> np.ndarray:
-        moved: np.ndarray = Rotation.from_quat(q[:-step]).inv().apply(p[step:] - p[:-step])
-        return moved
-    if len(positions) <= step:
-        return float("nan")
-    est, true = rel(positions, quaternions), rel(truth_pos, truth_quat)
-    length = np.linalg.norm(true, axis=1)
-    keep = length > 0.1
-    return float(np.linalg.norm(est - true, axis=1)[keep].sum() / max(length[keep].sum(), 1e-9))
-
-
 @dataclass(frozen=True)
 class _Score:
     ate_m: float
-    rpe: float
+    rpe_pct: float
     mesh_m: float
     ms_per_scan: float
 
@@ -69,8 +53,8 @@ def _score(folder: Path, name: str, run: tuple[PoseSource, bool], seed: int,
     index = np.searchsorted(truth.stamps, traj.stamps)
     tp, tq = truth.positions[index], truth.quaternions[index]
     mesh = float(mesh_distance(np.asarray(reg.cloud), load_ground_truth(folder)).mean())
-    return _Score(ate(traj.positions, tp), rpe(traj.positions, traj.quaternions, tp, tq),
-                  mesh, 1e3 * seconds / max(len(reg), 1))
+    errors = trajectory_errors(traj.stamps, traj.positions, traj.quaternions, tp, tq)
+    return _Score(errors.ate_m, errors.rpe_trans_pct, mesh, 1e3 * seconds / max(len(reg), 1))
 
 
 def sensor_row(name: str, data_dir: str | os.PathLike[str] = "data", seed: int = 0,
@@ -83,7 +67,7 @@ def sensor_row(name: str, data_dir: str | os.PathLike[str] = "data", seed: int =
     for key, (profile, pose, deskew) in RUNS.items():
         folder = ensure_terrain(name, data_dir, seed, profile=PROFILES[profile])
         score = _score(folder, name, (pose, deskew), seed, cache)
-        row |= {f"ate_{key}_m": score.ate_m, f"rpe_{key}": score.rpe,
+        row |= {f"ate_{key}_m": score.ate_m, f"rpe_{key}_pct": score.rpe_pct,
                 f"mesh_{key}_m": score.mesh_m, f"ms_per_scan_{key}": score.ms_per_scan}
     return row
 

@@ -6,7 +6,7 @@ from rosbags.typesys import Stores, get_typestore
 
 from alte.errors import TopicError
 from alte.io.imu import ImuSamples, imu_topic, read_imu
-from alte.io.pointcloud2 import decode_pointcloud2_timed, encode_pointcloud2
+from alte.io.pointcloud2 import decode_timed, encode_pointcloud2
 from alte.io.writer import write_bag
 from alte.types import Mount
 
@@ -53,11 +53,11 @@ def test_a_bag_without_imu(tmp_path):
 def test_point_times_in_seconds_from_the_stamp(name, values, seconds):
     pts = np.array([[1.0, 0, 0], [np.nan, 0, 0], [3.0, 0, 0]])
     msg = encode_pointcloud2(pts, STAMP, "lidar", STORE, extra_fields={name: values})
-    points, dropped, times = decode_pointcloud2_timed(msg)
+    points, times, dropped = decode_timed(msg, STAMP)
     assert dropped == 1 and len(points) == 2
     assert times == pytest.approx([seconds[0], seconds[2]], abs=1e-6)
 
 
 def test_no_time_field():
     msg = encode_pointcloud2(np.ones((2, 3)), STAMP, "lidar", STORE)
-    assert decode_pointcloud2_timed(msg)[2] is None
+    assert decode_timed(msg, STAMP)[1] is None
