@@ -40,9 +40,18 @@ def test_table_on_a_small_mission(tmp_path: Path) -> None:
     table = odometry_table(["exp_nav_2"], tmp_path / "data", frames=8, progress=False)
     row = table.iloc[0]
     assert row["terrain"] == "exp_nav_2" and row["frames_selected"] == 8
+    assert 15 < row["path_m"] < 30  # 8 scans of the fast-yaw mission: ~21 m flown
+    # Bounds against the simulator's true poses, each about twice what today's defaults
+    # give (ATE recorded 0.033 m, refine 0.16 m, point-to-plane 2.4 m, KISS-ICP 2.4 m;
+    # mesh distance 0.020, 0.028, 0.065, 0.090 m): recorded poses are late by 80 ms
+    # in the yaw swings, refinement must bring them back near the truth, odometry drifts.
+    ate = {"recorded": 0.08, "refine": 0.4, "odometry": 5.0, "kiss": 5.0}
+    mesh = {"recorded": 0.05, "refine": 0.06, "odometry": 0.15, "kiss": 0.2}
     for key in ("recorded", "odometry", "kiss", "refine"):
-        assert row[f"frames_{key}"] >= 7 and np.isfinite(row[f"ate_{key}_m"])
-        assert 0 < row[f"mesh_{key}_m"] < 5
+        assert row[f"frames_{key}"] >= 7
+        assert 0 < row[f"ate_{key}_m"] < ate[key], key
+        assert 0 < row[f"mesh_{key}_m"] < mesh[key], key
+    assert row["ate_refine_m"] < row["ate_odometry_m"]
     path = write_odometry_table(table, tmp_path / "tables")
     assert pd.read_csv(path).shape == table.shape
     with pytest.raises(AlteError, match="already exists"):
