@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 from typing import Any
 
@@ -12,7 +13,7 @@ from mcap_ros2.decoder import DecoderFactory
 
 from alte.errors import AlteError, ParameterError
 from alte.export import TOPICS, ExportOptions, export_map, export_registered
-from alte.export.maps import height_colours, raster, shown_cells
+from alte.export.maps import height_colours, shown_cells
 from alte.io.reader import open_bag, topic_table
 from alte.mappers import Feed
 from alte.mappers.octomap import read_bt
@@ -84,17 +85,19 @@ def test_alte2d_run_on_sim_lan_2_reads_back(terrains: dict[str, Path], tmp_path:
     for topic in ("/alte/map/occupancy", "/alte/map/grid_map", "/alte/map/cells",
                   "/alte/cloud", "/alte/trajectory"):
         assert table[topic] == (TOPICS[topic], "ros2msg", 1)
-    grid = raster(result.mapper.cells(), np.zeros(3))
+    # By hand: max_res 5 splits the domain's square into at most 2^5 x 2^5 cells, so
+    # the grid is 32 x 32 cells of size / 32, anchored at the domain's corner; sim_lan_2's
+    # domain is the control volume's cube (scenario.json crop_box)
+    crop = json.loads((terrains["sim_lan_2"] / "scenario.json").read_text())["crop_box"]
+    size = max(hi - lo for lo, hi in zip(crop[:3], crop[3:], strict=True))
     occupancy = messages["/alte/map/occupancy"][0][1]
-    assert occupancy.info.resolution == pytest.approx(grid.resolution)
+    assert occupancy.info.resolution == pytest.approx(size / 32, rel=1e-6)
     assert (occupancy.info.origin.position.x, occupancy.info.origin.position.y) == \
-        pytest.approx(tuple(grid.origin))
-    assert (occupancy.info.width, occupancy.info.height) == grid.shape[::-1]
-    domain = result.mapper.domain
-    assert domain is not None and grid.resolution == pytest.approx(domain.size / 2 ** 5)
+        pytest.approx((crop[0], crop[1]))
+    assert (occupancy.info.width, occupancy.info.height) == (32, 32)
     gm = messages["/alte/map/grid_map"][0][1]
     assert gm.layers == ["elevation", "occupancy"]
-    assert gm.info.resolution == pytest.approx(grid.resolution)
+    assert gm.info.resolution == pytest.approx(size / 32, rel=1e-6)
     cloud = messages["/alte/cloud"][0][1]
     assert cloud.width == len(result.cloud) and cloud.header.frame_id == "map"
     cells = result.mapper.cells()
