@@ -37,7 +37,7 @@ KEYS = {"tradeoff": ["terrain", "mapper", "params", "seed"],
 #: Trade-off columns compared (mapping time, the only noisy one, is left out).
 ROW_COLUMNS = ["frames", "points", "basis_functions", "occupied_cells", "memory_bytes",
                "mhd_m", "hd_m", "mh_ab_m", "mh_ba_m", "accuracy_mean_m", "completeness",
-               "height_rmse_m", "size_octaves"]
+               "height_rmse_m", "size_octaves", "cost", "cost_unit"]
 CELL_COLUMNS = ["seeds", "estimate", "low", "high", "outcome", "timed"]
 RTOL = 1e-9
 TIME_COLUMNS = {"elapsed_s"}
