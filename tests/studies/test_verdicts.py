@@ -436,3 +436,21 @@ def test_a_size_option_replaces_basis_functions_in_every_part(win):
     assert "occupied cells, Quadtree / 2D-ALTE" in occupied.evidence
     assert "at equal occupied cells" in occupied.evidence
     assert "basis functions" not in occupied.evidence
+
+
+def test_a_read_without_its_axis_or_a_shared_range_is_no_data(win):
+    """Equal-size reads need the size column, equal-fidelity reads the fidelity column,
+    and both mappers on a common terrain; otherwise the claim gets "no data", saying why."""
+    blank = win.assign(cost=np.nan)
+    at_size = Compare("lan", "alte2d", "quadtree", "mhd_m", "equal_size", size="cost")
+    found = evaluate(_claim(at_size), blank)
+    assert found.verdict == "no data" and "no values in column(s) cost" in found.evidence
+    at_fidelity = Compare("lan", "alte2d", "quadtree", "basis_functions", "equal_fidelity",
+                          fidelity="cost")
+    found = evaluate(_claim(at_fidelity), blank)
+    assert found.verdict == "no data" and "no values in column(s) cost" in found.evidence
+    apart = synthetic_tradeoff(WIN, terrains={"alte2d": ("sim_lan_1",),
+                                              "quadtree": ("sim_lan_2",)})
+    found = evaluate(_claim(Compare("lan", "alte2d", "quadtree", "mhd_m", "equal_size")), apart)
+    assert found.verdict == "no data"
+    assert "2D-ALTE and Quadtree share no terrain and size range" in found.evidence
