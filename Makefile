@@ -12,7 +12,7 @@ export PATH := $(CURDIR)/$(VENV)/bin:$(PATH)
 REPORT_ARGS ?=
 PYTEST_ARGS ?=
 
-.PHONY: bootstrap report report-quick test lint bench clean-venv
+.PHONY: bootstrap report report-quick test lint bench reference mutants clean-venv
 
 bootstrap:
 	@bash .ci/bootstrap
@@ -33,6 +33,19 @@ test: bootstrap
 	$(PY) -m ruff check alte tests bench
 	@$(PY) -m alte warmup & warm=$$!; $(PY) -m mypy; typed=$$?; wait $$warm && exit $$typed
 	$(PY) -m pytest -n 2 --dist loadfile --no-loadscope-reorder tests notebooks --nbval-lax $(PYTEST_ARGS)
+
+# Rewrite the checked-in reference results (tests/reference) from a fresh quick chapter 5
+# run, after a deliberate change; `git diff tests/reference` shows what moved.
+reference: bootstrap
+	$(PY) -m pytest tests/reference -p no:cacheprovider --update-reference -q
+
+# Mutation testing of the verdict logic and the metrics (tests/README.md): mutmut
+# ([tool.mutmut] in pyproject.toml) caches results in mutants/ and reruns only what
+# changed; MUTANTS='alte.studies.evidence*' narrows it; rm -rf mutants starts afresh.
+MUTANTS ?=
+mutants: bootstrap
+	$(PY) -m mutmut run --max-children 2 $(MUTANTS)
+	$(PY) tests/mutation_score.py
 
 bench: bootstrap
 	$(PY) -m alte bench

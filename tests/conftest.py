@@ -18,3 +18,10 @@ def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
     long_files = {item.path for item in items
                   if item.get_closest_marker("slow") or item.path.suffix == ".ipynb"}
     items.sort(key=lambda item: item.path not in long_files)
+
+
+def pytest_addoption(parser: pytest.Parser) -> None:
+    """``--update-reference``: rewrite tests/reference's expected tables from this run
+    (``make reference``; a deliberate change whose diff a reviewer reads)."""
+    parser.addoption("--update-reference", action="store_true", default=False,
+                     help="rewrite the expected tables of tests/reference from this run")

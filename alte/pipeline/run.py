@@ -124,6 +124,9 @@ class MapRun:
             "domain": None if info.domain is None else info.domain.as_dict(),
             "domain_policy": info.domain_policy, "voxel": info.frames.voxel,
             "pose_source": self.counts.poses.source,
+            "odometry": {"method": self.counts.poses.method,
+                         "settings": dict(self.counts.poses.settings)}
+            if self.counts.poses.method else None,
             "crop": None if info.frames.crop is None else list(info.frames.crop.values()),
             "frames": len(self.log.stamps), "frames_selected": self.counts.selected,
             "points": int(self.log.points.sum()),

@@ -16,13 +16,20 @@ from alte.mappers.alte2d import Alte2D
 from alte.mappers.domain import Domain
 from alte.mappers.quadtree import Quadtree
 from alte.pipeline import DomainPolicy
-from alte.types import Box, Frame, Mount
+from alte.types import Frame, Mount
 
 
 def terrain(n: int = 2000, seed: int = 0) -> np.ndarray:
     rng = np.random.default_rng(seed)
     xy = rng.uniform(0, 16, (n, 2))
     return np.column_stack([xy, np.where(xy[:, 0] > 8, 2.0, 0.0) + rng.normal(0, 0.01, n)])
+
+
+def cube_over(points: np.ndarray) -> dict[str, float]:
+    """The domain the data policy must give, by hand: the cube anchored at the points'
+    minimum corner whose edge is their longest extent (up to a relative 1e-9 slack)."""
+    lo, hi = points.min(axis=0), points.max(axis=0)
+    return {"xmin": lo[0], "ymin": lo[1], "zmin": lo[2], "size": float((hi - lo).max())}
 
 
 @pytest.fixture
@@ -40,7 +47,8 @@ def run_json(capsys, *argv: str) -> dict:
 def test_point_file_json_summary(capsys, cloud_file: Path) -> None:
     out = run_json(capsys, str(cloud_file), "--mapper", "alte2d", "--set", "kappa=0.01",
                    "--set", "max_res=5")
-    ref = Alte2D(Domain.over(Box.around(terrain())), kappa=0.01, max_res=5)
+    assert out["domain"] == pytest.approx(cube_over(terrain()), rel=1e-8)
+    ref = Alte2D(Domain(**out["domain"]), kappa=0.01, max_res=5)
     ref.build(terrain())
     assert out["mapper"] == "alte2d" and out["params"]["kappa"] == 0.01
     assert out["frames"] == 1 and out["points"] == 2000
@@ -60,7 +68,9 @@ def test_export_npz_and_overwrite(capsys, cloud_file: Path, tmp_path: Path) -> N
     argv = ["map", str(cloud_file), "--mapper", "quadtree", "--set", "max_points=50",
             "--export", str(target)]
     assert main(argv) == 0
-    ref = Quadtree(Domain.over(Box.around(terrain())), max_points=50)
+    lo = terrain().min(axis=0)
+    size = float(np.ptp(terrain(), axis=0).max())
+    ref = Quadtree(Domain(*lo, size * (1 + 1e-9) + 1e-9), max_points=50)
     ref.build(terrain())
     with np.load(target) as data:
         assert set(data.files) == {"centers", "sizes", "value", "occupied", "level"}
@@ -154,7 +164,6 @@ def test_bag_is_mapped_frame_by_frame(capsys, tmp_path: Path) -> None:
 def test_bag_without_domain_maps_with_every_mapper(capsys, tmp_path: Path, mapper) -> None:
     """No ``--domain``: a plain bag's domain is the cube over its registered frames."""
     from alte import io
-    from alte.registration import register_frames
 
     rng = np.random.default_rng(7)
     frames = [Frame(stamp=(i + 1) * 100_000_000, points=rng.uniform(-3, 3, (200, 3)),
@@ -169,6 +178,7 @@ def test_bag_without_domain_maps_with_every_mapper(capsys, tmp_path: Path, mappe
     if mapper == "octomap":  # no domain: it keys voxels around a local origin
         assert out["domain"] is None and out["domain_policy"] == "none (fixed key space)"
     else:
-        points = np.concatenate([p for _f, p, _o in register_frames(frames, Mount())])
+        # identity attitude and mount: each frame's points shifted by its position
+        points = np.concatenate([f.points + f.position for f in frames])
         assert out["domain_policy"] == "data"
-        assert out["domain"] == Domain.over(Box.around(points)).as_dict()
+        assert out["domain"] == pytest.approx(cube_over(points), rel=1e-8)

@@ -23,6 +23,10 @@ from alte.paths import realdata_dir
 REALDATA = realdata_dir()
 VLP_DIR = REALDATA / "vlp16_packets"
 MODE = {"strongest": 0x37, "last": 0x38, "dual": 0x39}
+#: The VLP-16 user manual's table of laser IDs and vertical angles (ch. 9): laser 0 looks
+#: 15 deg down, laser 1 one degree up, and so on, interleaved in 2 deg steps.
+MANUAL_ELEVATION_DEG = {0: -15, 1: 1, 2: -13, 3: 3, 4: -11, 5: 5, 6: -9, 7: 7,
+                        8: -7, 9: 9, 10: -5, 11: 11, 12: -3, 13: 13, 14: -1, 15: 15}
 
 
 def make_packet(azimuth, dist_mm, refl=None, mode="strongest", product=0x22):
@@ -54,13 +58,21 @@ def steady_azimuths(start=0, step=20, n=12):
 # ---------------------------------------------------------------- geometry
 
 
+def test_the_elevation_table_is_the_manuals():
+    assert VLP16_ELEVATIONS_DEG.tolist() == [MANUAL_ELEVATION_DEG[i] for i in range(16)]
+
+
 @pytest.mark.parametrize("channel", range(16))
 def test_each_laser_elevation_and_manual_frame(channel):
     az = np.full(12, 9000)  # 90 deg: the manual frame's +x
     pkt = make_packet(az, one_return(0, channel, 10.0))
     pts = decode_velodyne_packets(pkt[None], interpolation="none")
-    w = np.deg2rad(VLP16_ELEVATIONS_DEG[channel])
+    w = np.deg2rad(MANUAL_ELEVATION_DEG[channel])
     np.testing.assert_allclose(pts, [[10 * np.cos(w), 0.0, 10 * np.sin(w)]], atol=1e-9)
+    # channel + 16 is the same laser in the block's second firing sequence
+    second = decode_velodyne_packets(make_packet(az, one_return(0, channel + 16, 10.0))[None],
+                                     interpolation="none")
+    np.testing.assert_allclose(second, pts, atol=1e-9)
 
 
 def test_azimuth_zero_looks_along_manual_y_and_ros_x():

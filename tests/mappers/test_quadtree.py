@@ -222,7 +222,21 @@ def test_empty_map_and_empty_frames() -> None:
     assert len(qt.cells()) == 0 and len(qt.corners()) == 0
     fixed = Quadtree(domain=DOMAIN)
     assert len(fixed.cells()) == 1 and np.isnan(fixed.cells().value[0])
-    assert fixed.memory_bytes >= 0
+    assert fixed.memory_bytes == 0  # nothing inserted: no cell is held
+
+
+def test_memory_counts_each_held_cell_at_its_cost() -> None:
+    """A held cell costs its 8-byte key, its row of statistics (8 bytes for the count
+    and 3 x 8 for each of the two values it keeps: 56) and a 1-byte split flag."""
+    per_cell = 8 + 8 * (1 + 3 * 2) + 1
+    levels = 13  # max_depth 12: one cell per level down to the point's leaf
+    one = Quadtree(domain=Domain(0, 0, 0, 8))
+    one.insert(np.array([[1.0, 1.0, 0.5]]), np.zeros(3))
+    assert one.memory_bytes == levels * per_cell
+    two = Quadtree(domain=Domain(0, 0, 0, 8), max_points=1)
+    two.insert(np.array([[1.0, 1.0, 0.5], [7.0, 7.0, 1.0]]), np.zeros(3))
+    # the root holds both points; below it, each point its own cell on every level
+    assert two.memory_bytes == (1 + 2 * (levels - 1)) * per_cell
 
 
 @pytest.mark.parametrize(("key", "value", "match"), [

@@ -20,7 +20,6 @@ from alte.pipeline import (
     prepare,
     run,
 )
-from alte.types import Box
 
 PARAMS = {"quadtree": {"max_points": 50}, "alte2d": {"max_res": 5},
           "alte3d": {"max_res": 5, "min_pts": 5, "min_pts_split": 10},
@@ -50,16 +49,28 @@ def test_streamed_run_equals_the_prepared_one(terrain: Path, tmp_path: Path, map
     assert summary["feed"] == (live.info.feed.value)
 
 
+def _cube(lo, hi) -> list[float]:
+    """By hand: the cube anchored at ``lo`` whose edge is the box's longest side."""
+    return [*map(float, lo), float(np.max(np.subtract(hi, lo)))]
+
+
+def _as_list(domain: Domain) -> list[float]:
+    return [domain.xmin, domain.ymin, domain.zmin, domain.size]
+
+
 def test_domain_policies(terrain: Path, bag: Path) -> None:
-    crop = open_input(terrain).resolve(FrameSpec()).crop
-    assert crop is not None
+    # sim_lan_1's control volume (scenario.json crop_box): x, y in [-35, 35], z in [-1, 12]
+    crop = json.loads((terrain / "scenario.json").read_text())["crop_box"]
+    assert crop == [-35.0, -35.0, -1.0, 35.0, 35.0, 12.0]
     on_terrain = run(terrain, MapSpec("alte2d"), FrameSpec(frames=2))
     assert on_terrain.info.domain_policy == "control"
-    assert on_terrain.info.domain == Domain.over(crop)
+    assert _as_list(on_terrain.info.domain) == pytest.approx([-35.0, -35.0, -1.0, 70.0],
+                                                             rel=1e-8)
     on_bag = run(bag, MapSpec("alte2d"), FrameSpec(frames=2))
     assert on_bag.info.domain_policy == "data"
     reg = prepare(open_input(bag), FrameSpec(frames=2))
-    assert on_bag.info.domain == Domain.over(Box.around(reg.points))
+    expected = _cube(reg.points.min(axis=0), reg.points.max(axis=0))
+    assert _as_list(on_bag.info.domain) == pytest.approx(expected, rel=1e-8)
     assert on_bag.mapper.points_outside == 0
     explicit = Domain(-50.0, -50.0, -5.0, 100.0)
     chosen = run(terrain, MapSpec("alte3d", domain=explicit), FrameSpec(frames=2))

@@ -4,12 +4,12 @@ from __future__ import annotations
 
 import re
 from dataclasses import fields
-from pathlib import Path
 
 import pytest
 
 from alte.errors import ParameterError
 from alte.mappers import MAPPERS, make_mapper
+from alte.paths import realdata_dir
 from alte.studies.claims import (
     CASES,
     CLAIMS,
@@ -24,7 +24,7 @@ from alte.studies.claims import (
 from alte.studies.thesis import QUALITATIVE
 from alte.studies.tradeoff import METRICS, OPTIONAL_COLUMNS, REQUIRED_COLUMNS
 
-THESIS = Path("/work/shared/thesis/alte-thesis.txt")
+THESIS = realdata_dir().parent / "thesis" / "alte-thesis.txt"  # ../shared/thesis
 _MAPPER_FIELDS = ("better", "other", "mapper")
 _COLUMN_FIELDS = ("metric", "size", "fidelity", "reference", "reference_other", "column")
 _PARAM_FIELDS = ("param", "x", "other_param")
