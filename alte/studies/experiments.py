@@ -15,6 +15,7 @@ import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pandas as pd
 from tqdm.auto import tqdm
@@ -35,6 +36,9 @@ from alte.pipeline import (
 )
 from alte.studies.thesis import SWEEPS, sweep_table
 
+if TYPE_CHECKING:  # the obstacle study builds on the landing study, which builds on this one
+    from alte.studies.obstacles import ObstacleOptions, ObstacleScores
+
 __all__ = ["CACHE_DIR", "Measured", "ground_truth", "measure", "sweep", "terrain"]
 
 #: Where registrations are cached, inside the data folder (``DATA_DIR/.cache``).
@@ -43,10 +47,11 @@ CACHE_DIR = ".cache"
 
 @dataclass(eq=False)
 class Measured:
-    """A map run and its metrics."""
+    """A map run, its metrics and, when asked, its obstacle identification."""
 
     run: MapRun
     metrics: MapMetrics
+    obstacles: ObstacleScores | None = None
 
     @property
     def mapper(self) -> Mapper:
@@ -94,16 +99,27 @@ def ground_truth(data: Registered) -> GroundTruth | None:
 
 def measure(data: Registered, mapper: str, params: Mapping[str, object] | None = None, *,
             truth: TruthOptions | None = None, spec: MapSpec | None = None,
-            set_b: str = "corners", progress: bool = False) -> Measured:
+            set_b: str = "corners", obstacles: ObstacleOptions | None = None,
+            progress: bool = False) -> Measured:
     """Map ``data`` with ``mapper`` and ``params`` and measure it (``truth``: also against
     the true surface; ``set_b``: the map's points of HD/MHD, see
-    :data:`alte.metrics.maps.SET_B`). ``spec`` replaces the default map specification."""
+    :data:`alte.metrics.maps.SET_B`; ``obstacles``: also identify the terrain's true
+    obstacles, :mod:`alte.studies.obstacles`, on a simulated terrain). ``spec`` replaces
+    the default map specification."""
     chosen = spec or MapSpec(mapper, dict(params or {}))
     result = run(data, chosen, progress=progress)
+    cells = result.mapper.cells()  # listed once for every metric
     metrics = measure_map(result.mapper, data.cloud, elapsed_s=result.elapsed_s,
                           truth=ground_truth(data) if truth is not None else None,
-                          options=truth, set_b=set_b)
-    return Measured(result, metrics)
+                          options=truth, set_b=set_b, cells=cells)
+    scores = None
+    if obstacles is not None and ground_truth(data) is not None:
+        from alte.studies.obstacles import identify, map_raster, terrain_obstacles
+
+        known = terrain_obstacles(str(data.source.path), obstacles)
+        scores = identify(map_raster(cells, result.mapper.dims, known.grid,
+                                     obstacles.min_height), known)
+    return Measured(result, metrics, scores)
 
 
 def sweep(data: Registered, table: int, rows: Sequence[int] | None = None, *,

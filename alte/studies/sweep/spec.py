@@ -57,6 +57,8 @@ class SweepSettings(Record):
                                 "voxel filter of the registered cloud (m; None: unfiltered)")
     data_dir: str = param("data", help="folder of the simulated terrains")
     output: str | None = param(None, help="results folder (default: reports/sweeps/NAME)")
+    obstacles: bool = param(False, help="also score each map's obstacle identification "
+                                        "against the simulator's objects")
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -89,10 +91,11 @@ class SweepRun:
     truth: TruthOptions = field(default_factory=TruthOptions)
     domain: str = "auto"
     set_b: str = "corners"
+    obstacles: bool = False
 
     def key(self) -> dict[str, Any]:
-        """Everything that determines the run's result, JSON-ready (``domain`` and
-        ``set_b`` only when not the default, so earlier runs keep their ids)."""
+        """Everything that determines the run's result, JSON-ready (``domain``, ``set_b``
+        and ``obstacles`` only when not the default, so earlier runs keep their ids)."""
         key = {"terrain": self.terrain, "frames": self.frames, "seed": self.seed,
                "mapper": self.mapper, "params": dict(sorted(self.params.items())),
                "voxel": self.voxel, "truth": dataclasses.asdict(self.truth)}
@@ -100,6 +103,8 @@ class SweepRun:
             key["domain"] = self.domain
         if self.set_b != "corners":
             key["set_b"] = self.set_b
+        if self.obstacles:
+            key["obstacles"] = True
         return key
 
     @property
@@ -133,6 +138,7 @@ class SweepSpec:
     truth: TruthOptions = field(default_factory=TruthOptions)
     source: str = "spec"
     variants: tuple[Variant, ...] = ()
+    obstacles: bool = False
 
 
 def _fail(source: str, key: str, message: str) -> ParameterError:
@@ -238,7 +244,8 @@ def parse_spec(raw: Any, source: str = "spec") -> SweepSpec:
         output=settings.output or f"reports/sweeps/{name}",
         truth=_truth(source, raw.get("truth")), source=source,
         variants=parse_variants(source, raw.get("variants"), terrains,
-                                tuple(g.mapper for g in mappers)))
+                                tuple(g.mapper for g in mappers)),
+        obstacles=settings.obstacles)
 
 
 def load_spec(path: str | os.PathLike[str]) -> SweepSpec:
@@ -260,7 +267,8 @@ def _variant_runs(spec: SweepSpec, variant: Variant) -> list[SweepRun]:
     terrains = variant.terrains or spec.terrains
     return [SweepRun(terrain, spec.frames, seed, grid.mapper,
                      variant.params_for(grid.mapper, params), spec.voxel, spec.truth,
-                     variant.domain_for(grid.mapper), variant.set_b_for(grid.mapper))
+                     variant.domain_for(grid.mapper), variant.set_b_for(grid.mapper),
+                     spec.obstacles)
             for seed in spec.seeds for terrain in spec.terrains if terrain in terrains
             for grid in spec.mappers if terrain in grid.terrains for params in grid.rows]
 
