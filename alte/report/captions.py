@@ -114,6 +114,15 @@ FIGURES: dict[str, dict[str, Caption]] = {
         "tradeoff_time": Caption("Mapping time against map size",
                                  "Time spent in the mapper calls only. " + _FRONT),
         "tradeoff_memory": Caption("MHD against memory", _FRONT),
+        "tradeoff_obstacle_recall": Caption(
+            "Obstacle recall against map size",
+            "Share of the true obstacles the map shows (simulator objects standing at least "
+            "the landing study's obstacle step above the ground, 0.3 m at urban scale and "
+            "0.06 m in the lab, seen from above; higher is better). " + _FRONT),
+        "tradeoff_obstacle_precision": Caption(
+            "Obstacle precision against map size",
+            "Share of the map's obstacles (connected areas more than that step above its "
+            "ground) that lie on a true object (higher is better). " + _FRONT),
         "tradeoff_ablation_2d": Caption(
             "2D maps with one thing changed",
             "MHD against basis functions of Quadtree and 2D-ALTE on a landing terrain, one "

@@ -2,7 +2,9 @@
 fidelity, and ablations (what moves a verdict when one thing changes).
 
 :func:`write_evidence` is the one call the chapter 5 notebook makes: it evaluates every
-claim on the trade-off table and writes ``claims.csv`` (the front page's claims table),
+claim on the trade-off table and writes ``claims.csv`` (the front page's claims table;
+for a claim that depends, ``condition`` says where it holds and where not,
+:mod:`alte.studies.conditions`),
 ``claims_cells.csv`` (every number behind the verdicts), ``equal_size.csv`` and
 ``equal_fidelity.csv`` (each case's two mappers read off their fronts; mean over seeds
 with bootstrap intervals) and their headline rows with units in the headers
@@ -21,6 +23,7 @@ from typing import Any
 import pandas as pd
 
 from alte.studies.claims import CLAIMS, Claim
+from alte.studies.conditions import conditions
 from alte.studies.evidence import (
     EvidenceOptions,
     Finding,
@@ -124,13 +127,18 @@ def key_table(summary: pd.DataFrame, metric: str, level: str, value: str) -> pd.
 
 def write_evidence(table: pd.DataFrame, tables_dir: str | os.PathLike[str], *,
                    claims: Sequence[Claim] = CLAIMS, options: EvidenceOptions | None = None,
+                   variants: pd.DataFrame | None = None,
                    overwrite: bool = True) -> EvidenceFiles:
-    """Evaluate ``claims`` on the trade-off ``table`` and write the evidence CSVs (see the
-    module docstring) into ``tables_dir``."""
-    findings = evaluate_all(claims, table, options)
+    """Evaluate ``claims`` on the trade-off ``table`` (and the ablation ``variants``' rows,
+    for the claims that contrast them) and write the evidence CSVs (see the module
+    docstring) into ``tables_dir``."""
+    findings = evaluate_all(claims, table, options, variants)
     at_size, at_fidelity = comparison_tables(table, options=options)
+    verdicts = claims_table(findings)
+    verdicts.insert(list(verdicts.columns).index("depends_on") + 1, "condition",
+                    conditions(findings))
     paths = [write_csv(frame, tables_dir, name, overwrite=overwrite) for frame, name in (
-        (claims_table(findings), "claims"), (cells_table(findings), "claims_cells"),
+        (verdicts, "claims"), (cells_table(findings), "claims_cells"),
         (at_size, "equal_size"), (at_fidelity, "equal_fidelity"),
         (key_table(at_size, "mhd_m", "basis_functions", "mhd_m"), "key_equal_size"),
         (key_table(at_fidelity, "basis_functions", "mhd_m", "basis_functions"),

@@ -143,7 +143,8 @@ def ablations(grid: Grid, claims: Sequence[Claim] = CLAIMS,
                                                         "size": "occupied_cells"}))}
     tables[THESIS_ROWS] = (thesis_rows(prepare(base)), options)
     tables |= {v.name: (here[here["variant"] == v.name], options) for v in grid.spec.variants}
-    findings = {name: evaluate_all(claims, table, opts) for name, (table, opts) in tables.items()}
+    findings = {name: evaluate_all(claims, table, opts, rows)
+                for name, (table, opts) in tables.items()}
     cells = [cells_table(found).assign(variant=name) for name, found in findings.items()]
     return ablation_verdicts(claims, findings), pd.concat(cells, ignore_index=True)
 

@@ -55,7 +55,8 @@ def setting_text(params: Any) -> str:
 
 
 def _scored(grid: pd.DataFrame) -> pd.DataFrame:
-    if "obstacle_recall" not in grid:
+    """The rows of maps scored against at least one true obstacle."""
+    if not {"obstacles_true", OBJECTS_COLUMN} <= set(grid.columns):
         return grid.iloc[0:0]
     return grid[grid["obstacles_true"].fillna(0) > 0]
 

@@ -75,6 +75,13 @@ def test_true_obstacles_are_the_tall_objects_seen_from_above(truth):
 def test_truth_needs_classes_and_checks_its_options():
     with pytest.raises(MetricsError, match="no object classes"):
         true_obstacles(_surface(classes=False), BOUNDS, OPTIONS)
+    b = SceneBuilder()
+    b.slab("roof", "building", (0.0, 0.0), (40.0, 40.0), z=(0.0, 2.0))  # covers everything
+    scene = b.build()
+    roofed = TrueSurface(scene.vertices, scene.triangles, scene.object_ids, scene.labels,
+                         scene.classes)
+    with pytest.raises(MetricsError, match="no pixel sees the ground"):
+        true_obstacles(roofed, BOUNDS, OPTIONS)
     with pytest.raises(ParameterError, match="min_height=0"):
         ObstacleOptions(min_height=0.0)
     assert obstacle_options("exp_lan_1") == ObstacleOptions(min_height=0.06, step=0.05)
@@ -141,4 +148,4 @@ def test_tables_from_grid_rows(truth, tmp_path):
     assert obstacle_columns(None) == {}
     paths = write_obstacle_tables(grid, tmp_path)
     assert [p.name for p in paths] == ["obstacles.csv", "obstacle_objects.csv"]
-    assert write_obstacle_tables(grid.drop(columns="obstacle_recall"), tmp_path / "no") == []
+    assert write_obstacle_tables(grid.drop(columns="obstacles_true"), tmp_path / "no") == []
