@@ -9,7 +9,7 @@ draws them.
 
 from alte.studies.realdata.data import (
     BASELINE,
-    SAMPLES,
+    ISPRS_FOLDER,
     GroundRun,
     IsprsSample,
     RealData,
@@ -18,6 +18,7 @@ from alte.studies.realdata.data import (
     ground_runs,
     ground_table,
     isprs_sample,
+    isprs_samples,
     locate,
     map_runs,
     map_table,
@@ -36,7 +37,7 @@ from alte.studies.realdata.ground import (
 
 __all__ = [
     "BASELINE",
-    "SAMPLES",
+    "ISPRS_FOLDER",
     "GroundRun",
     "IsprsSample",
     "RealData",
@@ -47,6 +48,7 @@ __all__ = [
     "ground_runs",
     "ground_table",
     "isprs_sample",
+    "isprs_samples",
     "locate",
     "map_heights",
     "map_runs",
