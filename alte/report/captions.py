@@ -156,6 +156,13 @@ FIGURES: dict[str, dict[str, Caption]] = {
     "ch6_real_data": {
         "fig_6_1_ground_filter": Caption("Ground filter (fig. 6.1)",
                                          "Ground filter errors on the ISPRS samples."),
+        "tradeoff_real": Caption(
+            "The fronts on a real sequence (balm_seq)",
+            "Real scans mapped with their reference poses (bundle adjustment): every map one "
+            "dot, the line each mapper's Pareto front (one recording: no seeds, no band). "
+            "MHD is the thesis' metric against the cloud the map was made from; height RMSE, "
+            "mean accuracy and completeness are measured against the reference cloud (every "
+            "scan with its reference pose), the real stand-in for the simulator's truth."),
     },
     "ch7_landing": {
         "fig_landing_sites": Caption(

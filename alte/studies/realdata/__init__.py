@@ -3,8 +3,9 @@
 :mod:`~alte.studies.realdata.data` locates the folder (skipping cleanly when it is absent),
 loads the ISPRS airborne samples, the OctoMap scan and the VLP-16 packet bag, runs
 the mappers and tabulates them; :mod:`~alte.studies.realdata.ground` is the map-based ground
-filter and its Sithole & Vosselman (2004) scores; :mod:`~alte.plot.realdata`
-draws them.
+filter and its Sithole & Vosselman (2004) scores; :mod:`~alte.studies.realdata.fronts`
+maps a real sequence with reference poses over a grid of settings (the trade-off fronts on
+real data); :mod:`~alte.plot.realdata` draws them.
 """
 
 from alte.studies.realdata.data import (
@@ -27,6 +28,15 @@ from alte.studies.realdata.data import (
     vlp16_dataset,
     write_csv,
 )
+from alte.studies.realdata.fronts import (
+    FRONT_COLUMNS,
+    FRONT_GRID,
+    SEQUENCE,
+    RealSequence,
+    front_table,
+    reference_metrics,
+    sequence_data,
+)
 from alte.studies.realdata.ground import (
     classify_ground,
     ground_errors,
@@ -37,13 +47,18 @@ from alte.studies.realdata.ground import (
 
 __all__ = [
     "BASELINE",
+    "FRONT_COLUMNS",
+    "FRONT_GRID",
     "ISPRS_FOLDER",
+    "SEQUENCE",
     "GroundRun",
     "IsprsSample",
     "RealData",
+    "RealSequence",
     "classify_ground",
     "dataset_summary",
     "default_dir",
+    "front_table",
     "ground_errors",
     "ground_runs",
     "ground_table",
@@ -55,8 +70,10 @@ __all__ = [
     "map_table",
     "opened_surface",
     "reference_labels",
+    "reference_metrics",
     "results",
     "scan_dataset",
+    "sequence_data",
     "vlp16_dataset",
     "write_csv",
 ]
