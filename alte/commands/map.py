@@ -28,7 +28,8 @@ __all__ = ["add_map_options", "add_parser", "export_options", "map_spec", "mappe
 _SUMMARY_KEYS = ("mapper", "params", "input", "input_kind", "pose_source", "domain_policy",
                  "domain", "feed",
                  "frames", "points", "points_dropped_nonfinite", "points_dropped_crop",
-                 "points_outside", "local_origin", "elapsed_s", "wall_s", "basis_functions",
+                 "points_outside", "local_origin", "elapsed_s", "cpu_s", "cost", "cost_unit",
+                 "wall_s", "basis_functions",
                  "occupied_cells", "memory_bytes", "metrics", "export", "mcap")
 
 
@@ -99,10 +100,12 @@ def _summary(result: MapRun, metrics: bool) -> dict[str, object]:
     out = result.summary()
     if metrics:
         from alte.metrics.maps import measure_map
+        from alte.metrics.timing import Timing
 
         source = open_input(result.info.input)
         assert result.cloud is not None  # run(..., cloud=True) kept it for the metrics
-        out["metrics"] = measure_map(result.mapper, result.cloud, elapsed_s=result.elapsed_s,
+        timing = Timing.of([result.elapsed_s], [result.cpu_s])  # one run, no spread
+        out["metrics"] = measure_map(result.mapper, result.cloud, elapsed_s=timing,
                                      truth=source.ground_truth()).as_dict()
     return out
 

@@ -30,7 +30,7 @@ import numpy as np
 
 from alte.errors import MapperError
 from alte.mappers._octree import check_origin
-from alte.mappers.base import CellCounts, Cells, Feed, check_points
+from alte.mappers.base import CellCounts, Cells, Cost, Feed, check_points
 from alte.mappers.domain import Domain, DomainUse, check_domain
 from alte.params import Record, param
 from alte.types import Box
@@ -84,6 +84,7 @@ class Alte3D:
     default_feed: ClassVar[Feed] = Feed.FRAMES
     exports: ClassVar[frozenset[str]] = frozenset({".npz"})
     free_space: ClassVar[bool] = False
+    cost_unit: ClassVar[Cost] = Cost.CELL_UPDATES
     Params: ClassVar[type[Record]] = Alte3DParams
 
     def __init__(self, domain: Domain | None = None, **given: object) -> None:
@@ -99,6 +100,7 @@ class Alte3D:
         levels = self._params["max_res"] + 1
         self._keys = [np.empty(0, dtype=np.int64) for _ in range(levels)]
         self._counts = [np.empty(0, dtype=np.int64) for _ in range(levels)]
+        self._cost = 0
 
     @property
     def params(self) -> Record:
@@ -143,8 +145,10 @@ class Alte3D:
         if finest.size == 0:
             return
         max_res = self._params["max_res"]
+        self._cost += finest.size
         for level in range(max_res + 1):
             keys, counts = np.unique(self._at_level(finest, max_res - level), return_counts=True)
+            self._cost += keys.size
             self._keys[level], self._counts[level] = _merge(
                 self._keys[level], self._counts[level], keys, counts
             )
@@ -227,6 +231,11 @@ class Alte3D:
     @property
     def basis_functions(self) -> int:
         return len(self.cells())
+
+    @property
+    def cost(self) -> int:
+        """Points located plus cell counts written on every level (:class:`Cost`)."""
+        return self._cost
 
     @property
     def memory_bytes(self) -> int:

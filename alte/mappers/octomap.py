@@ -25,7 +25,7 @@ from alte.fsutil import atomic_path
 from alte.mappers._octomap_backends import NativeTree, ReferenceTree, SensorModel, tree_leaves
 from alte.mappers._octree import Leaves, check_origin, leaf_geometry
 from alte.mappers._raycast import TREE_DEPTH, TREE_MAX_VAL
-from alte.mappers.base import CellCounts, Cells, Feed, check_points
+from alte.mappers.base import CellCounts, Cells, Cost, Feed, check_points
 from alte.mappers.domain import Domain, DomainUse
 from alte.params import Record, param
 from alte.types import rows_all
@@ -56,6 +56,8 @@ class _Backend(Protocol):
     def num_leaves(self) -> int: ...
     @property
     def memory_bytes(self) -> int: ...
+    @property
+    def cost(self) -> int: ...
 
 
 #: Backend by name, built from (voxel size, max range, sensor model).
@@ -126,6 +128,7 @@ class Octomap:
     default_feed: ClassVar[Feed] = Feed.FRAMES
     exports: ClassVar[frozenset[str]] = frozenset({".npz", ".bt"})
     free_space: ClassVar[bool] = True
+    cost_unit: ClassVar[Cost] = Cost.RAY_STEPS
     Params: ClassVar[type[Record]] = OctomapParams
 
     def __init__(self, domain: Domain | None = None, **given: object) -> None:
@@ -206,6 +209,11 @@ class Octomap:
     @property
     def basis_functions(self) -> int:
         return self._tree.num_leaves
+
+    @property
+    def cost(self) -> int:
+        """Ray steps: voxels crossed by every ray plus its end voxel (:class:`Cost`)."""
+        return self._tree.cost
 
     @property
     def memory_bytes(self) -> int:

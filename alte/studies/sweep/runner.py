@@ -25,6 +25,7 @@ import pandas as pd
 from tqdm.auto import tqdm
 
 from alte.errors import ParameterError, SimulationError
+from alte.mappers import mapper_class
 from alte.pipeline import DomainPolicy, FrameSpec, MapSpec, Registered, open_input, prepare
 from alte.sim import ensure_terrain, terrain_folder
 from alte.studies.experiments import CACHE_DIR, measure
@@ -70,8 +71,9 @@ def _dataset(folder: str, frames: int | None, voxel: float | None, data_dir: str
 
 
 def run_one(run: SweepRun, data_dir: str) -> dict[str, Any]:
-    """Map one run's terrain and return its flat row (keys, ``p_*`` params, metrics, and
-    its cost: ``wall_s`` and ``cpu_s``, the CPU seconds of every thread of the process,
+    """Map one run's terrain and return its flat row (keys, ``p_*`` params, metrics, the
+    map's time and machine-independent ``cost`` with its ``cost_unit``, and the whole
+    run's cost: ``wall_s`` and ``cpu_s``, the CPU seconds of every thread of the process,
     which other load on the machine does not inflate)."""
     start, cpu = time.perf_counter(), time.process_time()
     folder = terrain_folder(data_dir, run.terrain, run.frames, run.seed)
@@ -89,6 +91,7 @@ def run_one(run: SweepRun, data_dir: str) -> dict[str, Any]:
         "frames": len(data), "points": len(data.cloud),
         **{k: v for k, v in metrics.items() if k != "elapsed_s"},
         **obstacle_columns(found.obstacles),
+        "cost_unit": mapper_class(run.mapper).cost_unit.value,
         "elapsed_s": float(metrics["elapsed_s"]), "wall_s": time.perf_counter() - start,
         "cpu_s": time.process_time() - cpu,
     }
