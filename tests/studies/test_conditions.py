@@ -104,6 +104,6 @@ def test_a_contrast_reads_the_ablation_rows_and_lacks_data_without_them():
 def test_claims_csv_carries_the_condition_column(tmp_path):
     files = write_evidence(_split(), tmp_path, claims=[_claim(MHD_AT_SIZE)])
     out = pd.read_csv(files.claims, keep_default_na=False)
-    assert list(out.columns[:6]) == ["claim", "section", "verdict", "evidence", "depends_on",
-                                     "condition"]
+    assert list(out.columns[:7]) == ["claim", "section", "verdict", "evidence", "depends_on",
+                                     "condition", "question"]
     assert out["condition"].iloc[0].startswith("holds on sim_lan_1")
