@@ -30,6 +30,7 @@ from alte.studies.answer.choose import (
     choose,
 )
 from alte.studies.answer.orders import Order, agreement, metric_words, order
+from alte.studies.thesis import TERRAIN_CASE
 from alte.studies.tradeoff import MAPPER_NAMES, METRICS
 from alte.studies.uncertainty import Interval
 
@@ -91,10 +92,10 @@ def interval_text(interval: Interval, metric: str) -> str:
 
 def pick_text(pick: Pick, use: Use) -> str:
     """A pick's figures: truth, second metric, MHD with intervals, size and time."""
+    time = f", {pick.ms:.2g} ms per scan" if np.isfinite(pick.ms) else ""
     return (f"{metric_words(use.truth)} {interval_text(pick.truth, use.truth)}, "
             f"{metric_words(use.second)} {interval_text(pick.second, use.second)}, "
-            f"MHD {interval_text(pick.mhd, 'mhd_m')}; {pick.size:,.0f} basis functions, "
-            f"{pick.ms:.2g} ms per scan")
+            f"MHD {interval_text(pick.mhd, 'mhd_m')}; {pick.size:,.0f} basis functions{time}")
 
 
 def _summary(use: Use, choices: Sequence[Choice]) -> str:
@@ -136,10 +137,13 @@ def _metrics(use: Use, table: pd.DataFrame) -> list[str]:
 
 
 def _use_answer(grid: pd.DataFrame, real: pd.DataFrame | None, use: Use) -> UseAnswer:
-    mine = grid[grid["case"] == use.case] if "case" in grid else grid
+    cases = grid["case"] if "case" in grid else grid["terrain"].map(TERRAIN_CASE)
+    mine = grid[cases == use.case]
     choices = []
     for group, prefix in GROUPS.items():
         terrains = sorted({t for t in mine["terrain"].astype(str) if t.startswith(prefix)})
+        if not terrains:
+            continue
         pool = candidates(mine, use, group)
         choices += [choose(pool, use, group, terrains, b) for b in budgets(pool, use)]
     orders = [order(mine, use, m) for m in _metrics(use, mine)]

@@ -117,9 +117,10 @@ class Choice:
 
 def ms_per_scan(table: pd.DataFrame) -> pd.Series:
     """Milliseconds of mapping per scan: the mapper's CPU time (wall time for tables
-    without it) over the scans mapped."""
+    without it) over the scans mapped (NaN where the table does not say how many)."""
     seconds = table["map_cpu_s"] if "map_cpu_s" in table else table["elapsed_s"]
-    return 1000.0 * seconds.astype(float) / table["frames"].astype(float)
+    frames = table["frames"] if "frames" in table else pd.Series(np.nan, index=table.index)
+    return 1000.0 * seconds.astype(float) / frames.astype(float)
 
 
 def candidates(table: pd.DataFrame, use: Use, group: str) -> pd.DataFrame:
