@@ -41,6 +41,10 @@ def add_frame_options(p: argparse.ArgumentParser, *, origin: bool = False) -> No
                         "(LiDAR odometry, kiss-icp), refine (recorded, aligned scan to map), "
                         "identity (static sensor); default: recorded, or odometry when the "
                         "bag has no pose topic")
+    p.add_argument("--no-deskew", action="store_true",
+                   help="register each point where it was taken, even when the cloud has "
+                        "per-point time (default: move it to the scan stamp with the "
+                        "sensor's motion)")
     p.add_argument("--no-pose", action="store_true",
                    help="ignore poses: identity body pose for every scan (= --poses identity)")
     p.add_argument("--max-rate", type=float, default=None, metavar="RAD_S",
@@ -109,6 +113,6 @@ def frame_spec(args: argparse.Namespace) -> FrameSpec:
         frames=args.frames, voxel=args.voxel,
         crop=parse_box(args.crop) if args.crop else None, mount=mount,
         cloud_topic=args.cloud_topic, pose_topic=args.pose_topic,
-        poses=poses,
+        poses=poses, deskew=not args.no_deskew,
         max_rate=args.max_rate, max_offset=args.max_offset,
         origin=parse_origin(args.origin) if getattr(args, "origin", None) else (0.0, 0.0, 0.0))

@@ -20,7 +20,7 @@ from tqdm.auto import tqdm
 
 from alte.errors import BagError, ParameterError, PoseError, TopicError
 from alte.io.messages import PointCloud2Msg, StampedMsg, VelodyneScanMsg
-from alte.io.pointcloud2 import decode_pointcloud2
+from alte.io.pointcloud2 import decode_pointcloud2_timed
 from alte.io.pose import POSE_TYPES, PoseTrack, header_stamp, pose_records, select_tf_child
 from alte.io.reader import (
     CLOUD_TYPES,
@@ -116,13 +116,15 @@ def _resolve_mount(static: Mount | None, mount: Mount | None, notes: list[str]) 
     return Mount()
 
 
-def _decode(msg: object, msgtype: str, topic: str, return_mode: str) -> tuple[np.ndarray, int]:
-    """Points of one cloud-topic message; ``msgtype`` names the class rosbags built."""
+def _decode(msg: object, msgtype: str, topic: str,
+            return_mode: str) -> tuple[np.ndarray, int, np.ndarray | None]:
+    """Points of one cloud-topic message, dropped count and per-point time (s from the
+    stamp, when the cloud has a time field); ``msgtype`` names the class rosbags built."""
     if msgtype == SCAN_TYPE:
         from alte.io.velodyne import decode_velodyne_scan
 
-        return decode_velodyne_scan(cast(VelodyneScanMsg, msg), return_mode), 0
-    return decode_pointcloud2(cast(PointCloud2Msg, msg), topic)
+        return decode_velodyne_scan(cast(VelodyneScanMsg, msg), return_mode), 0, None
+    return decode_pointcloud2_timed(cast(PointCloud2Msg, msg), topic)
 
 
 def evenly_spaced(total: int, limit: int | None) -> frozenset[int] | None:
@@ -238,12 +240,12 @@ def _scan_frames(reader: AnyReader, stream: FrameStream, counts: ReadCounts,
         pose = _pose_at(stream.track, stamp, opts.max_gap_s, counts)
         if pose is None:
             continue
-        points, dropped = _decode(msg, msgtype, topic, opts.return_mode)
+        points, dropped, times = _decode(msg, msgtype, topic, opts.return_mode)
         counts.points_nonfinite += dropped
         if points.shape[0] == 0:
             counts.scans_empty += 1
             continue
-        yield Frame(stamp, points, *pose, dropped_points=dropped)
+        yield Frame(stamp, points, *pose, dropped_points=dropped, times=times)
 
 
 def _raise_empty(stream: FrameStream, counts: ReadCounts, stamps: _StampRange) -> None:

@@ -21,8 +21,10 @@ if TYPE_CHECKING:  # rosbags declares MsgType (its message classes' type) for ch
 
 __all__ = [
     "POINTFIELD_DTYPES",
+    "TIME_FIELDS",
     "CoordType",
     "decode_pointcloud2",
+    "decode_pointcloud2_timed",
     "encode_pointcloud2",
     "make_header",
 ]
@@ -42,6 +44,10 @@ POINTFIELD_DTYPES: dict[int, np.dtype] = {
 CoordType = type[np.float32] | type[np.float64]
 _CODES = {dt: code for code, dt in POINTFIELD_DTYPES.items()}
 _XYZ = ("x", "y", "z")
+#: Per-point time fields, by driver: ``time`` (Velodyne: float32 s from the stamp), ``t``
+#: (Ouster: uint32 ns from the stamp), ``timestamp`` (Hesai, Robosense: float64 absolute s;
+#: Livox: absolute ns), ``offset_time`` (Livox: uint32 ns from the stamp).
+TIME_FIELDS = ("time", "t", "timestamp", "offset_time")
 
 
 def _xyz_dtype(msg: PointCloud2Msg, topic: str) -> np.dtype:
@@ -106,19 +112,55 @@ def decode_pointcloud2(msg: PointCloud2Msg, topic: str = "PointCloud2") -> tuple
     missing returns that way) are dropped and counted. ``topic`` names the source
     in error messages.
     """
+    points, dropped, _ = decode_pointcloud2_timed(msg, topic, times=False)
+    return points, dropped
+
+
+def decode_pointcloud2_timed(msg: PointCloud2Msg, topic: str = "PointCloud2", *,
+                             times: bool = True) -> tuple[np.ndarray, int, np.ndarray | None]:
+    """As :func:`decode_pointcloud2`, plus each kept point's time in seconds from the header
+    stamp (None when the cloud has no :data:`TIME_FIELDS` field, or ``times`` is False)."""
     dtype = _xyz_dtype(msg, topic)
     payload = _payload(msg, topic)
     count = int(msg.width) * int(msg.height)
     if count == 0:
-        return np.empty((0, 3)), 0
+        return np.empty((0, 3)), 0, None
     records = np.frombuffer(payload, dtype=dtype, count=count)
     points = np.empty((count, 3), dtype=np.float64)
     for axis, name in enumerate(_XYZ):
         points[:, axis] = records[name]
+    stamps = _point_times(msg, payload, count) if times else None
     finite = finite_rows(points)
     if finite is None:
-        return points, 0
-    return points[finite], int(count - np.count_nonzero(finite))
+        return points, 0, stamps
+    kept = None if stamps is None else stamps[finite]
+    return points[finite], int(count - np.count_nonzero(finite)), kept
+
+
+def _point_times(msg: PointCloud2Msg, payload: np.ndarray, count: int) -> np.ndarray | None:
+    """Seconds from the header stamp of each point, from the first time field present.
+
+    Integer fields are nanoseconds; float fields seconds (nanoseconds above 1e15).
+    Values larger than 1e8 s are absolute (since the epoch) and are made relative.
+    """
+    fields = {f.name: f for f in msg.fields}
+    name = next((n for n in TIME_FIELDS if n in fields), None)
+    if name is None:
+        return None
+    field = fields[name]
+    base = POINTFIELD_DTYPES.get(int(field.datatype))
+    if base is None:
+        return None
+    order: Literal[">", "<"] = ">" if msg.is_bigendian else "<"
+    view = np.dtype({"names": [name], "formats": [base.newbyteorder(order)],
+                     "offsets": [int(field.offset)], "itemsize": int(msg.point_step)})
+    raw = np.frombuffer(payload, dtype=view, count=count)[name].astype(np.float64)
+    scale = 1e-9 if base.kind in "iu" or np.nanmax(np.abs(raw)) > 1e15 else 1.0
+    seconds = raw * scale
+    if np.nanmedian(np.abs(seconds)) > 1e8:
+        stamp = msg.header.stamp
+        seconds = seconds - (int(stamp.sec) + int(stamp.nanosec) * 1e-9)
+    return seconds
 
 
 def encode_pointcloud2(

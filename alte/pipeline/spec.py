@@ -64,7 +64,9 @@ class FrameSpec:
     ``voxel`` (m): per-frame grid average and the merged cloud's box grid; ``crop``:
     the control volume points are kept in; ``origin``: the sensor position of a point
     file; ``max_rate`` (rad/s) / ``max_offset`` (s): the fast-manoeuvre filter;
-    ``odometry``: how odometry and refinement align scans (``poses`` odometry, refine).
+    ``odometry``: how odometry and refinement align scans (``poses`` odometry, refine);
+    ``deskew``: move the points of a cloud with per-point time to its stamp with the
+    sensor's motion (:mod:`alte.registration.deskew`; False: register them as taken).
     """
 
     frames: int | None = None
@@ -78,6 +80,7 @@ class FrameSpec:
     max_offset: float | None = None
     origin: tuple[float, float, float] = (0.0, 0.0, 0.0)
     odometry: OdometryParams = field(default_factory=OdometryParams)
+    deskew: bool = True
 
     def __post_init__(self) -> None:
         if self.frames is not None and (isinstance(self.frames, bool)
@@ -102,7 +105,7 @@ class FrameSpec:
                 "cloud_topic": self.cloud_topic, "pose_topic": self.pose_topic,
                 "poses": self.poses.value, "max_rate": self.max_rate,
                 "max_offset": self.max_offset, "origin": list(self.origin),
-                "odometry": self.odometry.as_dict()}
+                "odometry": self.odometry.as_dict(), "deskew": self.deskew}
 
 
 @dataclass(frozen=True)

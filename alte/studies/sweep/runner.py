@@ -28,6 +28,7 @@ from alte.errors import ParameterError, SimulationError
 from alte.mappers import mapper_class
 from alte.pipeline import DomainPolicy, FrameSpec, MapSpec, Registered, open_input, prepare
 from alte.sim import ensure_terrain, terrain_folder
+from alte.sim.profile import PROFILES
 from alte.studies.experiments import CACHE_DIR, measure
 from alte.studies.obstacles import obstacle_columns, obstacle_options
 from alte.studies.sweep.spec import SweepRun, SweepSettings, SweepSpec, plan_runs, plan_variants
@@ -64,9 +65,10 @@ class SweepResult:
 
 
 @functools.lru_cache(maxsize=2)
-def _dataset(folder: str, frames: int | None, voxel: float | None, data_dir: str) -> Registered:
+def _dataset(folder: str, frames: int | None, voxel: float | None, data_dir: str,
+             deskew: bool = True) -> Registered:
     """Per-process memo over the on-disk registration cache (``DATA_DIR/.cache``)."""
-    return prepare(open_input(folder), FrameSpec(frames=frames, voxel=voxel),
+    return prepare(open_input(folder), FrameSpec(frames=frames, voxel=voxel, deskew=deskew),
                    cache=Path(data_dir) / CACHE_DIR)
 
 
@@ -76,8 +78,8 @@ def run_one(run: SweepRun, data_dir: str) -> dict[str, Any]:
     run's cost: ``wall_s`` and ``cpu_s``, the CPU seconds of every thread of the process,
     which other load on the machine does not inflate)."""
     start, cpu = time.perf_counter(), time.process_time()
-    folder = terrain_folder(data_dir, run.terrain, run.frames, run.seed)
-    data = _dataset(str(folder), run.frames, run.voxel, data_dir)
+    folder = terrain_folder(data_dir, run.terrain, run.frames, run.seed, PROFILES[run.sensor])
+    data = _dataset(str(folder), run.frames, run.voxel, data_dir, run.deskew)
     spec = MapSpec(run.mapper, dict(run.params), domain=DomainPolicy(run.domain))
     found = measure(data, run.mapper, truth=run.truth, spec=spec, set_b=run.set_b,
                     obstacles=obstacle_options(run.terrain) if run.obstacles else None)
@@ -87,7 +89,7 @@ def run_one(run: SweepRun, data_dir: str) -> dict[str, Any]:
         "seed": run.seed, "mapper": run.mapper,
         "params_json": json.dumps(dict(run.params), sort_keys=True),
         **{f"p_{k}": v for k, v in run.params.items()},
-        "domain": run.domain, "set_b": run.set_b,
+        "domain": run.domain, "set_b": run.set_b, "sensor": run.sensor, "deskew": run.deskew,
         "frames": len(data), "points": len(data.cloud),
         **{k: v for k, v in metrics.items() if k != "elapsed_s"},
         **obstacle_columns(found.obstacles),
@@ -97,11 +99,11 @@ def run_one(run: SweepRun, data_dir: str) -> dict[str, Any]:
     }
 
 
-def _ensure(item: tuple[str, int | None, int, float | None], data_dir: str) -> str:
+def _ensure(item: tuple[str, int | None, int, float | None, str, bool], data_dir: str) -> str:
     """Simulate the terrain if needed and register it into the cache (once per item)."""
-    terrain, frames, seed, voxel = item
-    folder = ensure_terrain(terrain, data_dir, seed, frames)
-    prepare(open_input(folder), FrameSpec(frames=frames, voxel=voxel),
+    terrain, frames, seed, voxel, sensor, deskew = item
+    folder = ensure_terrain(terrain, data_dir, seed, frames, profile=PROFILES[sensor])
+    prepare(open_input(folder), FrameSpec(frames=frames, voxel=voxel, deskew=deskew),
             cache=Path(data_dir) / CACHE_DIR)
     return str(folder)
 
@@ -161,7 +163,8 @@ def _executor(scheduler: str, workers: int) -> Iterator[MapUnordered]:
 
 def _ensure_all(pool: MapUnordered, runs: Sequence[SweepRun], data_dir: str,
                 progress: bool) -> None:
-    items = sorted({(r.terrain, r.frames, r.seed, r.voxel) for r in runs}, key=str)
+    items = sorted({(r.terrain, r.frames, r.seed, r.voxel, r.sensor, r.deskew) for r in runs},
+                   key=str)
     bar = tqdm(total=len(items), desc="terrains", unit="terrain", disable=not progress)
     with bar:
         for i, _, err in pool(_ensure, items, data_dir):
