@@ -12,17 +12,15 @@ sequence (whether the real data agree).
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from dataclasses import dataclass, field
 
-import numpy as np
 import pandas as pd
 
 from alte.studies.answer.choose import Use
 from alte.studies.tradeoff import MAPPER_NAMES, equal_size, label, prepare
 from alte.studies.uncertainty import bootstrap_ci
 
-__all__ = ["HIGHER", "Order", "agreement", "metric_words", "order", "split"]
+__all__ = ["HIGHER", "Order", "agreement", "metric_words", "order"]
 
 #: Metrics where higher is better (the rest: lower is better).
 HIGHER = frozenset({"completeness", "obstacle_recall", "obstacle_precision"})
@@ -115,9 +113,3 @@ def agreement(first: Order, second: Order) -> bool | None:
 def metric_words(metric: str) -> str:
     """A metric's name for sentences (``"MHD"``, ``"height RMSE"``)."""
     return label(metric, False)
-
-
-def split(table: pd.DataFrame, prefixes: Sequence[str]) -> pd.DataFrame:
-    """The rows of terrains whose names start with one of ``prefixes``."""
-    names = table["terrain"].astype(str)
-    return table[np.logical_or.reduce([names.str.startswith(p) for p in prefixes])]
