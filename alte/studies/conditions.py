@@ -4,7 +4,8 @@ A claim that depends has cells (:func:`alte.studies.evidence.cells_table`: one p
 part, terrain and level read) with different outcomes. :func:`condition` reads them
 back into one line a reader can act on: per part of the claim (the metric and view it
 compares), the terrains where it holds, where it does not, where the interval straddles
-the claim's threshold ("undecided"), and on a terrain where the outcome changes with
+the claim's threshold ("undecided") or both maps read the same on every seed ("equal"),
+and on a terrain where the outcome changes with
 size (or MHD), the levels at which each outcome holds. Terrain sets that are all the
 simulated (urban-scale) or all the experimental (lab-scale) terrains of the claim's case
 are named as such.
@@ -32,7 +33,8 @@ from alte.studies.tradeoff import MAPPER_NAMES, METRICS, label
 
 __all__ = ["condition", "conditions", "part_label", "terrain_names"]
 
-_WORDS = {"holds": "holds", "does not hold": "does not hold", "inconclusive": "undecided"}
+_WORDS = {"holds": "holds", "does not hold": "does not hold", "inconclusive": "undecided",
+          "equal": "equal (no difference)"}
 _VIEWS = {"thesis_point": "at the thesis' settings", "rule": "by the thesis' rule",
           "equal_size": "at equal size", "equal_fidelity": "for equal MHD"}
 
@@ -98,7 +100,15 @@ def _where(terrains: list[str], cells: pd.DataFrame, check: Check) -> str:
     return terrain_names(terrains) + (f" at {_levels(here, check)}" if sized else "")
 
 
+def _outcomes(cells: pd.DataFrame) -> pd.DataFrame:
+    """The cells with ``equal`` where both mappers read the same on every seed (an
+    interval of zero width at zero: nothing to decide, e.g. two perfect precisions)."""
+    same = (cells["outcome"] == "inconclusive") & (cells["low"] == 0) & (cells["high"] == 0)
+    return cells.assign(outcome=cells["outcome"].where(~same, "equal"))
+
+
 def _part_text(cells: pd.DataFrame, check: Check) -> str:
+    cells = _outcomes(cells) if {"low", "high"} <= set(cells.columns) else cells
     whole: dict[str, list[str]] = {}
     mixed = []
     for terrain, here in cells.groupby("terrain", sort=True):
@@ -110,7 +120,7 @@ def _part_text(cells: pd.DataFrame, check: Check) -> str:
               for o in outcomes]
         mixed.append(f"on {terrain} {', '.join(at)}")
     parts = [f"{_WORDS.get(o, o)} on {_where(whole[o], cells, check)}"
-             for o in ("holds", "does not hold", "inconclusive") if o in whole]
+             for o in ("holds", "does not hold", "inconclusive", "equal") if o in whole]
     return "; ".join(parts + mixed)
 
 

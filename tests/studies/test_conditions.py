@@ -107,3 +107,13 @@ def test_claims_csv_carries_the_condition_column(tmp_path):
     assert list(out.columns[:7]) == ["claim", "section", "verdict", "evidence", "depends_on",
                                      "condition", "question"]
     assert out["condition"].iloc[0].startswith("holds on sim_lan_1")
+
+
+def test_two_maps_that_read_the_same_on_every_seed_are_equal_not_undecided():
+    table = synthetic_tradeoff({"alte2d": Curve(scale=0.5)})
+    table["obstacle_precision"] = 1.0  # both perfect everywhere
+    check = Compare("lan", "alte2d", "quadtree", "obstacle_precision", "equal_size",
+                    higher_is_better=True)
+    found = evaluate(_claim(check), table)
+    assert found.verdict == "depends"
+    assert condition(found).startswith("equal (no difference) on the simulated terrains")
