@@ -85,7 +85,7 @@ def _mhd(choice: Choice) -> str:
 
 
 def _row(choice: Choice) -> ChoiceRow:
-    group = f"{choice.group} ({', '.join(choice.terrains)})"
+    group = f"{choice.group} terrains ({', '.join(choice.terrains)})"
     if choice.best is None:
         return ChoiceRow(group, choice.budget.text(choice.use), "no map of the grid fits", "",
                          "", "", "")

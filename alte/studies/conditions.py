@@ -35,6 +35,7 @@ __all__ = ["condition", "conditions", "part_label", "terrain_names"]
 
 _WORDS = {"holds": "holds", "does not hold": "does not hold", "inconclusive": "undecided",
           "equal": "equal (no difference)"}
+_CASE_WORDS = {"lan": "landing", "nav": "navigation"}
 _VIEWS = {"thesis_point": "at the thesis' settings", "rule": "by the thesis' rule",
           "equal_size": "at equal size", "equal_fidelity": "for equal MHD"}
 
@@ -68,11 +69,14 @@ def part_label(check: Check, pair: bool = False) -> str:
 
 
 def terrain_names(terrains: Sequence[str]) -> str:
-    """``terrains`` in words; every simulated (or lab) terrain of one case named so."""
+    """``terrains`` in words; every terrain of one case, or every simulated (or lab)
+    terrain of it, named so."""
     chosen = sorted(terrains)
     cases = {TERRAIN_CASE.get(t) for t in chosen}
     if len(cases) == 1 and chosen:
         case = cases.pop()
+        if chosen == sorted(t for t, c in TERRAIN_CASE.items() if c == case):
+            return f"every {_CASE_WORDS.get(str(case), str(case))} terrain"
         for kind, words in (("sim", "simulated"), ("exp", "lab")):
             every = sorted(t for t, c in TERRAIN_CASE.items() if c == case and
                            t.startswith(kind))

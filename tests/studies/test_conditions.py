@@ -74,6 +74,8 @@ def test_labels_and_terrain_names():
         "spread of MHD against min_pts_per_leaf")
     assert terrain_names(["exp_nav_2", "exp_nav_1"]) == "the lab terrains (exp_nav_1, exp_nav_2)"
     assert terrain_names(["sim_lan_1", "exp_lan_1"]) == "exp_lan_1, sim_lan_1"
+    assert terrain_names(["sim_nav_1", "sim_nav_2", "exp_nav_1", "exp_nav_2"]) == (
+        "every navigation terrain")
 
 
 def _variants(table: pd.DataFrame, cv: float) -> pd.DataFrame:

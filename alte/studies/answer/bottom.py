@@ -50,7 +50,8 @@ class RealCheck:
         """The comparison in one sentence."""
         verdict = {True: "agrees", False: "disagrees", None: "cannot tell"}[self.agrees]
         return (f"{metric_words(self.metric)} at equal size: simulated terrains "
-                f"{self.simulated.text()}; {sequence} {self.real.text()}: {verdict}.")
+                f"{self.simulated.text(where=False)}; {sequence} {self.real.text(where=False)}: "
+                f"{verdict}.")
 
 
 @dataclass(frozen=True)

@@ -51,17 +51,18 @@ class Order:
             return ""
         return counts[0][0]
 
-    def text(self) -> str:
-        """e.g. ``"2D-ALTE on 9 of 12 reads (sim_lan_1, sim_lan_2), Quadtree on 1"``."""
+    def text(self, where: bool = True) -> str:
+        """e.g. ``"2D-ALTE on 9 of 12 reads (sim_lan_1, sim_lan_2), Quadtree on 1"``
+        (``where=False``: without the terrains)."""
         if not self.reads:
             return "no read"
         parts: list[str] = []
         for mapper, n in sorted(self.leads.items(), key=lambda kv: -kv[1]):
             if n:
-                where = ", ".join(self.where.get(mapper, ()))
+                places = ", ".join(self.where.get(mapper, ())) if where else ""
                 parts.append(f"{MAPPER_NAMES.get(mapper, mapper)} on {n} of {self.reads} "
                              f"read{'s' if self.reads != 1 else ''}"
-                             + (f" ({where})" if where and len(parts) == 0 else ""))
+                             + (f" ({places})" if places and not parts else ""))
         if self.undecided:
             parts.append(f"{self.undecided} within their interval")
         return ", ".join(parts) or "no read decided"
