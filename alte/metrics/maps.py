@@ -160,14 +160,16 @@ def _thesis(points: np.ndarray, cloud: np.ndarray) -> dict[str, float]:
 
 def measure_map(mapper: Mapper, cloud: np.ndarray, *, elapsed_s: float | Timing,
                 truth: GroundTruth | None = None, options: TruthOptions | None = None,
-                set_b: str = "corners") -> MapMetrics:
+                set_b: str = "corners", cells: Cells | None = None) -> MapMetrics:
     """Every metric of ``mapper`` against the registered ``cloud`` (and ``truth``);
     ``elapsed_s``: the mapping's time (one wall reading, or a :class:`Timing`);
-    ``set_b`` defines the map's points of HD/MHD (:data:`SET_B`)."""
+    ``set_b`` defines the map's points of HD/MHD (:data:`SET_B`). ``cells``: the map's
+    cells when the caller has listed them already (a large Octomap's leaves take
+    seconds to list)."""
     timing = elapsed_s if isinstance(elapsed_s, Timing) else Timing(float(elapsed_s))
     if set_b not in SET_B:
         raise MetricsError(f"set B {set_b!r}: expected one of {', '.join(SET_B)}")
-    cells = mapper.cells()  # once: a large Octomap's leaves take seconds to list
+    cells = mapper.cells() if cells is None else cells
     lo, hi, octaves = _size_spread(cells)
     truth_metrics = None
     if truth is not None:

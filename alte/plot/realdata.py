@@ -2,7 +2,9 @@
 
 :func:`ground_figure` shows every ISPRS sample x filter from above, each point
 coloured by its outcome against the reference (ground kept, object removed, type I,
-type II); :func:`show_maps` puts 3D maps side by side in one pyvista plotter, shown
+type II); :func:`fronts_figure` draws the real sequence's fronts (size against MHD and
+against the distance to the reference cloud, per pair of mappers); :func:`show_maps`
+puts 3D maps side by side in one pyvista plotter, shown
 through :func:`alte.plot.render.show` (a PNG headless, trame in JupyterLab).
 """
 
@@ -14,6 +16,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import pandas as pd
 from matplotlib.colors import ListedColormap
 from matplotlib.figure import Figure
 
@@ -21,7 +24,8 @@ from alte.notebook import save_figure as _save_figure
 from alte.studies.experiments import Measured
 from alte.studies.realdata.data import GroundRun
 
-__all__ = ["OUTCOMES", "ground_figure", "outcomes", "save_figure", "show_maps"]
+__all__ = ["FRONT_PANELS", "OUTCOMES", "fronts_figure", "ground_figure", "outcomes", "save_figure",
+           "show_maps"]
 
 #: Outcome classes of a ground filter, in the order of :func:`outcomes`' codes.
 OUTCOMES = ("ground kept", "object removed", "type I (ground removed)",
@@ -85,3 +89,41 @@ def show_maps(runs: Sequence[Measured], out_dir: str | os.PathLike[str] | None =
                          font_size=9)
     plotter.link_views()
     show(plotter, out_dir, name)
+
+
+#: Panels of :func:`fronts_figure`: (mappers, metric, higher is better).
+FRONT_PANELS: tuple[tuple[tuple[str, str], str, bool], ...] = (
+    (("quadtree", "alte2d"), "mhd_m", False), (("quadtree", "alte2d"), "height_rmse_m", False),
+    (("octomap", "alte3d"), "mhd_m", False), (("octomap", "alte3d"), "accuracy_mean_m", False),
+    (("octomap", "alte3d"), "completeness", True))
+
+
+def fronts_figure(table: pd.DataFrame) -> Figure | None:
+    """The real sequence's maps, one dot each, and each mapper's Pareto front, per panel of
+    :data:`FRONT_PANELS` (size on a log axis); None for an empty table."""
+    if table.empty:
+        return None
+    from alte.plot.tradeoff import COLORS, log_axis
+    from alte.studies.tradeoff import MAPPER_NAMES, fronts, label
+
+    fig = Figure(figsize=(4.0 * len(FRONT_PANELS), 3.6), layout="constrained")
+    axes = np.asarray(fig.subplots(1, len(FRONT_PANELS), squeeze=False)).ravel()
+    for ax, (pair, metric, higher) in zip(axes, FRONT_PANELS, strict=True):
+        rows = table[table["mapper"].isin(pair) & table[metric].notna()]
+        for mapper in pair:
+            dots = fronts(rows[rows["mapper"] == mapper], "basis_functions", metric, higher)
+            name = MAPPER_NAMES.get(mapper, mapper)
+            ax.scatter(dots["x"], dots["y"], s=14, alpha=0.5, color=COLORS.get(mapper), lw=0)
+            line = dots[dots["on_front"]].sort_values("x")
+            ax.plot(line["x"], line["y"], color=COLORS.get(mapper), lw=2, label=name)
+        ax.set_xscale("log")
+        ax.set_yscale("log" if log_axis(metric) else "linear")
+        against = "the cloud mapped" if metric.startswith(("mhd", "hd")) else "the reference"
+        ax.set(xlabel=label("basis_functions"), ylabel=label(metric),
+               title=f"{label(metric, False)} against {against}")
+        ax.grid(alpha=0.3, which="both")
+        ax.legend(fontsize=8)
+    name = str(table["terrain"].iloc[0])
+    fig.suptitle(f"{name}: real scans with reference poses, {int(table['frames'].iloc[0])} "
+                 f"scans mapped, {int(table['reference_points'].iloc[0]):,} reference points")
+    return fig

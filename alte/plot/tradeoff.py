@@ -201,6 +201,8 @@ CURVES: dict[str, tuple[str, str, bool]] = {
     "tradeoff_height_rmse": ("height_rmse_m", "basis_functions", False),
     "tradeoff_time": ("elapsed_s", "basis_functions", False),
     "tradeoff_memory": ("mhd_m", "memory_bytes", False),
+    "tradeoff_obstacle_recall": ("obstacle_recall", "basis_functions", True),
+    "tradeoff_obstacle_precision": ("obstacle_precision", "basis_functions", True),
 }
 #: Pairs compared at equal size / fidelity: figure suffix -> mappers.
 PAIRS = {"2d": ("quadtree", "alte2d"), "3d": ("octomap", "alte3d")}

@@ -114,6 +114,15 @@ FIGURES: dict[str, dict[str, Caption]] = {
         "tradeoff_time": Caption("Mapping time against map size",
                                  "Time spent in the mapper calls only. " + _FRONT),
         "tradeoff_memory": Caption("MHD against memory", _FRONT),
+        "tradeoff_obstacle_recall": Caption(
+            "Obstacle recall against map size",
+            "Share of the true obstacles the map shows (simulator objects standing at least "
+            "the landing study's obstacle step above the ground, 0.3 m at urban scale and "
+            "0.06 m in the lab, seen from above; higher is better). " + _FRONT),
+        "tradeoff_obstacle_precision": Caption(
+            "Obstacle precision against map size",
+            "Share of the map's obstacles (connected areas more than that step above its "
+            "ground) that lie on a true object (higher is better). " + _FRONT),
         "tradeoff_ablation_2d": Caption(
             "2D maps with one thing changed",
             "MHD against basis functions of Quadtree and 2D-ALTE on a landing terrain, one "
@@ -147,6 +156,13 @@ FIGURES: dict[str, dict[str, Caption]] = {
     "ch6_real_data": {
         "fig_6_1_ground_filter": Caption("Ground filter (fig. 6.1)",
                                          "Ground filter errors on the ISPRS samples."),
+        "tradeoff_real": Caption(
+            "The fronts on a real sequence (balm_seq)",
+            "Real scans mapped with their reference poses (bundle adjustment): every map one "
+            "dot, the line each mapper's Pareto front (one recording: no seeds, no band). "
+            "MHD is the thesis' metric against the cloud the map was made from; height RMSE, "
+            "mean accuracy and completeness are measured against the reference cloud (every "
+            "scan with its reference pose), the real stand-in for the simulator's truth."),
     },
     "ch7_landing": {
         "fig_landing_sites": Caption(

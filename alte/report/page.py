@@ -1,9 +1,11 @@
 """The front page as data: what a run's ``index.html`` shows, built from its folder.
 
 :func:`run_page` reads the run record, each notebook's ``results.json`` and figures and
-the run's tables, and returns a :class:`RunPage` the template renders: the claims table
-first (``tables/claims.csv``), the trade-off figures and tables, the key tables with the
-thesis' values beside ours, then one section per notebook run with its headline results,
+the run's tables, and returns a :class:`RunPage` the template renders: the bottom line
+first (:mod:`alte.report.answer`, from the run's tables), then the claims
+(``tables/claims.csv``) grouped by the thesis' question they bear on, each "depends"
+with its condition, the trade-off figures and tables, the key tables with the thesis'
+values beside ours, then one section per notebook run with its headline results,
 captioned figures and links. Nothing on it is a raw dict or JSON: results are shown as
 labelled scalars, tables through :mod:`alte.report.tableview`.
 """
@@ -19,6 +21,7 @@ from typing import Any
 
 import pandas as pd
 
+from alte.report.answer import AnswerView, answer_view
 from alte.report.captions import (
     FIGURES,
     KEY_TABLES,
@@ -29,9 +32,10 @@ from alte.report.captions import (
 )
 from alte.report.plan import PLAN
 from alte.report.tableview import TableView, cell_text, header, table_view
+from alte.studies.claims.questions import QUESTIONS, question
 
-__all__ = ["CLAIMS_CSV", "ClaimRow", "FigureItem", "RunPage", "RunSection", "TableItem",
-           "run_page"]
+__all__ = ["CLAIMS_CSV", "ClaimGroup", "ClaimRow", "FigureItem", "RunPage", "RunSection",
+           "TableItem", "run_page"]
 
 #: The claims table a run's chapter 5 notebook writes into ``tables/``.
 CLAIMS_CSV = "claims.csv"
@@ -51,6 +55,18 @@ class ClaimRow:
     depends_on: str
     evidence: str
     reading: str
+    condition: str = ""
+    question: str = ""
+
+
+@dataclass(frozen=True)
+class ClaimGroup:
+    """The claims bearing on one of the thesis' questions, with their verdict counts."""
+
+    anchor: str
+    title: str
+    verdicts: list[tuple[str, int, str]]
+    claims: list[ClaimRow]
 
 
 @dataclass(frozen=True)
@@ -96,6 +112,8 @@ class RunPage:
     problems: list[str]
     claims: list[ClaimRow]
     verdicts: list[tuple[str, int, str]]
+    answer: AnswerView | None = None
+    groups: list[ClaimGroup] = field(default_factory=list)
     tradeoff: list[FigureItem] = field(default_factory=list)
     key_tables: list[TableItem] = field(default_factory=list)
     sections: list[RunSection] = field(default_factory=list)
@@ -182,7 +200,32 @@ def _claims(tables_dir: Path) -> list[ClaimRow]:
     return [ClaimRow(str(r.get("section", "")), str(r["claim"]), str(r["verdict"]),
                      _VERDICT_CSS.get(str(r["verdict"]), "untested"),
                      str(r.get("depends_on", "")), str(r.get("evidence", "")),
-                     str(r.get("reading", ""))) for r in frame.to_dict(orient="records")]
+                     str(r.get("reading", "")), str(r.get("condition", "")),
+                     str(r.get("question", "")) or _question(str(r.get("id", ""))))
+            for r in frame.to_dict(orient="records")]
+
+
+def _question(claim_id: str) -> str:
+    """The question of a claim by id (claims tables written before the column existed)."""
+    from alte.errors import ParameterError
+    from alte.studies.claims import claim
+
+    try:
+        return question(claim(claim_id))
+    except ParameterError:
+        return ""
+
+
+def _groups(claims: Sequence[ClaimRow]) -> list[ClaimGroup]:
+    """The claims by question, in the page order of :data:`QUESTIONS` (unknown last)."""
+    order = [*QUESTIONS, ""]
+    groups = []
+    for key in order:
+        mine = [c for c in claims if (c.question if c.question in QUESTIONS else "") == key]
+        if mine:
+            groups.append(ClaimGroup(f"claims-{key or 'other'}",
+                                     QUESTIONS.get(key, "Other claims"), _counts(mine), mine))
+    return groups
 
 
 def _table(csv: Path, run_dir: Path, shown: KeyTable) -> TableItem:
@@ -214,7 +257,8 @@ def run_page(record: Mapping[str, Any], run_dir: str | os.PathLike[str],
                f"{len(failed)} failed, {record['seconds']:.1f} s in all")
     claims = _claims(run_dir / "tables")
     page = RunPage(f"alte report {run_dir.name}", summary, failed,
-                   [str(p) for p in record.get("problems", [])], claims, _counts(claims))
+                   [str(p) for p in record.get("problems", [])], claims, _counts(claims),
+                   answer_view(run_dir / "tables"), _groups(claims))
     for run in runs:
         section = _section(run, run_dir)
         page.tradeoff += [f for f in section.figures if _is_tradeoff(f)]

@@ -35,7 +35,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from alte.studies.claims.types import AllOf, Check, Claim, NotMeasurable, Property
+from alte.studies.claims.types import AllOf, Check, Claim, Contrast, NotMeasurable, Property
 from alte.studies.measures import CheckValues, NoDataError, measure_check
 from alte.studies.tradeoff import MAPPER_NAMES, METRICS, prepare
 from alte.studies.uncertainty import (
@@ -222,13 +222,17 @@ def _crosscheck_text(m: CheckValues, cells: pd.DataFrame, options: EvidenceOptio
     return f" Cross-check on the CPU time: {text} -> {verdict}; {contra}."
 
 
-def _one(check: Check, table: pd.DataFrame, options: EvidenceOptions) -> Result:
-    """(verdict, depends_on, evidence, cells, time check) of one check."""
+def _one(check: Check, table: pd.DataFrame, options: EvidenceOptions,
+         variants: pd.DataFrame | None = None) -> Result:
+    """(verdict, depends_on, evidence, cells, time check) of one check (``variants``: the
+    grid's rows of every ablation variant, which a :class:`Contrast` reads)."""
     if isinstance(check, NotMeasurable):
         return "not measurable", "", check.reason, pd.DataFrame(), ""
     if isinstance(check, Property):
         verdict, text = _property(check)
         return verdict, "", text, pd.DataFrame(), ""
+    if isinstance(check, Contrast):
+        table = variants if variants is not None else table
     try:
         m = measure_check(check, table)
     except NoDataError as err:
@@ -292,14 +296,15 @@ def _resized_check(check: Check, size: str) -> Check:
 
 
 def _evaluate(claim: Claim, table: pd.DataFrame, options: EvidenceOptions,
-              cache: dict[Any, Result] | None = None) -> Finding:
+              cache: dict[Any, Result] | None = None,
+              variants: pd.DataFrame | None = None) -> Finding:
     check = _resized(claim.check, options.size)
     parts = check.parts if isinstance(check, AllOf) else (check,)
     cache = {} if cache is None else cache
     results = []
     for part in parts:
         if part not in cache:  # many claims share a check: measure it once per table
-            cache[part] = _one(part, table, options)
+            cache[part] = _one(part, table, options, variants)
         results.append(cache[part])
     checks = "; ".join(dict.fromkeys(r[4] for r in results if r[4]))
     if len(parts) == 1:
@@ -319,18 +324,23 @@ def _evaluate(claim: Claim, table: pd.DataFrame, options: EvidenceOptions,
     return Finding(claim, verdict, depends, text, cells.reindex(columns=CELL_COLUMNS), checks)
 
 
-def evaluate(claim: Claim, table: pd.DataFrame,
-             options: EvidenceOptions | None = None) -> Finding:
-    """The verdict on ``claim`` from a trade-off table (see the module docstring)."""
-    return _evaluate(claim, prepare(table), options or EvidenceOptions())
+def evaluate(claim: Claim, table: pd.DataFrame, options: EvidenceOptions | None = None,
+             variants: pd.DataFrame | None = None) -> Finding:
+    """The verdict on ``claim`` from a trade-off table (see the module docstring);
+    ``variants``: the grid's rows of every ablation variant (a ``variant`` column, the
+    base grid as ``base``), for the claims that contrast them."""
+    ready = prepare(variants) if variants is not None else None
+    return _evaluate(claim, prepare(table), options or EvidenceOptions(), variants=ready)
 
 
 def evaluate_all(claims: Sequence[Claim], table: pd.DataFrame,
-                 options: EvidenceOptions | None = None) -> list[Finding]:
-    """:func:`evaluate` for every claim (the table is checked and prepared once)."""
+                 options: EvidenceOptions | None = None,
+                 variants: pd.DataFrame | None = None) -> list[Finding]:
+    """:func:`evaluate` for every claim (the tables are checked and prepared once)."""
     prepared = prepare(table)
+    ready = prepare(variants) if variants is not None else None
     cache: dict[Any, Result] = {}
-    return [_evaluate(c, prepared, options or EvidenceOptions(), cache) for c in claims]
+    return [_evaluate(c, prepared, options or EvidenceOptions(), cache, ready) for c in claims]
 
 
 def claims_table(findings: Sequence[Finding]) -> pd.DataFrame:

@@ -2,7 +2,9 @@
 fidelity, and ablations (what moves a verdict when one thing changes).
 
 :func:`write_evidence` is the one call the chapter 5 notebook makes: it evaluates every
-claim on the trade-off table and writes ``claims.csv`` (the front page's claims table),
+claim on the trade-off table and writes ``claims.csv`` (the front page's claims table;
+for a claim that depends, ``condition`` says where it holds and where not,
+:mod:`alte.studies.conditions`; ``question`` the thesis' question it bears on),
 ``claims_cells.csv`` (every number behind the verdicts), ``equal_size.csv`` and
 ``equal_fidelity.csv`` (each case's two mappers read off their fronts; mean over seeds
 with bootstrap intervals) and their headline rows with units in the headers
@@ -21,7 +23,10 @@ from typing import Any
 import pandas as pd
 
 from alte.studies.claims import CLAIMS, Claim
+from alte.studies.claims.questions import question
+from alte.studies.conditions import conditions
 from alte.studies.evidence import (
+    CLAIM_COLUMNS,
     EvidenceOptions,
     Finding,
     cells_table,
@@ -33,6 +38,7 @@ from alte.studies.thesis import CASE_MAPPERS, TERRAIN_CASE
 from alte.studies.tradeoff import equal_fidelity, equal_size, interval_table, prepare
 
 __all__ = [
+    "CLAIMS_CSV_COLUMNS",
     "EQUAL_FIDELITY",
     "EQUAL_SIZE",
     "SIZES",
@@ -44,6 +50,10 @@ __all__ = [
     "write_evidence",
 ]
 
+#: Columns of claims.csv: the claims table's, with each "depends"'s condition
+#: (:mod:`alte.studies.conditions`) and the question the claim bears on
+#: (:mod:`alte.studies.claims.questions`) after ``depends_on``.
+CLAIMS_CSV_COLUMNS = [*CLAIM_COLUMNS[:5], "condition", "question", *CLAIM_COLUMNS[5:]]
 #: Sizes (basis functions) fidelity is compared at.
 SIZES = (1_000.0, 5_000.0, 20_000.0)
 #: Metrics compared at equal size: (column, higher is better).
@@ -125,13 +135,18 @@ def key_table(summary: pd.DataFrame, metric: str, level: str, value: str) -> pd.
 
 def write_evidence(table: pd.DataFrame, tables_dir: str | os.PathLike[str], *,
                    claims: Sequence[Claim] = CLAIMS, options: EvidenceOptions | None = None,
+                   variants: pd.DataFrame | None = None,
                    overwrite: bool = True) -> EvidenceFiles:
-    """Evaluate ``claims`` on the trade-off ``table`` and write the evidence CSVs (see the
-    module docstring) into ``tables_dir``."""
-    findings = evaluate_all(claims, table, options)
+    """Evaluate ``claims`` on the trade-off ``table`` (and the ablation ``variants``' rows,
+    for the claims that contrast them) and write the evidence CSVs (see the module
+    docstring) into ``tables_dir``."""
+    findings = evaluate_all(claims, table, options, variants)
     at_size, at_fidelity = comparison_tables(table, options=options)
+    verdicts = claims_table(findings).assign(
+        condition=conditions(findings), question=[question(f.claim) for f in findings])
+    verdicts = verdicts[CLAIMS_CSV_COLUMNS]
     paths = [write_csv(frame, tables_dir, name, overwrite=overwrite) for frame, name in (
-        (claims_table(findings), "claims"), (cells_table(findings), "claims_cells"),
+        (verdicts, "claims"), (cells_table(findings), "claims_cells"),
         (at_size, "equal_size"), (at_fidelity, "equal_fidelity"),
         (key_table(at_size, "mhd_m", "basis_functions", "mhd_m"), "key_equal_size"),
         (key_table(at_fidelity, "basis_functions", "mhd_m", "basis_functions"),

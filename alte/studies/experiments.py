@@ -19,6 +19,7 @@ import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pandas as pd
 from tqdm.auto import tqdm
@@ -40,6 +41,9 @@ from alte.pipeline import (
 )
 from alte.studies.thesis import SWEEPS, sweep_table
 
+if TYPE_CHECKING:  # the obstacle study builds on the landing study, which builds on this one
+    from alte.studies.obstacles import ObstacleOptions, ObstacleScores
+
 __all__ = ["CACHE_DIR", "REPEATS", "REPEAT_BELOW_S", "Measured", "ground_truth", "measure",
            "sweep", "terrain", "timed_run"]
 
@@ -57,10 +61,11 @@ _WARM: set[tuple[str, str]] = set()
 
 @dataclass(eq=False)
 class Measured:
-    """A map run and its metrics."""
+    """A map run, its metrics and, when asked, its obstacle identification."""
 
     run: MapRun
     metrics: MapMetrics
+    obstacles: ObstacleScores | None = None
 
     @property
     def mapper(self) -> Mapper:
@@ -127,17 +132,27 @@ def timed_run(data: Registered, spec: MapSpec, *, repeats: int = REPEATS,
 
 def measure(data: Registered, mapper: str, params: Mapping[str, object] | None = None, *,
             truth: TruthOptions | None = None, spec: MapSpec | None = None,
-            set_b: str = "corners", progress: bool = False) -> Measured:
+            set_b: str = "corners", obstacles: ObstacleOptions | None = None,
+            progress: bool = False) -> Measured:
     """Map ``data`` with ``mapper`` and ``params`` and measure it (``truth``: also against
     the true surface; ``set_b``: the map's points of HD/MHD, see
-    :data:`alte.metrics.maps.SET_B`). ``spec`` replaces the default map specification.
-    The map is timed by :func:`timed_run`."""
+    :data:`alte.metrics.maps.SET_B`; ``obstacles``: also identify the terrain's true
+    obstacles, :mod:`alte.studies.obstacles`, on a simulated terrain). ``spec`` replaces
+    the default map specification. The map is timed by :func:`timed_run`."""
     chosen = spec or MapSpec(mapper, dict(params or {}))
     result, timing = timed_run(data, chosen, progress=progress)
+    cells = result.mapper.cells()  # listed once for every metric
     metrics = measure_map(result.mapper, data.cloud, elapsed_s=timing,
                           truth=ground_truth(data) if truth is not None else None,
-                          options=truth, set_b=set_b)
-    return Measured(result, metrics)
+                          options=truth, set_b=set_b, cells=cells)
+    scores = None
+    if obstacles is not None and ground_truth(data) is not None:
+        from alte.studies.obstacles import identify, map_raster, terrain_obstacles
+
+        known = terrain_obstacles(str(data.source.path), obstacles)
+        scores = identify(map_raster(cells, result.mapper.dims, known.grid,
+                                     obstacles.min_height), known)
+    return Measured(result, metrics, scores)
 
 
 def sweep(data: Registered, table: int, rows: Sequence[int] | None = None, *,

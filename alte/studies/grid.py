@@ -3,14 +3,16 @@
 :func:`run_grid` runs a sweep spec (:mod:`alte.studies.sweep`: every mapper's settings on
 every terrain and seed, registration cached once per terrain and seed, serial or on Dask)
 and returns a :class:`Grid`: the base grid as a trade-off table (one row per terrain,
-mapper, setting and seed; :data:`TRADEOFF_COLUMNS` first) and every ablation variant's
-rows. :func:`ablations` judges every claim once per variant, on the variants' terrains,
-beside the base grid on the same terrains and two evaluation-only changes (map size
-counted as occupied cells, so neither Octomap's free leaves nor 3D-ALTE's empty ones
-count; and only the thesis' own six settings per mapper, tables 5.7-5.9 and 5.12, so
-the thesis' selection rule and the fronts see the grid the thesis had).
-:func:`write_grid` writes ``tradeoff.csv``, ``tradeoff_variants.csv``, ``ablation.csv``
-and ``ablation_cells.csv``.
+mapper, setting and seed; :data:`TRADEOFF_COLUMNS` first; with the spec's ``obstacles``
+on, each map's obstacle identification, :mod:`alte.studies.obstacles`) and every
+ablation variant's rows. :func:`ablations` judges every claim once per variant, on the
+variants' terrains, beside the base grid on the same terrains and two evaluation-only
+changes (map size counted as occupied cells, so neither Octomap's free leaves nor
+3D-ALTE's empty ones count; and only the thesis' own six settings per mapper, tables
+5.7-5.9 and 5.12, so the thesis' selection rule and the fronts see the grid the thesis
+had).
+:func:`write_grid` writes ``tradeoff.csv``, ``tradeoff_variants.csv``, ``obstacles.csv``,
+``obstacle_objects.csv``, ``ablation.csv`` and ``ablation_cells.csv``.
 """
 
 from __future__ import annotations
@@ -29,6 +31,7 @@ from alte.errors import ParameterError
 from alte.studies.claims import CLAIMS, Claim
 from alte.studies.evidence import EvidenceOptions, cells_table, evaluate_all
 from alte.studies.evidence_tables import EQUAL_SIZE, SIZES, ablation_verdicts
+from alte.studies.obstacles import OBJECTS_COLUMN, write_obstacle_tables
 from alte.studies.sweep import BASE, SweepSpec, load_spec, override, run_sweep, variant_table
 from alte.studies.tables import write_csv
 from alte.studies.thesis import CASE_MAPPERS, SWEEPS, TERRAIN_CASE
@@ -141,7 +144,8 @@ def ablations(grid: Grid, claims: Sequence[Claim] = CLAIMS,
                                                         "size": "occupied_cells"}))}
     tables[THESIS_ROWS] = (thesis_rows(prepare(base)), options)
     tables |= {v.name: (here[here["variant"] == v.name], options) for v in grid.spec.variants}
-    findings = {name: evaluate_all(claims, table, opts) for name, (table, opts) in tables.items()}
+    findings = {name: evaluate_all(claims, table, opts, rows)
+                for name, (table, opts) in tables.items()}
     cells = [cells_table(found).assign(variant=name) for name, found in findings.items()]
     return ablation_verdicts(claims, findings), pd.concat(cells, ignore_index=True)
 
@@ -158,10 +162,14 @@ class GridTables:
 
 def write_grid(grid: Grid, tables_dir: str | os.PathLike[str], *,
                claims: Sequence[Claim] = CLAIMS, overwrite: bool = True) -> GridTables:
-    """Write tradeoff.csv, tradeoff_variants.csv and, with variants, ablation.csv and
-    ablation_cells.csv into ``tables_dir``."""
-    paths = [write_csv(grid.table, tables_dir, "tradeoff", overwrite),
-             write_csv(grid.variants, tables_dir, "tradeoff_variants", overwrite)]
+    """Write tradeoff.csv, tradeoff_variants.csv, with obstacles scored obstacles.csv and
+    obstacle_objects.csv (:mod:`alte.studies.obstacles`; the per-obstacle JSON stays out
+    of the trade-off tables) and, with variants, ablation.csv and ablation_cells.csv into
+    ``tables_dir``."""
+    paths = [write_csv(frame.drop(columns=[OBJECTS_COLUMN], errors="ignore"), tables_dir,
+                       name, overwrite)
+             for frame, name in ((grid.table, "tradeoff"), (grid.variants, "tradeoff_variants"))]
+    paths += write_obstacle_tables(grid.table, tables_dir, overwrite=overwrite)
     verdicts = cells = pd.DataFrame()
     if grid.spec.variants:
         verdicts, cells = ablations(grid, claims)

@@ -44,12 +44,14 @@ from alte.studies.claims.types import (
     Agreement,
     Check,
     Compare,
+    Contrast,
     Effect,
     Optimum,
     Summary,
     Trend,
 )
 from alte.studies.comparisons import measure_compare
+from alte.studies.sweep.variants import BASE
 from alte.studies.tables import TIME_COLUMN
 from alte.studies.tradeoff import label
 
@@ -196,9 +198,35 @@ def _summary(c: Summary, table: pd.DataFrame) -> CheckValues:
     return CheckValues(_per_seed(rows, stat), what, shown)
 
 
+def _contrast(c: Contrast, table: pd.DataFrame) -> CheckValues:
+    """Per terrain and seed: the aggregate in variant ``c.variant`` minus that in the base
+    grid (sign-flipped for higher-is-better columns), on the variant's terrains."""
+    if "variant" not in table:
+        raise NoDataError(f"no ablation rows: variant {c.variant!r} needs the grid's variants")
+    rows = case_rows(table, c.case, (c.mapper,), [c.column])
+    places = set(rows.loc[rows["variant"] == c.variant, "terrain"])
+    if not places:
+        raise NoDataError(f"no {name(c.mapper)} rows of variant {c.variant!r} on the {c.case} "
+                          "terrains")
+    rows = rows[rows["terrain"].isin(places) & rows["variant"].isin((BASE, c.variant))]
+    sign = -1.0 if c.higher_is_better else 1.0
+
+    def stat(group: pd.DataFrame) -> float:
+        base = _aggregate(group.loc[group["variant"] == BASE, c.column], c.agg)
+        other = _aggregate(group.loc[group["variant"] == c.variant, c.column], c.agg)
+        return sign * (other - base)
+
+    agg = "median" if c.agg == "median" else "coefficient of variation"
+    first, second = (("the grid as specified", c.variant) if c.higher_is_better
+                     else (c.variant, "the grid as specified"))
+    what = (f"{agg} of {label(c.column)} over {name(c.mapper)}'s settings, {first} minus "
+            f"{second}")
+    return CheckValues(_per_seed(rows, stat), what, unit(c.column) if c.agg == "median" else "")
+
+
 _MEASURES: dict[type, Callable[[Any, pd.DataFrame], CheckValues]] = {
     Compare: measure_compare, Trend: _trend, Optimum: _optimum, Effect: _effect,
-    Agreement: _agreement, Summary: _summary}
+    Agreement: _agreement, Summary: _summary, Contrast: _contrast}
 
 
 def _mappers(check: Check) -> tuple[str, ...]:

@@ -55,6 +55,8 @@ METRICS: dict[str, tuple[str, str]] = {
     "accuracy_mean_m": ("mean accuracy", "m"), "completeness": ("completeness", ""),
     "height_rmse_m": ("height RMSE", "m"), "size_octaves": ("cell-size octaves", ""),
     "free_share": ("share of free cells", ""),
+    "obstacle_recall": ("obstacle recall", ""), "obstacle_precision": ("obstacle precision", ""),
+    "obstacle_height_error_m": ("obstacle height error", "m"),
 }
 
 

@@ -92,6 +92,7 @@ def test_save_tradeoff_figures_writes_every_captioned_figure(tmp_path):
     drawn = {k for k, v in out.items() if not isinstance(v, str)}
     assert drawn == {"tradeoff_mhd", "tradeoff_accuracy", "tradeoff_completeness",
                      "tradeoff_height_rmse", "tradeoff_time", "tradeoff_memory",
+                     "tradeoff_obstacle_recall", "tradeoff_obstacle_precision",
                      "equal_size_2d", "equal_fidelity_2d"}
     assert out["equal_size_3d"].startswith("not drawn: no terrain has every mapper")
     assert all((tmp_path / "figures" / f"{k}.png").stat().st_size > 1000 for k in drawn)

@@ -30,11 +30,21 @@ def test_front_page_renders_with_every_figure_and_the_claims_table(tmp_path: Pat
         images = driver.execute_script("return document.images.length")
         assert images == 6
         assert driver.execute_script(_BROKEN) == []
+        first = driver.execute_script(
+            "return document.querySelector('h2').parentElement.id")
+        assert first == "answer"  # the bottom line opens the page, before the claims
+        answer = driver.execute_script(
+            "return document.getElementById('answer').innerText")
+        assert all(m in answer for m in ("Quadtree", "2D-ALTE", "Octomap", "3D-ALTE"))
+        assert "height RMSE" in answer and "basis functions" in answer and " m [" in answer
         rows = driver.execute_script(
-            "return document.querySelectorAll('#claims-table tbody tr').length")
+            "return document.querySelectorAll('#claims table.claims tbody tr').length")
         assert rows == 12
+        groups = driver.execute_script(
+            "return Array.from(document.querySelectorAll('#claims h3')).map(h => h.id)")
+        assert groups[0] == "claims-landing" and len(groups) >= 2
         badges = driver.execute_script(
-            "return Array.from(document.querySelectorAll('#claims-table .verdict'))"
+            "return Array.from(document.querySelectorAll('#claims table .verdict'))"
             ".map(b => getComputedStyle(b).backgroundColor)")
         assert len(set(badges)) >= 2  # verdicts are coloured
         keyed = driver.execute_script(

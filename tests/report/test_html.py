@@ -63,10 +63,10 @@ def front(tmp_path: Path) -> tuple[str, Path]:
     return page, tmp_path
 
 
-def test_front_page_order_claims_first_then_tradeoffs_tables_chapters(front) -> None:
+def test_front_page_order_answer_first_then_claims_tradeoffs_tables_chapters(front) -> None:
     page, _ = front
-    marks = ["<b>Failed:</b>", 'id="claims"', 'id="claims-table"', 'id="tradeoffs"',
-             'id="key-tables"', 'id="chapters"', 'id="tables"']
+    marks = ["<b>Failed:</b>", 'id="answer"', 'id="claims"', 'id="claims-landing"',
+             'id="tradeoffs"', 'id="key-tables"', 'id="chapters"', 'id="tables"']
     at = [page.index(m) for m in marks]
     assert at == sorted(at)
     assert '<a href="#ch5_analysis">ch5_analysis</a>: failed' in page
@@ -74,10 +74,13 @@ def test_front_page_order_claims_first_then_tradeoffs_tables_chapters(front) -> 
     assert "cell 2: ValueError: &lt;boom&gt;" in page
 
 
-def test_claims_table_shows_quotes_verdicts_and_evidence(front) -> None:
+def test_claims_tables_show_quotes_verdicts_conditions_and_evidence_by_question(front) -> None:
     page, _ = front
-    table = page[page.index('id="claims-table"'):page.index('id="tradeoffs"')]
-    assert table.count("<tr>") == 1 + 12
+    table = page[page.index('id="claims"'):page.index('id="tradeoffs"')]
+    groups = table.count('<table class="claims">')
+    assert 2 <= groups <= 6 and table.count("<tr>") == groups + 12
+    assert "<h3 id=\"claims-landing\">Landing: are 2D-ALTE&#39;s maps better" in table
+    assert table.count('<td class="condition">') == 12
     assert "<q>Adaptability: Quadtree Mid, 2D ALTE High</q>" in table
     assert '<span class="verdict holds">holds</span>' in table
     assert '<span class="verdict untested">not measurable</span>' in table

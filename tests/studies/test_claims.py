@@ -116,3 +116,18 @@ def test_claim_lookup():
     assert claim("5.2.2-2d-size").quote == "but ALTE has twenty times fewer basis functions"
     with pytest.raises(ParameterError, match=r"no claim 'nope'; ids: t5\.1-adaptability"):
         claim("nope")
+
+
+def test_every_claim_bears_on_one_of_the_thesis_questions():
+    from alte.studies.claims.questions import QUESTIONS, question
+
+    asked = {c.id: question(c) for c in CLAIMS}
+    assert set(asked.values()) == set(QUESTIONS)
+    assert asked["t5.3-obstacles"] == asked["6-landing-reliable"] == "landing"
+    assert asked["6-3d-undecided"] == asked["t5.4-size"] == "navigation"
+    assert asked["6-overall"] == "both" and asked["6-hd-inconsistent"] == "metric"
+    assert asked["6-occupancy-level"] == asked["t5.2-robustness"] == "parameters"
+    assert asked["t5.1-development"] == asked["t5.4-free-space"] == "design"
+    measured = [c.id for c in CLAIMS if isinstance(c.check, NotMeasurable)]
+    assert measured == ["t5.1-development", "t5.2-development", "t5.4-free-space",
+                        "5.1.1-alte2d-superior"]  # code maturity and design properties only

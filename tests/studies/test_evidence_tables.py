@@ -6,8 +6,13 @@ import pandas as pd
 from support.tradeoff import Curve, synthetic_tradeoff
 
 from alte.studies.claims import CLAIMS, claim
-from alte.studies.evidence import CELL_COLUMNS, CLAIM_COLUMNS, EvidenceOptions
-from alte.studies.evidence_tables import ablation_table, comparison_tables, write_evidence
+from alte.studies.evidence import CELL_COLUMNS, EvidenceOptions
+from alte.studies.evidence_tables import (
+    CLAIMS_CSV_COLUMNS,
+    ablation_table,
+    comparison_tables,
+    write_evidence,
+)
 
 
 def test_ablation_shows_what_moves_when_free_space_is_not_counted():
@@ -54,7 +59,7 @@ def test_write_evidence_writes_the_six_tables(tmp_path):
     table = synthetic_tradeoff({"alte2d": Curve(scale=0.5)})
     files = write_evidence(table, tmp_path, claims=CLAIMS[:5])
     claims = pd.read_csv(files.claims)
-    assert list(claims.columns) == CLAIM_COLUMNS and len(claims) == 5
+    assert list(claims.columns) == CLAIMS_CSV_COLUMNS and len(claims) == 5
     assert list(pd.read_csv(files.cells).columns) == CELL_COLUMNS
     assert files.equal_size.name == "equal_size.csv" and files.equal_fidelity.exists()
     assert len(files.findings) == 5

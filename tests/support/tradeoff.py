@@ -4,7 +4,8 @@ Each mapper gets a parameter grid (>= 10 settings, the thesis' chosen settings
 included); map size follows from the setting, MHD from the size through a power law
 ``scale * (size / 1000) ** -slope``, with a few percent of seeded noise per seed. The
 other metrics follow from those two (time and machine-independent cost in proportion to
-the size), so a test controls who wins by choosing the scales and slopes (:class:`Curve`).
+the size; obstacle recall and precision falling with MHD), so a test controls who wins by
+choosing the scales and slopes (:class:`Curve`).
 """
 
 from __future__ import annotations
@@ -75,6 +76,8 @@ def _row(terrain: str, mapper: str, p: Mapping[str, float], seed: int, *, curve:
         "mhd_m": mhd, "hd_m": 4.0 + 0.5 * rng.normal(), "mh_ab_m": mhd, "mh_ba_m": 0.5 * mhd,
         "accuracy_mean_m": 0.2 * mhd, "completeness": 1.0 - mhd / 5.0,
         "size_octaves": 5.0 if mapper.startswith("alte") else 2.0,
+        "obstacle_recall": float(np.clip(1.0 - mhd / 4.0, 0.0, 1.0)),
+        "obstacle_precision": float(np.clip(1.0 - mhd / 8.0, 0.0, 1.0)),
     }
     if mapper in ("quadtree", "alte2d"):
         row["height_rmse_m"] = 0.5 * mhd

@@ -15,6 +15,7 @@ from alte.studies.claims.types import (
     Check,
     Claim,
     Compare,
+    Contrast,
     Effect,
     NotMeasurable,
     Optimum,
@@ -26,7 +27,8 @@ from alte.studies.claims.types import (
 )
 
 __all__ = ["CASES", "CLAIMS", "SIZE_COLUMNS", "Agreement", "AllOf", "Check", "Claim", "Compare",
-           "Effect", "NotMeasurable", "Optimum", "Property", "Relation", "Summary", "Trend",
+           "Contrast", "Effect", "NotMeasurable", "Optimum", "Property", "Relation", "Summary",
+           "Trend",
            "Where", "claim"]
 
 #: Every comparative claim of thesis chapters 5 and 6, in the thesis' order.

@@ -21,6 +21,8 @@ Kinds of check:
   ``other``, or not beyond ``min_rho``);
 * :class:`Summary`: an aggregate of ``column`` over a mapper's settings (median,
   coefficient of variation) compared between two mappers or against a threshold;
+* :class:`Contrast`: the same aggregate in the base grid and in an ablation variant
+  (one thing changed), e.g. with and without 3D-ALTE's tree-level occupancy criterion;
 * :class:`Property`: a class attribute of the mapper implementations;
 * :class:`AllOf`: a conjunction (a quote making several comparisons);
 * :class:`NotMeasurable`: no map metric can decide it; the reason says why.
@@ -31,8 +33,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Literal
 
-__all__ = ["CASES", "SIZE_COLUMNS", "Agreement", "AllOf", "Check", "Claim", "Compare", "Effect",
-           "NotMeasurable", "Optimum", "Property", "Relation", "Summary", "Trend", "Where"]
+__all__ = ["CASES", "SIZE_COLUMNS", "Agreement", "AllOf", "Check", "Claim", "Compare",
+           "Contrast", "Effect", "NotMeasurable", "Optimum", "Property", "Relation", "Summary",
+           "Trend", "Where"]
 
 #: Terrain cases: landing (2D maps) and urban navigation (3D maps).
 CASES = ("lan", "nav")
@@ -151,6 +154,21 @@ class Summary:
 
 
 @dataclass(frozen=True)
+class Contrast:
+    """An aggregate of ``column`` over ``mapper``'s settings (as in :class:`Summary`) is
+    better in the base grid than in ablation ``variant`` (the grid with one thing
+    changed), read per terrain and seed on the variant's terrains of the case; the base
+    is better when lower (``higher_is_better``: when higher)."""
+
+    case: str
+    mapper: str
+    column: str
+    agg: Literal["median", "cv"]
+    variant: str
+    higher_is_better: bool = False
+
+
+@dataclass(frozen=True)
 class Property:
     """Boolean class attribute ``attribute`` of the mapper implementations (e.g.
     ``incremental``): true for every mapper in ``true`` and false for those in ``false``."""
@@ -167,7 +185,8 @@ class NotMeasurable:
     reason: str
 
 
-Check = Compare | Trend | Optimum | Effect | Agreement | Summary | Property | NotMeasurable
+Check = (Compare | Trend | Optimum | Effect | Agreement | Summary | Contrast | Property
+         | NotMeasurable)
 
 
 @dataclass(frozen=True)

@@ -3,13 +3,14 @@
 :mod:`~alte.studies.realdata.data` locates the folder (skipping cleanly when it is absent),
 loads the ISPRS airborne samples, the OctoMap scan and the VLP-16 packet bag, runs
 the mappers and tabulates them; :mod:`~alte.studies.realdata.ground` is the map-based ground
-filter and its Sithole & Vosselman (2004) scores; :mod:`~alte.plot.realdata`
-draws them.
+filter and its Sithole & Vosselman (2004) scores; :mod:`~alte.studies.realdata.fronts`
+maps a real sequence with reference poses over a grid of settings (the trade-off fronts on
+real data); :mod:`~alte.plot.realdata` draws them.
 """
 
 from alte.studies.realdata.data import (
     BASELINE,
-    SAMPLES,
+    ISPRS_FOLDER,
     GroundRun,
     IsprsSample,
     RealData,
@@ -18,6 +19,7 @@ from alte.studies.realdata.data import (
     ground_runs,
     ground_table,
     isprs_sample,
+    isprs_samples,
     locate,
     map_runs,
     map_table,
@@ -25,6 +27,15 @@ from alte.studies.realdata.data import (
     scan_dataset,
     vlp16_dataset,
     write_csv,
+)
+from alte.studies.realdata.fronts import (
+    FRONT_COLUMNS,
+    FRONT_GRID,
+    SEQUENCE,
+    RealSequence,
+    front_table,
+    reference_metrics,
+    sequence_data,
 )
 from alte.studies.realdata.ground import (
     classify_ground,
@@ -36,25 +47,33 @@ from alte.studies.realdata.ground import (
 
 __all__ = [
     "BASELINE",
-    "SAMPLES",
+    "FRONT_COLUMNS",
+    "FRONT_GRID",
+    "ISPRS_FOLDER",
+    "SEQUENCE",
     "GroundRun",
     "IsprsSample",
     "RealData",
+    "RealSequence",
     "classify_ground",
     "dataset_summary",
     "default_dir",
+    "front_table",
     "ground_errors",
     "ground_runs",
     "ground_table",
     "isprs_sample",
+    "isprs_samples",
     "locate",
     "map_heights",
     "map_runs",
     "map_table",
     "opened_surface",
     "reference_labels",
+    "reference_metrics",
     "results",
     "scan_dataset",
+    "sequence_data",
     "vlp16_dataset",
     "write_csv",
 ]

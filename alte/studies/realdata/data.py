@@ -48,7 +48,7 @@ from alte.studies.tables import write_csv as write_tables_csv
 
 __all__ = [
     "BASELINE",
-    "SAMPLES",
+    "ISPRS_FOLDER",
     "GroundRun",
     "IsprsSample",
     "RealData",
@@ -57,6 +57,7 @@ __all__ = [
     "ground_runs",
     "ground_table",
     "isprs_sample",
+    "isprs_samples",
     "locate",
     "map_runs",
     "map_table",
@@ -66,8 +67,9 @@ __all__ = [
     "write_csv",
 ]
 
-#: The ISPRS filter-test samples stored in ``isprs_terrain/``.
-SAMPLES: tuple[str, ...] = ("samp11", "samp21", "samp31")
+#: The folder of the ISPRS filter-test samples: ``<name>-utm.pcd`` with its reference
+#: bare earth ``<name>-utm-ground.pcd`` (today samp11, samp21, samp31 of the fifteen).
+ISPRS_FOLDER = "isprs_terrain"
 #: Name of the map-free filter (raw point heights) in the ground runs and table.
 BASELINE = "points"
 
@@ -122,10 +124,20 @@ class IsprsSample:
     origin: np.ndarray
 
 
+def isprs_samples(data: RealData) -> tuple[str, ...]:
+    """Every ISPRS sample present (a ``<name>-utm.pcd`` with its ``-ground`` subset), in
+    name order; () when the folder is absent."""
+    if not data.available or not data.file(ISPRS_FOLDER).is_dir():
+        return ()
+    clouds = data.file(ISPRS_FOLDER).glob("*-utm.pcd")
+    return tuple(sorted(p.name.removesuffix("-utm.pcd") for p in clouds
+                        if p.with_name(p.name.replace("-utm.pcd", "-utm-ground.pcd")).is_file()))
+
+
 def isprs_sample(data: RealData, name: str) -> IsprsSample:
     """Read ``isprs_terrain/<name>-utm.pcd`` and label it with ``<name>-utm-ground.pcd``."""
-    points = read_points(data.file("isprs_terrain", f"{name}-utm.pcd"))
-    ground = read_points(data.file("isprs_terrain", f"{name}-utm-ground.pcd"))
+    points = read_points(data.file(ISPRS_FOLDER, f"{name}-utm.pcd"))
+    ground = read_points(data.file(ISPRS_FOLDER, f"{name}-utm-ground.pcd"))
     origin = local_origin(points)
     return IsprsSample(name, points - origin, reference_labels(points - origin, ground - origin),
                        origin)
@@ -162,15 +174,20 @@ def _ground_run(sample: IsprsSample, name: str, params: Mapping[str, Any],
     return GroundRun(sample.name, name, dict(params), pts, ground, sample.reference, metrics)
 
 
-def ground_runs(data: RealData, samples: Sequence[str], mappers: Mapping[str, Mapping[str, Any]],
-                *, step: float = 1.0, window: float = 20.0, tolerance: float = 1.0,
-                baseline: bool = True, progress: bool = True) -> list[GroundRun]:
-    """Filter every sample with every 2D mapper (and the map-free baseline); [] if absent."""
+def ground_runs(data: RealData, samples: Sequence[str] | None,
+                mappers: Mapping[str, Mapping[str, Any]], *, step: float = 1.0,
+                window: float = 20.0, tolerance: float = 1.0, baseline: bool = True,
+                progress: bool = True) -> list[GroundRun]:
+    """Filter the named samples (None: every sample present, :func:`isprs_samples`) with
+    every 2D mapper (and the map-free baseline); [] if the folder is absent."""
     if not data.available:
         return []
-    bad = sorted(set(samples) - set(SAMPLES))
+    present = isprs_samples(data)
+    samples = present if samples is None else tuple(samples)
+    bad = sorted(set(samples) - set(present))
     if bad:
-        raise ParameterError(f"ISPRS samples {bad} unknown; stored samples: {list(SAMPLES)}")
+        raise ParameterError(f"ISPRS samples {bad} unknown; samples present in "
+                             f"{data.file(ISPRS_FOLDER)}: {list(present)}")
     options = {"step": step, "window": window, "tolerance": tolerance}
     sources = {**({BASELINE: {}} if baseline else {}), **mappers}
     runs = []

@@ -30,6 +30,7 @@ from alte.pipeline import DomainPolicy, FrameSpec, MapSpec, Registered, open_inp
 from alte.sim import ensure_terrain, terrain_folder
 from alte.sim.profile import PROFILES
 from alte.studies.experiments import CACHE_DIR, measure
+from alte.studies.obstacles import obstacle_columns, obstacle_options
 from alte.studies.sweep.spec import SweepRun, SweepSettings, SweepSpec, plan_runs, plan_variants
 from alte.studies.sweep.store import finished_ids, load_results, write_row
 
@@ -80,8 +81,9 @@ def run_one(run: SweepRun, data_dir: str) -> dict[str, Any]:
     folder = terrain_folder(data_dir, run.terrain, run.frames, run.seed, PROFILES[run.sensor])
     data = _dataset(str(folder), run.frames, run.voxel, data_dir, run.deskew)
     spec = MapSpec(run.mapper, dict(run.params), domain=DomainPolicy(run.domain))
-    metrics = measure(data, run.mapper, truth=run.truth, spec=spec,
-                      set_b=run.set_b).metrics.flat()
+    found = measure(data, run.mapper, truth=run.truth, spec=spec, set_b=run.set_b,
+                    obstacles=obstacle_options(run.terrain) if run.obstacles else None)
+    metrics = found.metrics.flat()
     return {
         "run_id": run.run_id, "terrain": run.terrain, "frames_requested": run.frames or 0,
         "seed": run.seed, "mapper": run.mapper,
@@ -90,6 +92,7 @@ def run_one(run: SweepRun, data_dir: str) -> dict[str, Any]:
         "domain": run.domain, "set_b": run.set_b, "sensor": run.sensor, "deskew": run.deskew,
         "frames": len(data), "points": len(data.cloud),
         **{k: v for k, v in metrics.items() if k != "elapsed_s"},
+        **obstacle_columns(found.obstacles),
         "cost_unit": mapper_class(run.mapper).cost_unit.value,
         "elapsed_s": float(metrics["elapsed_s"]), "wall_s": time.perf_counter() - start,
         "cpu_s": time.process_time() - cpu,

@@ -57,6 +57,8 @@ class SweepSettings(Record):
                                 "voxel filter of the registered cloud (m; None: unfiltered)")
     data_dir: str = param("data", help="folder of the simulated terrains")
     output: str | None = param(None, help="results folder (default: reports/sweeps/NAME)")
+    obstacles: bool = param(False, help="also score each map's obstacle identification "
+                                        "against the simulator's objects")
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -91,11 +93,12 @@ class SweepRun:
     set_b: str = "corners"
     sensor: str = "thesis"
     deskew: bool = True
+    obstacles: bool = False
 
     def key(self) -> dict[str, Any]:
         """Everything that determines the run's result, JSON-ready (``domain``, ``set_b``,
-        ``sensor`` and ``deskew`` only when not the default, so earlier runs keep their
-        ids)."""
+        ``sensor``, ``deskew`` and ``obstacles`` only when not the default, so earlier
+        runs keep their ids)."""
         key = {"terrain": self.terrain, "frames": self.frames, "seed": self.seed,
                "mapper": self.mapper, "params": dict(sorted(self.params.items())),
                "voxel": self.voxel, "truth": dataclasses.asdict(self.truth)}
@@ -107,6 +110,8 @@ class SweepRun:
             key["sensor"] = self.sensor
         if not self.deskew:
             key["deskew"] = False
+        if self.obstacles:
+            key["obstacles"] = True
         return key
 
     @property
@@ -140,6 +145,7 @@ class SweepSpec:
     truth: TruthOptions = field(default_factory=TruthOptions)
     source: str = "spec"
     variants: tuple[Variant, ...] = ()
+    obstacles: bool = False
 
 
 def _fail(source: str, key: str, message: str) -> ParameterError:
@@ -245,7 +251,8 @@ def parse_spec(raw: Any, source: str = "spec") -> SweepSpec:
         output=settings.output or f"reports/sweeps/{name}",
         truth=_truth(source, raw.get("truth")), source=source,
         variants=parse_variants(source, raw.get("variants"), terrains,
-                                tuple(g.mapper for g in mappers)))
+                                tuple(g.mapper for g in mappers)),
+        obstacles=settings.obstacles)
 
 
 def load_spec(path: str | os.PathLike[str]) -> SweepSpec:
@@ -268,7 +275,7 @@ def _variant_runs(spec: SweepSpec, variant: Variant) -> list[SweepRun]:
     return [SweepRun(terrain, spec.frames, seed, grid.mapper,
                      variant.params_for(grid.mapper, params), spec.voxel, spec.truth,
                      variant.domain_for(grid.mapper), variant.set_b_for(grid.mapper),
-                     variant.sensor, variant.deskew)
+                     variant.sensor, variant.deskew, spec.obstacles)
             for seed in spec.seeds for terrain in spec.terrains if terrain in terrains
             for grid in spec.mappers if terrain in grid.terrains for params in grid.rows]
 

@@ -57,7 +57,8 @@ def test_absent_folder_skips_everything(tmp_path: Path) -> None:
     data = realdata.locate(tmp_path / "nowhere")
     assert not data.available
     assert "nowhere" in data.reason and data.describe().startswith("SKIPPED")
-    assert realdata.ground_runs(data, realdata.SAMPLES, {"alte2d": ALTE2D}) == []
+    assert realdata.ground_runs(data, None, {"alte2d": ALTE2D}) == []
+    assert realdata.isprs_samples(data) == ()
     assert realdata.scan_dataset(data) is None and realdata.vlp16_dataset(data) is None
     assert realdata.map_runs(None, {"octomap": {}}) == []
     assert realdata.ground_table([]).empty and realdata.map_table([]).empty
@@ -83,13 +84,26 @@ def test_present_folder_and_results(fake_root: Path, tmp_path: Path) -> None:
     assert path.name == "table_6_9.csv" and pd.read_csv(path).equals(table)
 
 
+def test_every_sample_present_is_filtered(fake_root: Path) -> None:
+    data = realdata.locate(fake_root)
+    folder = fake_root / "isprs_terrain"
+    points, ground = _terrain(seed=1)
+    write_points(folder / "samp52-utm.pcd", points + UTM)
+    write_points(folder / "samp52-utm-ground.pcd", points[ground] + UTM)
+    write_points(folder / "samp61-utm.pcd", points + UTM)  # no reference: not a sample
+    assert realdata.isprs_samples(data) == ("samp21", "samp52")
+    runs = realdata.ground_runs(data, None, {}, progress=False)
+    assert [r.sample for r in runs] == ["samp21", "samp52"]
+
+
 def test_missing_file_in_present_folder_names_it(fake_root: Path) -> None:
     data = realdata.locate(fake_root)
     with pytest.raises(PointFileError, match=r"samp11-utm\.pcd"):
         realdata.isprs_sample(data, "samp11")
     with pytest.raises(PointFileError, match=r"scan\.dat\.bz2"):
         realdata.scan_dataset(data)
-    with pytest.raises(ParameterError, match=r"samples \['samp99'\] unknown"):
+    with pytest.raises(ParameterError, match=r"samples \['samp99'\] unknown; samples present "
+                       r"in .*isprs_terrain: \['samp21'\]"):
         realdata.ground_runs(data, ["samp99"], {})
     with pytest.raises(ParameterError, match="frames=0"):
         realdata.vlp16_dataset(data, frames=0)

@@ -1,0 +1,121 @@
+"""The front page's bottom line as text: read from the run's tables, never typed in.
+
+:func:`answer_view` reads ``tradeoff.csv`` (the grid, obstacle columns included) and,
+when chapter 6 ran, ``realdata_fronts.csv`` from a run's tables folder, computes the
+:func:`~alte.studies.answer.bottom_line` and turns it into rows of text the template
+shows under ``id="answer"``: per use a summary, one row per terrain group and budget
+(the pick with its figures and intervals, the other mapper's best, the pick the thesis'
+MHD would make), the orders at equal size, where MHD and the truth disagree, and
+whether the real sequence agrees.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import pandas as pd
+
+from alte.studies.answer import Choice, UseAnswer, bottom_line, interval_text, pick_text
+from alte.studies.answer.orders import metric_words
+from alte.studies.tradeoff import MAPPER_NAMES
+
+__all__ = ["REAL_CSV", "TRADEOFF_CSV", "AnswerView", "ChoiceRow", "UseView", "answer_view"]
+
+#: The tables the bottom line is read from (in the run's ``tables`` folder).
+TRADEOFF_CSV = "tradeoff.csv"
+REAL_CSV = "realdata_fronts.csv"
+
+
+@dataclass(frozen=True)
+class ChoiceRow:
+    """One budget on one terrain group: the pick and what it is measured against."""
+
+    group: str
+    budget: str
+    choose: str
+    mapper: str
+    figures: str
+    rival: str
+    mhd: str
+
+
+@dataclass(frozen=True)
+class UseView:
+    """A use's part of the bottom line."""
+
+    title: str
+    summary: str
+    disagreement: str
+    rows: list[ChoiceRow]
+    orders: list[str]
+    real: list[str]
+
+
+@dataclass(frozen=True)
+class AnswerView:
+    """The whole bottom line: the uses, then a note on the real data."""
+
+    uses: list[UseView]
+    real_note: str
+
+
+def _rival(choice: Choice) -> str:
+    if choice.rival is None:
+        other = [m for m in choice.use.mappers if choice.best and m != choice.best.mapper]
+        names = ", ".join(MAPPER_NAMES.get(m, m) for m in other)
+        return f"no {names} map fits" if names else ""
+    if choice.budget.kind == "need":
+        return (f"{choice.rival.name} at the least: {choice.rival.setting}, "
+                f"{choice.rival.size:,.0f} basis functions")
+    sure = ("the difference lies beyond its interval" if choice.decided
+            else "within the interval of the difference")
+    truth = interval_text(choice.rival.truth, choice.use.truth)
+    return (f"{choice.rival.name} at best: {choice.rival.setting}, "
+            f"{metric_words(choice.use.truth)} {truth} ({sure})")
+
+
+def _mhd(choice: Choice) -> str:
+    if choice.by_mhd is None or choice.best is None:
+        return ""
+    if (choice.by_mhd.mapper, choice.by_mhd.setting) == (choice.best.mapper,
+                                                         choice.best.setting):
+        return "the same map"
+    return f"{choice.by_mhd.name} {choice.by_mhd.setting}"
+
+
+def _row(choice: Choice) -> ChoiceRow:
+    group = f"{choice.group} terrains ({', '.join(choice.terrains)})"
+    if choice.best is None:
+        return ChoiceRow(group, choice.budget.text(choice.use), "no map of the grid fits", "",
+                         "", "", "")
+    return ChoiceRow(group, choice.budget.text(choice.use),
+                     f"{choice.best.name} {choice.best.setting}", choice.best.mapper,
+                     pick_text(choice.best, choice.use), _rival(choice), _mhd(choice))
+
+
+def _use(found: UseAnswer, sequence: str) -> UseView:
+    names = " or ".join(MAPPER_NAMES.get(m, m) for m in found.use.mappers)
+    title = (f"{found.use.name.capitalize()}: {names}, ranked by "
+             f"{metric_words(found.use.truth)}")
+    orders = [f"{metric_words(o.metric)}: {o.text()}" for o in found.orders]
+    return UseView(title, found.summary, found.disagreement, [_row(c) for c in found.choices],
+                   orders, [check.text(sequence) for check in found.real])
+
+
+def _read(path: Path) -> pd.DataFrame | None:
+    try:
+        return pd.read_csv(path) if path.is_file() else None
+    except (OSError, ValueError, pd.errors.EmptyDataError):
+        return None
+
+
+def answer_view(tables_dir: str | Path) -> AnswerView | None:
+    """The bottom line of the run whose tables are in ``tables_dir`` (None without a
+    trade-off grid)."""
+    folder = Path(tables_dir)
+    grid = _read(folder / TRADEOFF_CSV)
+    if grid is None or grid.empty:
+        return None
+    found = bottom_line(grid, _read(folder / REAL_CSV))
+    return AnswerView([_use(u, found.sequence) for u in found.uses], found.real_note)

@@ -1,0 +1,62 @@
+"""The front page's bottom line is read from the run's tables: change one, the text changes."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+from support.tradeoff import Curve, synthetic_tradeoff
+
+from alte.report.answer import answer_view
+from alte.report.html import run_index_html
+from alte.studies.tables import write_csv
+
+from .conftest import make_front_run
+
+
+def _answer(run_dir: Path) -> str:
+    record = make_front_run(run_dir)
+    page = run_index_html(record, run_dir, sorted((run_dir / "tables").glob("*.csv")))
+    section = page[page.index('id="answer"'):page.index('id="claims"')]
+    return re.sub(r"\s+", " ", re.sub(r"<[^>]+>", " ", section))
+
+
+def test_the_answer_follows_the_trade_off_table(tmp_path: Path) -> None:
+    before = _answer(tmp_path / "a")
+    assert "ranked by height RMSE: 2D-ALTE under" in before
+    assert "Quadtree under none" in before and "3D-ALTE under" in before
+    # the same run with Quadtree's maps made four times better: the choice turns
+    table = synthetic_tradeoff({"alte2d": Curve(scale=0.5), "alte3d": Curve(scale=0.5),
+                                "quadtree": Curve(scale=0.125)})
+    run = tmp_path / "b"
+    make_front_run(run)
+    write_csv(table, run / "tables", "tradeoff", overwrite=True)
+    view = answer_view(run / "tables")
+    landing = view.uses[0]
+    assert landing.summary.startswith("For landing, ranked by height RMSE: Quadtree under")
+    assert {row.mapper for row in landing.rows} == {"quadtree"}
+    assert landing.rows[0].choose.startswith("Quadtree max_points=")
+    assert "2D-ALTE at best:" in landing.rows[0].rival
+
+
+def test_without_a_grid_there_is_no_answer_and_the_page_says_so(tmp_path: Path) -> None:
+    run = tmp_path / "run"
+    record = make_front_run(run)
+    (run / "tables" / "tradeoff.csv").unlink()
+    assert answer_view(run / "tables") is None
+    page = run_index_html(record, run, sorted((run / "tables").glob("*.csv")))
+    assert "This run has no trade-off grid" in page
+
+
+def test_real_fronts_add_the_agreement_of_the_real_sequence(tmp_path: Path) -> None:
+    run = tmp_path / "run"
+    make_front_run(run)
+    real = synthetic_tradeoff({"alte2d": Curve(scale=2.0)}, seeds=(0,), terrains={
+        m: ("balm_seq",) for m in ("quadtree", "alte2d", "octomap", "alte3d")})
+    write_csv(real.assign(frames=20, reference_points=1000), run / "tables",
+              "realdata_fronts")
+    view = answer_view(run / "tables")
+    lines = " ".join(view.uses[0].real)
+    assert "MHD at equal size: simulated terrains 2D-ALTE on" in lines
+    assert "balm_seq Quadtree on 3 of 3 reads" in lines and "disagrees" in lines
+    assert "Real data: balm_seq, 20 real scans" in view.real_note

@@ -1,0 +1,110 @@
+"""The bottom line's choices and orders, on hand-made grids whose answers are known."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from alte.studies.answer import (
+    USES,
+    Budget,
+    bottom_line,
+    budgets,
+    candidates,
+    choose,
+    order,
+)
+
+LANDING, NAVIGATION = USES
+#: mapper -> setting -> (basis functions, height RMSE, MHD, completeness)
+SETTINGS = {
+    "quadtree": {"A": (500, 0.30, 0.10, 0.9), "B": (3000, 0.20, 0.05, 0.9),
+                 "S": (700, 0.05, 0.20, 0.3)},  # S: accurate but covers 30 %: never chosen
+    "alte2d": {"C": (800, 0.25, 0.40, 0.9), "D": (8000, 0.10, 0.30, 0.9)},
+}
+
+
+def grid(settings=SETTINGS, terrains=("sim_lan_1", "sim_lan_2"), seeds=(0, 1, 2)) -> pd.DataFrame:
+    """A landing grid: every setting on every terrain and seed, 1 % seeded noise."""
+    rng = np.random.default_rng(0)
+    rows = []
+    for mapper, mine in settings.items():
+        for name, (size, rmse, mhd, complete) in mine.items():
+            for terrain in terrains:
+                for seed in seeds:
+                    wiggle = 1 + 0.01 * rng.normal()
+                    rows.append({"terrain": terrain, "case": "lan", "mapper": mapper,
+                                 "params": json.dumps({"setting": name}), "seed": seed,
+                                 "basis_functions": size, "occupied_cells": size,
+                                 "memory_bytes": 8 * size, "elapsed_s": size * 1e-5,
+                                 "map_cpu_s": size * 1e-5, "frames": 10,
+                                 "mhd_m": mhd * wiggle, "hd_m": 2.0,
+                                 "accuracy_mean_m": rmse / 2, "completeness": complete,
+                                 "height_rmse_m": rmse * wiggle,
+                                 "obstacle_recall": 0.5 + rmse, "obstacle_precision": 1.0})
+    return pd.DataFrame(rows)
+
+
+def _choice(table: pd.DataFrame, budget: Budget):
+    pool = candidates(table, LANDING, "simulated")
+    return choose(pool, LANDING, "simulated", ("sim_lan_1", "sim_lan_2"), budget)
+
+
+def test_a_size_budget_picks_the_best_truth_that_fits_and_names_the_rival():
+    table = grid()
+    small = _choice(table, Budget("size", 1000))
+    assert (small.best.mapper, small.best.setting) == ("alte2d", "setting=C")
+    assert (small.rival.mapper, small.rival.setting) == ("quadtree", "setting=A")
+    assert small.decided  # 0.25 against 0.30 with 1 % noise
+    assert small.best.truth.estimate == pytest.approx(0.25, rel=0.02)
+    assert small.best.truth.low < 0.25 < small.best.truth.high or small.best.truth.seeds == 3
+    assert (small.by_mhd.mapper, small.by_mhd.setting) == ("quadtree", "setting=A")
+    middle = _choice(table, Budget("size", 5000))
+    assert (middle.best.mapper, middle.best.setting) == ("quadtree", "setting=B")
+    assert _choice(table, Budget("size", 20_000)).best.setting == "setting=D"
+    assert _choice(table, Budget("size", 100)).best is None
+
+
+def test_a_need_picks_the_smallest_map_meeting_it_everywhere():
+    need = _choice(grid(), Budget("need", 0.22))
+    assert (need.best.setting, need.best.size) == ("setting=B", 3000)
+    assert need.rival.setting == "setting=D" and need.by_mhd is None
+
+
+def test_time_budgets_and_the_need_sit_inside_the_candidates():
+    pool = candidates(grid(), LANDING, "simulated")
+    assert set(pool["params"].map(lambda p: json.loads(p)["setting"])) == {"A", "B", "C", "D"}
+    found = budgets(pool, LANDING)
+    assert [b.kind for b in found] == ["size"] * 3 + ["time", "time", "need"]
+    # ms per scan: 1e-5 s per basis function over 10 scans: A 0.5, C 0.8, B 3, D 8; the
+    # quartiles 0.725 and 4.25 to one digit; the need: the worst terrain's RMSE of the
+    # best third (0.1, 0.2, 0.25, 0.3 -> 0.2)
+    assert [b.limit for b in found[3:]] == [0.7, 4.0, 0.2]
+    assert Budget("need", 0.2).text(LANDING) == "height RMSE <= 0.2 m"
+    assert Budget("time", 2).text(LANDING) == "at most 2 ms per scan"
+
+
+def test_a_changed_table_changes_the_choice():
+    changed = {**SETTINGS, "alte2d": {**SETTINGS["alte2d"], "C": (800, 0.35, 0.40, 0.9)}}
+    small = _choice(grid(changed), Budget("size", 1000))
+    assert (small.best.mapper, small.best.setting) == ("quadtree", "setting=A")
+
+
+def test_orders_count_the_equal_size_reads_each_mapper_wins():
+    table = grid({"quadtree": {f"q{i}": (100 * 3**i, 0.3 / (i + 1), 0.1 / (i + 1), 0.9)
+                               for i in range(5)},
+                  "alte2d": {f"a{i}": (100 * 3**i, 0.2 / (i + 1), 0.2 / (i + 1), 0.9)
+                             for i in range(5)}})
+    mhd, truth = order(table, LANDING, "mhd_m"), order(table, LANDING, "height_rmse_m")
+    assert mhd.reads == truth.reads == 6  # three sizes on two terrains
+    assert mhd.leader == "quadtree" and mhd.leads == {"quadtree": 6, "alte2d": 0}
+    assert truth.leader == "alte2d" and truth.undecided == 0
+    assert truth.text().startswith("2D-ALTE on 6 of 6 reads (sim_lan_1, sim_lan_2)")
+    line = bottom_line(table).uses[0]
+    assert "MHD favours Quadtree, height RMSE" in line.disagreement
+    assert bottom_line(table).uses[1].choices == []  # no navigation rows
+    single = order(table[table["seed"] == 0], LANDING, "mhd_m")
+    assert single.leader == "quadtree" and single.reads == 6  # one recording: no interval
