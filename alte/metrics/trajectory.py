@@ -9,6 +9,8 @@
   alignment (it compares relative motions).
 * Cloud distance: each point of a registered cloud to its nearest point of the cloud
   registered with the reference poses (median and 90th percentile).
+* :func:`rigid_alignment`: the SE(3) transform that ATE applies (Umeyama, no scale), to
+  place an odometry cloud in the reference frame the same way.
 
 The poses must already be matched one to one (the same stamps): the caller samples the
 reference at the estimate's stamps.
@@ -23,7 +25,8 @@ import numpy as np
 from alte.errors import MetricsError
 from alte.metrics.hausdorff import directed_distances
 
-__all__ = ["CloudDistance", "TrajectoryErrors", "cloud_distance", "trajectory_errors"]
+__all__ = ["CloudDistance", "TrajectoryErrors", "cloud_distance", "rigid_alignment",
+           "trajectory_errors"]
 
 
 @dataclass(frozen=True)
@@ -106,3 +109,25 @@ def cloud_distance(cloud: np.ndarray, reference: np.ndarray) -> CloudDistance:
     distances = directed_distances(cloud, reference)
     median, p90 = np.percentile(distances, [50, 90])
     return CloudDistance(float(median), float(p90))
+
+
+def rigid_alignment(positions: np.ndarray, reference_positions: np.ndarray) -> np.ndarray:
+    """4x4 transform taking ``positions`` onto ``reference_positions`` in the least-squares
+    sense (Umeyama, rotation and translation, no scale: what ATE aligns with); on a
+    straight or single-point path, where the turn about it is unobservable, the shift of
+    the first position alone."""
+    from evo.core.geometry import GeometryException, umeyama_alignment
+
+    mine = np.asarray(positions, dtype=np.float64)
+    theirs = np.asarray(reference_positions, dtype=np.float64)
+    if mine.shape != theirs.shape or mine.ndim != 2 or mine.shape[1] != 3 or not len(mine):
+        raise MetricsError(f"rigid alignment needs matched positions (N x 3), got "
+                           f"{mine.shape} and {theirs.shape}")
+    out = np.eye(4)
+    try:
+        turn, shift, _ = umeyama_alignment(mine.T, theirs.T, False)
+    except GeometryException:
+        out[:3, 3] = theirs[0] - mine[0]
+        return out
+    out[:3, :3], out[:3, 3] = turn, shift
+    return out

@@ -7,7 +7,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from alte.errors import MetricsError
-from alte.metrics.trajectory import cloud_distance, trajectory_errors
+from alte.metrics.trajectory import cloud_distance, rigid_alignment, trajectory_errors
 
 N = 41
 
@@ -82,3 +82,25 @@ def test_cloud_distance_median_and_p90() -> None:
     found = cloud_distance(cloud, reference)
     assert found.median_m == pytest.approx(np.median(np.linspace(0.0, 0.099, 100)))
     assert found.p90_m == pytest.approx(np.percentile(np.linspace(0.0, 0.099, 100), 90))
+
+
+def test_rigid_alignment_undoes_a_rigid_motion_and_matches_kabsch() -> None:
+    _, positions, _ = _line()
+    turn = Rotation.from_euler("zyx", [40, -10, 5], degrees=True)
+    moved = turn.apply(positions) + np.array([3.0, -2.0, 1.0])
+    found = rigid_alignment(moved, positions)
+    assert np.allclose(moved @ found[:3, :3].T + found[:3, 3], positions, atol=1e-9)
+    noisy = positions + np.random.default_rng(1).normal(0, 0.05, positions.shape)
+    fit = rigid_alignment(noisy, positions)
+    placed = noisy @ fit[:3, :3].T + fit[:3, 3]
+    rmse = float(np.sqrt(np.mean(np.sum((placed - positions) ** 2, axis=1))))
+    assert rmse == pytest.approx(_kabsch_ate(noisy, positions), rel=1e-6)
+
+
+def test_rigid_alignment_of_a_straight_path_and_bad_input() -> None:
+    _, positions, _ = _line()
+    straight = positions * [1.0, 0.0, 0.0]
+    found = rigid_alignment(straight + np.array([0.0, 0.2, 0.0]), straight)
+    assert np.allclose(found[:3, :3], np.eye(3)) and np.allclose(found[:3, 3], [0, -0.2, 0])
+    with pytest.raises(MetricsError, match=r"rigid alignment needs matched positions"):
+        rigid_alignment(positions[:3], positions[:4])
