@@ -22,6 +22,7 @@ from alte.params import Record, param
 
 if TYPE_CHECKING:
     from alte.mappers.base import Cells, Mapper
+    from alte.metrics.reference import Reference
     from alte.metrics.surface import TrueSurface
     from alte.types import Box
 
@@ -139,27 +140,36 @@ def set_b_points(mapper: Mapper, cells: Cells, rule: str = "corners") -> np.ndar
     return np.asarray(cells.centers[keep], dtype=np.float64)
 
 
-def _thesis(points: np.ndarray, cloud: np.ndarray) -> dict[str, float]:
+def _thesis(points: np.ndarray, cloud: np.ndarray,
+            reference: Reference | None = None) -> dict[str, float]:
     """HD/MHD between the cloud and set B; NaN when set B is empty (nothing occupied)."""
     names = ("hd_m", "mhd_m", "hd_minus_mhd_m", "h_ab_m", "h_ba_m", "mh_ab_m", "mh_ba_m")
     if len(points) == 0 or len(cloud) == 0:  # undefined, not zero
         return dict.fromkeys(names, _NAN)
-    hd = hausdorff(cloud, points)
+    hd = hausdorff(cloud, points) if reference is None else reference.hausdorff(points)
     return dict(zip(names, (hd.hd, hd.mhd, hd.hd - hd.mhd, hd.h_ab, hd.h_ba, hd.mh_ab,
                             hd.mh_ba), strict=True))
 
 
 def measure_map(mapper: Mapper, cloud: np.ndarray, *, elapsed_s: float,
                 truth: GroundTruth | None = None, options: TruthOptions | None = None,
-                set_b: str = "corners") -> MapMetrics:
+                set_b: str = "corners", reference: Reference | None = None) -> MapMetrics:
     """Every metric of ``mapper`` against the registered ``cloud`` (and ``truth``);
-    ``set_b`` defines the map's points of HD/MHD (:data:`SET_B`)."""
+    ``set_b`` defines the map's points of HD/MHD (:data:`SET_B`). ``reference``: the
+    same ``cloud``, ``truth`` and ``options`` prepared once for many maps
+    (:class:`~alte.metrics.reference.Reference`): the same values, with the work the
+    maps of one input share done once."""
     if set_b not in SET_B:
         raise MetricsError(f"set B {set_b!r}: expected one of {', '.join(SET_B)}")
+    if reference is not None and not reference.matches(cloud, truth, options):
+        raise MetricsError("measure_map: the reference was prepared from another cloud, "
+                           "truth or truth options")
     cells = mapper.cells()  # once: a large Octomap's leaves take seconds to list
     lo, hi, octaves = _size_spread(cells)
     truth_metrics = None
-    if truth is not None:
+    if truth is not None and reference is not None:
+        truth_metrics = TruthMetrics(**reference.truth_metrics(cells, mapper.dims))
+    elif truth is not None:
         from alte.metrics.truth import ground_truth_metrics
 
         opts = options or TruthOptions()
@@ -171,5 +181,6 @@ def measure_map(mapper: Mapper, cloud: np.ndarray, *, elapsed_s: float,
         elapsed_s=float(elapsed_s), basis_functions=int(mapper.basis_functions),
         memory_bytes=int(mapper.memory_bytes),
         occupied_cells=int(np.count_nonzero(cells.occupied)), cell_min_m=lo, cell_max_m=hi,
-        size_octaves=octaves, **_thesis(set_b_points(mapper, cells, set_b), cloud),
+        size_octaves=octaves,
+        **_thesis(set_b_points(mapper, cells, set_b), cloud, reference),
         truth=truth_metrics)

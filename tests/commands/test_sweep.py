@@ -6,7 +6,7 @@ import pytest
 
 from alte.cli import main
 from alte.studies.sweep import load_results
-from alte.studies.sweep import runner as sweep_runner
+from alte.studies.sweep import work as sweep_work
 
 SPEC = """\
 name: cli
@@ -62,7 +62,7 @@ def test_failed_runs_exit_1(spec_file, capsys, monkeypatch):
     def broken(*args, **kwargs):
         raise RuntimeError("mapper crashed")
 
-    monkeypatch.setattr(sweep_runner, "measure", broken)
+    monkeypatch.setattr(sweep_work, "run_pipeline", broken)
     assert main(["sweep", str(spec_file), "--scheduler", "serial", "--no-progress"]) == 1
     out = capsys.readouterr().out
     assert "failed: sim_lan_1 quadtree {'max_points': 300}: RuntimeError: mapper crashed" in out

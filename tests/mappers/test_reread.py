@@ -78,7 +78,7 @@ def test_fed_map_and_copy_refuse_points_until_rebuilt(mapper, base, views):
     copy = fed.reread(**views[0])
     points, origin = _frames(1, seed=5)[0]
     for m in (fed, copy):
-        with pytest.raises(MapperError, match="re-read with other parameters .* afresh"):
+        with pytest.raises(MapperError, match=r"re-read with other parameters .* afresh"):
             m.insert(points, origin)
     copy.build(points)  # a build starts afresh: nothing shared any more
     assert copy.basis_functions > 0
