@@ -182,7 +182,7 @@ def _section(run: Mapping[str, Any], run_dir: Path) -> RunSection:
                       _results(data), _figures(run_dir, name, params, own or {}))
 
 
-def _whole_missions(tables_dir: Path) -> dict[str, dict[str, Any]]:
+def _whole_missions(tables_dir: Path) -> dict[str, Mapping[Any, Any]]:
     """Per claim id, its row of ``claims_missions.csv`` (empty without that table)."""
     path = tables_dir / MISSIONS_CSV
     if not path.is_file():
