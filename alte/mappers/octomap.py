@@ -23,7 +23,7 @@ import numpy as np
 from alte.errors import MapperError, ParameterError
 from alte.fsutil import atomic_path
 from alte.mappers._octomap_backends import NativeTree, ReferenceTree, SensorModel, tree_leaves
-from alte.mappers._octree import Leaves, check_origin, leaf_geometry
+from alte.mappers._octree import Leaves, check_origin, leaf_boxes, leaf_geometry
 from alte.mappers._raycast import TREE_DEPTH, TREE_MAX_VAL
 from alte.mappers._rows import unique_rows
 from alte.mappers.base import CellCounts, Cells, Feed, check_points, check_view
@@ -259,9 +259,8 @@ def _subset(leaves: Leaves, mask: np.ndarray) -> Leaves:
 def leaves_to_cells(leaves: Leaves, voxel: float,
                     occupied_log_odds: float | np.float32) -> Cells:
     """Cells of pruned leaves: centres, cubic sizes, probability, occupied flag, depth."""
-    _, side, centers = leaf_geometry(leaves, voxel)
+    centers, sizes = leaf_boxes(leaves, voxel)
     value = 1.0 - 1.0 / (1.0 + np.exp(leaves.value.astype(np.float64)))
-    sizes = np.repeat((side * voxel)[:, None], 3, axis=1).astype(np.float64)
     return Cells(centers, sizes, value, leaves.value > occupied_log_odds, leaves.depth.copy())
 
 

@@ -270,13 +270,10 @@ def query_grid(grid: Grid, queries: np.ndarray, rings: int) -> tuple[np.ndarray,
                       grid.scale)
 
 
-def _kdtree(queries: np.ndarray, targets: np.ndarray) -> np.ndarray:
-    return np.asarray(KDTree(targets).query(queries, k=1)[0], dtype=np.float64)
-
-
 class NearestIndex:
     """Targets (N, 3) prepared once for any number of nearest-distance queries: the first
-    grid is built at once, each coarser one when a query first needs it, then kept (a
+    grid is built at once, each coarser one (and pykdtree's tree) when a query first needs
+    it, then kept (a
     sweep measures every map of one input against the same cloud: one build, not one per
     map). The distances are :func:`nearest_distances`'s."""
 
@@ -284,6 +281,13 @@ class NearestIndex:
         self.targets = targets
         self.box = bounds(targets)
         self.grids = [build_grid(targets, first_side(self.box, len(targets)), self.box)]
+        self._tree: KDTree | None = None
+
+    def _kdtree(self, queries: np.ndarray) -> np.ndarray:
+        """The queries the grids leave to pykdtree (its tree built once, then kept)."""
+        if self._tree is None:
+            self._tree = KDTree(self.targets)
+        return np.asarray(self._tree.query(queries, k=1)[0], dtype=np.float64)
 
     def _grid(self, i: int) -> Grid:
         if i == len(self.grids):
@@ -294,7 +298,7 @@ class NearestIndex:
         """Distance from every query (M, 3) to its nearest target (finite float64)."""
         grid = self.grids[0]
         if grid.load > MAX_LOAD:
-            return _kdtree(queries, self.targets)
+            return self._kdtree(queries)
         dist, settled = query_grid(grid, queries, RINGS)
         todo = np.flatnonzero(~settled)
         level = 0
@@ -302,7 +306,7 @@ class NearestIndex:
             level += 1
             grid = self._grid(level)
             if grid.load > MAX_LOAD:
-                dist[todo] = _kdtree(queries[todo], self.targets)
+                dist[todo] = self._kdtree(queries[todo])
                 break
             found, settled = query_grid(grid, queries[todo], RINGS)
             dist[todo] = found

@@ -118,8 +118,8 @@ class MapMetrics:
 
 def _size_spread(cells: Cells) -> tuple[float, float, float]:
     """Cell edge range of the known cells: the "adaptability" of tables 5.1-5.2."""
-    known = np.isfinite(cells.centers).all(axis=1)
-    edge = cells.sizes[known, 0]
+    finite = np.isfinite(cells.centers)
+    edge = cells.sizes[:, 0] if finite.all() else cells.sizes[finite.all(axis=1), 0]
     if edge.size == 0:
         return _NAN, _NAN, _NAN
     lo, hi = float(edge.min()), float(edge.max())

@@ -31,6 +31,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
+import numba
 import numpy as np
 from scipy.spatial import cKDTree
 
@@ -248,15 +249,28 @@ def free_space_truth(cells: Cells, surface: TrueSurface, max_cells: int | None =
                             max_cells, seed)
 
 
+@numba.njit(cache=True)
+def _free_volumes(occupied: np.ndarray, sizes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Indices of the free cells and their volumes (edges multiplied left to right, as
+    ``np.prod(axis=1)``), one pass: an Octomap flight at 0.1 m has tens of millions."""
+    free, volume = np.empty(occupied.shape[0], np.int64), np.empty(occupied.shape[0])
+    m = 0
+    for i in range(occupied.shape[0]):
+        if not occupied[i]:
+            free[m], volume[m] = i, sizes[i, 0] * sizes[i, 1] * sizes[i, 2]
+            m += 1
+    return free[:m], volume[:m]
+
+
 def free_space_share(cells: Cells, inside: Callable[[np.ndarray], np.ndarray],
                      max_cells: int | None = None, seed: int = 0) -> float:
     """:func:`free_space_truth` with ``inside(rows)``: whether the centres of the cells
     ``rows`` lie inside a solid."""
     max_cells = FREE_SPACE_CELLS if max_cells is None else max_cells
-    free = np.flatnonzero(~cells.occupied.astype(bool))
+    free, volume = _free_volumes(np.ascontiguousarray(cells.occupied, np.bool_),
+                                 np.ascontiguousarray(cells.sizes, np.float64))
     if free.size == 0:
         return float("nan")
-    volume = np.prod(cells.sizes[free], axis=1)
     if free.size <= max_cells:
         truly = ~inside(free)
         return float(volume[truly].sum() / volume.sum())
