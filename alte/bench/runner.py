@@ -23,6 +23,7 @@ from alte.bench.maps import batch_builds, insert_latency, octomap_memory, octoma
 from alte.bench.memory import map_memory
 from alte.bench.scaling import scaling
 from alte.bench.stream import scan_peer, streaming_chain
+from alte.bench.sweep import sweep_throughput
 from alte.bench.timing import machine_info, peak_rss_bytes
 from alte.bench.wall import report_wall_time
 from alte.errors import ParameterError
@@ -44,6 +45,8 @@ ROWS: dict[int, tuple[str, Row]] = {
     9: ("alte map peak RSS: a mission flown 4x vs once", map_memory),
     10: ("alte map BAG: wall time vs mission time, per-frame latency", streaming_chain),
     11: ("Octomap native vs DUFOMap (UFOMap) scan integration", scan_peer),
+    12: ("sweep runs per core-second (20 scans, whole missions) and the grid's time",
+         sweep_throughput),
 }
 
 

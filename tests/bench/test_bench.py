@@ -176,7 +176,7 @@ def quick_bench(tmp_path_factory):
 @pytest.mark.slow
 def test_quick_bench_runs_every_row_and_writes_its_outputs(quick_bench):
     assert quick_bench.errors == {}
-    assert {r.row for r in quick_bench.results} == set(range(1, 12))
+    assert {r.row for r in quick_bench.results} == set(range(1, 13))
     for r in quick_bench.results:
         if r.row != 8:
             assert math.isfinite(r.ours) and r.peer > 0, r.case
@@ -193,6 +193,13 @@ def test_quick_bench_runs_every_row_and_writes_its_outputs(quick_bench):
     assert len(chain) == 8 and all(r.detail["frames"] == 6 for r in chain)
     assert all(r.detail["latency_ms"]["max"] >= r.detail["insert_ms"]["max"] for r in chain)
     assert [r.detail["frames"] for r in quick_bench.results if r.row == 11] == [3]
+    sweeps = [r for r in quick_bench.results if r.row == 12]
+    assert [r.case.split(" (")[0] for r in sweeps] == [
+        "sweep runs per core-second, 20 scans", "sweep runs per core-second, whole missions"]
+    for r in sweeps:  # grouped runs beat today's run-by-run path; the grid is estimated
+        assert r.ours > r.peer and r.detail["grid_cpu_h"] > 0 and r.met is None
+        assert r.detail["grid_runs"] > r.detail["sample_runs"] >= 12
+        assert len(r.detail["per_stratum"]) == 12
     paths = write_outputs(quick_bench, quick_bench.config.reports_dir)
     record = json.loads(paths["json"].read_text())
     assert record["machine"]["cpu"] and len(record["results"]) == len(quick_bench.results)
