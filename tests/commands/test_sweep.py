@@ -69,6 +69,19 @@ def test_failed_runs_exit_1(spec_file, capsys, monkeypatch):
     assert "0 run, 0 already done, 3 failed" in out
 
 
+def test_evidence_is_not_written_while_runs_fail(spec_file, tmp_path, capsys, monkeypatch):
+    def broken(*args, **kwargs):
+        raise RuntimeError("mapper crashed")
+
+    monkeypatch.setattr(sweep_work, "run_pipeline", broken)
+    folder = tmp_path / "evidence"
+    assert main(["sweep", str(spec_file), "--scheduler", "serial", "--no-progress",
+                 "--evidence", str(folder)]) == 1
+    assert f"evidence not written to {folder}: rerun to retry the failed runs" in \
+        capsys.readouterr().out
+    assert not folder.exists()
+
+
 @pytest.mark.parametrize(("args", "message"), [
     (["--frames", "0"], "sweep: frames=0 out of range (frames >= 1)"),
     (["--scheduler", "mars"], "--scheduler 'mars': expected serial"),
