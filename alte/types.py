@@ -116,7 +116,9 @@ class Frame:
     ``points`` are in the sensor frame; ``position`` and ``quaternion`` (x, y, z, w)
     give the body pose in the inertial frame. ``pose_offset_s`` is the time from the
     scan stamp to the nearest pose sample and ``angular_rate`` the body rate (rad/s)
-    there; the fast-manoeuvre filter of thesis ch. 4 uses both.
+    there; the fast-manoeuvre filter of thesis ch. 4 uses both. ``times`` (N,) holds
+    each point's time in seconds from the stamp when the cloud carries one (a sweeping
+    sensor: :mod:`alte.registration.deskew` uses it), else None.
     """
 
     stamp: int
@@ -126,6 +128,7 @@ class Frame:
     pose_offset_s: float = 0.0
     angular_rate: float = 0.0
     dropped_points: int = 0
+    times: np.ndarray | None = None
 
     @property
     def time(self) -> float:
@@ -154,13 +157,15 @@ class Frame:
 @dataclass(frozen=True, eq=False)
 class RegisteredFrame:
     """One scan after registration: inertial ``points`` (N, 3) and the sensor ``origin`` (3,),
-    with the scan's stamp (ns) and the body pose it was registered with."""
+    with the scan's stamp (ns) and the body pose it was registered with; ``fields``: the
+    points' other values by name (a point file's intensity, colours, ...), when kept."""
 
     stamp: int
     points: np.ndarray
     origin: np.ndarray
     position: np.ndarray
     quaternion: np.ndarray
+    fields: dict[str, np.ndarray] | None = None
 
 
 @dataclass(frozen=True, eq=False)

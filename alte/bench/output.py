@@ -90,15 +90,15 @@ def _row7(results: list[Result]) -> list[str]:
     return (["", "Row 7 timings (plot: bench_scaling.png):", "", *out]) if out else []
 
 
-def _row12(results: list[Result]) -> list[str]:
+def _row13(results: list[Result]) -> list[str]:
     out = [f"- {r.case}: {d['sample_runs']} runs in {d['sample_cpu_s']:.1f} CPU s, inputs "
            f"prepared in {d['prepare_cpu_s_per_input']:.1f} CPU s each; the grid's "
            f"{d['grid_runs']:,} runs on {d['grid_inputs']} inputs: {d['grid_cpu_h']:.2f} CPU h, "
            f"{d['grid_wall_h']:.2f} h on {d['workers']} cores ({d['grid_runs_per_core_s']:.2f} "
            f"runs per core-second); today's path run by run: {d['peer_runs']} runs in "
            f"{d['peer_cpu_s']:.1f} CPU s"
-           for r in results if r.row == 12 for d in (r.detail,)]
-    return (["", "Row 12 estimates (stratified sample of map groups, CPU seconds):", "",
+           for r in results if r.row == 13 for d in (r.detail,)]
+    return (["", "Row 13 estimates (stratified sample of map groups, CPU seconds):", "",
              *out]) if out else []
 
 
@@ -116,7 +116,7 @@ def render_markdown(bench: Bench) -> str:
         lines += ["", "Rows that failed:", ""]
         lines += [f"- row {n} ({ROWS[n][0]}): {msg}" for n, msg in bench.errors.items()]
     return "\n".join([*lines, *_row7(bench.results), *_row8(bench.results),
-                      *_row12(bench.results), ""])
+                      *_row13(bench.results), ""])
 
 
 def plot_scaling(results: list[Result], path: Path) -> Path | None:

@@ -21,6 +21,7 @@ from alte.bench.clouds import cloud_stages, hausdorff_speed
 from alte.bench.core import BenchConfig, Context, Result
 from alte.bench.maps import batch_builds, insert_latency, octomap_memory, octomap_speed
 from alte.bench.memory import map_memory
+from alte.bench.poses import pose_speed
 from alte.bench.scaling import scaling
 from alte.bench.stream import scan_peer, streaming_chain
 from alte.bench.sweep import sweep_throughput
@@ -45,7 +46,8 @@ ROWS: dict[int, tuple[str, Row]] = {
     9: ("alte map peak RSS: a mission flown 4x vs once", map_memory),
     10: ("alte map BAG: wall time vs mission time, per-frame latency", streaming_chain),
     11: ("Octomap native vs DUFOMap (UFOMap) scan integration", scan_peer),
-    12: ("sweep runs per core-second (20 scans, whole missions) and the grid's time",
+    12: ("odometry / refinement per real scan vs kiss-icp's pipeline", pose_speed),
+    13: ("sweep runs per core-second (20 scans, whole missions) and the grid's time",
          sweep_throughput),
 }
 

@@ -1,4 +1,4 @@
-"""Row 12: the sweep's throughput in runs per core-second, and a grid's time from it.
+"""Row 13: the sweep's throughput in runs per core-second, and a grid's time from it.
 
 A sweep spends its time in its per-run work (:mod:`alte.studies.sweep.work`): feeding a
 map once for the runs that share it, measuring it per run. The row draws a stratified
@@ -102,7 +102,7 @@ def _prepare_input(run: Any, data_dir: str) -> float:
     from alte.studies.sweep.work import _inputs
 
     start = time.process_time()
-    _ensure((run.terrain, run.frames, run.seed, run.voxel), data_dir)
+    _ensure((run.terrain, run.frames, run.seed, run.voxel, run.sensor, run.deskew), data_dir)
     _, reference = _inputs(run, data_dir)
     reference.cloud_index  # noqa: B018 - prepared now, as a worker does on its first map
     if reference.truth is not None:
@@ -154,15 +154,13 @@ def _peer(sample_spec: Any, data_dir: str, seed: int, strata: int | None) -> tup
     """Runs and CPU seconds of today's path (one fresh map per run, metrics from scratch)
     on the first run of each sampled group."""
     from alte.pipeline import DomainPolicy, MapSpec
-    from alte.sim import terrain_folder
     from alte.studies.experiments import measure
-    from alte.studies.sweep.work import _dataset
+    from alte.studies.sweep.work import _inputs
 
     runs, cpu = 0, 0.0
     for group, _ in _thinned(stratified_groups(sample_spec, seed), strata):
         run = group.runs[0]
-        folder = terrain_folder(data_dir, run.terrain, run.frames, run.seed)
-        data = _dataset(str(folder), run.frames, run.voxel, data_dir)
+        data, _ = _inputs(run, data_dir)
         start = time.process_time()
         measure(data, run.mapper, truth=run.truth, set_b=run.set_b,
                 spec=MapSpec(run.mapper, dict(run.params), domain=DomainPolicy(run.domain)))
@@ -186,7 +184,7 @@ def _spec(path: str, ctx: Context, data_dir: str) -> Any:
 
 
 def sweep_throughput(ctx: Context) -> list[Result]:
-    """Row 12 (module docstring): one result per case."""
+    """Row 13 (module docstring): one result per case."""
     cfg = ctx.config
     data_dir = str(workload_dir(cfg.data_dir, cfg.quick).resolve())
     out = []
@@ -202,7 +200,7 @@ def sweep_throughput(ctx: Context) -> list[Result]:
         met = (grid["wall_h"] <= GRID_HOURS) if whole else None
         target = (f"full grid <= {GRID_HOURS:g} h on {WORKERS} cores (~{RUN_CORE_S} core-s "
                   "a run)" if whole else "informative")
-        out.append(Result(12, f"sweep runs per core-second, {case} ({Path(path).name}, "
+        out.append(Result(13, f"sweep runs per core-second, {case} ({Path(path).name}, "
                               f"{sample.runs} runs in {sample.groups} maps)",
                           sample.runs_per_core_s, peer, "runs/core-s", target, met, {
                               "sample_runs": sample.runs, "sample_cpu_s": sample.cpu_s,

@@ -1,9 +1,10 @@
 """``alte export INPUT --mcap FILE --mapper M``: a map run as one ROS 2 MCAP file.
 
 Open the file in Foxglove Studio, or play it into RViz (``ros2 bag play FILE``); the
-topics and their types are listed in :mod:`alte.export.mcap` and the README. With
-``--timeline N`` the map is written every N mapped scans, stamped with the scan's
-time, so scrubbing the timeline replays the mapping.
+topics and their types are listed in :mod:`alte.export.mcap` and the README. The final
+map is there from the file's first instant; with ``--timeline N`` it is also written
+every N mapped scans, stamped with the scan's time, so scrubbing the timeline replays
+the mapping.
 """
 
 from __future__ import annotations
@@ -23,9 +24,13 @@ def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) 
         "export", help="map an input and write the result as a ROS 2 MCAP (Foxglove, RViz)",
         description="Map INPUT like `alte map` and write one ROS 2 MCAP file: registered "
                     "cloud and scans (PointCloud2), trajectory (Path), pose (PoseStamped, "
-                    "/tf), map cells (MarkerArray), 2D maps (OccupancyGrid, GridMap) and "
-                    "Octomap (octomap_msgs/Octomap). An existing file is never replaced "
-                    "without --force.")
+                    "/tf), map cells (MarkerArray), occupancy for landing (OccupancyGrid: 0 "
+                    "free, 100 occupied, -1 unseen; see --occupancy-set), height and "
+                    "occupancy as a Foxglove grid (foxglove_msgs/Grid), 2D maps for RViz "
+                    "(GridMap) and Octomap (octomap_msgs/Octomap). The final map, trajectory "
+                    "and cloud are also written at the file's first instant, so a viewer "
+                    "shows them on opening. An existing file is never replaced without "
+                    "--force.")
     add_frame_options(p, origin=True)
     add_map_options(p)
     p.add_argument("--mcap", type=Path, required=True, metavar="FILE",

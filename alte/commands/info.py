@@ -1,7 +1,8 @@
 """``alte info INPUT``: a bag's topics, counts, duration and the cloud/pose topics alte would use.
 
 For a terrain folder (``alte simulate``) it also shows what the pipeline takes from it:
-the control volume (crop and domain) and the registration voxel.
+the control volume (crop and domain) and the registration voxel. For a point file it
+describes the file: format, encoding, fields, points, NaN rows, bounds.
 """
 
 from __future__ import annotations
@@ -9,25 +10,27 @@ from __future__ import annotations
 import argparse
 import json
 from pathlib import Path
+from typing import Any
 
-from alte.errors import BagError
 from alte.io.baginfo import BagInfo, inspect_bag
+from alte.io.pointfiles import describe_points
 from alte.pipeline import InputKind, Source, open_input
 
-__all__ = ["add_parser", "format_info", "pose_source", "run"]
+__all__ = ["add_parser", "format_info", "format_points", "pose_source", "run"]
 
 
 def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Register ``alte info``."""
     p = subparsers.add_parser(
         "info",
-        help="show a bag's topics and the cloud/pose topics alte detects",
+        help="show a bag's topics (or a point file's contents) and what alte detects",
         description="List the topics of INPUT (ROS 1 .bag file, ROS 2 bag folder, or a terrain "
         "folder) with their types and message counts, the duration, the detected cloud and "
-        "pose topics and the /tf_static sensor mount.",
+        "pose topics and the /tf_static sensor mount; or describe a point file (.pcd, .ply, "
+        ".las, .laz, .npz, .xyz): format, encoding, fields, points, NaN rows, bounds.",
     )
     p.add_argument("input", type=Path,
-                   help="ROS 1 .bag file, ROS 2 bag folder, or a terrain folder")
+                   help="ROS 1 .bag file, ROS 2 bag folder, a terrain folder, or a point file")
     p.add_argument("--json", action="store_true", help="print one JSON object instead of text")
     p.add_argument("--cloud-topic", default=None, help="PointCloud2 / VelodyneScan topic")
     p.add_argument("--pose-topic", default=None, help="pose / odometry / TF topic")
@@ -38,7 +41,10 @@ def pose_source(info: BagInfo) -> str:
     """What ``alte map``/``register`` use for poses by default (``--poses`` unset)."""
     if info.pose_topic:
         return f"recorded ({info.pose_topic})"
-    return "odometry (no pose topic: LiDAR odometry, in the first scan's body frame)"
+    from alte.registration.odometry import OdometryParams, odometry_label
+
+    return (f"odometry (no pose topic: LiDAR odometry, {odometry_label(OdometryParams())} "
+            "unless --odometry says otherwise, in the first scan's body frame)")
 
 
 def format_info(info: BagInfo) -> list[str]:
@@ -76,12 +82,34 @@ def format_terrain(terrain: dict[str, object]) -> list[str]:
             f"voxel:     {terrain['voxel']} m (registration grid)"]
 
 
+def format_points(about: dict[str, Any]) -> list[str]:
+    """Human-readable lines describing a point file (:func:`describe_points`)."""
+    fields = ", ".join(f"{f['name']} {f['type']}" + (f" x{f['count']}" if f["count"] > 1 else "")
+                       for f in about["fields"])
+    lines = [f"file:      {about['file']}", f"format:    {about['format']}, {about['encoding']}",
+             f"fields:    {fields}",
+             f"points:    {about['rows']} rows: {about['points']} finite, "
+             f"{about['nonfinite']} non-finite ({about['nan']} with NaN)"]
+    if about.get("height", 1) > 1:
+        lines.append(f"layout:    organised, {about['width']} x {about['height']}")
+    if about["bounds"] is not None:
+        lo, hi = about["bounds"]
+        lines.append("bounds:    " + ", ".join(f"{c} {a:.3f} .. {b:.3f}"
+                                               for c, a, b in zip("xyz", lo, hi, strict=True)))
+    ranges = about["field_ranges"]
+    lines += ["ranges:"] * bool(ranges)
+    lines += [f"  {name:<12} {lo:.6g} .. {hi:.6g}" for name, (lo, hi) in ranges.items()]
+    return lines
+
+
 def run(args: argparse.Namespace) -> int:
     """Inspect the input and print the summary."""
     source = open_input(args.input)
-    if source.bag is None:
-        raise BagError(f"{args.input}: a point file has no topics; `alte info` reads bags and "
-                       "terrain folders")
+    if source.kind is InputKind.POINTS:
+        about = describe_points(source.path)
+        print(json.dumps(about, sort_keys=True) if args.json else "\n".join(format_points(about)))
+        return 0
+    assert source.bag is not None  # bags and terrain folders have one
     info = inspect_bag(source.bag, cloud_topic=args.cloud_topic, pose_topic=args.pose_topic)
     terrain = _terrain(source)
     if args.json:

@@ -19,6 +19,7 @@ from alte.errors import ParameterError
 from alte.export import ExportOptions
 from alte.export import export_map as export_mcap
 from alte.fsutil import refuse_overwrite
+from alte.ground.surface import SurfaceRule
 from alte.mappers import MAPPERS, Domain, Feed, check_export, export_map, mapper_class
 from alte.pipeline import DomainPolicy, MapRun, MapSpec, open_input, run
 
@@ -28,7 +29,8 @@ __all__ = ["add_map_options", "add_parser", "export_options", "map_spec", "mappe
 _SUMMARY_KEYS = ("mapper", "params", "input", "input_kind", "pose_source", "domain_policy",
                  "domain", "feed",
                  "frames", "points", "points_dropped_nonfinite", "points_dropped_crop",
-                 "points_outside", "local_origin", "elapsed_s", "wall_s", "basis_functions",
+                 "points_outside", "local_origin", "elapsed_s", "cpu_s", "cost", "cost_unit",
+                 "wall_s", "basis_functions",
                  "occupied_cells", "memory_bytes", "metrics", "export", "mcap")
 
 
@@ -49,6 +51,11 @@ def add_map_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--timeline", type=int, default=None, metavar="N",
                    help="with --mcap: write the map every N mapped scans, stamped with the "
                         "scan's time (the map as it grows; batch feeds switch to frames)")
+    p.add_argument("--occupancy-set", action="append", default=[], metavar="KEY=VALUE",
+                   dest="occupancy_sets",
+                   help="with --mcap: landing criterion of the occupancy grids (repeatable): "
+                        + "; ".join(f"{k}: {v}" for k, v in SurfaceRule.help().items())
+                        + f"; defaults {SurfaceRule().as_dict()}")
 
 
 def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -72,13 +79,13 @@ def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) 
     p.set_defaults(func=run_command)
 
 
-def parse_sets(items: list[str]) -> dict[str, str]:
-    """``["k=v", ...]`` -> ``{"k": "v"}``; an item without '=' raises."""
+def parse_sets(items: list[str], flag: str = "--set") -> dict[str, str]:
+    """``["k=v", ...]`` -> ``{"k": "v"}``; an item without '=' raises (naming ``flag``)."""
     out: dict[str, str] = {}
     for item in items:
         key, sep, value = item.partition("=")
         if not sep or not key.strip():
-            raise ParameterError(f"--set {item!r}: expected KEY=VALUE")
+            raise ParameterError(f"{flag} {item!r}: expected KEY=VALUE")
         out[key.strip()] = value.strip()
     return out
 
@@ -99,10 +106,12 @@ def _summary(result: MapRun, metrics: bool) -> dict[str, object]:
     out = result.summary()
     if metrics:
         from alte.metrics.maps import measure_map
+        from alte.metrics.timing import Timing
 
         source = open_input(result.info.input)
         assert result.cloud is not None  # run(..., cloud=True) kept it for the metrics
-        out["metrics"] = measure_map(result.mapper, result.cloud, elapsed_s=result.elapsed_s,
+        timing = Timing.of([result.elapsed_s], [result.cpu_s])  # one run, no spread
+        out["metrics"] = measure_map(result.mapper, result.cloud, elapsed_s=timing,
                                      truth=source.ground_truth()).as_dict()
     return out
 
@@ -136,16 +145,23 @@ def mapped(args: argparse.Namespace, mcap: Path | None, options: ExportOptions,
 
 
 def export_options(args: argparse.Namespace, mcap: Path | None) -> ExportOptions:
-    """``--timeline`` and the MCAP flags, checked (and the target refused) before the read."""
+    """``--timeline``, ``--occupancy-set`` and the MCAP flags, checked (and the target
+    refused) before the read."""
     if mcap is None:
-        if args.timeline is not None:
-            raise ParameterError("--timeline writes the growing map into --mcap FILE; add it")
+        for flag, given in (("--timeline", args.timeline is not None),
+                            ("--occupancy-set", bool(args.occupancy_sets))):
+            if given:
+                raise ParameterError(f"{flag} shapes the map written into --mcap FILE; add it")
         return ExportOptions()
     if mcap.suffix.lower() != ".mcap":
         raise ParameterError(f"--mcap {mcap}: the file name must end in .mcap")
+    try:
+        rule = SurfaceRule.parse(parse_sets(args.occupancy_sets, "--occupancy-set"))
+    except ParameterError as err:
+        raise ParameterError(f"--occupancy-set: {err}") from err
     refuse_overwrite(mcap, args.force)
     return ExportOptions(args.timeline, scans=not getattr(args, "no_scans", False),
-                         all_cells=getattr(args, "all_cells", False))
+                         all_cells=getattr(args, "all_cells", False), surface=rule)
 
 
 def run_command(args: argparse.Namespace) -> int:

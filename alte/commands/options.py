@@ -13,9 +13,11 @@ import numpy as np
 
 from alte.errors import ParameterError
 from alte.pipeline import FrameSpec, PoseSource
+from alte.registration.odometry import METHODS, OdometryParams, odometry_params
 from alte.types import Box, Mount
 
-__all__ = ["add_frame_options", "frame_spec", "parse_box", "parse_origin"]
+__all__ = ["add_frame_options", "add_odometry_options", "frame_spec", "odometry_spec",
+           "parse_box", "parse_key_values", "parse_origin"]
 
 INPUT_HELP = ("ROS 1 .bag file or ROS 2 bag folder, a terrain folder made by `alte simulate` "
               "(its control volume and voxel are used), or a point file")
@@ -36,11 +38,19 @@ def add_frame_options(p: argparse.ArgumentParser, *, origin: bool = False) -> No
                    help="sensor offset (m) and rotation (deg) on the body (default: the bag's)")
     p.add_argument("--cloud-topic", default=None, help="PointCloud2 / VelodyneScan topic")
     p.add_argument("--pose-topic", default=None, help="pose / odometry / TF topic")
+    p.add_argument("--pose-file", type=Path, default=None, metavar="FILE",
+                   help="poses from a TUM file (t x y z qx qy qz qw per line) instead of a "
+                        "pose topic")
     p.add_argument("--poses", choices=[s.value for s in PoseSource], default=None,
                    help="where scan poses come from: recorded (the pose topic), odometry "
-                        "(LiDAR odometry, kiss-icp), refine (recorded, aligned scan to map), "
-                        "identity (static sensor); default: recorded, or odometry when the "
-                        "bag has no pose topic")
+                        "(LiDAR odometry, see --odometry), refine (recorded, aligned scan to "
+                        "map where that is clearly better), identity (static sensor); "
+                        "default: recorded, or odometry when the bag has no pose topic")
+    add_odometry_options(p)
+    p.add_argument("--no-deskew", action="store_true",
+                   help="register each point where it was taken, even when the cloud has "
+                        "per-point time (default: move it to the scan stamp with the "
+                        "sensor's motion)")
     p.add_argument("--no-pose", action="store_true",
                    help="ignore poses: identity body pose for every scan (= --poses identity)")
     p.add_argument("--max-rate", type=float, default=None, metavar="RAD_S",
@@ -50,6 +60,34 @@ def add_frame_options(p: argparse.ArgumentParser, *, origin: bool = False) -> No
     if origin:
         p.add_argument("--origin", default="0,0,0", metavar="X,Y,Z",
                        help="sensor position for a point file (default 0,0,0)")
+
+
+def add_odometry_options(p: argparse.ArgumentParser) -> None:
+    """``--odometry`` and ``--odometry-set`` (the backend and its settings)."""
+    p.add_argument("--odometry", choices=METHODS, default=None,
+                   help="LiDAR odometry backend for --poses odometry: kiss (KISS-ICP, the "
+                        "default) or plane (point-to-plane scan-to-map ICP)")
+    p.add_argument("--odometry-set", action="append", default=[], metavar="KEY=VALUE",
+                   dest="odometry_sets",
+                   help="odometry / refinement setting (repeatable), e.g. --odometry-set "
+                        "voxel=0.5; valid keys: " + ", ".join(OdometryParams.names()[1:]))
+
+
+def parse_key_values(items: list[str], flag: str) -> dict[str, str]:
+    """``["k=v", ...]`` -> ``{"k": "v"}``; an item without '=' is an error naming ``flag``."""
+    out: dict[str, str] = {}
+    for item in items:
+        key, sep, value = item.partition("=")
+        if not sep or not key.strip():
+            raise ParameterError(f"{flag} {item!r}: expected KEY=VALUE")
+        out[key.strip()] = value.strip()
+    return out
+
+
+def odometry_spec(args: argparse.Namespace) -> OdometryParams:
+    """The :class:`OdometryParams` of ``--odometry`` / ``--odometry-set`` (errors name them)."""
+    settings = parse_key_values(getattr(args, "odometry_sets", []) or [], "--odometry-set")
+    return odometry_params(getattr(args, "odometry", None), settings)
 
 
 def parse_box(text: str, flag: str = "--crop") -> Box:
@@ -105,10 +143,15 @@ def frame_spec(args: argparse.Namespace) -> FrameSpec:
     if poses is PoseSource.IDENTITY and args.pose_topic:
         raise ParameterError("--no-pose (--poses identity) and --pose-topic exclude each other")
     mount = Mount.from_string(args.mount) if args.mount else None
+    odometry = odometry_spec(args)
+    pose_file = getattr(args, "pose_file", None)
+    if pose_file is not None and not pose_file.is_file():
+        raise ParameterError(f"--pose-file {pose_file}: no such file")
     return FrameSpec(
         frames=args.frames, voxel=args.voxel,
         crop=parse_box(args.crop) if args.crop else None, mount=mount,
         cloud_topic=args.cloud_topic, pose_topic=args.pose_topic,
-        poses=poses,
-        max_rate=args.max_rate, max_offset=args.max_offset,
+        poses=poses, deskew=not args.no_deskew,
+        max_rate=args.max_rate, max_offset=args.max_offset, odometry=odometry,
+        pose_file=pose_file,
         origin=parse_origin(args.origin) if getattr(args, "origin", None) else (0.0, 0.0, 0.0))

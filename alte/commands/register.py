@@ -1,4 +1,8 @@
-"""``alte register``: an input's LiDAR frames -> one inertial point cloud file (thesis 2.1.3)."""
+"""``alte register``: an input's LiDAR frames -> one inertial point cloud file (thesis 2.1.3).
+
+A point file is one frame: its summary speaks of the file's rows rather than of scans,
+and its other fields (intensity, colours, labels, ...) go into ``--out`` where that format
+can hold them (every point kept, no ``--voxel``)."""
 
 from __future__ import annotations
 
@@ -11,11 +15,11 @@ from alte.commands.options import add_frame_options, frame_spec
 from alte.errors import ParameterError, PointFileError
 from alte.export import export_registered
 from alte.fsutil import refuse_overwrite
-from alte.io.pointfiles import WRITE_SUFFIXES, write_points
-from alte.pipeline import StreamCounts, merged_cloud, open_input, prepare
+from alte.io.pointfiles import WRITE_SUFFIXES, storable, write_points
+from alte.pipeline import InputKind, StreamCounts, merge_frames, open_input, prepare
 from alte.registration import RegistrationCounts
 
-__all__ = ["add_parser", "format_counts", "run"]
+__all__ = ["add_parser", "format_counts", "format_file_counts", "pose_line", "run"]
 
 
 def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -49,6 +53,22 @@ def format_counts(counts: RegistrationCounts) -> list[str]:
     ]
 
 
+def pose_line(counts: StreamCounts) -> str:
+    """Where the poses came from, with the backend, its settings and refinement's counts."""
+    poses = counts.poses
+    if poses.method == "refine":
+        kept = ", ".join(f"{n} {r}" for r, n in sorted(poses.kept.items()))
+        return (f"refine ({poses.corrected} corrected, {poses.frames - poses.corrected} kept"
+                + (f": {kept})" if kept else ")"))
+    if poses.method:
+        from alte.registration.odometry import OdometryParams, odometry_label
+
+        label = odometry_label(OdometryParams.parse(poses.settings))
+        return f"{poses.source} ({label}, {1e3 * poses.seconds / max(poses.frames, 1):.0f} " \
+               "ms per scan)"
+    return poses.source
+
+
 def _reader_line(counts: StreamCounts) -> str:
     parts = ", ".join(f"{k.replace('_', ' ')} {v}" for k, v in counts.read.as_dict().items())
     return f"bag: {parts}" if parts else "bag: read"
@@ -60,24 +80,49 @@ def _check_mcap(path: Path, force: bool) -> None:
     refuse_overwrite(path, force)
 
 
+def format_file_counts(path: Path, counts: StreamCounts) -> list[str]:
+    """Human summary for a point file: its rows, what was dropped, what came out."""
+    c, read = counts.registration, counts.read
+    rows = c.points_in + read.points_nonfinite
+    out = f"{c.points_registered} after down-sampling, " if c.points_registered != \
+        c.points_in - c.points_dropped_crop else ""
+    return [f"file: {path}: {rows} rows; dropped {read.points_nonfinite} (NaN/inf), "
+            f"{c.points_dropped_crop} (outside crop box); {out}{c.points_out} points out"]
+
+
+def _fields_line(out: Path, fields: dict[str, np.ndarray]) -> tuple[dict[str, np.ndarray], str]:
+    """The fields ``out`` can hold, and a line naming what is kept and what is not (why)."""
+    kept, dropped = storable(out.suffix.lower(), fields)
+    parts = [f"kept {', '.join(kept)}"] if kept else []
+    parts += [f"not kept {name} ({why})" for name, why in dropped.items()]
+    return kept, f"fields: {'; '.join(parts)}"
+
+
 def run(args: argparse.Namespace) -> int:
     """Read, register, write; print the counts."""
     if args.out.suffix.lower() not in WRITE_SUFFIXES:
         raise PointFileError(f"--out {args.out}: unknown point file type; use {WRITE_SUFFIXES}")
     refuse_overwrite(args.out, args.force)  # fail before the long read
-    spec = frame_spec(args)
+    spec, source = frame_spec(args), open_input(args.input)
+    fields: dict[str, np.ndarray] = {}
     if args.mcap is not None:
         _check_mcap(args.mcap, args.force)
-        reg = prepare(open_input(args.input), spec, progress=True)
+        reg = prepare(source, spec, progress=True)
         cloud, counts = np.asarray(reg.cloud), reg.counts
         topics = export_registered(reg, args.mcap, overwrite=args.force)
+        if source.kind is InputKind.POINTS:  # one frame: read again for its fields
+            fields = merge_frames(source, spec).fields
     else:
-        cloud, counts = merged_cloud(open_input(args.input), spec, progress=True)
-    write_points(args.out, cloud, overwrite=args.force)
-    print(_reader_line(counts))
-    for line in format_counts(counts.registration):
-        print(line)
-    print(f"poses: {counts.poses.source}")
+        merged = merge_frames(source, spec, progress=True)
+        cloud, counts, fields = merged.points, merged.counts, merged.fields
+    kept, line = _fields_line(args.out, fields)
+    write_points(args.out, cloud, overwrite=args.force, fields=kept)
+    if source.kind is InputKind.POINTS:
+        lines = format_file_counts(source.path, counts) + ([line] if fields else [])
+    else:
+        lines = [_reader_line(counts), *format_counts(counts.registration),
+                 f"poses: {pose_line(counts)}"]
+    print("\n".join([*lines, *(f"note: {n}" for n in counts.notes)]))
     print(f"wrote {len(cloud)} points to {args.out}")
     if args.mcap is not None:
         print(f"wrote {sum(topics.values())} messages to {args.mcap}: "

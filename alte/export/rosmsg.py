@@ -1,10 +1,12 @@
 """ROS 2 messages built from arrays: the type store, headers, poses, paths, TF and clouds.
 
-The store is rosbags' ROS 2 Humble set plus two packages it lacks, registered from
-their message definitions: ``octomap_msgs/msg/Octomap`` (RViz's OctoMap plugin) and
+The store is rosbags' ROS 2 Humble set plus three packages it lacks, registered from
+their message definitions: ``octomap_msgs/msg/Octomap`` (RViz's OctoMap plugin),
 ``grid_map_msgs/msg/GridMap`` (the ROS 2 layout: header, ``GridMapInfo`` with the
-map centre's pose, named float32 layers). Every message an exporter writes is built
-here or in :mod:`alte.export.maps`, as the store's own classes (typed fields).
+map centre's pose, named float32 layers) and ``foxglove_msgs/msg/Grid`` (Foxglove's
+own grid, as its ``ros_foxglove_msgs`` package defines it for ROS 2). Every message an
+exporter writes is built here, in :mod:`alte.export.maps` or in :mod:`alte.export.grids`,
+as the store's own classes (typed fields).
 """
 
 from __future__ import annotations
@@ -42,6 +44,33 @@ EXTRA_MSGDEFS: dict[str, str] = {
         "std_msgs/Float32MultiArray[] data\n"
         "uint16 outer_start_index\n"
         "uint16 inner_start_index\n"),
+    # foxglove/schemas ros_foxglove_msgs/ros2 (comments left out)
+    "foxglove_msgs/msg/Vector2": (
+        "float64 x\n"
+        "float64 y\n"),
+    "foxglove_msgs/msg/PackedElementField": (
+        "string name\n"
+        "uint32 offset\n"
+        "uint8 UNKNOWN=0\n"
+        "uint8 UINT8=1\n"
+        "uint8 INT8=2\n"
+        "uint8 UINT16=3\n"
+        "uint8 INT16=4\n"
+        "uint8 UINT32=5\n"
+        "uint8 INT32=6\n"
+        "uint8 FLOAT32=7\n"
+        "uint8 FLOAT64=8\n"
+        "uint8 type\n"),
+    "foxglove_msgs/msg/Grid": (
+        "builtin_interfaces/Time timestamp\n"
+        "string frame_id\n"
+        "geometry_msgs/Pose pose\n"
+        "uint32 column_count\n"
+        "foxglove_msgs/Vector2 cell_size\n"
+        "uint32 row_stride\n"
+        "uint32 cell_stride\n"
+        "foxglove_msgs/PackedElementField[] fields\n"
+        "uint8[] data\n"),
 }
 
 _NUMPY = {"bool": np.bool_, "int8": np.int8, "uint8": np.uint8, "byte": np.uint8,

@@ -2,22 +2,27 @@
 
 :func:`export_map` runs the pipeline (:func:`alte.pipeline.run`) with a
 :class:`MapExporter` as its frame observer: every mapped scan goes out as it is
-mapped (scan, pose, TF) and, with a timeline, the map every ``N`` scans; the final
-map, the merged cloud and the whole trajectory close the file. :func:`export_registered`
+mapped (scan, pose, TF) and, with a timeline, the map every ``N`` scans. The final
+map, the whole trajectory and the merged cloud are written twice: at the file's start
+time (so a viewer shows them from the first instant) and at its last scan (so they
+are the latest state at the end, after a timeline's growth). :func:`export_registered`
 writes a registration without a map (``alte register --mcap``).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from alte.errors import ParameterError
-from alte.export import maps
+from alte.export import grids, maps
 from alte.export.mcap import McapFile
 from alte.export.rosmsg import cloud_msg, path_msg, pose_stamped, tf_msg
+from alte.ground.surface import SurfaceRule
 from alte.mappers import Feed, Mapper, Octomap, mapper_class
 from alte.pipeline import FrameSpec, MapRun, MapSpec, Registered, Source, run
 from alte.types import RegisteredFrame
@@ -33,12 +38,14 @@ _IDENTITY = np.array([0.0, 0.0, 0.0, 1.0])
 class ExportOptions:
     """``timeline``: a map update every that many mapped scans (None: the final map only);
     ``scans``: write each registered scan; ``all_cells``: free cells of 3D maps too;
-    ``max_grid_cells``: largest 2D grid (coarsened by powers of two beyond it)."""
+    ``max_grid_cells``: largest 2D grid (coarsened by powers of two beyond it);
+    ``surface``: the landing criterion that makes grid cells free or occupied."""
 
     timeline: int | None = None
     scans: bool = True
     all_cells: bool = False
     max_grid_cells: int = 4_000_000
+    surface: SurfaceRule = field(default_factory=SurfaceRule)
 
     def __post_init__(self) -> None:
         t = self.timeline
@@ -53,7 +60,6 @@ class MapExporter:
         self.out, self.options = out, options
         self.poses: list[RegisteredFrame] = []
         self.last_map: int | None = None
-        self.local_sent = False
 
     def frame(self, frame: RegisteredFrame) -> None:
         """One registered scan: its points, body pose and ``map -> base_link``."""
@@ -73,51 +79,59 @@ class MapExporter:
         if every is not None and (index + 1) % every == 0:
             self.map(index, mapper, shift)
 
-    def trajectory(self, stamp: int) -> None:
+    def trajectory(self, stamp: int, opening: bool = False) -> None:
         """The path through every pose so far."""
         p = self.poses
         self.out.put("/alte/trajectory", stamp, path_msg(
             stamp, WORLD, np.array([f.stamp for f in p]), np.array([f.position for f in p]),
-            np.array([f.quaternion for f in p])))
+            np.array([f.quaternion for f in p])), opening)
 
-    def map(self, index: int, mapper: Mapper, shift: np.ndarray) -> None:
-        """The map after mapped scan ``index``, stamped with that scan's time."""
-        stamp = int(self.poses[index].stamp)
-        cells = mapper.cells()
+    def map(self, index: int, mapper: Mapper, shift: np.ndarray, stamp: int | None = None,
+            opening: bool = False) -> None:
+        """The map after mapped scan ``index``, stamped with that scan's time (or ``stamp``,
+        with ``opening``: kept for the start of the file)."""
+        at = int(self.poses[index].stamp) if stamp is None else stamp
+        cells, put = mapper.cells(), self._put(at, opening)
         mask = maps.shown_cells(cells, mapper.dims, self.options.all_cells)
-        self.out.put("/alte/map/cells", stamp, maps.cell_markers(cells, mask, stamp, WORLD,
-                                                                 shift))
-        if mapper.dims == 2 and np.isfinite(cells.centers[:, 2]).any():
-            grid = maps.raster(cells, shift, self.options.max_grid_cells)
-            self.out.put("/alte/map/occupancy", stamp, maps.occupancy_grid(grid, stamp, WORLD))
-            self.out.put("/alte/map/grid_map", stamp, maps.grid_map(grid, stamp, WORLD))
+        put("/alte/map/cells", maps.cell_markers(cells, mask, at, WORLD, shift))
+        if np.isfinite(cells.centers).all(axis=1).any():
+            grid = grids.raster(cells, shift, self.options.max_grid_cells, mapper.dims,
+                                self.options.surface)
+            put("/alte/map/occupancy", grids.occupancy_grid(grid, at, WORLD))
+            put("/alte/map/grid", grids.foxglove_grid(grid, at, WORLD))
+            if mapper.dims == 2:
+                put("/alte/map/grid_map", grids.grid_map(grid, at, WORLD))
         if isinstance(mapper, Octomap):
-            self.out.put("/alte/map/octomap", stamp,
-                         maps.octomap_msg(mapper, stamp, self._local(stamp, shift)))
-        self.trajectory(stamp)
-        self.last_map = index
+            frame = LOCAL if np.any(shift) else WORLD
+            put("/alte/map/octomap", maps.octomap_msg(mapper, at, frame))
+        self.trajectory(at, opening)
+        if not opening:
+            self.last_map = index
 
-    def _local(self, stamp: int, shift: np.ndarray) -> str:
-        """The frame of a map kept in local coordinates (``map`` when not shifted)."""
-        if not np.any(shift):
-            return WORLD
-        if not self.local_sent:
-            self.out.put("/tf_static", stamp, tf_msg(stamp, WORLD, LOCAL, shift, _IDENTITY))
-            self.local_sent = True
-        return LOCAL
+    def _put(self, stamp: int, opening: bool) -> Callable[[str, Any], None]:
+        """``put(topic, message)`` at ``stamp``, streamed or kept for the opening."""
+        return lambda topic, message: self.out.put(topic, stamp, message, opening)
 
     def finish(self, mapper: Mapper | None, shift: np.ndarray, cloud: np.ndarray | None) -> None:
-        """The final map (unless the timeline just wrote it), merged cloud and trajectory."""
+        """The final map (unless the timeline just wrote it), merged cloud and trajectory,
+        at the last scan and again at the first (the opening)."""
         if not self.poses:
             return
-        last = len(self.poses) - 1
+        last, first = len(self.poses) - 1, int(self.poses[0].stamp)
         stamp = int(self.poses[last].stamp)
-        if mapper is not None and self.last_map != last:
-            self.map(last, mapper, shift)
-        elif mapper is None:
+        if np.any(shift):
+            self.out.put("/tf_static", first, tf_msg(first, WORLD, LOCAL, shift, _IDENTITY),
+                         opening=True)
+        if mapper is not None:
+            if self.last_map != last:
+                self.map(last, mapper, shift)
+            self.map(last, mapper, shift, stamp=first, opening=True)
+        else:
             self.trajectory(stamp)
+            self.trajectory(first, opening=True)
         if cloud is not None:
             self.out.put("/alte/cloud", stamp, cloud_msg(cloud, stamp, WORLD))
+            self.out.put("/alte/cloud", first, cloud_msg(cloud, first, WORLD), opening=True)
 
 
 def _frames_feed(spec: MapSpec, options: ExportOptions) -> MapSpec:

@@ -20,7 +20,7 @@ from tqdm.auto import tqdm
 
 from alte.errors import BagError, ParameterError, PoseError, TopicError
 from alte.io.messages import PointCloud2Msg, StampedMsg, VelodyneScanMsg
-from alte.io.pointcloud2 import decode_pointcloud2
+from alte.io.pointcloud2 import decode_timed
 from alte.io.pose import POSE_TYPES, PoseTrack, header_stamp, pose_records, select_tf_child
 from alte.io.reader import (
     CLOUD_TYPES,
@@ -116,13 +116,15 @@ def _resolve_mount(static: Mount | None, mount: Mount | None, notes: list[str]) 
     return Mount()
 
 
-def _decode(msg: object, msgtype: str, topic: str, return_mode: str) -> tuple[np.ndarray, int]:
-    """Points of one cloud-topic message; ``msgtype`` names the class rosbags built."""
+def _decode(msg: object, msgtype: str, topic: str, return_mode: str,
+            stamp: int) -> tuple[np.ndarray, np.ndarray | None, int]:
+    """Points, per-point times (s from ``stamp``, None without) and dropped points of one
+    cloud-topic message; ``msgtype`` names the class rosbags built."""
     if msgtype == SCAN_TYPE:
         from alte.io.velodyne import decode_velodyne_scan
 
-        return decode_velodyne_scan(cast(VelodyneScanMsg, msg), return_mode), 0
-    return decode_pointcloud2(cast(PointCloud2Msg, msg), topic)
+        return decode_velodyne_scan(cast(VelodyneScanMsg, msg), return_mode), None, 0
+    return decode_timed(cast(PointCloud2Msg, msg), stamp, topic)
 
 
 def evenly_spaced(total: int, limit: int | None) -> frozenset[int] | None:
@@ -157,19 +159,32 @@ class FrameStream:
                  pose_topic: str | None = None, mount: Mount | None = None,
                  allow_no_pose: bool = False, body_frame: str | None = None,
                  frames: int | None = None, max_gap_s: float = 0.5,
-                 return_mode: str = "strongest", progress: bool = False) -> None:
+                 return_mode: str = "strongest", progress: bool = False,
+                 pose_file: str | Path | None = None) -> None:
         if not max_gap_s > 0:
             raise ParameterError(f"max_gap_s={max_gap_s!r} must be > 0")
         self.path = Path(path)
         self.notes: list[str] = []
         with open_bag(self.path) as reader:
             self.cloud_topic, self.pose_topic, self.track, self.mount = _sources(
-                reader, self.path, (cloud_topic, pose_topic, body_frame), mount=mount,
-                allow_no_pose=allow_no_pose, notes=self.notes)
+                reader, self.path, (cloud_topic, "" if pose_file else pose_topic, body_frame),
+                mount=mount, allow_no_pose=allow_no_pose or pose_file is not None,
+                notes=self.notes)
             self.scans = int(reader.topics[self.cloud_topic].msgcount)
+        if pose_file is not None:
+            self._use_pose_file(Path(pose_file), pose_topic)
         self.options = ReadOptions(max_gap_s, return_mode, evenly_spaced(self.scans, frames),
                                    progress)
         self.counts = self._new_counts()
+
+    def _use_pose_file(self, pose_file: Path, pose_topic: str | None) -> None:
+        """Poses from a TUM file instead of a topic (``--pose-file``)."""
+        from alte.io.tum import read_tum
+
+        if pose_topic:
+            raise ParameterError("--pose-file and --pose-topic exclude each other")
+        self.track, self.pose_topic = read_tum(pose_file), str(pose_file)
+        self.notes[:] = [n for n in self.notes if n != NO_POSE_NOTE]
 
     def _new_counts(self) -> ReadCounts:
         track = self.track
@@ -238,12 +253,12 @@ def _scan_frames(reader: AnyReader, stream: FrameStream, counts: ReadCounts,
         pose = _pose_at(stream.track, stamp, opts.max_gap_s, counts)
         if pose is None:
             continue
-        points, dropped = _decode(msg, msgtype, topic, opts.return_mode)
+        points, times, dropped = _decode(msg, msgtype, topic, opts.return_mode, stamp)
         counts.points_nonfinite += dropped
         if points.shape[0] == 0:
             counts.scans_empty += 1
             continue
-        yield Frame(stamp, points, *pose, dropped_points=dropped)
+        yield Frame(stamp, points, *pose, dropped_points=dropped, times=times)
 
 
 def _raise_empty(stream: FrameStream, counts: ReadCounts, stamps: _StampRange) -> None:
@@ -257,7 +272,8 @@ def _raise_empty(stream: FrameStream, counts: ReadCounts, stamps: _StampRange) -
         f"{stamps.high} ns, pose stamps {int(track.stamps[0])}..{int(track.stamps[-1])} ns "
         f"({counts.scans_outside_poses} outside the pose track, "
         f"{counts.scans_in_pose_gap} in gaps > {stream.options.max_gap_s} s, "
-        f"{counts.scans_empty} without points): different clocks?"
+        f"{counts.scans_empty} without points): different clocks? Use --poses odometry to "
+        "pose the scans without it, or --pose-topic / --pose-file for poses on the scans' clock"
     )
 
 
@@ -273,6 +289,7 @@ class StreamOptions(TypedDict, total=False):
     max_gap_s: float
     return_mode: str
     progress: bool
+    pose_file: str | Path | None
 
 
 def read_frames(path: str | Path, **options: Unpack[StreamOptions]) -> FrameSet:

@@ -21,8 +21,10 @@ if TYPE_CHECKING:  # rosbags declares MsgType (its message classes' type) for ch
 
 __all__ = [
     "POINTFIELD_DTYPES",
+    "TIME_FIELDS",
     "CoordType",
     "decode_pointcloud2",
+    "decode_timed",
     "encode_pointcloud2",
     "make_header",
 ]
@@ -42,11 +44,18 @@ POINTFIELD_DTYPES: dict[int, np.dtype] = {
 CoordType = type[np.float32] | type[np.float64]
 _CODES = {dt: code for code, dt in POINTFIELD_DTYPES.items()}
 _XYZ = ("x", "y", "z")
+#: Per-point time fields, in the order they are looked for (Ouster ``t``, Velodyne ``time``,
+#: Hesai ``timestamp``, Livox ``offset_time``).
+TIME_FIELDS = ("t", "time", "timestamp", "offset_time")
+#: Per-point times further than this from the scan stamp (s) mean a unit the reader missed.
+_MAX_SPAN_S = 2.0
 
 
-def _xyz_dtype(msg: PointCloud2Msg, topic: str) -> np.dtype:
-    """Structured dtype holding x, y, z at their offsets, ``itemsize == point_step``."""
+def _xyz_dtype(msg: PointCloud2Msg, topic: str, timed: bool = False) -> np.dtype:
+    """Structured dtype holding x, y, z (and the first per-point time field when ``timed``)
+    at their offsets, ``itemsize == point_step``."""
     order: Literal[">", "<"] = ">" if msg.is_bigendian else "<"
+    wanted = _XYZ + (TIME_FIELDS if timed else ())
     fields = {}
     needed = 0
     for field in msg.fields:
@@ -55,7 +64,7 @@ def _xyz_dtype(msg: PointCloud2Msg, topic: str) -> np.dtype:
             raise BagError(f"{topic}: field {field.name!r} has unknown datatype {field.datatype}")
         count = max(int(field.count), 1)
         needed = max(needed, int(field.offset) + base.itemsize * count)
-        if field.name in _XYZ and field.name not in fields:
+        if field.name in wanted and field.name not in fields:
             fields[field.name] = (base.newbyteorder(order), int(field.offset))
     missing = [name for name in _XYZ if name not in fields]
     if missing:
@@ -66,11 +75,12 @@ def _xyz_dtype(msg: PointCloud2Msg, topic: str) -> np.dtype:
             f"{topic}: point_step {msg.point_step} is smaller than the {needed} bytes"
             " its fields need"
         )
+    names = [*_XYZ, *[n for n in TIME_FIELDS if n in fields][:1]]
     return np.dtype(
         {
-            "names": list(_XYZ),
-            "formats": [fields[n][0] for n in _XYZ],
-            "offsets": [fields[n][1] for n in _XYZ],
+            "names": names,
+            "formats": [fields[n][0] for n in names],
+            "offsets": [fields[n][1] for n in names],
             "itemsize": int(msg.point_step),
         }
     )
@@ -106,19 +116,63 @@ def decode_pointcloud2(msg: PointCloud2Msg, topic: str = "PointCloud2") -> tuple
     missing returns that way) are dropped and counted. ``topic`` names the source
     in error messages.
     """
-    dtype = _xyz_dtype(msg, topic)
+    points, _, dropped = _decode(msg, topic, None)
+    return points, dropped
+
+
+def decode_timed(msg: PointCloud2Msg, stamp_ns: int,
+                 topic: str = "PointCloud2") -> tuple[np.ndarray, np.ndarray | None, int]:
+    """As :func:`decode_pointcloud2`, plus each point's time in seconds from ``stamp_ns``
+    (None when the cloud has no :data:`TIME_FIELDS` field).
+
+    Integer fields are nanoseconds, floating ones seconds (nanoseconds above 1e15, as
+    Livox writes them); times that look absolute (over 1e6 s) are made relative to the
+    scan stamp. Times further than 2 s from the
+    stamp are a unit alte cannot tell: a :class:`BagError` naming the field.
+    """
+    return _decode(msg, topic, stamp_ns)
+
+
+def _seconds(raw: np.ndarray, stamp_ns: int, name: str, topic: str) -> np.ndarray:
+    """Per-point times as float64 seconds relative to the scan stamp (see decode_timed)."""
+    if raw.dtype.kind in "iu":
+        ns = raw.astype(np.int64)
+        if ns.size and int(np.median(ns)) > 10**15:
+            ns = ns - stamp_ns
+        times = ns * 1e-9
+    elif raw.size and float(np.median(raw)) > 1e15:  # nanoseconds in a float (Livox)
+        times = (raw.astype(np.float64) - stamp_ns) * 1e-9
+    else:
+        times = raw.astype(np.float64)
+        if times.size and float(np.median(times)) > 1e6:
+            times = times - stamp_ns * 1e-9
+    if times.size and float(np.abs(times).max()) > _MAX_SPAN_S:
+        raise BagError(f"{topic}: per-point time field {name!r} spans "
+                       f"{float(times.min()):.6g}..{float(times.max()):.6g} s from the scan "
+                       "stamp; expected seconds (float) or nanoseconds (integer), relative "
+                       "or absolute")
+    return times
+
+
+def _decode(msg: PointCloud2Msg, topic: str,
+            stamp_ns: int | None) -> tuple[np.ndarray, np.ndarray | None, int]:
+    dtype = _xyz_dtype(msg, topic, timed=stamp_ns is not None)
     payload = _payload(msg, topic)
     count = int(msg.width) * int(msg.height)
     if count == 0:
-        return np.empty((0, 3)), 0
+        return np.empty((0, 3)), None, 0
     records = np.frombuffer(payload, dtype=dtype, count=count)
     points = np.empty((count, 3), dtype=np.float64)
     for axis, name in enumerate(_XYZ):
         points[:, axis] = records[name]
+    names = dtype.names or ()
+    times = _seconds(records[names[3]], int(stamp_ns or 0), names[3], topic) \
+        if len(names) > 3 else None
     finite = finite_rows(points)
     if finite is None:
-        return points, 0
-    return points[finite], int(count - np.count_nonzero(finite))
+        return points, times, 0
+    return (points[finite], None if times is None else times[finite],
+            int(count - np.count_nonzero(finite)))
 
 
 def encode_pointcloud2(

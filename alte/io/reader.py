@@ -22,6 +22,7 @@ from rosbags.rosbag2 import ReaderError as Reader2Error
 from rosbags.serde import SerdeError
 from rosbags.typesys import Stores, get_typestore
 from rosbags.typesys.base import TypesysError
+from scipy.spatial.transform import Rotation
 
 from alte.errors import BagError, TopicError
 from alte.io.messages import StampedMsg
@@ -217,11 +218,31 @@ def first_frame_id(reader: AnyReader, topic: str | None, path: Path) -> str | No
 
 
 def static_mount(reader: AnyReader, sensor: str | None, path: Path) -> tuple[Mount | None, str]:
-    """Mount and body frame from the ``/tf_static`` transform whose child is ``sensor``."""
+    """Mount and body frame from ``/tf_static``: the chain of transforms from ``sensor`` up
+    to the top of its static tree (``base_link -> lidar_mount -> lidar`` gives the mount of
+    ``lidar`` on ``base_link``); a cycle is a :class:`TopicError`."""
     if sensor is None or TF_STATIC not in reader.topics:
         return None, ""
+    parents: dict[str, tuple[str, tuple[float, ...]]] = {}
     for log_time, msgtype, msg in read_messages(reader, TF_STATIC, path):
         for parent, child, _, values in pose_records(msg, msgtype, log_time):
-            if child == sensor:
-                return Mount(np.asarray(values[:3]), np.asarray(values[3:])), parent
-    return None, ""
+            parents.setdefault(child, (parent, values))
+    if sensor not in parents:
+        return None, ""
+    matrix, frame, seen = np.eye(4), sensor, [sensor]
+    while frame in parents:
+        frame, values = parents[frame]
+        if frame in seen:
+            raise TopicError(f"{path}: {TF_STATIC} has a cycle: {' -> '.join([*seen, frame])}")
+        seen.append(frame)
+        matrix = _matrix(values) @ matrix
+    quaternion = Rotation.from_matrix(matrix[:3, :3]).as_quat()
+    return Mount(matrix[:3, 3].copy(), quaternion), frame
+
+
+def _matrix(values: tuple[float, ...]) -> np.ndarray:
+    """4x4 transform of ``(x, y, z, qx, qy, qz, qw)``."""
+    out = np.eye(4)
+    out[:3, :3] = Rotation.from_quat(np.asarray(values[3:])).as_matrix()
+    out[:3, 3] = values[:3]
+    return out

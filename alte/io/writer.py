@@ -1,8 +1,10 @@
 """Write ROS 2 bags (sqlite3 or mcap) that :func:`alte.io.bag.read_frames` reads back.
 
 Used by the simulator and the tests: scans go out as PointCloud2 in the sensor
-frame, body poses as PoseStamped (at their own rate, e.g. 100 Hz motion capture)
-and the mount as one ``/tf_static`` body -> sensor transform. Output is atomic and
+frame (with extra per-point fields such as a ``time`` when given), body poses as
+PoseStamped (at their own rate, e.g. 100 Hz motion capture), IMU samples as
+``sensor_msgs/msg/Imu`` and the mounts as one ``/tf_static`` message (body -> sensor,
+body -> IMU). Output is atomic and
 deterministic: the same input gives byte-identical files (rosbags writes no wall
 clock or random data; only its version string enters the mcap header).
 """
@@ -22,6 +24,7 @@ from tqdm.auto import tqdm
 
 from alte.errors import BagError, ParameterError
 from alte.fsutil import atomic_dir
+from alte.io.imu import IMU_TYPE, ImuSamples
 from alte.io.pointcloud2 import CoordType, encode_pointcloud2, make_header
 from alte.types import Frame, Mount
 
@@ -37,6 +40,8 @@ _TF = "tf2_msgs/msg/TFMessage"
 _TYPESTORE = get_typestore(Stores.ROS2_HUMBLE)
 #: Poses to interleave with the clouds: stamps, positions, quaternions, write order.
 _Poses = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+#: A scan: stamp and points, optionally extra per-point fields (name -> (N,) array).
+Cloud = tuple[int, np.ndarray] | tuple[int, np.ndarray, dict[str, np.ndarray]]
 
 
 def _pose_arrays(
@@ -62,16 +67,32 @@ def _pose_msg(header: MsgType, position: np.ndarray, quat: np.ndarray) -> MsgTyp
     return types[_POSE](header=header, pose=types["geometry_msgs/msg/Pose"](point, orientation))
 
 
-def _tf_static_msg(mount: Mount, stamp: int, body: str, sensor: str) -> MsgType:
+def _transform(mount: Mount, stamp: int, body: str, child: str) -> MsgType:
     types = _TYPESTORE.types
     vector = types["geometry_msgs/msg/Vector3"](*map(float, mount.translation))
     rotation = types["geometry_msgs/msg/Quaternion"](*map(float, mount.quaternion))
-    tf = types["geometry_msgs/msg/TransformStamped"](
+    return types["geometry_msgs/msg/TransformStamped"](
         header=make_header(stamp, body, _TYPESTORE),
-        child_frame_id=sensor,
+        child_frame_id=child,
         transform=types["geometry_msgs/msg/Transform"](vector, rotation),
     )
-    return types[_TF](transforms=[tf])
+
+
+def _imu_msg(imu: ImuSamples, k: int) -> MsgType:
+    """Sample ``k`` as ``sensor_msgs/msg/Imu``: orientation not given (covariance -1, REP 145)."""
+    types = _TYPESTORE.types
+    vec = types["geometry_msgs/msg/Vector3"]
+    no_orientation = np.zeros(9)
+    no_orientation[0] = -1.0
+    return types[IMU_TYPE](
+        header=make_header(int(imu.stamps[k]), imu.frame_id, _TYPESTORE),
+        orientation=types["geometry_msgs/msg/Quaternion"](0.0, 0.0, 0.0, 1.0),
+        orientation_covariance=no_orientation,
+        angular_velocity=vec(*map(float, imu.angular_velocity[k])),
+        angular_velocity_covariance=np.eye(3).reshape(-1) * imu.gyro_sigma**2,
+        linear_acceleration=vec(*map(float, imu.linear_acceleration[k])),
+        linear_acceleration_covariance=np.eye(3).reshape(-1) * imu.accel_sigma**2,
+    )
 
 
 @dataclass(frozen=True)
@@ -96,13 +117,24 @@ class _BagOut:
             for topic, msgtype in topics.items()
         }
         self.next_pose = 0
+        self.imu: ImuSamples | None = None
+        self.next_imu = 0
 
     def put(self, topic: str, stamp: int, msg: object) -> None:
         data = _TYPESTORE.serialize_cdr(msg, self.conns[topic].msgtype)
         self.writer.write(self.conns[topic], int(stamp), data)
 
+    def imu_until(self, until: int | None) -> None:
+        """Write the not yet written IMU samples stamped at or before ``until`` (all: None)."""
+        imu = self.imu
+        while imu is not None and self.next_imu < len(imu) and (
+                until is None or imu.stamps[self.next_imu] <= until):
+            self.put(_IMU_TOPIC, int(imu.stamps[self.next_imu]), _imu_msg(imu, self.next_imu))
+            self.next_imu += 1
+
     def poses_until(self, poses: _Poses, until: int | None) -> None:
         """Write the not yet written poses stamped at or before ``until`` (all for None)."""
+        self.imu_until(until)
         stamps, pos, quat, order = poses
         while self.next_pose < order.size and (
             until is None or stamps[order[self.next_pose]] <= until
@@ -112,23 +144,27 @@ class _BagOut:
             self.put(self.names.pose, int(stamps[k]), _pose_msg(header, pos[k], quat[k]))
             self.next_pose += 1
 
-    def clouds(
-        self, clouds: Iterable[tuple[int, np.ndarray]], poses: _Poses, progress: bool
-    ) -> None:
-        """Write every scan, each preceded by the poses up to its stamp."""
+    def clouds(self, clouds: Iterable[Cloud], poses: _Poses, progress: bool) -> None:
+        """Write every scan, each preceded by the poses (and IMU samples) up to its stamp."""
         topic = self.names.cloud
-        for stamp, points in tqdm(clouds, desc=topic, unit="scan", disable=not progress):
+        for cloud in tqdm(clouds, desc=topic, unit="scan", disable=not progress):
+            stamp, points = cloud[0], cloud[1]
+            extra = cloud[2] if len(cloud) > 2 else None
             self.poses_until(poses, int(stamp))
             msg = encode_pointcloud2(
-                points, int(stamp), self.names.sensor, _TYPESTORE, dtype=self.names.dtype
+                points, int(stamp), self.names.sensor, _TYPESTORE, dtype=self.names.dtype,
+                extra_fields=extra,
             )
             self.put(topic, int(stamp), msg)
         self.poses_until(poses, None)
 
 
+_IMU_TOPIC = "/imu"
+
+
 def write_bag(  # noqa: PLR0917 - positional arrays as specified for the simulator
     path: str | Path,
-    clouds: Iterable[tuple[int, np.ndarray]],
+    clouds: Iterable[Cloud],
     pose_stamps: Sequence[int] | np.ndarray,
     positions: np.ndarray,
     quaternions: np.ndarray,
@@ -143,11 +179,13 @@ def write_bag(  # noqa: PLR0917 - positional arrays as specified for the simulat
     dtype: CoordType = np.float32,
     overwrite: bool = False,
     progress: bool = False,
+    imu: ImuSamples | None = None,
 ) -> Path:
-    """Write scans ``(stamp_ns, points)`` plus body poses (and mount) as a ROS 2 bag folder.
+    """Write scans ``(stamp_ns, points[, fields])`` plus body poses (and mount) as a ROS 2 bag.
 
-    Messages are logged at their header stamps, poses interleaved in time order
-    with the scans. Refuses to replace ``path`` unless ``overwrite``.
+    Messages are logged at their header stamps, poses (and ``imu`` samples, on
+    ``/imu`` with their mount in ``/tf_static``) interleaved in time order with the
+    scans. Refuses to replace ``path`` unless ``overwrite``.
     """
     if storage not in STORAGES:
         raise ParameterError(f"storage={storage!r}; expected one of {sorted(STORAGES)}")
@@ -155,7 +193,9 @@ def write_bag(  # noqa: PLR0917 - positional arrays as specified for the simulat
     order = np.argsort(stamps, kind="stable")
     target = Path(path)
     topics = {cloud_topic: _PC2, pose_topic: _POSE}
-    if mount is not None:
+    if imu is not None:
+        topics[_IMU_TOPIC] = IMU_TYPE
+    if mount is not None or (imu is not None and imu.mount is not None):
         topics["/tf_static"] = _TF
     names = _Names(world_frame, sensor_frame, cloud_topic, pose_topic, dtype)
     plugin = STORAGES[storage]
@@ -164,10 +204,13 @@ def write_bag(  # noqa: PLR0917 - positional arrays as specified for the simulat
         Writer(tmp, version=Writer.VERSION_LATEST, storage_plugin=plugin) as writer,
     ):
         out = _BagOut(writer, topics, names)
-        if mount is not None:
-            first = int(stamps[order[0]]) if stamps.size else 0
-            tf = _tf_static_msg(mount, first, body_frame, sensor_frame)
-            out.put("/tf_static", first, tf)
+        out.imu = imu
+        first = int(stamps[order[0]]) if stamps.size else 0
+        statics = [] if mount is None else [_transform(mount, first, body_frame, sensor_frame)]
+        if imu is not None and imu.mount is not None:
+            statics.append(_transform(imu.mount, first, body_frame, imu.frame_id))
+        if statics:
+            out.put("/tf_static", first, _TYPESTORE.types[_TF](transforms=statics))
         out.clouds(clouds, (stamps, pos, quat, order), progress)
     return target
 

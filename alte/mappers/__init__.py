@@ -11,15 +11,15 @@ from alte.errors import MapperError
 from alte.fsutil import atomic_path, refuse_overwrite
 from alte.mappers.alte2d import Alte2D
 from alte.mappers.alte3d import Alte3D
-from alte.mappers.base import CellCounts, Cells, Feed, Mapper
+from alte.mappers.base import CellCounts, Cells, Cost, Feed, Mapper
 from alte.mappers.domain import Domain, DomainUse
 from alte.mappers.octomap import Octomap
 from alte.mappers.quadtree import Quadtree
 from alte.params import Record
 
-__all__ = ["MAPPERS", "Alte2D", "Alte3D", "CellCounts", "Cells", "Domain", "DomainUse", "Feed",
-           "Mapper", "MapperClass", "Octomap", "Quadtree", "check_export", "export_map",
-           "make_mapper", "mapper_class"]
+__all__ = ["MAPPERS", "Alte2D", "Alte3D", "CellCounts", "Cells", "Cost", "Domain",
+           "DomainUse", "Feed", "Mapper", "MapperClass", "Octomap", "Quadtree", "check_export",
+           "export_map", "make_mapper", "mapper_class"]
 
 MapperClass = type[Quadtree] | type[Octomap] | type[Alte2D] | type[Alte3D]
 

@@ -19,7 +19,7 @@ import numpy as np
 from alte.mappers._blockset import WORDS, keys_to_blocks
 from alte.mappers._octree import Leaves, prune_voxels, write_bt
 from alte.mappers._raycast import TREE_DEPTH, TREE_MAX_VAL, morton_decode, morton_encode
-from alte.mappers._scan import ScanWork, scan_blocks
+from alte.mappers._scan import ScanWork, scan_blocks, scan_cost
 from alte.mappers._voxelstore import VoxelStore
 
 if TYPE_CHECKING:
@@ -95,6 +95,7 @@ class NativeTree:
         self.store = VoxelStore()
         self._leaves: Leaves | None = None
         self._work = ScanWork()
+        self._hits = 0
 
     def insert_scan(self, points: np.ndarray, origin: np.ndarray) -> None:
         """OctoMap ``insertPointCloud``: each voxel updated once, occupied beats free (one
@@ -105,7 +106,14 @@ class NativeTree:
 
     def insert_hits(self, points: np.ndarray) -> None:
         """Mark the voxels holding ``points`` occupied once (no ray casting)."""
-        self._update(*keys_to_blocks(voxel_keys(points, self.voxel), WORDS))
+        keys = voxel_keys(points, self.voxel)
+        self._hits += len(keys)
+        self._update(*keys_to_blocks(keys, WORDS))
+
+    @property
+    def cost(self) -> int:
+        """Ray steps of the scans (:func:`alte.mappers._scan.scan_cost`) and voxels hit."""
+        return self._work.steps + self._hits
 
     def _update(self, blocks: np.ndarray, bits: np.ndarray) -> None:
         model = self.model
@@ -152,8 +160,11 @@ class ReferenceTree:
         self.model = model
         self.tree = pyoctomap.OcTree(self.voxel)
         _configure(self.tree, model)
+        self.cost = 0
 
     def insert_scan(self, points: np.ndarray, origin: np.ndarray) -> None:
+        self.cost += scan_cost(points.astype(np.float32), origin.astype(np.float32),
+                               self.voxel, self.max_range)
         self.tree.insertPointCloud(
             np.ascontiguousarray(points, dtype=np.float64),
             np.ascontiguousarray(origin, dtype=np.float64),
@@ -162,6 +173,7 @@ class ReferenceTree:
 
     def insert_hits(self, points: np.ndarray) -> None:
         keys = voxel_keys(points, self.voxel)
+        self.cost += len(keys)
         centers = (morton_decode(keys) - TREE_MAX_VAL + 0.5) * self.voxel
         self.tree.updateNodes(centers, True)
 

@@ -24,7 +24,8 @@ from alte.mappers._blockset import WORDS, local_index, new_table, reserve, row_o
 from alte.mappers._lanes import walk_lanes
 from alte.mappers._raycast import Ray, flat_starts, morton, prepare, walk_hashed
 
-__all__ = ["DENSE_ANY_WORDS", "DENSE_MAX_WORDS", "WORDS_PER_STEP", "ScanWork", "scan_blocks"]
+__all__ = ["DENSE_ANY_WORDS", "DENSE_MAX_WORDS", "WORDS_PER_STEP", "ScanWork", "scan_blocks",
+           "scan_cost"]
 
 #: Largest flat bit grid (uint64 words; 2^24 = 128 MiB, of which only the pages the rays
 #: cross are ever written) before the hashed set is used.
@@ -40,13 +41,15 @@ WORDS_PER_STEP = 8
 class ScanWork:
     """Buffers reused by the scans of one map: the flat bit grid and the cell flags (all
     zero between scans), the box cell -> row table (all -1) and the last scan's block
-    count (the hashed set's first size)."""
+    count (the hashed set's first size); and ``steps``, the ray steps of its scans so far
+    (:func:`scan_cost`)."""
 
     def __init__(self) -> None:
         self.grid = np.zeros(1, dtype=np.uint64)
         self.cell = np.full(8, -1, dtype=np.int64)
         self.flags = np.zeros(1, dtype=np.uint64)
         self.blocks = 1024
+        self.steps = 0
 
 
 @numba.njit(cache=True, inline="always")
@@ -85,6 +88,29 @@ def _steps(okey: np.ndarray, ekeys: np.ndarray) -> int:
             steps += abs(ekeys[i, 0] - okey[0]) + abs(ekeys[i, 1] - okey[1]) + \
                 abs(ekeys[i, 2] - okey[2])
     return steps
+
+
+@numba.njit(cache=True)
+def _cost(okey: np.ndarray, ekeys: np.ndarray) -> tuple[int, int]:
+    """The voxels a scan's walks step through (none when the origin is off the key space),
+    and its ray steps: those plus one end voxel per valid ray."""
+    ends = 0
+    for i in range(ekeys.shape[0]):
+        ends += ekeys[i, 0] >= 0
+    steps = _steps(okey, ekeys) if okey.min() >= 0 else 0
+    return steps, steps + ends
+
+
+@numba.njit(cache=True)
+def _prepared_cost(points: np.ndarray, origin: np.ndarray, res: float, max_range: float) -> int:
+    okey, _ends, ekeys, _hit = prepare(points, origin, res, max_range)
+    return int(_cost(okey, ekeys)[1])
+
+
+def scan_cost(points: np.ndarray, origin: np.ndarray, res: float, max_range: float) -> int:
+    """Ray steps of one scan (float32 ``points`` and ``origin``), as :func:`scan_blocks`
+    counts them into :attr:`ScanWork.steps`: for a backend that walks the rays itself."""
+    return int(_prepared_cost(points, origin, res, max_range))
 
 
 @numba.njit(cache=True, inline="always")
@@ -268,23 +294,23 @@ def _finish(blocks: np.ndarray, bits: np.ndarray, ekeys: np.ndarray,
 @numba.njit(cache=True)
 def _scan(cloud: tuple[np.ndarray, np.ndarray], res: float, max_range: float,
           work: tuple[np.ndarray, np.ndarray, np.ndarray],
-          sizes: tuple[int, int, int, int]) -> tuple[np.ndarray, np.ndarray, np.ndarray,
-                                                     np.ndarray, np.ndarray]:
+          sizes: tuple[int, int, int, int]) -> tuple[tuple[np.ndarray, np.ndarray, np.ndarray,
+                                                           np.ndarray, np.ndarray], int]:
     """:func:`scan_blocks` of ``cloud`` (points, origin) in one compiled call; ``sizes``
     is the hashed set's first capacity and the flat grid's limits (DENSE_MAX_WORDS,
-    DENSE_ANY_WORDS, WORDS_PER_STEP). Also returns the work buffers."""
+    DENSE_ANY_WORDS, WORDS_PER_STEP). Also returns the work buffers, and the ray steps."""
     (points, origin), (capacity, most, anyway, per_step) = cloud, sizes
     okey, ends, ekeys, hit = prepare(points, origin, res, max_range)
+    steps, cost = _cost(okey, ekeys)
     box = _box(okey, ekeys)
     words = 8 * box[3] * box[4] * box[5]
-    if okey.min() >= 0 and words <= most and (
-            words <= anyway or words <= per_step * _steps(okey, ekeys)):
-        return _dense((origin, okey, ends, ekeys), res, box, work, hit)
+    if okey.min() >= 0 and words <= most and (words <= anyway or words <= per_step * steps):
+        return _dense((origin, okey, ends, ekeys), res, box, work, hit), cost
     blocks, bits = np.empty(0, np.uint64), np.empty((0, 2 * WORDS), np.uint64)
     if okey.min() >= 0:
         blocks, bits = _rays_hashed((origin, okey, ends, ekeys), res, capacity)
     blocks, bits = _finish(blocks, bits, ekeys, hit)
-    return blocks, bits, work[0], work[1], work[2]
+    return (blocks, bits, work[0], work[1], work[2]), cost
 
 
 def scan_blocks(points: np.ndarray, origin: np.ndarray, res: float, max_range: float,
@@ -298,8 +324,9 @@ def scan_blocks(points: np.ndarray, origin: np.ndarray, res: float, max_range: f
     a map's scans (fresh ones without).
     """
     work = work or ScanWork()
-    blocks, bits, work.grid, work.cell, work.flags = _scan(
+    (blocks, bits, work.grid, work.cell, work.flags), steps = _scan(
         (points, origin), res, max_range, (work.grid, work.cell, work.flags),
         (work.blocks + 64, DENSE_MAX_WORDS, DENSE_ANY_WORDS, WORDS_PER_STEP))
     work.blocks = blocks.size + blocks.size // 4
+    work.steps += steps
     return blocks, bits

@@ -32,7 +32,7 @@ import numpy as np
 from alte.errors import MapperError
 from alte.mappers._octree import check_origin
 from alte.mappers._rows import unique_rows
-from alte.mappers.base import CellCounts, Cells, Feed, check_points, check_view
+from alte.mappers.base import CellCounts, Cells, Cost, Feed, check_points, check_view
 from alte.mappers.domain import Domain, DomainUse, check_domain
 from alte.params import Record, param
 from alte.types import Box
@@ -90,6 +90,7 @@ class Alte3D:
     #: ``max_res`` (and the variant) only.
     view_params: ClassVar[frozenset[str]] = frozenset({"min_pts", "min_pts_split",
                                                        "occupancy_level"})
+    cost_unit: ClassVar[Cost] = Cost.CELL_UPDATES
     Params: ClassVar[type[Record]] = Alte3DParams
 
     def __init__(self, domain: Domain | None = None, **given: object) -> None:
@@ -107,6 +108,7 @@ class Alte3D:
         self._counts = [np.empty(0, dtype=np.int64) for _ in range(levels)]
         self._cells: Cells | None = None  # the leaves, until the next insert or build
         self._shared = False  # the count tables are shared with a re-read copy
+        self._cost = 0
 
     @property
     def params(self) -> Record:
@@ -165,8 +167,10 @@ class Alte3D:
         if finest.size == 0:
             return
         max_res = self._params["max_res"]
+        self._cost += finest.size
         for level in range(max_res + 1):
             keys, counts = np.unique(self._at_level(finest, max_res - level), return_counts=True)
+            self._cost += keys.size
             self._keys[level], self._counts[level] = _merge(
                 self._keys[level], self._counts[level], keys, counts
             )
@@ -255,6 +259,11 @@ class Alte3D:
     @property
     def basis_functions(self) -> int:
         return len(self.cells())
+
+    @property
+    def cost(self) -> int:
+        """Points located plus cell counts written on every level (:class:`Cost`)."""
+        return self._cost
 
     @property
     def memory_bytes(self) -> int:

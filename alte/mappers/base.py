@@ -20,7 +20,7 @@ from alte.mappers.domain import Domain, DomainUse
 from alte.params import Record
 from alte.types import as_points
 
-__all__ = ["CellCounts", "Cells", "Feed", "Mapper", "check_points", "check_view"]
+__all__ = ["CellCounts", "Cells", "Cost", "Feed", "Mapper", "check_points", "check_view"]
 
 
 @dataclass(frozen=True)
@@ -66,6 +66,20 @@ class CellCounts:
         return cls(len(cells), int(np.count_nonzero(cells.occupied)))
 
 
+class Cost(enum.Enum):
+    """What a mapper's :attr:`Mapper.cost` counts: the work of its mapping, independent of
+    the machine (and of other load on it), to be read beside the measured time.
+
+    ``CELL_UPDATES``: points located in the tree plus, on every level, the cells whose
+    statistics an insertion or build wrote (the tree maps: Quadtree, 2D-ALTE, 3D-ALTE).
+    ``RAY_STEPS``: voxels the scan's rays step through (free-space ray casting) plus the
+    end voxel of every ray (Octomap). Counts of different units are not comparable.
+    """
+
+    CELL_UPDATES = "cell updates"
+    RAY_STEPS = "ray steps"
+
+
 class Feed(enum.Enum):
     """How a map is fed: one registered frame at a time, or the merged cloud once."""
 
@@ -80,8 +94,9 @@ class Mapper(Protocol):
     Capabilities are class attributes the pipeline reads (never probed with hasattr):
     ``dims``, ``incremental``, ``domain_use``, ``default_feed`` (the thesis' protocol:
     Quadtree ran once on the final cloud), ``exports`` (file suffixes it writes),
-    ``free_space`` (its unoccupied cells were observed free) and ``view_params`` (the
-    parameters :meth:`reread` can change).
+    ``free_space`` (its unoccupied cells were observed free), ``cost_unit`` (what
+    :attr:`cost` counts) and ``view_params`` (the parameters :meth:`reread` can
+    change).
     """
 
     name: ClassVar[str]
@@ -99,6 +114,8 @@ class Mapper(Protocol):
     #: are occupied), not what ``insert``/``build`` store nor the work they do: a map
     #: re-read with other values of these equals the map made with them.
     view_params: ClassVar[frozenset[str]]
+    #: The unit of :attr:`cost`.
+    cost_unit: ClassVar[Cost]
 
     @property
     def params(self) -> Record:
@@ -113,6 +130,12 @@ class Mapper(Protocol):
     @property
     def points_outside(self) -> int:
         """Points given to ``insert``/``build`` that fell outside the domain and were dropped."""
+        ...
+
+    @property
+    def cost(self) -> int:
+        """Machine-independent work (in ``cost_unit``) of the calls that made this map:
+        every ``insert`` since creation or the last ``build``, which starts it afresh."""
         ...
 
     def insert(self, points: np.ndarray, origin: np.ndarray) -> None:

@@ -113,6 +113,8 @@ class LevelStats:
         self._defer = 0
         self._source: tuple[Sorted, float] | None = None  # see build_tree
         self._shared = False  # cells shared with a branch: no more points (see branch)
+        #: Cell statistics written so far, every level (the maps' machine-free cost).
+        self.updates = 0
         self.keys = _PerLevel(self, self._k)
         self.rows = _PerLevel(self, self._r)
         self.split = _PerLevel(self, self._s)
@@ -149,6 +151,7 @@ class LevelStats:
             if level < self.depth:
                 keys, agg = combine(keys, agg, self.nv)
             touched[level] = self._merge(level, keys, agg)
+            self.updates += len(keys)
         return None if was_empty else touched
 
     def build_tree(self, fine_keys: np.ndarray, values: np.ndarray, split_above: float) -> None:
@@ -162,6 +165,7 @@ class LevelStats:
         points = sort_points(fine_keys, values, 2 * self.depth, reuse_keys=True)
         for level, cells in enumerate(tree_cells(points, self.depth, split_above)):
             self._set_level(level, *cells)
+            self.updates += len(cells[0])
         self._source = (points, split_above)
 
     def complete(self) -> None:

@@ -26,7 +26,7 @@ from alte.mappers._octomap_backends import NativeTree, ReferenceTree, SensorMode
 from alte.mappers._octree import Leaves, check_origin, leaf_boxes, leaf_geometry
 from alte.mappers._raycast import TREE_DEPTH, TREE_MAX_VAL
 from alte.mappers._rows import unique_rows
-from alte.mappers.base import CellCounts, Cells, Feed, check_points, check_view
+from alte.mappers.base import CellCounts, Cells, Cost, Feed, check_points, check_view
 from alte.mappers.domain import Domain, DomainUse
 from alte.params import Record, param
 from alte.types import rows_all
@@ -57,6 +57,8 @@ class _Backend(Protocol):
     def num_leaves(self) -> int: ...
     @property
     def memory_bytes(self) -> int: ...
+    @property
+    def cost(self) -> int: ...
 
 
 #: Backend by name, built from (voxel size, max range, sensor model).
@@ -129,6 +131,7 @@ class Octomap:
     free_space: ClassVar[bool] = True
     #: Every parameter changes the log-odds the tree stores.
     view_params: ClassVar[frozenset[str]] = frozenset()
+    cost_unit: ClassVar[Cost] = Cost.RAY_STEPS
     Params: ClassVar[type[Record]] = OctomapParams
 
     def __init__(self, domain: Domain | None = None, **given: object) -> None:
@@ -221,6 +224,11 @@ class Octomap:
     @property
     def basis_functions(self) -> int:
         return self._tree.num_leaves
+
+    @property
+    def cost(self) -> int:
+        """Ray steps: voxels crossed by every ray plus its end voxel (:class:`Cost`)."""
+        return self._tree.cost
 
     @property
     def memory_bytes(self) -> int:

@@ -25,7 +25,7 @@ import numpy as np
 
 from alte.errors import MapperError
 from alte.mappers._rows import unique_rows
-from alte.mappers.base import CellCounts, Cells, Feed, check_points, check_view
+from alte.mappers.base import CellCounts, Cells, Cost, Feed, check_points, check_view
 from alte.mappers.domain import Domain, DomainUse, check_domain
 from alte.mappers.levelstats import LevelStats
 from alte.mappers.quadgrid import Square
@@ -54,6 +54,7 @@ class QuadMap:
     default_feed: ClassVar[Feed] = Feed.FRAMES
     exports: ClassVar[frozenset[str]] = frozenset({".npz"})
     free_space: ClassVar[bool] = False
+    cost_unit: ClassVar[Cost] = Cost.CELL_UPDATES
     Params: ClassVar[type[Record]] = Record
     view_params: ClassVar[frozenset[str]] = frozenset()
     _NVALUES: ClassVar[int] = 1
@@ -111,6 +112,11 @@ class QuadMap:
         if self.square is None:
             return None
         return Domain(self.square.xmin, self.square.ymin, self._zmin, self.square.size)
+
+    @property
+    def cost(self) -> int:
+        """Points located plus cell statistics written on every level (:class:`Cost`)."""
+        return self.points_inserted + self.stats.updates
 
     def write_native(self, path: Path, overwrite: bool = False) -> Path:
         """2D maps have no format of their own: export ``.npz`` cells instead."""

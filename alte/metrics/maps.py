@@ -18,6 +18,7 @@ import numpy as np
 from alte.errors import MetricsError
 from alte.mappers.quadmap import rectangle_corners
 from alte.metrics.hausdorff import hausdorff
+from alte.metrics.timing import Timing
 from alte.params import Record, param
 
 if TYPE_CHECKING:
@@ -80,9 +81,17 @@ class TruthMetrics:
 
 @dataclass(frozen=True)
 class MapMetrics:
-    """One map's size, thesis fidelity metrics (set A = cloud, set B = corners) and truth."""
+    """One map's time (:class:`~alte.metrics.timing.Timing`: the medians ``elapsed_s``
+    and ``map_cpu_s`` over ``time_repeats`` runs, with their spreads) and its
+    machine-independent ``cost`` (in its mapper's ``cost_unit``), size, thesis fidelity
+    metrics (set A = cloud, set B = corners) and truth."""
 
     elapsed_s: float
+    elapsed_spread: float
+    map_cpu_s: float
+    map_cpu_spread: float
+    time_repeats: int
+    cost: int
     basis_functions: int
     memory_bytes: int
     occupied_cells: int
@@ -151,14 +160,16 @@ def _thesis(points: np.ndarray, cloud: np.ndarray,
                             hd.mh_ba), strict=True))
 
 
-def measure_map(mapper: Mapper, cloud: np.ndarray, *, elapsed_s: float,
+def measure_map(mapper: Mapper, cloud: np.ndarray, *, elapsed_s: float | Timing,
                 truth: GroundTruth | None = None, options: TruthOptions | None = None,
                 set_b: str = "corners", reference: Reference | None = None) -> MapMetrics:
     """Every metric of ``mapper`` against the registered ``cloud`` (and ``truth``);
+    ``elapsed_s``: the mapping's time (one wall reading, or a :class:`Timing`);
     ``set_b`` defines the map's points of HD/MHD (:data:`SET_B`). ``reference``: the
     same ``cloud``, ``truth`` and ``options`` prepared once for many maps
     (:class:`~alte.metrics.reference.Reference`): the same values, with the work the
     maps of one input share done once."""
+    timing = elapsed_s if isinstance(elapsed_s, Timing) else Timing(float(elapsed_s))
     if set_b not in SET_B:
         raise MetricsError(f"set B {set_b!r}: expected one of {', '.join(SET_B)}")
     if reference is not None and not reference.matches(cloud, truth, options):
@@ -178,7 +189,10 @@ def measure_map(mapper: Mapper, cloud: np.ndarray, *, elapsed_s: float,
             tolerance=opts.tolerance, n_samples=opts.n_samples, grid_step=opts.grid_step,
             seed=opts.seed))
     return MapMetrics(
-        elapsed_s=float(elapsed_s), basis_functions=int(mapper.basis_functions),
+        elapsed_s=timing.elapsed_s, elapsed_spread=timing.elapsed_spread,
+        map_cpu_s=timing.cpu_s, map_cpu_spread=timing.cpu_spread,
+        time_repeats=timing.repeats, cost=int(mapper.cost),
+        basis_functions=int(mapper.basis_functions),
         memory_bytes=int(mapper.memory_bytes),
         occupied_cells=int(np.count_nonzero(cells.occupied)), cell_min_m=lo, cell_max_m=hi,
         size_octaves=octaves,

@@ -6,7 +6,14 @@ an input once for several maps (:mod:`~alte.pipeline.prepare`); the specificatio
 and their policies are in :mod:`~alte.pipeline.spec`.
 """
 
-from alte.pipeline.prepare import Registered, cache_key, merged_cloud, prepare
+from alte.pipeline.prepare import (
+    Merged,
+    Registered,
+    cache_key,
+    merge_frames,
+    merged_cloud,
+    prepare,
+)
 from alte.pipeline.run import (
     FrameLog,
     FrameObserver,
@@ -27,6 +34,7 @@ __all__ = [
     "InputKind",
     "MapRun",
     "MapSpec",
+    "Merged",
     "PoseSource",
     "Registered",
     "RunInfo",
@@ -34,6 +42,7 @@ __all__ = [
     "Source",
     "StreamCounts",
     "cache_key",
+    "merge_frames",
     "merged_cloud",
     "open_input",
     "prepare",

@@ -26,15 +26,16 @@ from alte.fsutil import atomic_dir
 from alte.io.bag import ReadCounts
 from alte.pipeline.source import Source, StreamCounts, stream_frames
 from alte.pipeline.spec import FrameSpec
+from alte.registration.deskew import DeskewCounts
 from alte.registration.grid import GridAccumulator
 from alte.registration.odometry import PoseCounts
 from alte.registration.register import RegistrationCounts, empty_reason
 from alte.types import Box, RegisteredFrame, Trajectory
 
-__all__ = ["Registered", "cache_key", "merged_cloud", "prepare"]
+__all__ = ["Merged", "Registered", "cache_key", "merge_frames", "merged_cloud", "prepare"]
 
 #: Bump when the registered output of the same input and spec changes.
-CACHE_VERSION = 1
+CACHE_VERSION = 2
 _POINTS, _ARRAYS, _META = "points.f64", "arrays.npz", "meta.json"
 
 
@@ -124,8 +125,9 @@ def _counts(raw: dict[str, Any]) -> StreamCounts:
     read = ReadCounts(**raw["read"])
     reg = RegistrationCounts(**raw["registration"])
     poses = PoseCounts(**raw.get("poses", {}))
+    deskew = DeskewCounts(**raw.get("deskew", {}))
     return StreamCounts(read, reg, int(raw["scans"]), int(raw["selected"]), list(raw["notes"]),
-                        poses)
+                        poses, deskew)
 
 
 def _load(folder: Path, source: Source, spec: FrameSpec, key: str) -> Registered:
@@ -162,17 +164,38 @@ def prepare(source: Source, spec: FrameSpec | None = None, *, cache: Path | None
 
 
 
-def merged_cloud(source: Source, spec: FrameSpec | None = None, *,
-                 progress: bool = False) -> tuple[np.ndarray, StreamCounts]:
+@dataclass(frozen=True, eq=False)
+class Merged:
+    """An input's merged registered cloud, its points' other fields (a point file's, kept
+    while every point is) and the counts."""
+
+    points: np.ndarray
+    fields: dict[str, np.ndarray]
+    counts: StreamCounts
+
+
+def merge_frames(source: Source, spec: FrameSpec | None = None, *,
+                 progress: bool = False) -> Merged:
     """The input's merged registered cloud (thesis 2.1.3), streamed: with a voxel only the
-    box grid is held, never the frames; without one every registered point is kept."""
+    box grid is held, never the frames; without one every registered point is kept, with
+    its fields."""
     resolved = source.resolve(spec or FrameSpec())
     counts = StreamCounts()
     merge = GridAccumulator(resolved.voxel) if resolved.voxel is not None else None
-    parts = [f.points for f in stream_frames(source, resolved, counts, merge=merge,
-                                             progress=progress) if merge is None]
+    frames = [f for f in stream_frames(source, resolved, counts, merge=merge,
+                                       progress=progress) if merge is None]
     if counts.registration.frames_kept == 0:
         raise RegistrationError(f"{source.path}: {empty_reason(counts.registration)}")
-    cloud = merge.points() if merge is not None else np.concatenate(parts)
+    cloud = merge.points() if merge is not None else np.concatenate([f.points for f in frames])
     counts.registration.points_out = len(cloud)
-    return cloud, counts
+    names = set.intersection(*(set(f.fields or {}) for f in frames)) if frames else set()
+    order = [k for k in (frames[0].fields or {}) if k in names] if frames else []
+    fields = {k: np.concatenate([(f.fields or {})[k] for f in frames]) for k in order}
+    return Merged(cloud, fields, counts)
+
+
+def merged_cloud(source: Source, spec: FrameSpec | None = None, *,
+                 progress: bool = False) -> tuple[np.ndarray, StreamCounts]:
+    """The points and counts of :func:`merge_frames`."""
+    merged = merge_frames(source, spec, progress=progress)
+    return merged.points, merged.counts

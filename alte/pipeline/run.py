@@ -5,8 +5,9 @@ come either live from the input (:func:`~alte.pipeline.source.stream_frames`, on
 time) or from a prepared registration (:class:`~alte.pipeline.prepare.Registered`);
 the domain is resolved by one policy; the map is fed frame by frame (``insert``) or
 once (``build`` on the merged cloud). Timing follows thesis 5.2.1: ``elapsed_s`` is
-the time inside the mapper calls only; ``latency_s`` per frame covers the whole chain
-(read, register, insert) for the real-time view.
+the time inside the mapper calls only, ``cpu_s`` the CPU time of the process during them
+(every thread; what other load on the machine does not inflate); ``latency_s`` per
+frame covers the whole chain (read, register, insert) for the real-time view.
 """
 
 from __future__ import annotations
@@ -58,13 +59,14 @@ class FrameObserver(Protocol):
 @dataclass(frozen=True, eq=False)
 class FrameLog:
     """Per mapped frame: stamp (ns), points, seconds in the mapper, whole-chain seconds,
-    and (with snapshots) basis functions after the frame."""
+    (with snapshots) basis functions after the frame, and CPU seconds in the mapper."""
 
     stamps: np.ndarray
     points: np.ndarray
     insert_s: np.ndarray
     latency_s: np.ndarray
     basis_functions: np.ndarray
+    insert_cpu_s: np.ndarray
 
     @property
     def times(self) -> np.ndarray:
@@ -107,6 +109,11 @@ class MapRun:
         """Seconds spent inside the mapper calls (thesis 5.2.1)."""
         return float(self.log.insert_s.sum())
 
+    @property
+    def cpu_s(self) -> float:
+        """CPU seconds of the process inside the mapper calls (all its threads)."""
+        return float(self.log.insert_cpu_s.sum())
+
     def summary(self) -> dict[str, object]:
         """The run as one JSON-ready object (what ``alte map --json`` prints)."""
         counts = self.mapper.cell_counts()
@@ -117,6 +124,9 @@ class MapRun:
             "domain": None if info.domain is None else info.domain.as_dict(),
             "domain_policy": info.domain_policy, "voxel": info.frames.voxel,
             "pose_source": self.counts.poses.source,
+            "odometry": {"method": self.counts.poses.method,
+                         "settings": dict(self.counts.poses.settings)}
+            if self.counts.poses.method else None,
             "crop": None if info.frames.crop is None else list(info.frames.crop.values()),
             "frames": len(self.log.stamps), "frames_selected": self.counts.selected,
             "points": int(self.log.points.sum()),
@@ -124,7 +134,9 @@ class MapRun:
             "points_dropped_crop": self.counts.registration.points_dropped_crop,
             "points_outside": int(self.mapper.points_outside),
             "local_origin": list(info.local_origin), "elapsed_s": self.elapsed_s,
-            "wall_s": self.wall_s, "basis_functions": int(self.mapper.basis_functions),
+            "cpu_s": self.cpu_s, "cost": int(self.mapper.cost),
+            "cost_unit": self.mapper.cost_unit.value, "wall_s": self.wall_s,
+            "basis_functions": int(self.mapper.basis_functions),
             "cells": counts.cells, "occupied_cells": counts.occupied,
             "memory_bytes": int(self.mapper.memory_bytes), "counts": self.counts.as_dict(),
         }
@@ -164,18 +176,19 @@ class Feeder:
         self.observer = observer
         self.keep = set(_snapshot_indices(total, spec.snapshots)) if spec.snapshots else set()
         self.count_basis = spec.snapshots > 0
-        self.rows: list[tuple[int, int, float, float, int]] = []
+        self.rows: list[tuple[int, int, float, float, int, float]] = []
         self.snapshots: list[Snapshot] = []
         self.poses: list[RegisteredFrame] = []
 
     def frame(self, f: RegisteredFrame, waited: float) -> None:
-        start = time.perf_counter()
+        points, origin = f.points - self.shift, f.origin - self.shift
+        cpu, start = time.process_time(), time.perf_counter()
         if self.feed is Feed.FRAMES:
-            self.mapper.insert(f.points - self.shift, f.origin - self.shift)
-        spent = time.perf_counter() - start
+            self.mapper.insert(points, origin)
+        spent, cpu = time.perf_counter() - start, time.process_time() - cpu
         basis = self.mapper.basis_functions if self.count_basis else 0
         i = len(self.rows)
-        self.rows.append((f.stamp, len(f.points), spent, waited + spent, basis))
+        self.rows.append((f.stamp, len(f.points), spent, waited + spent, basis, cpu))
         self.poses.append(RegisteredFrame(f.stamp, np.empty((0, 3)), f.origin, f.position,
                                           f.quaternion))
         if i in self.keep:
@@ -191,24 +204,26 @@ class Feeder:
                    unit="frame", disable=not progress, leave=False)
         for frame, waited in bar:
             self.frame(frame, waited)
-        build_s = 0.0
+        build = (0.0, 0.0)
         if self.feed is Feed.BATCH:
             points = cloud()
-            start = time.perf_counter()
-            self.mapper.build(np.empty((0, 3)) if points is None else points - self.shift)
-            build_s = time.perf_counter() - start
-        return self.log(build_s)
+            points = np.empty((0, 3)) if points is None else points - self.shift
+            cpu, start = time.process_time(), time.perf_counter()
+            self.mapper.build(points)
+            build = (time.perf_counter() - start, time.process_time() - cpu)
+        return self.log(build)
 
-    def log(self, build_s: float = 0.0) -> FrameLog:
-        arr = np.array(self.rows, dtype=np.float64).reshape(-1, 5)
-        insert, latency = arr[:, 2].copy(), arr[:, 3].copy()
+    def log(self, build: tuple[float, float] = (0.0, 0.0)) -> FrameLog:
+        """The frames fed so far; ``build``: wall and CPU seconds of a batch build."""
+        arr = np.array(self.rows, dtype=np.float64).reshape(-1, 6)
+        insert, latency, cpu = arr[:, 2].copy(), arr[:, 3].copy(), arr[:, 5].copy()
         if self.feed is Feed.BATCH and len(insert):  # the map exists after the build only
-            insert[:] = 0.0
-            insert[-1] = build_s
-            latency[-1] += build_s
+            insert[:], cpu[:] = 0.0, 0.0
+            insert[-1], cpu[-1] = build
+            latency[-1] += build[0]
         stamps = np.array([row[0] for row in self.rows], dtype=np.int64)  # exact ns
         return FrameLog(stamps, arr[:, 1].astype(np.int64), insert, latency,
-                        arr[:, 4].astype(np.int64))
+                        arr[:, 4].astype(np.int64), cpu)
 
 
 def _snapshot_indices(total: int, snapshots: int) -> list[int]:

@@ -22,12 +22,19 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from alte.errors import BagError, ParameterError, PointFileError, TopicError
+from alte.errors import BagError, ParameterError, PointFileError, PoseError, TopicError
 from alte.io.bag import NO_POSE_NOTE, FrameStream, ReadCounts
 from alte.io.pose import POSE_TYPES
 from alte.pipeline.spec import FrameSpec, PoseSource
+from alte.registration.deskew import DeskewCounts, deskew_frames
 from alte.registration.grid import GridAccumulator, grid_average
-from alte.registration.odometry import PoseCounts, odometry_frames, refine_frames
+from alte.registration.odometry import (
+    KEYS,
+    PoseCounts,
+    odometry_frames,
+    odometry_label,
+    refine_frames,
+)
 from alte.registration.register import RegistrationCounts, crop_mask, register_frames
 from alte.types import Box, Frame, RegisteredFrame
 
@@ -123,19 +130,32 @@ class StreamCounts:
     selected: int = 0
     notes: list[str] = field(default_factory=list)
     poses: PoseCounts = field(default_factory=PoseCounts)
+    deskew: DeskewCounts = field(default_factory=DeskewCounts)
 
     def as_dict(self) -> dict[str, object]:
         """JSON-ready form."""
         return {"scans": self.scans, "selected": self.selected, "read": self.read.as_dict(),
                 "registration": self.registration.as_dict(), "notes": list(self.notes),
-                "poses": self.poses.as_dict()}
+                "poses": self.poses.as_dict(), "deskew": self.deskew.as_dict()}
 
 
 def _open(source: Source, spec: FrameSpec, pose_topic: str | None, progress: bool,
           allow_no_pose: bool = True) -> FrameStream:
+    pose_file = spec.pose_file if pose_topic != "" else None
     return FrameStream(source.bag or source.path, cloud_topic=spec.cloud_topic,
                        pose_topic=pose_topic, mount=spec.mount, allow_no_pose=allow_no_pose,
-                       frames=spec.frames, progress=progress)
+                       frames=spec.frames, progress=progress, pose_file=pose_file)
+
+
+def _start(probe: FrameStream, stamp: int) -> tuple[np.ndarray, np.ndarray] | None:
+    """The recorded pose at the first scan, or None (no track, or one on another clock)."""
+    if probe.track is None:
+        return None
+    try:
+        at = probe.track.interpolate([stamp], probe.options.max_gap_s)
+    except PoseError:  # stamps in another unit: odometry does without the anchor
+        return None
+    return (at.positions[0], at.quaternions[0]) if at.valid[0] else None
 
 
 def _odometry(stream: FrameStream, probe: FrameStream, spec: FrameSpec,
@@ -145,22 +165,28 @@ def _odometry(stream: FrameStream, probe: FrameStream, spec: FrameSpec,
     first = next(frames, None)
     if first is None:
         return
-    start = None
-    if probe.track is not None:
-        at = probe.track.interpolate([first.stamp], probe.options.max_gap_s)
-        if at.valid[0]:
-            start = (at.positions[0], at.quaternions[0])
+    start = _start(probe, first.stamp)
     anchor = f"the recorded pose of the first scan ({probe.pose_topic})" if start is not None \
         else "the first scan's body frame"
-    method = "point-to-plane" if spec.odometry.method == "plane" else "kiss-icp"
-    stream.notes.append(f"poses from LiDAR odometry ({method}), anchored at {anchor}")
+    stream.notes.append(f"poses from LiDAR odometry ({odometry_label(spec.odometry)}), "
+                        f"anchored at {anchor}")
     yield from odometry_frames(itertools.chain([first], frames), stream.mount, counts=counts,
                                params=spec.odometry, start=start)
 
 
-def _posed(source: Source, spec: FrameSpec, counts: PoseCounts,
-           progress: bool) -> tuple[FrameStream, Iterator[Frame]]:
+def _deskewed(stream: FrameStream, spec: FrameSpec, counts: DeskewCounts) -> Iterator[Frame]:
+    """The stream's frames, deskewed along its pose track when ``spec.deskew`` (clouds
+    with per-point time), else as read (their time dropped: registered as taken)."""
+    if spec.deskew and stream.track is not None:
+        return deskew_frames(iter(stream), stream.track, stream.mount, counts=counts,
+                             max_gap_s=stream.options.max_gap_s)
+    return (replace(f, times=None) for f in stream)
+
+
+def _posed(source: Source, spec: FrameSpec, counts: PoseCounts, progress: bool,
+           deskew: DeskewCounts | None = None) -> tuple[FrameStream, Iterator[Frame]]:
     """The scan stream and its frames posed as ``spec.poses`` says (:class:`PoseSource`)."""
+    deskew = DeskewCounts() if deskew is None else deskew
     choice = spec.poses
     counts.source = choice.value
     if choice is PoseSource.IDENTITY:
@@ -173,13 +199,15 @@ def _posed(source: Source, spec: FrameSpec, counts: PoseCounts,
                          f"{probe.cloud_topic}; use --poses odometry (LiDAR odometry) or "
                          "--poses identity (static sensor)")
     if choice is PoseSource.RECORDED:
-        return probe, iter(probe)
+        return probe, _deskewed(probe, spec, deskew)
     if choice is PoseSource.REFINE:
-        return probe, refine_frames(iter(probe), probe.mount, counts=counts,
+        counts.method = "refine"
+        counts.settings = {k: spec.odometry.as_dict()[k] for k in KEYS["refine"]}
+        return probe, refine_frames(_deskewed(probe, spec, deskew), probe.mount, counts=counts,
                                     params=spec.odometry)
     if choice is PoseSource.AUTO and probe.track is not None:
         counts.source = PoseSource.RECORDED.value
-        return probe, iter(probe)
+        return probe, _deskewed(probe, spec, deskew)
     counts.source = PoseSource.ODOMETRY.value
     stream = probe if probe.track is None else _open(source, spec, "", progress)
     stream.notes[:] = [n for n in stream.notes if n != NO_POSE_NOTE]
@@ -188,7 +216,7 @@ def _posed(source: Source, spec: FrameSpec, counts: PoseCounts,
 
 def _bag_frames(source: Source, spec: FrameSpec, counts: StreamCounts,
                 merge: GridAccumulator | None, progress: bool) -> Iterator[RegisteredFrame]:
-    stream, posed = _posed(source, spec, counts.poses, progress)
+    stream, posed = _posed(source, spec, counts.poses, progress, counts.deskew)
     counts.scans, counts.selected, counts.notes = stream.scans, stream.selected, stream.notes
     frames = register_frames(posed, stream.mount, voxel=spec.voxel,
                              crop_box=None if spec.crop is None else spec.crop.values(),
@@ -203,7 +231,8 @@ def _bag_frames(source: Source, spec: FrameSpec, counts: StreamCounts,
 
 def _file_frames(source: Source, spec: FrameSpec, counts: StreamCounts,
                  merge: GridAccumulator | None) -> Iterator[RegisteredFrame]:
-    """A point file as one frame: finite, cropped, grid-averaged, seen from ``spec.origin``."""
+    """A point file as one frame: finite, cropped, grid-averaged, seen from ``spec.origin``;
+    the file's other fields ride along while every point is kept (no voxel)."""
     from alte.io.pointfiles import read_points_info
 
     if spec.poses in (PoseSource.ODOMETRY, PoseSource.REFINE):
@@ -214,12 +243,12 @@ def _file_frames(source: Source, spec: FrameSpec, counts: StreamCounts,
     reg = counts.registration
     counts.scans = counts.selected = counts.read.scans_read = counts.read.frames = 1
     counts.read.points_nonfinite = info.nonfinite
-    points = info.points
+    points, fields = info.points, info.fields
     reg.frames_in, reg.points_in = 1, len(points)
     if spec.crop is not None:
         inside = crop_mask(points, spec.crop.values())
         reg.points_dropped_crop = int(len(points) - np.count_nonzero(inside))
-        points = points[inside]
+        points, fields = points[inside], {k: v[inside] for k, v in fields.items()}
     if len(points) == 0:
         reg.frames_dropped_empty = 1
         return
@@ -227,9 +256,13 @@ def _file_frames(source: Source, spec: FrameSpec, counts: StreamCounts,
         merge.add(points)
     if spec.voxel is not None:
         points = grid_average(points, spec.voxel)
+        if fields:
+            counts.notes.append(f"fields {', '.join(fields)} not kept: --voxel averages the "
+                                "points into cells")
     reg.frames_kept, reg.points_registered = 1, len(points)
     origin = np.array(spec.origin)
-    yield RegisteredFrame(0, points, origin, origin.copy(), np.array([0.0, 0.0, 0.0, 1.0]))
+    yield RegisteredFrame(0, points, origin, origin.copy(), np.array([0.0, 0.0, 0.0, 1.0]),
+                          fields if spec.voxel is None else None)
 
 
 def stream_frames(source: Source, spec: FrameSpec, counts: StreamCounts, *,

@@ -13,6 +13,7 @@ from __future__ import annotations
 import enum
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 
@@ -56,6 +57,14 @@ class PoseSource(enum.Enum):
     IDENTITY = "identity"
 
 
+def _file_identity(path: Path | None) -> list[object] | None:
+    """A file's path, size and modification time (a cache key changes with its content)."""
+    if path is None:
+        return None
+    stat = path.stat() if path.is_file() else None
+    return [str(path.resolve()), stat.st_size if stat else 0, stat.st_mtime_ns if stat else 0]
+
+
 @dataclass(frozen=True)
 class FrameSpec:
     """How the input becomes registered frames (module docstring).
@@ -64,7 +73,10 @@ class FrameSpec:
     ``voxel`` (m): per-frame grid average and the merged cloud's box grid; ``crop``:
     the control volume points are kept in; ``origin``: the sensor position of a point
     file; ``max_rate`` (rad/s) / ``max_offset`` (s): the fast-manoeuvre filter;
-    ``odometry``: how odometry and refinement align scans (``poses`` odometry, refine).
+    ``odometry``: how odometry and refinement align scans (``poses`` odometry, refine);
+    ``deskew``: move the points of a cloud with per-point time to its stamp with the
+    sensor's motion (:mod:`alte.registration.deskew`; False: register them as taken).
+    ``pose_file``: poses from a TUM file (``t x y z qx qy qz qw``) instead of a topic.
     """
 
     frames: int | None = None
@@ -78,6 +90,8 @@ class FrameSpec:
     max_offset: float | None = None
     origin: tuple[float, float, float] = (0.0, 0.0, 0.0)
     odometry: OdometryParams = field(default_factory=OdometryParams)
+    deskew: bool = True
+    pose_file: Path | None = None
 
     def __post_init__(self) -> None:
         if self.frames is not None and (isinstance(self.frames, bool)
@@ -93,6 +107,10 @@ class FrameSpec:
         if origin.shape != (3,) or not np.isfinite(origin).all():
             raise ParameterError(f"origin {self.origin!r}: expected 3 finite numbers x,y,z")
         object.__setattr__(self, "origin", tuple(float(v) for v in origin))
+        if self.pose_file is not None:
+            object.__setattr__(self, "pose_file", Path(self.pose_file))
+            if self.pose_topic:
+                raise ParameterError("--pose-file and --pose-topic exclude each other")
 
     def key(self) -> dict[str, object]:
         """Everything that decides the registered frames, JSON-ready (the cache key)."""
@@ -102,7 +120,8 @@ class FrameSpec:
                 "cloud_topic": self.cloud_topic, "pose_topic": self.pose_topic,
                 "poses": self.poses.value, "max_rate": self.max_rate,
                 "max_offset": self.max_offset, "origin": list(self.origin),
-                "odometry": self.odometry.as_dict()}
+                "odometry": self.odometry.as_dict(), "deskew": self.deskew,
+                "pose_file": _file_identity(self.pose_file)}
 
 
 @dataclass(frozen=True)

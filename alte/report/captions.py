@@ -189,10 +189,12 @@ class KeyTable:
 KEY_TABLES: tuple[KeyTable, ...] = (
     KeyTable("table_5_10", "Table 5.10: best 2D maps by the thesis' rule",
              "Each mapper's map picked from our sweep by the thesis' comparison rule, beside "
-             "the thesis' choice."),
+             "the thesis' choice. Times are CPU seconds known within their spread: maps "
+             "the rule cannot separate within it are all shown (rule_pick: tie)."),
     KeyTable("table_5_11", "Table 5.11: best 3D maps by the thesis' rule",
              "Each mapper's map picked from our sweep by the thesis' comparison rule, beside "
-             "the thesis' choice."),
+             "the thesis' choice. Times are CPU seconds known within their spread: maps "
+             "the rule cannot separate within it are all shown (rule_pick: tie)."),
     KeyTable("key_equal_size", "MHD at equal size",
              "The MHD each mapper reaches at 1,000 / 5,000 / 20,000 basis functions, read "
              "off its Pareto front (only where its maps reach that size); mean over seeds "

@@ -7,20 +7,29 @@ speeds and dynamics, fewer scans), and every scan draws its noise from its own
 points do not depend on ``frames`` or on which other terrains were simulated.
 Experimental cases stamp each scan ``time_offset_s`` + N(0, ``jitter_s``) earlier
 than it was really taken, the desynchronization of thesis fig. 4.34.
+
+A :class:`~alte.sim.profile.SensorProfile` other than the thesis' adds what a real sensor
+does (per-point time and the sweep in motion, the IMU, a faster pose topic, dropouts,
+mixed pixels); each draws from its own stream (3 = dropouts, 4 = IMU), so the thesis'
+noise is the same under every profile.
 """
 
 from __future__ import annotations
 
 import zlib
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 from tqdm.auto import tqdm
 
 from alte.errors import ParameterError
+from alte.sim.imu import ImuStream, imu_stream
 from alte.sim.platform import Cart, Trajectory, mocap_stream
+from alte.sim.profile import SensorProfile
+from alte.sim.returns import BEAM_DIVERGENCE_MRAD, lost_returns, mixed_distance
 from alte.sim.scene import CLASSES
-from alte.sim.sensor import VLP16, cast, measure
+from alte.sim.sensor import VLP16, Hits, cast, cast_sweep, measure
 from alte.sim.terrains import Terrain
 from alte.types import Mount
 
@@ -34,7 +43,11 @@ _BATCH = 48
 
 @dataclass(frozen=True, eq=False)
 class Simulation:
-    """Simulated scans (sensor frame) with their stamps, and the pose stream of the body."""
+    """Simulated scans (sensor frame) with their stamps, and the pose stream of the body.
+
+    ``times`` holds each scan's per-point time (s from its stamp) for a swept sensor,
+    ``imu`` the IMU samples when the profile has an IMU.
+    """
 
     stamps: np.ndarray
     scans: list[np.ndarray]
@@ -45,6 +58,9 @@ class Simulation:
     mount: Mount
     counts: dict[str, int]
     duration_s: float
+    times: list[np.ndarray] | None = None
+    imu: ImuStream | None = None
+    profile: SensorProfile = field(default_factory=SensorProfile)
 
 
 def scan_indices(total: int, frames: int | None) -> np.ndarray:
@@ -78,13 +94,17 @@ def _acquisition_times(terrain: Terrain, seed: int, stamps_s: np.ndarray,
     return late
 
 
-def _pose_stream(terrain: Terrain, traj: Trajectory, seed: int,
-                 stamps: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Gazebo's true state at the scan stamps, or 100 Hz motion capture (cart)."""
+def _pose_stream(terrain: Terrain, traj: Trajectory, seed: int, stamps: np.ndarray,
+                 pose_hz: float = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Gazebo's true state at the scan stamps (or at ``pose_hz``), or 100 Hz motion
+    capture (cart)."""
     platform = terrain.spec.platform
     if not isinstance(platform, Cart):
+        if pose_hz > 0:
+            step = round(1e9 / pose_hz)
+            stamps = START_NS + step * np.arange(int((traj.duration + 0.1) * 1e9) // step + 1)
         pos, rot = traj.pose((stamps - START_NS) / 1e9)
-        return stamps, pos, rot.as_quat(canonical=False)
+        return stamps.astype(np.int64), pos, rot.as_quat(canonical=False)
     step = round(1e9 / platform.mocap_hz)
     pose_stamps = START_NS + step * np.arange(int((traj.duration + 0.1) * 1e9) // step + 1)
     rng = _rng(seed, terrain.spec.name, 2)
@@ -127,32 +147,75 @@ def true_poses(terrain: Terrain, seed: int = 0, frames: int | None = None,
 
 
 def simulate(terrain: Terrain, seed: int = 0, frames: int | None = None,
-             sensor: VLP16 | None = None, progress: bool = False) -> Simulation:
+             sensor: VLP16 | None = None, *, progress: bool = False,
+             profile: SensorProfile | None = None) -> Simulation:
     """Simulate ``terrain``'s mission (all scans, or ``frames`` evenly spaced ones)."""
-    sensor = sensor or VLP16()
-    spec, mount = terrain.spec, terrain.spec.mount
+    sensor, profile = sensor or VLP16(), profile or SensorProfile()
+    spec = terrain.spec
     index, stamps, traj, acq = _mission(terrain, seed, frames, sensor)
-    body_pos, body_rot = traj.pose(acq)
-    sensor_pos = body_pos + body_rot.apply(mount.translation)
-    sensor_rot = body_rot * mount.rotation
-    directions, raycaster = sensor.directions(), terrain.scene.raycaster()
-    class_ids = terrain.scene.class_ids
+    caster = _Caster(terrain, traj, sensor, profile)
     scans: list[np.ndarray] = []
+    times: list[np.ndarray] = []
     counts: dict[str, int] = {}
     for lo in tqdm(range(0, len(index), _BATCH), desc=spec.name, unit="batch",
                    disable=not progress):
         sl = slice(lo, lo + _BATCH)
-        hits = cast(raycaster, sensor_pos[sl], sensor_rot[sl], directions)
-        rngs = [_rng(seed, spec.name, 0, int(i)) for i in index[sl]]
-        ranges, part = measure(hits, sensor, rngs)
+        hits = caster.hits(acq[sl])
+        ranges, part = measure(hits, sensor, [_rng(seed, spec.name, 0, int(i)) for i in index[sl]])
+        if profile.dropout:
+            lost = lost_returns(hits, caster.class_ids, profile,
+                                [_rng(seed, spec.name, 3, int(i)) for i in index[sl]])
+            part["dropout"] = int((lost & np.isfinite(ranges)).sum())
+            part["returns"] -= part["dropout"]
+            ranges[lost] = np.nan
         valid = np.isfinite(ranges)
-        scans += [directions[v] * r[v, None] for v, r in zip(valid, ranges, strict=True)]
-        part.update(_class_counts(class_ids[hits.triangle[valid]]))
+        scans += [caster.directions[v] * r[v, None] for v, r in zip(valid, ranges, strict=True)]
+        times += [caster.ray_times[v] for v in valid]
+        part.update(_class_counts(caster.class_ids[hits.triangle[valid]]))
         counts = {k: counts.get(k, 0) + part.get(k, 0) for k in {*counts, *part}}
-    pose_stamps, positions, quats = _pose_stream(terrain, traj, seed, stamps)
+    pose_stamps, positions, quats = _pose_stream(terrain, traj, seed, stamps, profile.pose_hz)
+    imu = imu_stream(traj, START_NS, profile, _rng(seed, spec.name, 4)) if profile.imu_hz else None
     counts["frames"], counts["poses"] = len(index), len(pose_stamps)
-    return Simulation(stamps.astype(np.int64), scans, index, pose_stamps, positions, quats, mount,
-                      dict(sorted(counts.items())), traj.duration)
+    if imu is not None:
+        counts["imu"] = len(imu)
+    return Simulation(stamps.astype(np.int64), scans, index, pose_stamps, positions, quats,
+                      spec.mount, dict(sorted(counts.items())), traj.duration,
+                      times if profile.sweep else None, imu, profile)
+
+
+class _Caster:
+    """Casts a batch of scans as the profile says: one pose a scan (the thesis) or one
+    pose a firing sequence (sweep); with mixed pixels, two more sub-rays a beam."""
+
+    def __init__(self, terrain: Terrain, traj: Trajectory, sensor: VLP16,
+                 profile: SensorProfile) -> None:
+        self.traj, self.mount, self.profile = traj, terrain.spec.mount, profile
+        self.directions = sensor.directions()
+        half = np.degrees(BEAM_DIVERGENCE_MRAD / 2e3)
+        self.sub_rays = [sensor.directions(-half), sensor.directions(half)]
+        self.raycaster = terrain.scene.raycaster()
+        self.class_ids = terrain.scene.class_ids
+        self.group_times, self.ray_times = sensor.firing_times()
+
+    def hits(self, acq: np.ndarray) -> Hits:
+        """Hits (K, M) of the scans taken at ``acq`` (s from the mission start)."""
+        t = (acq[:, None] + self.group_times[None, :]).reshape(-1) if self.profile.sweep \
+            else acq
+        body_pos, body_rot = self.traj.pose(t)
+        pos = body_pos + body_rot.apply(self.mount.translation)
+        rot = body_rot * self.mount.rotation
+        if self.profile.sweep:
+            pos = pos.reshape(len(acq), -1, 3)
+        centre = self._shoot(pos, rot, self.directions)
+        if not self.profile.mixed_pixels:
+            return centre
+        left, right = (self._shoot(pos, rot, d) for d in self.sub_rays)
+        return mixed_distance(centre, left, right, self.profile)
+
+    def _shoot(self, pos: np.ndarray, rot: Rotation, directions: np.ndarray) -> Hits:
+        if self.profile.sweep:
+            return cast_sweep(self.raycaster, pos, rot, directions)
+        return cast(self.raycaster, pos, rot, directions)
 
 
 def _class_counts(class_ids: np.ndarray) -> dict[str, int]:

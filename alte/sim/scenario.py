@@ -4,7 +4,9 @@
 spec hash and seed already exists; the folder is built under a temporary name and
 renamed when complete (:func:`alte.fsutil.atomic_dir`), and scenario.json records
 the size and SHA-256 of every file, so an interrupted or altered run is never
-mistaken for a finished one. :func:`load_scenario` reads a folder back.
+mistaken for a finished one. :func:`load_scenario` reads a folder back. A sensor profile
+other than the thesis' (:mod:`alte.sim.profile`) is part of the spec hash and of the
+folder name (``NAME-uav``), so it never replaces the thesis' terrain.
 """
 
 from __future__ import annotations
@@ -12,9 +14,10 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -22,14 +25,19 @@ from alte.errors import AlteError, SimulationError
 from alte.fsutil import atomic_dir
 from alte.sim.groundtruth import GROUND_TRUTH_FILE, load_ground_truth, write_ground_truth
 from alte.sim.mission import Simulation, simulate
+from alte.sim.profile import PROFILES, SensorProfile
 from alte.sim.scene import Scene
 from alte.sim.sensor import VLP16
 from alte.sim.terrains import TERRAINS, Terrain
 from alte.types import Mount
 
-__all__ = ["BAG_DIR", "SCENARIO_FILE", "SIM_VERSION", "Scenario", "ensure_terrain", "get_terrain",
-           "is_current", "load_metadata", "load_scenario", "spec_hash", "terrain_folder",
-           "update_terrain", "write_scenario"]
+if TYPE_CHECKING:
+    from alte.io.imu import ImuSamples
+    from alte.io.writer import Cloud
+
+__all__ = ["BAG_DIR", "IMU_TOPIC", "SCENARIO_FILE", "SIM_VERSION", "Scenario", "ensure_terrain",
+           "get_terrain", "is_current", "load_metadata", "load_scenario", "profile_label",
+           "spec_hash", "terrain_folder", "update_terrain", "write_scenario"]
 
 #: Bump when the simulator's output changes for the same spec (invalidates caches).
 SIM_VERSION = 1
@@ -37,6 +45,7 @@ SCENARIO_FILE = "scenario.json"
 BAG_DIR = "bag"
 CLOUD_TOPIC = "/velodyne_points"
 POSE_TOPIC = "/pose"
+IMU_TOPIC = "/imu"
 
 
 def get_terrain(name: str) -> Terrain:
@@ -48,12 +57,23 @@ def get_terrain(name: str) -> Terrain:
     return builder()
 
 
+def profile_label(profile: SensorProfile) -> str:
+    """The profile's name in :data:`PROFILES`, else ``custom-<hash>`` of its settings."""
+    for name, known in PROFILES.items():
+        if known == profile:
+            return name
+    digest = hashlib.sha256(json.dumps(profile.as_dict(), sort_keys=True).encode())
+    return f"custom-{digest.hexdigest()[:8]}"
+
+
 def spec_hash(terrain: Terrain, frames: int | None, storage: str,
-              sensor: VLP16 | None = None) -> str:
+              sensor: VLP16 | None = None, profile: SensorProfile | None = None) -> str:
     """SHA-256 of everything that defines the output except the seed (the cache key)."""
     sensor = sensor or VLP16()
     spec = {"version": SIM_VERSION, "spec": terrain.spec.to_dict(), "sensor": sensor.to_dict(),
             "frames": frames, "storage": storage, "mount": terrain.spec.mount.to_string()}
+    if profile is not None and not profile.instantaneous:  # the thesis' hash is unchanged
+        spec["profile"] = profile.as_dict()
     digest = hashlib.sha256(json.dumps(spec, sort_keys=True).encode())
     scene = terrain.scene
     for arr in (scene.vertices, scene.triangles, scene.object_ids):
@@ -89,6 +109,10 @@ def _metadata(terrain: Terrain, sim: Simulation, run: dict[str, Any]) -> dict[st
         "extent": terrain.scene.bounds().tolist(), "landing_zone": spec.landing_zone,
         "registration_voxel": spec.registration_voxel, "mount": _mount_dict(spec.mount),
         "duration_s": sim.duration_s, "spec": spec.to_dict(), "sensor": VLP16().to_dict(),
+        "sensor_profile": {"name": profile_label(sim.profile), **sim.profile.as_dict()},
+        "point_time_field": sim.profile.time_field if sim.times is not None else None,
+        "imu_topic": IMU_TOPIC if sim.imu is not None else None,
+        "imu_mount": _mount_dict(sim.imu.mount) if sim.imu is not None else None,
         "counts": sim.counts,
         "objects": [{"id": i, "name": o.name, "class": o.cls}
                     for i, o in enumerate(terrain.scene.objects)],
@@ -101,13 +125,12 @@ def write_scenario(target: str | os.PathLike[str], terrain: Terrain, sim: Simula
     """Write bag, ground truth and scenario.json into ``target`` atomically (replacing it)."""
     from alte.io.writer import write_bag
 
-    key = spec_hash(terrain, frames, storage)
+    key = spec_hash(terrain, frames, storage, profile=sim.profile)
     with atomic_dir(target, overwrite=True) as tmp:
         tmp.mkdir()
-        write_bag(tmp / BAG_DIR, zip(sim.stamps.tolist(), sim.scans, strict=True),
-                  sim.pose_stamps, sim.positions, sim.quaternions, sim.mount,
-                  cloud_topic=CLOUD_TOPIC, pose_topic=POSE_TOPIC, storage=storage,
-                  progress=progress)
+        write_bag(tmp / BAG_DIR, _clouds(sim), sim.pose_stamps, sim.positions, sim.quaternions,
+                  sim.mount, cloud_topic=CLOUD_TOPIC, pose_topic=POSE_TOPIC, storage=storage,
+                  progress=progress, imu=_imu_samples(sim))
         write_ground_truth(tmp / GROUND_TRUTH_FILE, terrain.scene)
         run = {"seed": int(seed), "frames_requested": frames, "spec_hash": key,
                "storage": storage}
@@ -115,6 +138,29 @@ def write_scenario(target: str | os.PathLike[str], terrain: Terrain, sim: Simula
         meta["files"] = _file_table(tmp)
         (tmp / SCENARIO_FILE).write_text(json.dumps(meta, indent=2, sort_keys=True) + "\n")
     return Path(target)
+
+
+def _clouds(sim: Simulation) -> Iterator[Cloud]:
+    """The scans to write, each with its per-point time field when the sensor sweeps."""
+    if sim.times is None:
+        yield from zip(sim.stamps.tolist(), sim.scans, strict=True)
+        return
+    for stamp, points, times in zip(sim.stamps.tolist(), sim.scans, sim.times, strict=True):
+        if sim.profile.time_field == "t":
+            field = {"t": np.round(times * 1e9).astype(np.uint32)}
+        else:
+            field = {"time": times.astype(np.float32)}
+        yield stamp, points, field
+
+
+def _imu_samples(sim: Simulation) -> ImuSamples | None:
+    from alte.io.imu import ImuSamples
+
+    imu = sim.imu
+    if imu is None:
+        return None
+    return ImuSamples(imu.stamps, imu.angular_velocity, imu.linear_acceleration, "imu_link",
+                      imu.mount, imu.gyro_sigma, imu.accel_sigma)
 
 
 def is_current(folder: Path, key: str, seed: int) -> bool:
@@ -129,39 +175,42 @@ def is_current(folder: Path, key: str, seed: int) -> bool:
 
 
 def terrain_folder(out_dir: str | os.PathLike[str], name: str, frames: int | None = None,
-                   seed: int = 0) -> Path:
+                   seed: int = 0, profile: SensorProfile | None = None) -> Path:
     """Where a terrain lives: ``out_dir/NAME`` (full mission, seed 0), ``NAME-Nf`` (N scans),
-    ``NAME-sS`` / ``NAME-Nf-sS`` (seed S).
+    ``NAME-sS`` / ``NAME-Nf-sS`` (seed S), each with ``-PROFILE`` for another sensor
+    profile than the thesis' (``NAME-uav``).
 
-    Reduced missions (quick runs, tests) and other seeds get their own folders, so they
-    never replace the full one and concurrent runs of different sizes or seeds cannot
-    collide.
+    Reduced missions (quick runs, tests), other seeds and profiles get their own folders,
+    so they never replace the full one and concurrent runs cannot collide.
     """
-    stem = name if frames is None else f"{name}-{int(frames)}f"
+    stem = name if profile is None or profile.instantaneous else \
+        f"{name}-{profile_label(profile)}"
+    stem = stem if frames is None else f"{stem}-{int(frames)}f"
     return Path(out_dir) / (stem if seed == 0 else f"{stem}-s{int(seed)}")
 
 
 def ensure_terrain(name: str, out_dir: str | os.PathLike[str] = "data", seed: int = 0,
                    frames: int | None = None, *, storage: str = "sqlite3", force: bool = False,
-                   progress: bool = False) -> Path:
+                   progress: bool = False, profile: SensorProfile | None = None) -> Path:
     """Simulate terrain ``name`` into :func:`terrain_folder` unless it is already current."""
     return update_terrain(name, out_dir, seed, frames, storage=storage, force=force,
-                          progress=progress)[0]
+                          progress=progress, profile=profile)[0]
 
 
 def update_terrain(name: str, out_dir: str | os.PathLike[str] = "data", seed: int = 0,
                    frames: int | None = None, *, storage: str = "sqlite3", force: bool = False,
-                   progress: bool = False) -> tuple[Path, bool]:
+                   progress: bool = False, profile: SensorProfile | None = None
+                   ) -> tuple[Path, bool]:
     """As :func:`ensure_terrain`; also says whether the terrain was (re)simulated."""
     terrain = get_terrain(name)
-    target = terrain_folder(out_dir, name, frames, seed)
-    key = spec_hash(terrain, frames, storage)
+    target = terrain_folder(out_dir, name, frames, seed, profile)
+    key = spec_hash(terrain, frames, storage, profile=profile)
     if not force and is_current(target, key, seed):
         return target, False
     if target.exists() and not force and not (target / SCENARIO_FILE).is_file():
         raise SimulationError(f"{target} exists but is not a simulated terrain folder; "
                               "remove it or pass force=True (--force)")
-    sim = simulate(terrain, seed=seed, frames=frames, progress=progress)
+    sim = simulate(terrain, seed=seed, frames=frames, progress=progress, profile=profile)
     folder = write_scenario(target, terrain, sim, seed=seed, frames=frames, storage=storage,
                             progress=progress)
     return folder, True

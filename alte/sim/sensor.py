@@ -8,7 +8,9 @@ sequence advances 0.2 deg. The field of view is limited to 45 deg either side of
 surface hit. Simplifications (stated): the vehicle's motion during the 25 ms the beam
 sweeps the field of view and the 2.3 us laser-to-laser azimuth drift are ignored;
 each scan is taken from one sensor pose. Range noise is Gaussian (sigma = the data
-sheet's 3 cm accuracy), truncated at 4 sigma.
+sheet's 3 cm accuracy), truncated at 4 sigma. The ``uav`` sensor profile
+(:mod:`alte.sim.profile`) lifts the first simplification: :func:`cast_sweep` casts each
+firing from the pose at its own instant (:meth:`VLP16.firing_times`).
 """
 
 from __future__ import annotations
@@ -24,11 +26,13 @@ from alte.tensors import to_array, to_tensor
 if TYPE_CHECKING:
     import open3d as o3d
 
-__all__ = ["FIRING_ORDER_DEG", "VLP16", "Hits", "cast", "measure"]
+__all__ = ["FIRING_ORDER_DEG", "FIRING_US", "VLP16", "Hits", "cast", "cast_sweep", "measure"]
 
 #: Elevation (deg) of laser ids 0..15, in firing order (VLP-16 manual, table 9-1).
 FIRING_ORDER_DEG = np.array([-15, 1, -13, 3, -11, 5, -9, 7, -7, 9, -5, 11, -3, 13, -1, 15],
                             dtype=np.float64)
+#: Time between two lasers of one firing sequence (VLP-16 manual, 9.7), microseconds.
+FIRING_US = 2.304
 
 
 @dataclass(frozen=True)
@@ -61,11 +65,23 @@ class VLP16:
         laser = np.tile(np.arange(n_lasers), len(az))
         return np.repeat(az, n_lasers), FIRING_ORDER_DEG[laser], laser
 
-    def directions(self) -> np.ndarray:
-        """Unit ray directions (M, 3) in the sensor frame, in firing order."""
+    def directions(self, azimuth_offset_deg: float = 0.0) -> np.ndarray:
+        """Unit ray directions (M, 3) in the sensor frame, in firing order (azimuths
+        shifted by ``azimuth_offset_deg``: the sub-rays of a beam's footprint)."""
         az, el, _ = self.beams()
-        a, w = np.radians(az), np.radians(el)
+        a, w = np.radians(az + azimuth_offset_deg), np.radians(el)
         return np.column_stack([np.cos(w) * np.sin(a), np.cos(w) * np.cos(a), np.sin(w)])
+
+    def firing_times(self) -> tuple[np.ndarray, np.ndarray]:
+        """When each firing sequence starts (G,) and each ray fires (M,), seconds after
+        the start of the rotation at azimuth -180 deg (the scan stamp of a swept scan).
+
+        The head turns at ``rpm``; the lasers of one sequence fire 2.304 us apart.
+        """
+        period = 60.0 / self.rpm
+        group = (self.azimuths_deg() + 180.0) / 360.0 * period
+        slot = np.arange(len(FIRING_ORDER_DEG)) * FIRING_US * 1e-6
+        return group, (group[:, None] + slot[None, :]).reshape(-1)
 
     def to_dict(self) -> dict[str, float]:
         """Parameters for scenario.json."""
@@ -89,8 +105,31 @@ def cast(raycaster: o3d.t.geometry.RaycastingScene, positions: np.ndarray, rotat
     frame, ``directions`` (M, 3) the rays in the sensor frame.
     """
     world = np.einsum("kij,mj->kmi", rotations.as_matrix().reshape(-1, 3, 3), directions)
+    return _cast(raycaster, np.asarray(positions, dtype=np.float64), world)
+
+
+def cast_sweep(raycaster: o3d.t.geometry.RaycastingScene, positions: np.ndarray,
+               rotations: Rotation, directions: np.ndarray) -> Hits:
+    """Cast K swept scans: each of the G firing sequences from its own sensor pose.
+
+    ``positions`` (K, G, 3) and ``rotations`` (K * G, row-major) are the sensor poses
+    at each firing, ``directions`` (G * L, 3) the rays in firing order (L lasers a
+    sequence). One ``cast_rays`` call for the whole batch; returns hits (K, G * L).
+    """
+    k, g = positions.shape[:2]
+    rays = np.asarray(directions, dtype=np.float64).reshape(g, -1, 3)
+    mats = rotations.as_matrix().reshape(k, g, 3, 3)
+    world = np.einsum("kgij,glj->kgli", mats, rays).reshape(k, -1, 3)
+    origins = np.repeat(np.asarray(positions, dtype=np.float64), rays.shape[1], axis=1)
+    return _cast(raycaster, origins, world)
+
+
+def _cast(raycaster: o3d.t.geometry.RaycastingScene, origins: np.ndarray,
+          world: np.ndarray) -> Hits:
+    """First hits of rays from ``origins`` ((K, 3) or (K, M, 3)) along ``world`` (K, M, 3)."""
     k, m = world.shape[:2]
-    origins = np.broadcast_to(np.asarray(positions, dtype=np.float64)[:, None, :], (k, m, 3))
+    if origins.ndim == 2:
+        origins = np.broadcast_to(origins[:, None, :], (k, m, 3))
     rays = np.concatenate([origins, world], axis=2).reshape(-1, 6)
     out = raycaster.cast_rays(to_tensor(rays))
     dist = to_array(out["t_hit"], np.float64).reshape(k, m)

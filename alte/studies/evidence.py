@@ -12,6 +12,15 @@ holds when all parts hold, does not hold when all parts do not, and otherwise de
 on what tells the parts apart (``view``, ``metric``, ``mapper``, ``case``).
 Claims no map metric decides are ``not measurable``; checks the table cannot feed
 (missing rows, columns or settings) give ``no data``.
+
+Time (:mod:`alte.studies.measures`): a within-mapper check on the elapsed time is judged
+on the mapper's machine-independent cost and cross-checked on its CPU time; a
+comparison of two mappers' times is judged on their CPU times, each seed's value known
+only within the times' spreads, so its interval runs from the bootstrap low of the
+seeds' lower bounds to the bootstrap high of their upper bounds (as for a tie of the
+thesis' rule). A verdict thus never rests on a difference smaller than a time's spread.
+``time_check`` says how (``cost``, or ``CPU time``); for the cost, the evidence ends with
+the same statistic on the CPU time and the cells where it decides the other way.
 """
 
 from __future__ import annotations
@@ -26,7 +35,13 @@ import pandas as pd
 from alte.studies.claims.types import AllOf, Check, Claim, NotMeasurable, Property
 from alte.studies.measures import CheckValues, NoDataError, measure_check
 from alte.studies.tradeoff import MAPPER_NAMES, METRICS, prepare
-from alte.studies.uncertainty import CONFIDENCE, bootstrap_ci
+from alte.studies.uncertainty import (
+    CONFIDENCE,
+    TIME_SPREAD_FLOOR,
+    Interval,
+    bootstrap_bounds,
+    bootstrap_ci,
+)
 
 __all__ = ["CELL_COLUMNS", "CLAIM_COLUMNS", "VERDICTS", "EvidenceOptions", "Finding",
            "cells_table", "claims_table", "evaluate", "evaluate_all"]
@@ -34,7 +49,8 @@ __all__ = ["CELL_COLUMNS", "CLAIM_COLUMNS", "VERDICTS", "EvidenceOptions", "Find
 #: Every verdict a claim can get.
 VERDICTS = ("holds", "does not hold", "depends", "not measurable", "no data")
 #: Columns of :func:`claims_table` (the first four are the report's claims.csv schema).
-CLAIM_COLUMNS = ["claim", "section", "verdict", "evidence", "depends_on", "reading", "id"]
+CLAIM_COLUMNS = ["claim", "section", "verdict", "evidence", "depends_on", "reading", "id",
+                 "time_check"]
 #: Columns of :func:`cells_table`.
 CELL_COLUMNS = ["id", "part", "what", "terrain", "level", "seeds", "estimate", "low", "high",
                 "unit", "outcome"]
@@ -59,13 +75,15 @@ class EvidenceOptions:
 
 @dataclass(frozen=True)
 class Finding:
-    """A claim's verdict, what it depends on, the evidence text and the per-cell numbers."""
+    """A claim's verdict, what it depends on, the evidence text, the per-cell numbers and
+    how its times were judged (``time_check``, see the module docstring)."""
 
     claim: Claim
     verdict: str
     depends_on: str
     evidence: str
     cells: pd.DataFrame
+    time_check: str = ""
 
 
 def _number(value: float, ratio: bool) -> str:
@@ -95,12 +113,21 @@ def _outcome(low: float, high: float, seeds: int, m: CheckValues, min_seeds: int
     return _HOLDS if low > m.threshold else _FAILS if high < m.threshold else "inconclusive"
 
 
+def _interval(group: pd.DataFrame, options: EvidenceOptions) -> Interval:
+    """The bootstrap interval of one cell's seeds (of their bounds, where they have them)."""
+    if "low" in group:
+        return bootstrap_bounds(group["value"].to_numpy(), group["low"].to_numpy(),
+                                group["high"].to_numpy(), level=options.level,
+                                n_resamples=options.n_resamples, seed=options.seed)
+    return bootstrap_ci(group["value"].to_numpy(), options.level, options.n_resamples,
+                        options.seed)
+
+
 def _cells(m: CheckValues, options: EvidenceOptions) -> pd.DataFrame:
     rows = []
     for (terrain, level), group in m.stats.groupby(["terrain", "level"], dropna=False,
                                                    sort=True):
-        ci = bootstrap_ci(group["value"].to_numpy(), options.level, options.n_resamples,
-                          options.seed)
+        ci = _interval(group, options)
         rows.append({"terrain": terrain, "level": level, "seeds": ci.seeds,
                      "estimate": ci.estimate, "low": ci.low, "high": ci.high,
                      "outcome": _outcome(ci.low, ci.high, ci.seeds, m, options.min_seeds)})
@@ -158,27 +185,58 @@ def _property(p: Property) -> tuple[str, str]:
     return (_FAILS if wrong else _HOLDS), f"our implementations: {text}"
 
 
-def _one(check: Check, table: pd.DataFrame, options: EvidenceOptions
-         ) -> tuple[str, str, str, pd.DataFrame]:
-    """(verdict, depends_on, evidence, cells) of one check."""
+Result = tuple[str, str, str, pd.DataFrame, str]
+
+
+def _time_check(m: CheckValues) -> str:
+    """How the check's time was judged: on the cost, or on the CPU time within its spread."""
+    if m.time == "cpu":
+        return f"CPU time, within its spread (>= x{np.exp(TIME_SPREAD_FLOOR):.2f})"
+    return "cost" if m.time == "cost" else ""
+
+
+def _crosscheck_text(m: CheckValues, cells: pd.DataFrame, options: EvidenceOptions) -> str:
+    """The cost's statistic measured again on the CPU time: its verdict and the cells where
+    the two decide opposite ways (readings of one run, not judged within their spread)."""
+    if m.crosscheck is None:
+        return ""
+    time = _cells(m.crosscheck, options)
+    time = time[time["seeds"] > 0]
+    if time.empty:
+        return " Cross-check on the CPU time: no value."
+    verdict, depends = _cell_verdict(time, m.crosscheck.level_kind)
+    both = cells.merge(time, on=["terrain", "level"], suffixes=("", "_time"))
+    decided = {_HOLDS, _FAILS}
+    against = both[both["outcome"].isin(decided) & both["outcome_time"].isin(decided)
+                   & (both["outcome"] != both["outcome_time"])]
+    where = ", ".join(dict.fromkeys(against["terrain"].astype(str)))
+    verdict += f" ({depends})" if depends else ""
+    contra = f"it contradicts the cost on {where}" if where else "no cell contradicts the cost"
+    text = _check_text(m.crosscheck, time)
+    return f" Cross-check on the CPU time: {text} -> {verdict}; {contra}."
+
+
+def _one(check: Check, table: pd.DataFrame, options: EvidenceOptions) -> Result:
+    """(verdict, depends_on, evidence, cells, time check) of one check."""
     if isinstance(check, NotMeasurable):
-        return "not measurable", "", check.reason, pd.DataFrame()
+        return "not measurable", "", check.reason, pd.DataFrame(), ""
     if isinstance(check, Property):
         verdict, text = _property(check)
-        return verdict, "", text, pd.DataFrame()
+        return verdict, "", text, pd.DataFrame(), ""
     try:
         m = measure_check(check, table)
     except NoDataError as err:
-        return "no data", "", f"not measured: {err}", pd.DataFrame()
+        return "no data", "", f"not measured: {err}", pd.DataFrame(), ""
     cells = _cells(m, options)
     cells = cells[cells["seeds"] > 0].reset_index(drop=True)
     if cells.empty:
-        return "no data", "", f"{m.what}: no terrain and seed gives a value", cells
+        return "no data", "", f"{m.what}: no terrain and seed gives a value", cells, ""
     verdict, depends = _cell_verdict(cells, m.level_kind)
     scale = np.exp if m.ratio else (lambda v: v)
     shown = cells.assign(what=m.what, unit=m.unit, estimate=scale(cells["estimate"]),
                          low=scale(cells["low"]), high=scale(cells["high"]))
-    return verdict, depends, _check_text(m, cells), shown
+    text = _check_text(m, cells) + _crosscheck_text(m, cells, options)
+    return verdict, depends, text, shown, _time_check(m)
 
 
 def _part_dims(good: Sequence[Any], bad: Sequence[Any]) -> list[str]:
@@ -193,8 +251,7 @@ def _part_dims(good: Sequence[Any], bad: Sequence[Any]) -> list[str]:
     return sorted(dims, key=_PRIORITY.index)
 
 
-def _combine(parts: Sequence[Any], results: Sequence[tuple[str, str, str, pd.DataFrame]]
-             ) -> tuple[str, str]:
+def _combine(parts: Sequence[Any], results: Sequence[Result]) -> tuple[str, str]:
     verdicts = [r[0] for r in results]
     tested = [v for v in verdicts if v in (_HOLDS, _FAILS, _DEPENDS)]
     if not tested:
@@ -226,9 +283,6 @@ def _resized_check(check: Check, size: str) -> Check:
     return replace(check, **changes)
 
 
-Result = tuple[str, str, str, pd.DataFrame]
-
-
 def _evaluate(claim: Claim, table: pd.DataFrame, options: EvidenceOptions,
               cache: dict[Any, Result] | None = None) -> Finding:
     check = _resized(claim.check, options.size)
@@ -239,8 +293,9 @@ def _evaluate(claim: Claim, table: pd.DataFrame, options: EvidenceOptions,
         if part not in cache:  # many claims share a check: measure it once per table
             cache[part] = _one(part, table, options)
         results.append(cache[part])
+    checks = "; ".join(dict.fromkeys(r[4] for r in results if r[4]))
     if len(parts) == 1:
-        verdict, depends, text, cells = results[0]
+        verdict, depends, text, cells, _ = results[0]
     else:
         verdict, depends = _combine(parts, results)
         text = " ".join(f"({i}) {r[2]} -> {r[0]}{' (' + r[1] + ')' if r[1] else ''}."
@@ -253,7 +308,7 @@ def _evaluate(claim: Claim, table: pd.DataFrame, options: EvidenceOptions,
     cells = cells.assign(id=claim.id) if not cells.empty else pd.DataFrame(columns=CELL_COLUMNS)
     if "part" not in cells:
         cells["part"] = 1
-    return Finding(claim, verdict, depends, text, cells.reindex(columns=CELL_COLUMNS))
+    return Finding(claim, verdict, depends, text, cells.reindex(columns=CELL_COLUMNS), checks)
 
 
 def evaluate(claim: Claim, table: pd.DataFrame,
@@ -272,11 +327,12 @@ def evaluate_all(claims: Sequence[Claim], table: pd.DataFrame,
 
 def claims_table(findings: Sequence[Finding]) -> pd.DataFrame:
     """The report's claims table: claim (the quote), section, verdict, evidence, then
-    depends_on, reading and id."""
+    depends_on, reading, id and time_check."""
     return pd.DataFrame([{"claim": f.claim.quote, "section": f.claim.section,
                           "verdict": f.verdict, "evidence": f.evidence,
                           "depends_on": f.depends_on, "reading": f.claim.reading,
-                          "id": f.claim.id} for f in findings], columns=CLAIM_COLUMNS)
+                          "id": f.claim.id, "time_check": f.time_check} for f in findings],
+                        columns=CLAIM_COLUMNS)
 
 
 def cells_table(findings: Sequence[Finding]) -> pd.DataFrame:

@@ -48,9 +48,10 @@ __all__ = ["OCCUPIED_SIZE", "THESIS_ROWS", "TRADEOFF_COLUMNS", "Grid", "GridTabl
 
 #: The columns tradeoff.csv starts with (then the parameters as ``p_*`` and the rest).
 TRADEOFF_COLUMNS = ("terrain", "case", "mapper", "params", "seed", "basis_functions",
-                    "occupied_cells", "memory_bytes", "elapsed_s", "mhd_m", "mh_ab_m", "mh_ba_m",
-                    "hd_m", "hd_minus_mhd_m", "accuracy_mean_m", "completeness", "height_rmse_m",
-                    "frames", "points")
+                    "occupied_cells", "memory_bytes", "elapsed_s", "elapsed_spread", "map_cpu_s",
+                    "map_cpu_spread", "time_repeats", "cost", "cost_unit", "mhd_m", "mh_ab_m",
+                    "mh_ba_m", "hd_m", "hd_minus_mhd_m", "accuracy_mean_m", "completeness",
+                    "height_rmse_m", "frames", "points")
 #: Name of the evaluation-only ablation that counts map size as occupied cells.
 OCCUPIED_SIZE = "size_occupied"
 #: Name of the evaluation-only ablation that keeps only the thesis' own settings.

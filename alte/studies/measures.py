@@ -6,12 +6,26 @@ above ``threshold`` supports the claim (``relation="better"``), plus what it is 
 its unit. Ratios (sizes, times) are natural-log ratios, shown as factors. Terrains
 are those of the check's case: the table's ``case`` column when it has one, else
 :data:`alte.studies.thesis.TERRAIN_CASE`.
+
+Time is the one measurement that differs between runs, so a check on the elapsed time
+is judged on what does not:
+
+* within one mapper (trends, effects, ...), on the mapper's machine-independent
+  ``cost`` (:class:`alte.mappers.Cost`), and measured again on its CPU time as a
+  cross-check (:attr:`CheckValues.crosscheck`);
+* between mappers (different cost units), on the mapper's CPU time (``map_cpu_s``),
+  each value known only within the time's spread
+  (:func:`alte.studies.uncertainty.time_spreads`): the per-seed ``low`` and ``high``.
+
+Where the thesis' rule picks (``at="rule"``) and cannot separate rows within the times'
+spreads (:func:`alte.studies.tables.rule_picks`), a seed's value is the mean over the
+tie and its bounds span the tie.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, fields, replace
 from typing import Any
 
 import numpy as np
@@ -19,6 +33,7 @@ import pandas as pd
 from scipy.stats import spearmanr
 
 from alte.errors import ParameterError
+from alte.mappers import mapper_class
 from alte.studies.claims.types import (
     SIZE_COLUMNS,
     Agreement,
@@ -29,7 +44,7 @@ from alte.studies.claims.types import (
     Summary,
     Trend,
 )
-from alte.studies.tables import THESIS_CRITERIA, best_row
+from alte.studies.tables import TIME_COLUMN, rule_criteria, rule_picks
 from alte.studies.thesis import TERRAIN_CASE
 from alte.studies.tradeoff import (
     MAPPER_NAMES,
@@ -40,12 +55,16 @@ from alte.studies.tradeoff import (
     matching,
     thesis_setting,
 )
+from alte.studies.uncertainty import time_spreads
 
 __all__ = ["STAT_COLUMNS", "CheckValues", "NoDataError", "measure_check"]
 
-#: Columns of :attr:`CheckValues.stats`.
+#: Columns of :attr:`CheckValues.stats` (``low`` and ``high`` only where a seed's value is
+#: known within bounds: a time, a tie of the rule).
 STAT_COLUMNS = ["terrain", "level", "seed", "value"]
-_RATIO_METRICS = (*SIZE_COLUMNS, "elapsed_s")
+#: The time a claim names: the thesis' elapsed time.
+ELAPSED = "elapsed_s"
+_RATIO_METRICS = (*SIZE_COLUMNS, ELAPSED, TIME_COLUMN, "cost")
 
 
 class NoDataError(ParameterError):
@@ -58,6 +77,9 @@ class CheckValues:
 
     ``level_name`` is the column the levels are values of (equal-size or equal-fidelity
     reads), ``level_kind`` ``"size"`` or ``"fidelity"`` (empty without levels).
+    ``time``: how a time was read (``"cost"``: judged on the machine-independent cost,
+    with ``crosscheck`` the same statistic on the CPU time; ``"cpu"``: the CPU time
+    within its spread; empty: no time).
     """
 
     stats: pd.DataFrame
@@ -69,6 +91,8 @@ class CheckValues:
     band: float = 0.0
     level_name: str = ""
     level_kind: str = ""
+    time: str = ""
+    crosscheck: CheckValues | None = None
 
 
 def _name(mapper: str) -> str:
@@ -95,8 +119,32 @@ def _case_rows(table: pd.DataFrame, case: str, mappers: Sequence[str],
     return rows
 
 
-def _point_values(rows: pd.DataFrame, c: Compare) -> pd.DataFrame:
-    """(terrain, level, seed, mapper, value) at the thesis' settings or the rule's pick."""
+def _bounded(chosen: pd.DataFrame, metric: str) -> tuple[float, float, float]:
+    """Mean, least and largest of ``metric`` over ``chosen`` rows (a time within its
+    spread)."""
+    values = chosen[metric].to_numpy(dtype=np.float64)
+    low = high = values
+    if metric == TIME_COLUMN:
+        spread = time_spreads(chosen)
+        low, high = values * np.exp(-spread), values * np.exp(spread)
+    if not np.isfinite(values).any():
+        return np.nan, np.nan, np.nan
+    return float(np.nanmean(values)), float(np.nanmin(low)), float(np.nanmax(high))
+
+
+def _picked(group: pd.DataFrame, c: Compare) -> pd.DataFrame | None:
+    """The rows of one mapper, terrain and seed the view reads (None: none can)."""
+    if c.at != "rule":
+        return group
+    criteria = rule_criteria(group)
+    if group[list(criteria)].notna().all(axis=1).sum() == 0:
+        return None
+    return group.iloc[rule_picks(group, criteria)]
+
+
+def _point_values(rows: pd.DataFrame, c: Compare, metric: str) -> pd.DataFrame:
+    """(terrain, level, seed, mapper, value, low, high) at the thesis' settings or the
+    rule's pick (a tie: the mean, and bounds over it)."""
     out = []
     for mapper in (c.better, c.other):
         mine = rows[rows["mapper"] == mapper]
@@ -109,32 +157,47 @@ def _point_values(rows: pd.DataFrame, c: Compare) -> pd.DataFrame:
                 text = ", ".join(f"{k}={v}" for k, v in setting.items())
                 raise NoDataError(f"the table lacks the thesis' setting {mapper} {text}")
         for (terrain, seed), group in mine.groupby(["terrain", "seed"], sort=True):
-            chosen = group
-            if c.at == "rule":
-                if group[list(THESIS_CRITERIA)].notna().all(axis=1).sum() == 0:
-                    continue
-                chosen = group.iloc[[best_row(group)]]
+            chosen = _picked(group, c)
+            if chosen is None:
+                continue
+            value, low, high = _bounded(chosen, metric)
             out.append({"terrain": terrain, "level": np.nan, "seed": seed, "mapper": mapper,
-                        "value": float(chosen[c.metric].mean())})
-    return pd.DataFrame(out, columns=["terrain", "level", "seed", "mapper", "value"])
+                        "value": value, "low": low, "high": high})
+    return pd.DataFrame(out, columns=["terrain", "level", "seed", "mapper", "value", "low",
+                                      "high"])
 
 
-def _compare_values(c: Compare, table: pd.DataFrame) -> pd.DataFrame:
+def _read_bounds(reads: pd.DataFrame, table: pd.DataFrame, metric: str) -> pd.DataFrame:
+    """Front reads with bounds: a time read off a front moves at most as far (in log) as
+    the most uncertain time of the mapper's maps on that terrain and seed."""
+    if metric != TIME_COLUMN or reads.empty:
+        return reads.assign(low=reads["value"], high=reads["value"])
+    worst = table.assign(_spread=time_spreads(table)).groupby(
+        ["terrain", "seed", "mapper"])["_spread"].max().rename("_u").reset_index()
+    out = reads.merge(worst, on=["terrain", "seed", "mapper"], how="left")
+    factor = np.exp(out.pop("_u").to_numpy(dtype=np.float64))
+    return out.assign(low=out["value"] / factor, high=out["value"] * factor)
+
+
+def _compare_values(c: Compare, table: pd.DataFrame, metric: str) -> pd.DataFrame:
     pair = (c.better, c.other)
     if c.at == "equal_size":
-        return equal_size(table, pair, c.metric, size=c.size, levels=c.levels or None,
-                          higher_is_better=c.higher_is_better)
-    if c.at == "equal_fidelity":
-        return equal_fidelity(table, pair, c.metric, fidelity=c.fidelity,
-                              levels=c.levels or None)
-    return _point_values(table, c)
+        reads = equal_size(table, pair, metric, size=c.size, levels=c.levels or None,
+                           higher_is_better=c.higher_is_better)
+    elif c.at == "equal_fidelity":
+        reads = equal_fidelity(table, pair, metric, fidelity=c.fidelity,
+                               levels=c.levels or None,
+                               spread="map_cpu_spread" if metric == TIME_COLUMN else None)
+    else:
+        return _point_values(table, c, metric)
+    return _read_bounds(reads, table, metric)
 
 
-def _compare_what(c: Compare, ratio: bool) -> tuple[str, str]:
+def _compare_what(c: Compare, metric: str, ratio: bool) -> tuple[str, str]:
     sign = "/" if ratio else "minus"
     first, second = ((c.better, c.other) if c.relation == "similar" or
                      (c.higher_is_better and not ratio) else (c.other, c.better))
-    head = f"{label(c.metric)}, {_name(first)} {sign} {_name(second)}"
+    head = f"{label(metric)}, {_name(first)} {sign} {_name(second)}"
     where = {"thesis_point": ("at the thesis' chosen settings", ""),
              "rule": ("at the settings the thesis' rule picks from our sweep", ""),
              "equal_size": (f"at equal {label(c.size, False)}", c.size),
@@ -143,11 +206,27 @@ def _compare_what(c: Compare, ratio: bool) -> tuple[str, str]:
     return f"{head} {text}", level
 
 
+def _oriented(wide: pd.DataFrame, ratio: bool, sign: float) -> pd.DataFrame:
+    """Per seed: the statistic (log ratio or difference, times ``sign``) of the better
+    and the other mapper's values, and its bounds from theirs."""
+    b, o, lo_b, hi_b, lo_o, hi_o = (wide[k].to_numpy(float) for k in (
+        "value_b", "value_o", "low_b", "high_b", "low_o", "high_o"))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        if ratio:
+            value, low, high = np.log(b / o), np.log(lo_b / hi_o), np.log(hi_b / lo_o)
+        else:
+            value, low, high = b - o, lo_b - hi_o, hi_b - lo_o
+    if sign < 0:
+        low, high = -high, -low
+    return wide[["terrain", "level", "seed"]].assign(value=sign * value, low=low, high=high)
+
+
 def _compare(c: Compare, table: pd.DataFrame) -> CheckValues:
-    columns = [c.metric] + ([c.size] if c.at == "equal_size" else []) + (
+    metric = TIME_COLUMN if c.metric == ELAPSED else c.metric
+    columns = [metric] + ([c.size] if c.at == "equal_size" else []) + (
         [c.fidelity] if c.at == "equal_fidelity" else [])
     rows = _case_rows(table, c.case, (c.better, c.other), columns)
-    values = _compare_values(c, rows)
+    values = _compare_values(c, rows, metric)
     keys = ["terrain", "level", "seed"]
     wide = values[values["mapper"] == c.better].merge(
         values[values["mapper"] == c.other], on=keys, suffixes=("_b", "_o"))
@@ -155,17 +234,15 @@ def _compare(c: Compare, table: pd.DataFrame) -> CheckValues:
     if wide.empty:
         raise NoDataError(f"{_name(c.better)} and {_name(c.other)} share no terrain and "
                           "size range")
-    ratio = c.metric in _RATIO_METRICS
-    b, o = wide["value_b"].to_numpy(float), wide["value_o"].to_numpy(float)
+    ratio = metric in _RATIO_METRICS
     sign = 1.0 if c.relation == "similar" or c.higher_is_better else -1.0
-    with np.errstate(divide="ignore", invalid="ignore"):
-        value = sign * (np.log(b / o) if ratio else b - o)
-    stats = wide[keys].assign(value=value)
-    what, level = _compare_what(c, ratio)
+    stats = _oriented(wide, ratio, sign)
+    what, level = _compare_what(c, metric, ratio)
     band = float(np.log1p(c.tolerance)) if ratio else c.tolerance
     kind = {"equal_size": "size", "equal_fidelity": "fidelity"}.get(c.at, "")
-    return CheckValues(stats, what, "x" if ratio else _unit(c.metric), ratio,
-                    float(np.log(c.factor)) if ratio else 0.0, c.relation, band, level, kind)
+    return CheckValues(stats, what, "x" if ratio else _unit(metric), ratio,
+                       float(np.log(c.factor)) if ratio else 0.0, c.relation, band, level, kind,
+                       "cpu" if metric == TIME_COLUMN else "")
 
 
 def _rho(x: np.ndarray, y: np.ndarray) -> float:
@@ -310,6 +387,34 @@ _MEASURES: dict[type, Callable[[Any, pd.DataFrame], CheckValues]] = {
     Agreement: _agreement, Summary: _summary}
 
 
+def _mappers(check: Check) -> tuple[str, ...]:
+    if isinstance(check, Summary):
+        return (check.better,) + ((check.other,) if check.other else ())
+    if isinstance(check, Trend | Optimum | Effect | Agreement):
+        return (check.mapper,)
+    return ()
+
+
+def _on(check: Check, column: str) -> Check:
+    """``check`` with every field naming the elapsed time naming ``column`` instead."""
+    return replace(check, **{f.name: column for f in fields(check)  # type: ignore[arg-type]
+                             if getattr(check, f.name) == ELAPSED})
+
+
+def _by_cost(check: Check, table: pd.DataFrame,
+             fn: Callable[[Any, pd.DataFrame], CheckValues]) -> CheckValues:
+    """A within-mapper check on the time: judged on the cost where every map of its
+    mappers has one, with the CPU time as cross-check (else on the CPU time alone)."""
+    timed = _on(check, TIME_COLUMN)
+    mine = table[table["mapper"].isin(_mappers(check))]
+    if "cost" not in mine or mine.empty or mine["cost"].isna().any():
+        return replace(fn(timed, table), time="cpu")
+    found = fn(_on(check, "cost"), table)
+    units = ", ".join(dict.fromkeys(mapper_class(m).cost_unit.value for m in _mappers(check)))
+    return replace(found, what=f"{found.what}; cost in {units}", time="cost",
+                   crosscheck=fn(timed, table))
+
+
 def measure_check(check: Check, table: pd.DataFrame) -> CheckValues:
     """Per-seed statistics of ``check`` on ``table`` (prepared by
     :func:`alte.studies.tradeoff.prepare`); :class:`NoDataError` when it cannot be measured."""
@@ -317,4 +422,7 @@ def measure_check(check: Check, table: pd.DataFrame) -> CheckValues:
         fn = _MEASURES[type(check)]
     except KeyError as err:
         raise ParameterError(f"{type(check).__name__} checks are not measured on a table") from err
+    if not isinstance(check, Compare) and any(getattr(check, f.name) == ELAPSED
+                                              for f in fields(check)):
+        return _by_cost(check, table, fn)
     return fn(check, table)

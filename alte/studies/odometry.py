@@ -1,22 +1,28 @@
-"""LiDAR odometry and pose refinement against the simulator's truth, on the eight terrains.
+"""The pose benchmark: every pose source of a recording scored against reference poses.
 
-For each terrain the mission is registered four times through the pipeline (poses
-``recorded``, ``odometry`` with each backend, point-to-plane and KISS-ICP, and
-``refine``; cached like the chapters' registrations) and scored against the truth:
-the trajectory error (ATE: RMSE of body positions after the rigid alignment of
-:func:`align_rigid`) of each, and the merged cloud's mean distance to the true mesh.
-Odometry is anchored at the recorded pose of the first scan (the terrain bags have
-poses), so its cloud lies in the map frame; its ATE is nevertheless computed after
-alignment, as usual for odometry.
-``exp_nav_2`` is the case the thesis lost frames to: recorded poses desynchronised
-by 80 ms during fast yaw swings.
+An input is a bag (its pose topic, or a TUM file, is the reference) or a simulated
+terrain (the simulator's true poses are the reference, written as a TUM file beside the
+registration cache). Each pose source (``recorded``, LiDAR odometry with each backend,
+``refine``) registers the scans through the pipeline, and is scored
+(:mod:`alte.metrics.trajectory`): ATE and RPE against the reference poses sampled at
+the same scans, and the registered cloud's median / p90 distance to the cloud registered
+with the reference poses (a grid five times finer than the source clouds' voxel), plus,
+on a terrain, the mean distance to the true mesh. ``ms_per_scan`` is the time the pose
+step itself took (odometry or refinement; reading and registering are not counted), wall
+and CPU (the machine may be shared: CPU time is the steadier figure).
+
+Odometry's poses and cloud are moved so that its first scan sits at the reference pose
+of that scan (the pipeline anchors odometry at the recorded pose of the first scan, or
+at the first body frame when the bag has no poses), so its cloud is compared in the
+reference frame and drift counts in full; its ATE is taken after the rigid alignment
+all the same, as evo does.
 """
 
 from __future__ import annotations
 
 import os
-import time
-from dataclasses import dataclass
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -24,115 +30,217 @@ import pandas as pd
 from tqdm.auto import tqdm
 
 from alte.errors import ParameterError
-from alte.pipeline import FrameSpec, PoseSource, Registered, open_input, prepare
+from alte.metrics.trajectory import cloud_distance, trajectory_errors
+from alte.pipeline import FrameSpec, PoseSource, Registered, Source, open_input, prepare
 from alte.registration.odometry import OdometryParams
 from alte.studies.experiments import CACHE_DIR
 from alte.studies.tables import write_csv
 
-__all__ = ["SOURCES", "PoseRun", "align_rigid", "ate", "odometry_row", "odometry_table",
-           "write_odometry_table"]
+__all__ = ["COLUMNS", "REAL_SEQUENCE", "SOURCES", "BenchInput", "bench_input", "odometry_table",
+           "pose_benchmark", "realdata_table", "write_odometry_table"]
 
-#: The pose sources compared, in table order: column key, pose source, odometry backend.
-SOURCES: tuple[tuple[str, PoseSource, str], ...] = (
-    ("recorded", PoseSource.RECORDED, "plane"), ("odometry", PoseSource.ODOMETRY, "plane"),
-    ("kiss", PoseSource.ODOMETRY, "kiss"), ("refine", PoseSource.REFINE, "plane"))
-
-
-def align_rigid(source: np.ndarray, target: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Rotation R and translation t minimising ``|target - (source R^T + t)|`` (Kabsch /
-    Umeyama without scale) for matched (N, 3) point sets."""
-    src = np.asarray(source, dtype=np.float64).reshape(-1, 3)
-    dst = np.asarray(target, dtype=np.float64).reshape(-1, 3)
-    if src.shape != dst.shape or len(src) < 3:
-        raise ParameterError(f"align_rigid: need two matched sets of >= 3 points, got "
-                             f"{src.shape} and {dst.shape}")
-    mu_s, mu_d = src.mean(axis=0), dst.mean(axis=0)
-    u, _, vt = np.linalg.svd((dst - mu_d).T @ (src - mu_s))
-    sign = np.sign(np.linalg.det(u @ vt)) or 1.0
-    rotation = u @ np.diag([1.0, 1.0, sign]) @ vt
-    return rotation, mu_d - rotation @ mu_s
-
-
-def ate(estimated: np.ndarray, truth: np.ndarray) -> float:
-    """Absolute trajectory error: RMSE of positions after rigid alignment (m)."""
-    rotation, shift = align_rigid(estimated, truth)
-    moved = np.asarray(estimated, dtype=np.float64) @ rotation.T + shift
-    return float(np.sqrt(np.mean(np.sum((moved - truth) ** 2, axis=1))))
+#: Pose sources in table order: name -> (pose source, odometry backend or None).
+SOURCES: dict[str, tuple[PoseSource, str | None]] = {
+    "recorded": (PoseSource.RECORDED, None), "kiss": (PoseSource.ODOMETRY, "kiss"),
+    "plane": (PoseSource.ODOMETRY, "plane"), "refine": (PoseSource.REFINE, None)}
+#: Voxel (m) of a bag's clouds when neither the input nor the caller sets one.
+BAG_VOXEL = 0.05
+#: The table's columns (units in the names).
+COLUMNS = ("input", "source", "settings", "frames", "path_m", "ate_m", "rpe_trans_pct",
+           "rpe_rot_deg_m", "cloud_median_m", "cloud_p90_m", "mesh_mean_m", "ms_per_scan",
+           "cpu_ms_per_scan", "corrected", "kept")
 
 
 @dataclass(frozen=True)
-class PoseRun:
-    """One registration of a terrain with one pose source, scored."""
+class BenchInput:
+    """One recording to score: the input, its reference poses (TUM file, or None for the
+    bag's own pose topic), the clouds' voxel and the scans read (None: all)."""
 
-    source: PoseSource
-    ate_m: float
-    mesh_mean_m: float
-    frames: int
-    frames_selected: int
-    corrected: int
-    above_bound: int
-    seconds: float
+    name: str
+    source: Source
+    reference: Path | None
+    voxel: float
+    frames: int | None = None
 
 
-def _score(reg: Registered, truth_stamps: np.ndarray, truth_positions: np.ndarray,
-           source: PoseSource, seconds: float) -> PoseRun:
-    from alte.sim import load_ground_truth, mesh_distance
-
-    traj = reg.trajectory
-    index = np.searchsorted(truth_stamps, traj.stamps)
-    if np.any(index >= len(truth_stamps)) or np.any(truth_stamps[index] != traj.stamps):
-        raise ParameterError(f"{reg.source.path}: registered stamps are not the scan stamps")
-    scene = load_ground_truth(reg.source.path)
-    poses = reg.counts.poses
-    return PoseRun(source, ate(traj.positions, truth_positions[index]),
-                   float(mesh_distance(np.asarray(reg.cloud), scene).mean()), len(reg),
-                   reg.counts.selected, poses.corrected, poses.corrections_above_bound,
-                   seconds)
-
-
-def odometry_row(name: str, data_dir: str | os.PathLike[str] = "data", frames: int | None = None,
-                 seed: int = 0, progress: bool = False) -> dict[str, object]:
-    """One terrain's row: ATE and mesh distance per pose source (module docstring)."""
+def _terrain_input(name: str, data_dir: Path, frames: int | None, seed: int) -> BenchInput:
+    from alte.io.tum import write_tum
     from alte.sim import ensure_terrain, get_terrain, true_poses
 
-    folder = ensure_terrain(name, data_dir, seed, frames, progress=progress)
-    truth = true_poses(get_terrain(name), seed, frames)
+    folder = ensure_terrain(name, data_dir, seed, frames)
     source = open_input(folder)
-    row: dict[str, object] = {"terrain": name}
-    for key, pose, method in SOURCES:
-        start = time.perf_counter()
-        spec = FrameSpec(frames=frames, poses=pose, odometry=OdometryParams(method=method))
-        reg = prepare(source, spec, cache=Path(data_dir) / CACHE_DIR, progress=progress)
-        done = _score(reg, truth.stamps, truth.positions, pose, time.perf_counter() - start)
-        row.update({f"ate_{key}_m": done.ate_m, f"mesh_{key}_m": done.mesh_mean_m,
-                    f"frames_{key}": done.frames, f"seconds_{key}": done.seconds})
-        if pose is PoseSource.REFINE:
-            row.update({"refine_corrected": done.corrected,
-                        "refine_above_bound": done.above_bound})
-    row["frames_selected"] = done.frames_selected
-    steps = np.diff(truth.positions, axis=0)
-    row["path_m"] = float(np.linalg.norm(steps, axis=1).sum())
-    return row
+    truth = true_poses(get_terrain(name), seed, frames)
+    tum = data_dir / CACHE_DIR / f"truth-{name}-{seed}-{frames or 'all'}.tum"
+    if not tum.is_file():
+        write_tum(tum, truth.stamps, truth.positions, truth.quaternions,
+                  header=f"true body poses of {name} (seed {seed}); t x y z qx qy qz qw")
+    return BenchInput(name, source, tum, float(source.voxel or BAG_VOXEL), frames)
 
 
-def odometry_table(names: list[str] | None = None, data_dir: str | os.PathLike[str] = "data",
-                   frames: int | None = None, seed: int = 0,
-                   progress: bool = True) -> pd.DataFrame:
-    """The table for ``names`` (default: the eight terrains), full 10 Hz missions unless
-    ``frames`` asks for a reduced one."""
+def bench_input(what: str | os.PathLike[str], *, reference: str | os.PathLike[str] | None = None,
+                voxel: float | None = None, frames: int | None = None,
+                data_dir: str | os.PathLike[str] = "data", seed: int = 0) -> BenchInput:
+    """A terrain name (simulated when absent, true poses as reference) or a bag / terrain
+    folder (``reference``: a TUM file; None: the bag's pose topic)."""
     from alte.sim import TERRAINS
 
-    chosen = list(names or TERRAINS)
-    unknown = sorted(set(chosen) - set(TERRAINS))
+    if str(what) in TERRAINS:
+        if reference is not None:
+            raise ParameterError(f"--reference: {what} is a simulated terrain; its true "
+                                 "poses are the reference")
+        made = _terrain_input(str(what), Path(data_dir), frames, seed)
+        return made if voxel is None else replace(made, voxel=voxel)
+    if not Path(what).exists():
+        raise ParameterError(f"{what}: neither a simulated terrain ({', '.join(TERRAINS)}) "
+                             "nor a bag or terrain folder")
+    source = open_input(Path(what))
+    if reference is not None and not Path(reference).is_file():
+        raise ParameterError(f"--reference {reference}: no such TUM file")
+    return BenchInput(source.name or Path(what).name, source,
+                      None if reference is None else Path(reference),
+                      voxel or source.voxel or BAG_VOXEL, frames)
+
+
+def _spec(item: BenchInput, poses: PoseSource, odometry: OdometryParams) -> FrameSpec:
+    return FrameSpec(frames=item.frames, voxel=item.voxel, poses=poses, odometry=odometry)
+
+
+def _reference_spec(item: BenchInput) -> FrameSpec:
+    return FrameSpec(frames=item.frames, voxel=item.voxel / 5, poses=PoseSource.RECORDED,
+                     pose_file=item.reference)
+
+
+def _anchored(reg: Registered, reference: Registered, mine: np.ndarray,
+              theirs: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Odometry's positions, quaternions and cloud moved so that its first matched pose is
+    the reference's (module docstring)."""
+    from scipy.spatial.transform import Rotation
+
+    from alte.registration.odometry import pose_matrix
+
+    est, ref = reg.trajectory, reference.trajectory
+    first = pose_matrix(ref.positions[theirs[0]], ref.quaternions[theirs[0]]) @ np.linalg.inv(
+        pose_matrix(est.positions[mine[0]], est.quaternions[mine[0]]))
+    turn, shift = first[:3, :3], first[:3, 3]
+    quats = (Rotation.from_matrix(turn) * Rotation.from_quat(est.quaternions[mine])).as_quat()
+    return (est.positions[mine] @ turn.T + shift, quats,
+            np.asarray(reg.cloud) @ turn.T + shift)
+
+
+def _matched(reg: Registered, reference: Registered) -> tuple[np.ndarray, np.ndarray]:
+    """Indices of the scans both registrations kept, in each."""
+    common, mine, theirs = np.intersect1d(reg.trajectory.stamps, reference.trajectory.stamps,
+                                          return_indices=True)
+    if len(common) < 3:
+        raise ParameterError(f"{reg.source.path}: only {len(common)} scans have both an "
+                             "estimated and a reference pose")
+    return mine, theirs
+
+
+def _score(item: BenchInput, key: str, reg: Registered, reference: Registered,
+           odometry: OdometryParams) -> dict[str, object]:
+    mine, theirs = _matched(reg, reference)
+    est, ref = reg.trajectory, reference.trajectory
+    if reg.spec.poses is PoseSource.ODOMETRY:
+        positions, quaternions, points = _anchored(reg, reference, mine, theirs)
+    else:
+        positions, quaternions = est.positions[mine], est.quaternions[mine]
+        points = np.asarray(reg.cloud)
+    errors = trajectory_errors(est.stamps[mine], positions, quaternions,
+                               ref.positions[theirs], ref.quaternions[theirs])
+    cloud = cloud_distance(points, np.asarray(reference.cloud))
+    poses = reg.counts.poses
+    path = float(np.linalg.norm(np.diff(ref.positions[theirs], axis=0), axis=1).sum())
+    return {"input": item.name, "source": key, "settings": _settings(key, odometry),
+            "frames": len(reg), "path_m": path, "ate_m": errors.ate_m,
+            "rpe_trans_pct": errors.rpe_trans_pct, "rpe_rot_deg_m": errors.rpe_rot_deg_m,
+            "cloud_median_m": cloud.median_m, "cloud_p90_m": cloud.p90_m,
+            "mesh_mean_m": _mesh_mean(item, points),
+            "ms_per_scan": 1e3 * poses.seconds / max(poses.frames, 1),
+            "cpu_ms_per_scan": 1e3 * poses.cpu_seconds / max(poses.frames, 1),
+            "corrected": poses.corrected if key == "refine" else 0,
+            "kept": poses.frames - poses.corrected if key == "refine" else 0}
+
+
+def _settings(key: str, odometry: OdometryParams) -> str:
+    """The settings a source ran with, as ``key=value`` text (those that differ from the
+    defaults), or ``-`` for recorded poses."""
+    if key == "recorded":
+        return "-"
+    default = OdometryParams(method=odometry.method).as_dict()
+    changed = {k: v for k, v in odometry.as_dict().items() if v != default[k]}
+    return " ".join(f"{k}={v}" for k, v in changed.items()) or "defaults"
+
+
+def _mesh_mean(item: BenchInput, points: np.ndarray) -> float:
+    if item.source.ground_truth() is None:
+        return float("nan")
+    from alte.sim import load_ground_truth, mesh_distance
+
+    scene = load_ground_truth(item.source.path)
+    return float(mesh_distance(points, scene).mean())
+
+
+def pose_benchmark(item: BenchInput, sources: Sequence[str] = tuple(SOURCES), *,
+                   settings: Mapping[str, Mapping[str, object]] | None = None,
+                   cache: Path | None = None, progress: bool = False) -> pd.DataFrame:
+    """One row per pose source of ``item`` (module docstring); ``settings`` maps a
+    backend (``kiss``, ``plane``, ``refine``) to :class:`OdometryParams` overrides."""
+    unknown = sorted(set(sources) - set(SOURCES))
     if unknown:
-        raise ParameterError(f"unknown terrain(s) {', '.join(unknown)}; "
-                             f"valid: {', '.join(TERRAINS)}")
-    rows = [odometry_row(n, data_dir, frames, seed, progress)
-            for n in tqdm(chosen, desc="odometry", unit="terrain", disable=not progress)]
-    return pd.DataFrame(rows)
+        raise ParameterError(f"unknown pose source(s) {', '.join(unknown)}; "
+                             f"valid: {', '.join(SOURCES)}")
+    settings = settings or {}
+    reference = prepare(item.source, _reference_spec(item), cache=cache, progress=progress)
+    rows = []
+    for key in sources:
+        poses, method = SOURCES[key]
+        odometry = OdometryParams.parse({"method": method or "kiss", **settings.get(key, {})})
+        reg = prepare(item.source, _spec(item, poses, odometry), cache=cache,
+                      progress=progress)
+        rows.append(_score(item, key, reg, reference, odometry))
+    return pd.DataFrame(rows, columns=list(COLUMNS))
+
+
+def odometry_table(inputs: Sequence[str | os.PathLike[str]] | None = None, *,
+                   reference: str | os.PathLike[str] | None = None,
+                   data_dir: str | os.PathLike[str] = "data", frames: int | None = None,
+                   seed: int = 0, voxel: float | None = None,
+                   sources: Sequence[str] = tuple(SOURCES),
+                   settings: Mapping[str, Mapping[str, object]] | None = None,
+                   progress: bool = True) -> pd.DataFrame:
+    """The benchmark over ``inputs`` (terrain names or bag / terrain folders; default: the
+    eight terrains), registrations cached under ``data_dir``."""
+    from alte.sim import TERRAINS
+
+    chosen = [str(v) for v in inputs] if inputs else list(TERRAINS)
+    cache = Path(data_dir) / CACHE_DIR
+    tables = []
+    for what in tqdm(chosen, desc="pose benchmark", unit="input", disable=not progress):
+        item = bench_input(what, reference=reference, voxel=voxel, frames=frames,
+                           data_dir=data_dir, seed=seed)
+        tables.append(pose_benchmark(item, sources, settings=settings, cache=cache,
+                                     progress=progress))
+    return pd.concat(tables, ignore_index=True)
+
+
+#: The real sequence of the benchmark, under the real-data folder.
+REAL_SEQUENCE = ("balm_seq", "bag")
+
+
+def realdata_table(root: Path | None, terrains: Sequence[str] = (), *,
+                   sources: Sequence[str] = tuple(SOURCES),
+                   data_dir: str | os.PathLike[str] = "data",
+                   progress: bool = False) -> pd.DataFrame:
+    """The benchmark on the real sequence under ``root`` (its pose topic as the reference),
+    then on ``terrains``; an empty table when ``root`` is None (no real data)."""
+    if root is None:
+        return pd.DataFrame(columns=list(COLUMNS))
+    inputs = [str(Path(root).joinpath(*REAL_SEQUENCE)), *terrains]
+    return odometry_table(inputs, data_dir=data_dir, sources=sources, progress=progress)
 
 
 def write_odometry_table(table: pd.DataFrame, out_dir: str | os.PathLike[str],
-                         overwrite: bool = False) -> Path:
-    """``out_dir/odometry.csv`` (the report's table writer)."""
-    return write_csv(table, out_dir, "odometry", overwrite)
+                         overwrite: bool = False, name: str = "odometry") -> Path:
+    """``out_dir/NAME.csv`` (the report's table writer)."""
+    return write_csv(table, out_dir, name, overwrite)

@@ -34,7 +34,7 @@ import pandas as pd
 from alte.metrics.maps import TruthOptions
 from alte.pipeline import Registered
 from alte.studies.experiments import Measured, measure
-from alte.studies.tables import best_row
+from alte.studies.tables import rule_pick
 from alte.studies.thesis import QUALITATIVE
 
 __all__ = ["MEASURES", "class_completeness", "qualitative_inputs", "qualitative_table"]
@@ -126,12 +126,13 @@ def qualitative_inputs(sweeps: Mapping[str, tuple[pd.DataFrame, Sequence[Measure
                        overhang: Mapping[str, float] | None = None) -> dict[str, dict[str, Any]]:
     """Inputs of :func:`qualitative_table` from :func:`alte.studies.experiments.sweep` results.
 
-    The chosen map of each sweep is the row the comparison rule picks; ``overhang``
+    The chosen map of each sweep is the row the comparison rule picks (of a tie, by the
+    cost: :func:`alte.studies.tables.rule_pick`); ``overhang``
     maps mapper name to its completeness on the overhang objects of sim_nav_2.
     """
     out = {}
     for mapper, (table, runs) in sweeps.items():
-        run = runs[best_row(table)]
+        run = runs[rule_pick(table)]
         out[mapper] = {"best": run.metrics.flat(), "sweep_mhd": table["mhd_m"].to_numpy(),
                        "incremental": bool(type(run.mapper).incremental),
                        "overhang_completeness": (overhang or {}).get(mapper, np.nan)}
@@ -145,7 +146,7 @@ def class_completeness(data: Registered,
     completeness on objects of class ``cls`` per mapper (NaN when the terrain has none)."""
     out = {}
     for mapper, (table, runs) in sweeps.items():
-        found = measure(data, mapper, runs[best_row(table)].params.as_dict(), truth=truth)
+        found = measure(data, mapper, runs[rule_pick(table)].params.as_dict(), truth=truth)
         by_class = found.metrics.truth.completeness_by_class if found.metrics.truth else {}
         out[mapper] = float(by_class.get(cls, np.nan))
     return out

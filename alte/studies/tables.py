@@ -9,6 +9,14 @@ Applied to the thesis' own numbers the rule reproduces its 3D-ALTE choice (table
 but not the other three: the thesis' tables are not consistent with any one rule (its
 2D-ALTE pick, row 4 of table 5.9, is beaten by row 1 on time and basis functions at
 equal HD and MHD). :func:`comparison_table` prints both choices side by side.
+
+On our maps the time is the mapper's CPU seconds (``map_cpu_s``, the median of repeated
+runs; :func:`rule_criteria`), and it is known only within its spread
+(:func:`alte.studies.uncertainty.time_spreads`). :func:`rule_picks` keeps every row that
+no other row beats whatever the times within their spreads: one row, or a *tie* of rows
+the rule cannot separate, all of which the comparison tables show. Where one map is
+needed, :func:`rule_pick` breaks a tie by the machine-independent cost in place of the
+time (the same mapper's rows, so one unit), never by a time reading.
 """
 
 from __future__ import annotations
@@ -25,13 +33,18 @@ from scipy.stats import spearmanr
 from alte.errors import ParameterError
 from alte.fsutil import atomic_path
 from alte.studies.thesis import COMPARISONS, POINT_CLOUDS, SWEEPS, sweep_table
+from alte.studies.uncertainty import time_spreads
 
-__all__ = ["COMPARISON_TRENDS", "SWEEP_TRENDS", "THESIS_CRITERIA", "best_row",
-           "comparison_scores", "comparison_table", "point_cloud_table", "thesis_metrics",
-           "trend_table", "write_csv", "write_table"]
+__all__ = ["COMPARISON_TRENDS", "SWEEP_TRENDS", "THESIS_CRITERIA", "TIME_COLUMN", "best_row",
+           "comparison_scores", "comparison_table", "point_cloud_table", "rule_criteria",
+           "rule_pick", "rule_picks", "thesis_metrics", "trend_table", "write_csv",
+           "write_table"]
 
 #: The criteria of the comparison rule, all lower-is-better, equally weighted.
 THESIS_CRITERIA: tuple[str, ...] = ("elapsed_s", "basis_functions", "mhd_m", "hd_minus_mhd_m")
+#: The time of our maps the rule weighs: the mapper's CPU seconds, median of repeats.
+TIME_COLUMN = "map_cpu_s"
+_TIMES = ("elapsed_s", TIME_COLUMN)
 
 _THESIS_COLS = {"elapsed_s": "thesis_elapsed_s", "basis_functions": "thesis_basis_functions",
                 "hd_m": "thesis_hd_m", "mhd_m": "thesis_mhd_m"}
@@ -95,9 +108,62 @@ def comparison_scores(table: pd.DataFrame,
 
 
 def best_row(table: pd.DataFrame, criteria: Sequence[str] = THESIS_CRITERIA) -> int:
-    """Position of the row the comparison rule picks (first on ties; rows with a missing
-    criterion, e.g. NaN HD of an empty map, never win)."""
+    """Position of the row the comparison rule picks on the readings as they are (first
+    on equal scores; rows with a missing criterion, e.g. NaN HD of an empty map, never
+    win). :func:`rule_picks` takes the time's spread into account."""
     return int(np.argmin(comparison_scores(table, criteria)))
+
+
+def rule_criteria(table: pd.DataFrame) -> tuple[str, ...]:
+    """The rule's criteria for ``table``: the time as the mapper's CPU seconds where the
+    table has them (our maps), else the elapsed time (the thesis' numbers)."""
+    if TIME_COLUMN in table:
+        return (TIME_COLUMN, *THESIS_CRITERIA[1:])
+    return THESIS_CRITERIA
+
+
+def _surely_beaten(fixed: np.ndarray, times: np.ndarray, spreads: np.ndarray) -> np.ndarray:
+    """``out[i, j]``: row i's score is below row j's whatever the times within their
+    spreads (``fixed``: the score without the time term). The time term of a row is
+    (t - min t) / (max t - min t) over perturbed times; its largest difference i - j
+    puts t_i at its top and t_j at its bottom, over the narrowest range they allow when
+    that difference is positive, the widest when it is negative."""
+    top, bottom = times * np.exp(spreads), times * np.exp(-spreads)
+    gap = top[:, None] - bottom[None, :]
+    widest = top.max() - bottom.min()
+    narrowest = np.maximum(bottom.max() - top.min(), gap)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        worst = np.where(gap > 0, gap / narrowest, gap / widest)
+    worst = np.nan_to_num(worst, nan=0.0)
+    return np.asarray(fixed[:, None] - fixed[None, :] + worst < -1e-12)
+
+
+def rule_picks(table: pd.DataFrame, criteria: Sequence[str] | None = None) -> np.ndarray:
+    """Positions (ascending) of the rows the rule cannot tell from the best one: every
+    row with all criteria that no other row beats whatever the times within their
+    spreads (:func:`~alte.studies.uncertainty.time_spreads`). One position, or a tie."""
+    chosen = tuple(criteria or rule_criteria(table))
+    scores = comparison_scores(table, chosen)
+    valid = np.flatnonzero(np.isfinite(scores))
+    timed = [c for c in chosen if c in _TIMES]
+    if not timed:
+        return np.asarray(valid[scores[valid] == scores[valid].min()])
+    times = table[timed[0]].to_numpy(dtype=np.float64)[valid]
+    lo, hi = times.min(), times.max()
+    fixed = scores[valid] - (times - lo) / (hi - lo if hi > lo else 1.0)
+    beaten = _surely_beaten(fixed, times, time_spreads(table.iloc[valid]))
+    return valid[~beaten.any(axis=0)]
+
+
+def rule_pick(table: pd.DataFrame, criteria: Sequence[str] | None = None) -> int:
+    """One row of :func:`rule_picks`: of a tie, the best by the rule with the time replaced
+    by the machine-independent ``cost`` (the first, where the table has no cost)."""
+    picks = rule_picks(table, criteria)
+    chosen = tuple(criteria or rule_criteria(table))
+    if len(picks) == 1 or "cost" not in table or table["cost"].isna().any():
+        return int(picks[0])
+    by_cost = tuple("cost" if c in _TIMES else c for c in chosen)
+    return int(picks[np.argmin(comparison_scores(table, by_cost)[picks])])
 
 
 def _params_text(params: Mapping[str, Any]) -> str:
@@ -105,10 +171,12 @@ def _params_text(params: Mapping[str, Any]) -> str:
 
 
 def comparison_table(number: int, sweeps: Mapping[str, pd.DataFrame]) -> pd.DataFrame:
-    """Table 5.10 or 5.11: per mapper our best row (by the rule) beside the thesis' choice.
+    """Table 5.10 or 5.11: per mapper our best row by the rule (every row of a tie, with
+    ``rule_pick`` "tie"; else "best") beside the thesis' choice.
 
-    ``sweeps`` maps mapper name to its sweep table from :func:`alte.studies.analysis.sweep`.
-    ``rule_on_thesis`` is what the same rule picks from the thesis' own numbers.
+    ``sweeps`` maps mapper name to its sweep table from
+    :func:`alte.studies.experiments.sweep`. ``rule_score`` is the row's score on the
+    readings; ``rule_on_thesis`` is what the same rule picks from the thesis' own numbers.
     """
     if number not in COMPARISONS:
         raise ParameterError(f"table 5.{number} is not a comparison; those are 10 and 11")
@@ -117,17 +185,22 @@ def comparison_table(number: int, sweeps: Mapping[str, pd.DataFrame]) -> pd.Data
         if mapper not in sweeps:
             raise ParameterError(f"table 5.{number} needs the {mapper} sweep (table 5.{table})")
         ours = sweeps[mapper]
-        pick = ours.iloc[best_row(ours)]
+        picks, scores = rule_picks(ours), comparison_scores(ours, rule_criteria(ours))
         theirs = thesis_metrics(table)
         params = SWEEPS[table]["rows"]
-        row = {"mapper": mapper, "params": _params_text(params[int(pick["thesis_row"])][0]),
-               **{k: v for k, v in pick.items() if not str(k).startswith("thesis_")}}
         chosen = theirs.iloc[thesis_row]
-        row.update({"thesis_params": _params_text(params[thesis_row][0]),
-                    **{v: chosen[k] for k, v in _THESIS_COLS.items()},
-                    "thesis_hd_minus_mhd_m": chosen["hd_minus_mhd_m"],
-                    "rule_on_thesis": _params_text(params[best_row(theirs)][0])})
-        rows.append(row)
+        thesis = {"thesis_params": _params_text(params[thesis_row][0]),
+                  **{v: chosen[k] for k, v in _THESIS_COLS.items()},
+                  "thesis_hd_minus_mhd_m": chosen["hd_minus_mhd_m"],
+                  "rule_on_thesis": _params_text(params[best_row(theirs)][0])}
+        for at in picks:
+            pick = ours.iloc[at]
+            rows.append({"mapper": mapper,
+                         "params": _params_text(params[int(pick["thesis_row"])][0]),
+                         "rule_pick": "tie" if len(picks) > 1 else "best",
+                         "rule_score": float(scores[at]),
+                         **{k: v for k, v in pick.items() if not str(k).startswith("thesis_")},
+                         **thesis})
     return pd.DataFrame(rows)
 
 
@@ -148,30 +221,46 @@ def _rho(x: pd.Series, y: pd.Series) -> float:
 
 
 def _sweep_trends(number: int, ours: pd.DataFrame) -> list[dict[str, Any]]:
+    """A time trend is read on our maps' machine-independent cost where they have one
+    (``ours_rho``), with the rank correlation of their CPU time beside it."""
     theirs = thesis_metrics(number)
     out = []
     for text, param, metric, sign in SWEEP_TRENDS[number]:
-        r_t, r_o = _rho(theirs[param], theirs[metric]), _rho(ours[param], ours[metric])
+        timed = metric == "elapsed_s" and "cost" in ours and ours["cost"].notna().all()
+        r_t = _rho(theirs[param], theirs[metric])
+        r_o = _rho(ours[param], ours["cost" if timed else metric])
+        r_time = _rho(ours[param], ours[TIME_COLUMN]) if timed and TIME_COLUMN in ours \
+            else np.nan
         out.append({"table": f"5.{number}", "trend": text, "thesis_rho": r_t, "ours_rho": r_o,
                     "holds_in_thesis": bool(r_t * sign >= 0.5), "holds_on_ours":
-                    bool(r_o * sign >= 0.5)})
+                    bool(r_o * sign >= 0.5), "ours_on": "cost" if timed else metric,
+                    "ours_time_rho": r_time})
     return out
 
 
+def _lower(table: pd.DataFrame, column: str, low: str, high: str) -> bool:
+    """Every row of mapper ``low`` below every row of ``high`` in ``column`` (a time
+    beyond the two rows' spreads)."""
+    values = table[column].to_numpy(dtype=np.float64)
+    top = bottom = values
+    if column in _TIMES and "thesis_" not in column:
+        spreads = time_spreads(table)
+        top, bottom = values * np.exp(spreads), values * np.exp(-spreads)
+    mine = (table["mapper"] == low).to_numpy()
+    other = (table["mapper"] == high).to_numpy()
+    return bool(top[mine].max() < bottom[other].min())
+
+
 def _comparison_trends(number: int, table: pd.DataFrame) -> list[dict[str, Any]]:
-    by = table.set_index("mapper")
-
-    def lower(column: str, low: str, high: str) -> bool:
-        values = by[column].astype(np.float64)
-        return bool(values[low] < values[high])
-
     out = []
     for text, low, high, metric in COMPARISON_TRENDS[number]:
         tcol = "thesis_hd_minus_mhd_m" if metric == "hd_minus_mhd_m" else _THESIS_COLS[metric]
+        ours = TIME_COLUMN if metric == "elapsed_s" and TIME_COLUMN in table else metric
         out.append({"table": f"5.{number}", "trend": text,
                     "thesis_rho": np.nan, "ours_rho": np.nan,
-                    "holds_in_thesis": lower(tcol, low, high),
-                    "holds_on_ours": lower(metric, low, high)})
+                    "holds_in_thesis": _lower(table, tcol, low, high),
+                    "holds_on_ours": _lower(table, ours, low, high), "ours_on": ours,
+                    "ours_time_rho": np.nan})
     return out
 
 
@@ -179,8 +268,10 @@ def trend_table(number: int, table: pd.DataFrame) -> pd.DataFrame:
     """Which of the thesis' stated trends for table 5.``number`` hold, there and on ours.
 
     Sweeps: a trend holds when the Spearman rank correlation between parameter and metric
-    has the stated sign and magnitude >= 0.5 (NaN with fewer than 3 rows). Comparisons:
-    the stated inequality between the two chosen maps.
+    has the stated sign and magnitude >= 0.5 (NaN with fewer than 3 rows); a time trend
+    is read on our maps' cost (``ours_on``; ``ours_time_rho``: the CPU time's). Comparisons:
+    the stated inequality between the two chosen maps (between every pair of a tie; our
+    times beyond their spreads).
     """
     if number in SWEEP_TRENDS:
         return pd.DataFrame(_sweep_trends(number, table))

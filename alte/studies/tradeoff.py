@@ -25,7 +25,7 @@ import pandas as pd
 
 from alte.errors import ParameterError
 from alte.studies.thesis import COMPARISONS, SWEEPS
-from alte.studies.uncertainty import CONFIDENCE, bootstrap_ci
+from alte.studies.uncertainty import CONFIDENCE, bootstrap_ci, time_spreads
 
 __all__ = ["MAPPER_NAMES", "METRICS", "OPTIONAL_COLUMNS", "REQUIRED_COLUMNS", "equal_fidelity",
            "equal_size", "fronts", "interval_table", "label", "matching", "pareto_front",
@@ -37,8 +37,11 @@ Levels = Sequence[float] | np.ndarray
 REQUIRED_COLUMNS = ("terrain", "mapper", "params", "seed", "basis_functions", "occupied_cells",
                     "memory_bytes", "elapsed_s", "mhd_m", "hd_m", "accuracy_mean_m",
                     "completeness")
-#: Columns some claims need (2D maps: height RMSE; cell-size spread; directed MHDs).
-OPTIONAL_COLUMNS = ("mh_ab_m", "mh_ba_m", "height_rmse_m", "size_octaves", "hd_minus_mhd_m")
+#: Columns some claims need (2D maps: height RMSE; cell-size spread; directed MHDs; the
+#: time as measured, :class:`alte.metrics.timing.Timing`, and the mapper's cost).
+OPTIONAL_COLUMNS = ("mh_ab_m", "mh_ba_m", "height_rmse_m", "size_octaves", "hd_minus_mhd_m",
+                    "elapsed_spread", "map_cpu_s", "map_cpu_spread", "time_repeats", "cost",
+                    "cost_unit")
 #: Display names of the mappers.
 MAPPER_NAMES = {"quadtree": "Quadtree", "octomap": "Octomap", "alte2d": "2D-ALTE",
                 "alte3d": "3D-ALTE"}
@@ -46,6 +49,7 @@ MAPPER_NAMES = {"quadtree": "Quadtree", "octomap": "Octomap", "alte2d": "2D-ALTE
 METRICS: dict[str, tuple[str, str]] = {
     "basis_functions": ("basis functions", ""), "occupied_cells": ("occupied cells", ""),
     "memory_bytes": ("memory", "B"), "elapsed_s": ("mapping time", "s"),
+    "map_cpu_s": ("mapping CPU time", "s"), "cost": ("mapping cost", ""),
     "mhd_m": ("MHD", "m"), "hd_m": ("HD", "m"), "hd_minus_mhd_m": ("HD - MHD", "m"),
     "mh_ab_m": ("MHD cloud to map", "m"), "mh_ba_m": ("MHD map to cloud", "m"),
     "accuracy_mean_m": ("mean accuracy", "m"), "completeness": ("completeness", ""),
@@ -86,7 +90,9 @@ def prepare(table: pd.DataFrame) -> pd.DataFrame:
     """Check the trade-off schema; add ``p_*`` parameter columns (parsed from ``params``
     when absent), ``hd_minus_mhd_m`` and ``free_share`` (1 - occupied/basis functions).
     Rows of ``alte sweep`` (:func:`alte.studies.sweep.load_results`) name the setting
-    ``params_json``; it serves as ``params``."""
+    ``params_json``; it serves as ``params``. A table without the CPU time of its maps
+    (older runs, other tools) gets ``map_cpu_s`` = ``elapsed_s`` with no spread, and
+    ``cost`` NaN (not measured)."""
     if "params" not in table.columns and "params_json" in table.columns:  # `alte sweep` rows
         table = table.assign(params=table["params_json"])
     missing = [c for c in REQUIRED_COLUMNS if c not in table.columns]
@@ -99,6 +105,10 @@ def prepare(table: pd.DataFrame) -> pd.DataFrame:
         out = out.join(parsed.add_prefix("p_"))
     if "hd_minus_mhd_m" not in out:
         out["hd_minus_mhd_m"] = out["hd_m"] - out["mhd_m"]
+    if "map_cpu_s" not in out:
+        out["map_cpu_s"], out["map_cpu_spread"] = out["elapsed_s"], np.nan
+    if "cost" not in out:
+        out["cost"] = np.nan
     basis = out["basis_functions"].astype(float)
     out["free_share"] = 1.0 - out["occupied_cells"].astype(float) / basis.where(basis > 0)
     return out
@@ -199,18 +209,33 @@ def _levels(lo: float, hi: float, log: bool) -> list[float]:
     return sorted({r if lo <= r <= hi else v for r, v in zip(rounded, values, strict=True)})
 
 
-Curve = tuple[np.ndarray, np.ndarray, float]
+#: A front: its x and (signed) y, sorted by x; the largest x made; and the highest y it
+#: can be read at (its first point's, or lower where the fastest map is uncertain).
+Curve = tuple[np.ndarray, np.ndarray, float, float]
 
 
-def _curves(part: pd.DataFrame, x: str, y: str, sign: float) -> dict[tuple[str, Any], Curve]:
-    """Each (mapper, seed)'s front on one terrain (y times ``sign``) and its largest x."""
+def _top(xv: np.ndarray, yv: np.ndarray, spreads: np.ndarray) -> float:
+    """The least (signed) error among the maps that could be the fastest, their times
+    within ``spreads``: a level it reaches is censored (:func:`equal_fidelity`)."""
+    ok = np.isfinite(xv) & (xv > 0) & np.isfinite(yv)
+    x, y, u = xv[ok], yv[ok], spreads[ok]
+    could = x * np.exp(-u) <= np.min(x * np.exp(u))
+    return float(y[could].min())
+
+
+def _curves(part: pd.DataFrame, x: str, y: str, sign: float,
+            spread: str | None = None) -> dict[tuple[str, Any], Curve]:
+    """Each (mapper, seed)'s front on one terrain (y times ``sign``), its largest x and
+    the highest y it can be read at (:func:`_top` with an uncertain x)."""
     curves = {}
     for (mapper, seed), group in part.groupby(["mapper", "seed"], sort=True):
         xv = group[x].to_numpy(dtype=np.float64)
         yv = sign * group[y].to_numpy(dtype=np.float64)
         idx = pareto_front(np.where(xv > 0, xv, np.nan), yv)
         if idx.size:
-            curves[(str(mapper), seed)] = (xv[idx], yv[idx], float(np.nanmax(xv)))
+            top = float(yv[idx][0]) if spread is None else _top(
+                xv, yv, time_spreads(group, spread))
+            curves[(str(mapper), seed)] = (xv[idx], yv[idx], float(np.nanmax(xv)), top)
     return curves
 
 
@@ -218,14 +243,15 @@ def _span(curves: Sequence[Curve], by_size: bool) -> tuple[float, float]:
     """The range of sizes (signed errors) every curve can be read at."""
     if by_size:
         return max(float(c[0][0]) for c in curves), min(c[2] for c in curves)
-    return max(float(c[1][-1]) for c in curves), min(float(c[1][0]) for c in curves)
+    return max(float(c[1][-1]) for c in curves), min(c[3] for c in curves)
 
 
 def _front_reads(table: pd.DataFrame, mappers: Sequence[str], axes: tuple[str, str], *,
-                 sign: float, levels: Levels | None, by_size: bool) -> pd.DataFrame:
+                 sign: float, levels: Levels | None, by_size: bool,
+                 spread: str | None = None) -> pd.DataFrame:
     rows = []
     for terrain, part in table[table["mapper"].isin(mappers)].groupby("terrain", sort=True):
-        curves = _curves(part, *axes, sign)
+        curves = _curves(part, *axes, sign, spread)
         if {m for m, _ in curves} != set(mappers):
             continue
         lo, hi = _span(list(curves.values()), by_size)
@@ -234,9 +260,10 @@ def _front_reads(table: pd.DataFrame, mappers: Sequence[str], axes: tuple[str, s
         wanted = list(levels) if levels is not None and len(levels) else _levels(lo, hi,
                                                                                log=by_size)
         at = np.asarray(wanted, dtype=np.float64)
-        for (mapper, seed), (xs, ys, x_max) in curves.items():
+        for (mapper, seed), (xs, ys, x_max, top) in curves.items():
             values = (sign * read_at_size(xs, ys, at, x_max) if by_size
-                      else size_for_fidelity(xs, ys, sign * at))
+                      else np.where(sign * at > top, np.nan, size_for_fidelity(xs, ys,
+                                                                                sign * at)))
             rows += [{"terrain": terrain, "seed": seed, "level": lv, "mapper": mapper,
                       "value": v} for lv, v in zip(wanted, values, strict=True)]
     return pd.DataFrame(rows, columns=["terrain", "seed", "level", "mapper", "value"])
@@ -256,14 +283,20 @@ def equal_size(table: pd.DataFrame, mappers: Sequence[str], metric: str = "mhd_m
 
 def equal_fidelity(table: pd.DataFrame, mappers: Sequence[str],
                    metric: str = "basis_functions", *, fidelity: str = "mhd_m",
-                   levels: Levels | None = None,
-                   higher_is_better: bool = False) -> pd.DataFrame:
+                   levels: Levels | None = None, higher_is_better: bool = False,
+                   spread: str | None = None) -> pd.DataFrame:
     """The ``metric`` (a size or the time) each mapper needs to reach ``fidelity`` levels,
-    read off its (metric, fidelity) front; same columns as :func:`equal_size`."""
+    read off its (metric, fidelity) front; same columns as :func:`equal_size`.
+
+    A level the front's first (smallest, fastest) map already reaches is censored (a
+    smaller map might reach it too). ``spread`` names the column of the metric's spread
+    (a time, :func:`~alte.studies.uncertainty.time_spreads`): then a level is censored
+    when any map that could be the fastest within the spreads reaches it, so which map
+    a reading put first never decides which levels are read."""
     _need(table, ["terrain", "mapper", "seed", metric, fidelity])
     sign = -1.0 if higher_is_better else 1.0
     return _front_reads(table, mappers, (metric, fidelity), sign=sign, levels=levels,
-                        by_size=False)
+                        by_size=False, spread=spread)
 
 
 def interval_table(reads: pd.DataFrame, level: float = CONFIDENCE, seed: int = 0) -> pd.DataFrame:

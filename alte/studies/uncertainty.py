@@ -1,10 +1,20 @@
-"""Confidence intervals over simulation seeds: a seeded percentile bootstrap.
+"""Confidence intervals over simulation seeds (a seeded percentile bootstrap), and the
+measurement uncertainty of a map's time.
 
 Every compared number of the trade-off analysis is a mean over seeds (one value per
 seed, e.g. the MHD difference of two mappers read at one size on one terrain). Its
 interval is the percentile bootstrap of that mean (``scipy.stats.bootstrap``), with a
 seeded generator so a report is reproducible. With one seed there is no interval: the
-bounds equal the value and :attr:`Interval.seeds` says so.
+bounds equal the value and :attr:`Interval.seeds` says so. A value that is itself known
+only within bounds (a time, read within its spread; a pick the rule cannot separate
+from another) enters as its bounds: :func:`bootstrap_bounds` takes the interval's low
+end from the seeds' lower bounds and its high end from their upper bounds.
+
+Times are the one quantity that differs between two runs of the same commit. A map's
+time spread (:mod:`alte.metrics.timing`: half the log of max/min over repeated runs) is
+taken at least :data:`TIME_SPREAD_FLOOR`, the run-to-run spread of the same maps'
+CPU times measured between whole grid runs on a shared machine: a map timed once, or
+whose repeats happened to agree, is no better known than that (:func:`time_spreads`).
 """
 
 from __future__ import annotations
@@ -12,12 +22,17 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import pandas as pd
 from scipy.stats import bootstrap
 
-__all__ = ["CONFIDENCE", "Interval", "bootstrap_ci", "bootstrap_columns"]
+__all__ = ["CONFIDENCE", "TIME_SPREAD_FLOOR", "Interval", "bootstrap_bounds", "bootstrap_ci",
+           "bootstrap_columns", "time_spreads"]
 
 #: Confidence level of every interval in the report.
 CONFIDENCE = 0.95
+#: Least spread of a map's time (half the log of max/min; 0.25: within a factor 1.28 of
+#: the middle), from the run-to-run differences of the grid's CPU times (README, "Time").
+TIME_SPREAD_FLOOR = 0.25
 
 
 @dataclass(frozen=True)
@@ -65,3 +80,27 @@ def bootstrap_columns(values: np.ndarray, level: float = CONFIDENCE, n_resamples
     ci = result.confidence_interval
     flat = np.ptp(data, axis=0) == 0  # identical seeds: no spread, no interval
     return mean, np.where(flat, mean, ci.low), np.where(flat, mean, ci.high)
+
+
+def bootstrap_bounds(values: np.ndarray | list[float], low: np.ndarray | list[float],
+                     high: np.ndarray | list[float], *, level: float = CONFIDENCE,
+                     n_resamples: int = 2000, seed: int = 0) -> Interval:
+    """Mean of ``values`` over the seeds where all three are finite, with an interval from
+    the bootstrap interval of the mean of ``low`` (its low end) and of ``high`` (its high
+    end): each seed's value known only within [low, high]."""
+    data = np.column_stack([np.asarray(a, dtype=np.float64) for a in (values, low, high)])
+    data = data[np.isfinite(data).all(axis=1)]
+    if data.size == 0:
+        return Interval(np.nan, np.nan, np.nan, 0, level)
+    lower = bootstrap_ci(data[:, 1], level, n_resamples, seed)
+    upper = bootstrap_ci(data[:, 2], level, n_resamples, seed)
+    return Interval(float(data[:, 0].mean()), lower.low, upper.high, len(data), level)
+
+
+def time_spreads(table: pd.DataFrame, spread: str = "map_cpu_spread") -> np.ndarray:
+    """Each row's time spread, at least :data:`TIME_SPREAD_FLOOR` (the floor alone where
+    the table has no ``spread`` column or a row no value: a time read once)."""
+    if spread not in table:
+        return np.full(len(table), TIME_SPREAD_FLOOR)
+    values = pd.to_numeric(table[spread], errors="coerce").to_numpy(dtype=np.float64)
+    return np.asarray(np.fmax(np.nan_to_num(values, nan=0.0), TIME_SPREAD_FLOOR))

@@ -8,10 +8,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 from mcap.reader import make_reader
+from support.mcapfiles import container, read_back
 from support.synthetic import scene
 
 from alte.cli import main
 from alte.io import write_frames
+from alte.sim import ensure_terrain
 
 
 @pytest.fixture
@@ -36,7 +38,8 @@ def test_export_writes_the_mcap_with_a_timeline(bag: Path, tmp_path: Path, capsy
     out = json.loads(capsys.readouterr().out)
     assert out["feed"] == "frames"  # quadtree's batch build switched to frames for a timeline
     assert out["mcap"]["messages"] == topics(target)
-    assert topics(target)["/alte/map/occupancy"] == 3 and topics(target)["/alte/scan"] == 6
+    # the final map at the first instant, then scans 2, 4 and 6
+    assert topics(target)["/alte/map/occupancy"] == 4 and topics(target)["/alte/scan"] == 6
     assert main(argv) == 2
     assert "already exists" in capsys.readouterr().err
 
@@ -45,6 +48,12 @@ def test_export_writes_the_mcap_with_a_timeline(bag: Path, tmp_path: Path, capsy
     (["--mcap", "run.bag"], "--mcap run.bag: the file name must end in .mcap"),
     (["--mcap", "run.mcap", "--timeline", "0"], "--timeline 0: expected a positive number"),
     (["--mcap", "run.mcap", "--timeline", "2", "--feed", "batch"], "use --feed frames"),
+    (["--mcap", "run.mcap", "--occupancy-set", "max_slope_deg=95"],
+     r"--occupancy-set: occupancy: max_slope_deg=95.0 out of range (0 < max_slope_deg < 90)"),
+    (["--mcap", "run.mcap", "--occupancy-set", "slope=5"],
+     "--occupancy-set: occupancy: unknown parameter(s) slope; valid: ground, ground_window"),
+    (["--mcap", "run.mcap", "--occupancy-set", "ground"],
+     "--occupancy-set: --occupancy-set 'ground': expected KEY=VALUE"),
 ])
 def test_export_refuses_bad_flags(bag: Path, tmp_path: Path, capsys, extra, message) -> None:
     argv = ["export", str(bag), "--mapper", "quadtree", *extra]
@@ -59,12 +68,40 @@ def test_map_and_register_write_mcap_too(bag: Path, tmp_path: Path, capsys) -> N
     target = tmp_path / "map.mcap"
     assert main(["map", str(bag), "--mapper", "alte3d", "--mcap", str(target), "--json"]) == 0
     summary = json.loads(capsys.readouterr().out)
-    assert summary["mcap"]["messages"]["/alte/map/cells"] == 1
+    assert summary["mcap"]["messages"]["/alte/map/cells"] == 2  # at the start and the end
     assert main(["map", str(bag), "--mapper", "alte3d", "--timeline", "2"]) == 2
-    assert "--timeline writes the growing map into --mcap FILE" in capsys.readouterr().err
+    assert "--timeline shapes the map written into --mcap FILE; add it" in \
+        capsys.readouterr().err
+    assert main(["map", str(bag), "--mapper", "alte3d", "--occupancy-set", "window=2"]) == 2
+    assert "--occupancy-set shapes the map written into --mcap FILE" in capsys.readouterr().err
     reg = tmp_path / "reg.mcap"
     assert main(["register", str(bag), "--out", str(tmp_path / "c.npz"), "--mcap", str(reg)]) == 0
     assert "messages to" in capsys.readouterr().out
-    assert topics(reg) == {"/alte/scan": 6, "/alte/pose": 6, "/tf": 6, "/alte/trajectory": 1,
-                           "/alte/cloud": 1}
+    assert topics(reg) == {"/alte/scan": 6, "/alte/pose": 6, "/tf": 6, "/alte/trajectory": 2,
+                           "/alte/cloud": 2}
     assert np.load(tmp_path / "c.npz")["points"].shape[1] == 3
+
+
+def test_map_of_a_landing_terrain_opens_on_the_final_map(tmp_path: Path, capsys) -> None:
+    """``alte map TERRAIN --mapper alte2d --mcap F``: map, occupancy and Foxglove grid at the
+    file's start time, free and occupied cells, -1 only where unseen, zstd chunks; read
+    back by rosbags (container, CRCs) and decoded by mcap_ros2."""
+    terrain = ensure_terrain("sim_lan_2", tmp_path / "data", frames=8)
+    target = tmp_path / "F.mcap"
+    assert main(["map", str(terrain), "--mapper", "alte2d", "--mcap", str(target),
+                 "--occupancy-set", "max_slope_deg=12", "--json"]) == 0
+    capsys.readouterr()
+    table, messages = read_back(target)
+    start = min(stamp for topic in messages for stamp, _ in messages[topic])
+    for topic in ("/alte/map/cells", "/alte/map/occupancy", "/alte/map/grid",
+                  "/alte/map/grid_map", "/alte/trajectory", "/alte/cloud"):
+        assert messages[topic][0][0] == start
+    assert table["/alte/map/grid"][0] == "foxglove_msgs/msg/Grid"
+    grid = messages["/alte/map/occupancy"][0][1]
+    values = np.asarray(grid.data)
+    heights = np.frombuffer(bytes(messages["/alte/map/grid"][0][1].data), dtype=np.uint8)
+    elevation = heights.reshape(-1, 9)[:, :4].copy().view("<f4").ravel()
+    assert (values == 0).any() and (values == 100).any()
+    assert ((values == -1) == np.isnan(elevation)).all()
+    compressions, chunk_crcs, data_crc = container(target)
+    assert compressions == {"zstd"} and chunk_crcs and data_crc != 0

@@ -14,8 +14,8 @@ from alte.commands.options import parse_box
 from alte.commands.register import format_counts
 from alte.errors import ParameterError
 from alte.io import read_frames, write_frames
-from alte.io.bag import ReadCounts
-from alte.io.pointfiles import read_points
+from alte.io.bag import ReadCounts, ReadOptions
+from alte.io.pointfiles import read_points, read_points_info
 from alte.paths import realdata_dir
 from alte.pipeline import InputKind, Source
 from alte.pipeline import source as source_module
@@ -63,12 +63,13 @@ def fake_io(monkeypatch):
             self.notes: list[str] = []
             self.counts = ReadCounts(scans_read=len(frames))
             self.track = object()  # a recorded pose stream: the frames keep their poses
+            self.options = ReadOptions()  # read as FrameStream reads (deskew's gap limit)
 
         def __iter__(self):
             return iter(frames)
 
-    def write_points(path, points, overwrite=False):
-        calls["write"] = (path, points, overwrite)
+    def write_points(path, points, overwrite=False, fields=None):
+        calls["write"] = (path, points, overwrite, fields)
         Path(path).write_text("cloud")
 
     monkeypatch.setattr(command, "open_input",
@@ -159,3 +160,28 @@ def test_register_real_ros1_bag_without_poses(tmp_path, capsys):
     text = capsys.readouterr().out
     assert f"points: {len(raw)} in" in text
     assert "frames: 5 in, 5 kept" in text
+
+
+def test_register_a_point_file_speaks_of_its_rows_and_keeps_its_fields(tmp_path, capsys):
+    rng = np.random.default_rng(4)
+    points = rng.uniform(-5, 5, (200, 3))
+    points[3] = np.nan
+    fields = {"intensity": np.arange(200, dtype=np.uint16),
+              "label": rng.integers(0, 9, 200).astype(np.int32)}
+    source = tmp_path / "scan.npz"
+    np.savez(source, points=points, **fields)
+    out = tmp_path / "cloud.ply"
+    assert main(["register", str(source), "--out", str(out), "--crop=-4,-4,-4,4,4,4"]) == 0
+    text = capsys.readouterr().out
+    inside = np.all(np.abs(np.nan_to_num(points, nan=9)) <= 4, axis=1)
+    assert f"file: {source}: 200 rows; dropped 1 (NaN/inf), {199 - inside.sum()} (outside " \
+           f"crop box); {inside.sum()} points out" in text
+    assert "fields: kept intensity, label" in text
+    assert "scans" not in text and "frames:" not in text
+    back = read_points_info(out)
+    np.testing.assert_array_equal(back.fields["intensity"], fields["intensity"][inside])
+    np.testing.assert_array_equal(back.fields["label"], fields["label"][inside])
+    assert main(["register", str(source), "--out", str(tmp_path / "c.xyz")]) == 0
+    assert "fields: not kept intensity (plain text holds x y z only)" in capsys.readouterr().out
+    assert main(["register", str(source), "--out", str(tmp_path / "v.npz"), "--voxel", "1"]) == 0
+    assert "note: fields intensity, label not kept: --voxel averages" in capsys.readouterr().out

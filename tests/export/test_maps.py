@@ -1,4 +1,5 @@
-"""Map messages: rasterised 2D maps, grid_map's index convention, cube lists, Octomap."""
+"""Map messages: rasterised maps, occupancy by the landing criterion, grid_map's index
+convention, Foxglove grids, cube lists, Octomap."""
 
 from __future__ import annotations
 
@@ -8,17 +9,18 @@ import numpy as np
 import pytest
 
 from alte.errors import ParameterError
-from alte.export.maps import (
-    CUBE_LIST,
-    DELETEALL,
-    cell_markers,
+from alte.export.grids import (
+    GRID_FIELDS,
+    foxglove_grid,
+    grid_cells,
     grid_map,
     height_colours,
     occupancy_grid,
-    octomap_msg,
     raster,
-    shown_cells,
 )
+from alte.export.maps import CUBE_LIST, DELETEALL, cell_markers, octomap_msg, shown_cells
+from alte.export.rosmsg import typestore
+from alte.ground.surface import SurfaceRule
 from alte.mappers import Cells, Octomap
 from alte.mappers.octomap import read_bt
 
@@ -37,10 +39,90 @@ def test_raster_paints_every_leaf_at_the_finest_size() -> None:
     grid = raster(two_level_cells(), np.array([10.0, 20.0, 0.0]))
     assert grid.resolution == 1.0 and grid.shape == (4, 4)
     assert grid.origin.tolist() == [10.0, 20.0]
-    assert (grid.height[:2, :2] == 1.0).all() and (grid.occupancy[:2, :2] == 100).all()
+    assert (grid.height[:2, :2] == 1.0).all()
     assert grid.height[0, 2] == 0.2 and grid.height[1, 2] == 0.6
     assert np.isnan(grid.height[1, 3]) and grid.occupancy[1, 3] == -1
-    assert (grid.height[2:, 2:] == 2.0).all() and (grid.occupancy[2:, :2] == 0).all()
+    assert (grid.height[2:, 2:] == 2.0).all() and (grid.height[2:, :2] == 0.0).all()
+    known = np.isfinite(grid.height)
+    assert set(np.unique(grid.occupancy[known])) <= {0, 100}
+    assert (grid.occupancy[~known] == -1).all()  # -1 only where no leaf lies
+
+
+def grid_of_two_levels():
+    return raster(two_level_cells(), np.zeros(3))
+
+
+def flat_with_a_box(size: int = 40) -> Cells:
+    """A 40 m x 40 m flat 2D map of 1 m cells at height 5 with a 4 m x 4 m, 2 m tall box,
+    a 30 deg ramp beyond x = 30 and one unknown cell."""
+    ij = np.stack(np.meshgrid(np.arange(size), np.arange(size), indexing="ij"), -1).reshape(-1, 2)
+    centers = np.column_stack([ij[:, 1] + 0.5, ij[:, 0] + 0.5, np.full(len(ij), 5.0)])
+    box = (np.abs(centers[:, 0] - 10) < 2) & (np.abs(centers[:, 1] - 10) < 2)
+    centers[box, 2] = 7.0
+    ramp = centers[:, 0] > 30  # 30 deg slope along x
+    centers[ramp, 2] = 5.0 + np.tan(np.radians(30.0)) * (centers[ramp, 0] - 30)
+    centers[(ij[:, 0] == 20) & (ij[:, 1] == 20), 2] = np.nan
+    sizes = np.column_stack([np.ones(len(ij)), np.ones(len(ij)), np.zeros(len(ij))])
+    return Cells(centers, sizes, centers[:, 2], np.ones(len(ij), bool), np.zeros(len(ij), int))
+
+
+@pytest.mark.parametrize("ground", ["local", "plane"])
+def test_occupancy_tells_landable_ground_from_obstacles_and_slopes(ground: str) -> None:
+    grid = raster(flat_with_a_box(), np.zeros(3), rule=SurfaceRule(ground=ground))
+    occ = grid.occupancy
+    assert occ[20, 20] == -1 and (occ == -1).sum() == 1
+    assert (occ[8:12, 8:12] == 100).all()  # the box
+    assert occ[30, 20] == 0 and occ[5, 25] == 0  # open flat ground
+    assert (occ[:, 34:] == 100).all()  # the 30 deg ramp
+    assert (occ[20, 21:23] == 0).all()  # an unknown neighbour does not spoil flat ground
+    steep = raster(flat_with_a_box(), np.zeros(3), rule=SurfaceRule(max_slope_deg=45.0))
+    assert (steep.occupancy[:, 34:] == 0).all()  # a steeper vehicle limit frees the ramp
+
+
+def test_a_3d_map_is_classified_on_its_top_occupied_surface() -> None:
+    """Columns: flat ground leaves (occupied) under free air leaves; a 3 m pillar; one column
+    seen only as free space; nothing beyond x = 20."""
+    cx, cy = np.meshgrid(np.arange(20) + 0.5, np.arange(20) + 0.5)
+    cx, cy = cx.ravel(), cy.ravel()
+    ground = np.column_stack([cx, cy, np.full(cx.size, 0.5)])
+    air = np.column_stack([cx, cy, np.full(cx.size, 1.5)])
+    occupied = np.r_[np.ones(cx.size, bool), np.zeros(cx.size, bool)]
+    centers = np.vstack([ground, air])
+    pillar = np.array([[10.5, 10.5, 1.5], [10.5, 10.5, 2.5]])
+    hole = (cx == 3.5) & (cy == 15.5)
+    occupied[: cx.size][hole] = False  # that column is free all the way down
+    centers, occupied = np.vstack([centers, pillar]), np.r_[occupied, True, True]
+    cells = Cells(centers, np.ones_like(centers), np.zeros(len(centers)), occupied,
+                  np.zeros(len(centers), int))
+    grid = raster(cells, np.zeros(3), dims=3)
+    assert grid.shape == (20, 20) and grid.height[10, 10] == 3.0 and grid.height[0, 0] == 1.0
+    assert np.isnan(grid.height[15, 3]) and grid.occupancy[15, 3] == 100
+    assert grid.occupancy[10, 10] == 100 and grid.occupancy[2, 2] == 0
+    assert not (grid.occupancy == -1).any()
+
+
+def test_foxglove_grid_packs_height_occupancy_and_colours() -> None:
+    grid = grid_of_two_levels()
+    msg = foxglove_grid(grid, 3_000_000_000, "map")
+    kinds = typestore().types["foxglove_msgs/msg/PackedElementField"]
+    assert [(f.name, f.offset, f.type) for f in msg.fields] == [
+        ("elevation", 0, kinds.FLOAT32), ("occupancy", 4, kinds.INT8), ("red", 5, kinds.UINT8),
+        ("green", 6, kinds.UINT8), ("blue", 7, kinds.UINT8), ("alpha", 8, kinds.UINT8)]
+    assert [f[0] for f in GRID_FIELDS] == [f.name for f in msg.fields]
+    assert (msg.column_count, msg.cell_stride, msg.row_stride) == (4, 9, 36)
+    assert len(msg.data) == 4 * 36 and msg.timestamp.sec == 3 and msg.frame_id == "map"
+    assert (msg.cell_size.x, msg.cell_size.y) == (1.0, 1.0)
+    assert msg.pose.position.z == -1.5 and msg.pose.position.x == 0.0
+    # decode the bytes independently: row-major from the origin corner, little-endian
+    raw = np.asarray(msg.data, dtype=np.uint8).reshape(4, 4, 9)
+    elevation = raw[..., 0:4].copy().view("<f4")[..., 0]
+    assert np.allclose(elevation, grid.height, equal_nan=True)
+    assert (raw[..., 4].view(np.int8) == grid.occupancy).all()
+    assert raw[1, 3, 8] == 0 and (raw[..., 8][np.isfinite(grid.height)] == 255).all()
+    top = np.argwhere(grid.height == 2.0)[0]
+    assert np.allclose(raw[top[0], top[1], 5:8] / 255, height_colours(np.array([0.0, 2.0]))[1, :3],
+                       atol=1 / 255)
+    assert grid_cells(grid).shape == (4, 4)
 
 
 def test_raster_coarsens_to_fit_and_refuses_an_empty_map() -> None:
@@ -59,7 +141,8 @@ def test_occupancy_grid_is_row_major_from_its_origin() -> None:
     assert (msg.info.width, msg.info.height, msg.info.resolution) == (4, 4, 1.0)
     assert msg.header.stamp.sec == 5 and msg.header.stamp.nanosec == 1
     data = msg.data.reshape(4, 4)
-    assert data[0, 0] == 100 and data[1, 3] == -1 and data[0, 2] == 0
+    assert data.tolist() == grid_of_two_levels().occupancy.tolist() and data[1, 3] == -1
+    assert msg.info.origin.position.z == -1.0  # one cell below the lowest height (0 m)
 
 
 def test_grid_map_follows_grid_map_index_convention() -> None:

@@ -1,18 +1,18 @@
-"""MCAP exports of map runs, written with rosbags and read back with mcap + mcap_ros2."""
+"""MCAP exports of map runs: serialised by rosbags, written by mcap, read back by rosbags'
+MCAP reader (container, CRCs) and decoded by mcap_ros2 (an independent CDR decoder)."""
 
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 import pytest
-from mcap.reader import make_reader
-from mcap_ros2.decoder import DecoderFactory
+from support.mcapfiles import container, read_back
 
 from alte.errors import AlteError, ParameterError
 from alte.export import TOPICS, ExportOptions, export_map, export_registered
-from alte.export.maps import height_colours, raster, shown_cells
+from alte.export.grids import height_colours, raster
+from alte.export.maps import shown_cells
 from alte.io.reader import open_bag, topic_table
 from alte.mappers import Feed
 from alte.mappers.octomap import read_bt
@@ -28,22 +28,6 @@ def terrains(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
     return {n: ensure_terrain(n, root, frames=FRAMES) for n in ("sim_nav_1", "sim_lan_2")}
 
 
-def read_back(path: Path) -> tuple[dict[str, tuple[str, str, int]], dict[str, list[Any]]]:
-    """Schemas (name, encoding), counts and decoded messages per topic, with mcap_ros2."""
-    with path.open("rb") as fh:
-        reader = make_reader(fh, decoder_factories=[DecoderFactory()])
-        summary = reader.get_summary()
-        assert summary is not None and summary.statistics is not None
-        table = {c.topic: (summary.schemas[c.schema_id].name,
-                           summary.schemas[c.schema_id].encoding,
-                           summary.statistics.channel_message_counts[c.id])
-                 for c in summary.channels.values()}
-        messages: dict[str, list[Any]] = {}
-        for _, channel, message, decoded in reader.iter_decoded_messages():
-            messages.setdefault(channel.topic, []).append((message.log_time, decoded))
-    return table, messages
-
-
 def test_octomap_run_on_sim_nav_1_reads_back(terrains: dict[str, Path], tmp_path: Path) -> None:
     target = tmp_path / "nav.mcap"
     result, counts = export_map(open_input(terrains["sim_nav_1"]), target,
@@ -51,13 +35,19 @@ def test_octomap_run_on_sim_nav_1_reads_back(terrains: dict[str, Path], tmp_path
                                 options=ExportOptions(timeline=4))
     table, messages = read_back(target)
     expected = {"/alte/scan": FRAMES, "/alte/pose": FRAMES, "/tf": FRAMES,
-                "/alte/map/cells": 2, "/alte/map/octomap": 2, "/alte/trajectory": 2,
-                "/alte/cloud": 1}
+                "/alte/map/cells": 3, "/alte/map/octomap": 3, "/alte/map/occupancy": 3,
+                "/alte/map/grid": 3, "/alte/trajectory": 3, "/alte/cloud": 2}
     assert {t: n for t, (_, _, n) in table.items()} == expected == counts
     assert all(table[t][:2] == (TOPICS[t], "ros2msg") for t in table)
     stamps = result.log.stamps
-    assert [t for t, _ in messages["/alte/map/cells"]] == [stamps[3], stamps[7]]
-    assert len(messages["/alte/trajectory"][-1][1].poses) == FRAMES
+    # the final map at the first instant, then the timeline's growth (scans 4 and 8)
+    assert [t for t, _ in messages["/alte/map/cells"]] == [stamps[0], stamps[3], stamps[7]]
+    assert [len(m.poses) for _, m in messages["/alte/trajectory"]] == [FRAMES, 4, FRAMES]
+    first, last = (messages["/alte/map/cells"][k][1].markers for k in (0, -1))
+    assert [len(m.points) for m in first] == [len(m.points) for m in last]
+    assert first[1].header.stamp.sec * 10**9 + first[1].header.stamp.nanosec == stamps[0]
+    occupancy = messages["/alte/map/occupancy"][0][1].data
+    assert {0, 100} <= set(np.unique(occupancy)) <= {-1, 0, 100}  # from the top surface
     cells = result.mapper.cells()
     occupied = cells.centers[cells.occupied]
     markers = messages["/alte/map/cells"][-1][1].markers
@@ -81,11 +71,26 @@ def test_alte2d_run_on_sim_lan_2_reads_back(terrains: dict[str, Path], tmp_path:
     result, _ = export_map(open_input(terrains["sim_lan_2"]), target,
                            MapSpec("alte2d", {"max_res": 5}))
     table, messages = read_back(target)
-    for topic in ("/alte/map/occupancy", "/alte/map/grid_map", "/alte/map/cells",
-                  "/alte/cloud", "/alte/trajectory"):
-        assert table[topic] == (TOPICS[topic], "ros2msg", 1)
+    start = min(stamp for topic in messages for stamp, _ in messages[topic])
+    assert start == result.log.stamps[0]
+    for topic in ("/alte/map/occupancy", "/alte/map/grid", "/alte/map/grid_map",
+                  "/alte/map/cells", "/alte/cloud", "/alte/trajectory"):
+        assert table[topic] == (TOPICS[topic], "ros2msg", 2)  # at the start and at the end
+        assert [t for t, _ in messages[topic]] == [start, result.log.stamps[-1]]
+    compressions, chunk_crcs, data_crc = container(target)
+    assert compressions == {"zstd"} and chunk_crcs and data_crc != 0
     grid = raster(result.mapper.cells(), np.zeros(3))
     occupancy = messages["/alte/map/occupancy"][0][1]
+    values = np.asarray(occupancy.data).reshape(grid.shape)
+    assert (values == grid.occupancy).all()
+    assert (values == 0).sum() > 0.5 * values.size and (values == 100).any()
+    assert ((values == -1) == ~np.isfinite(grid.height)).all()  # -1 only where unseen
+    assert occupancy.info.origin.position.z < np.nanmin(grid.height)  # under the map
+    fox = messages["/alte/map/grid"][0][1]
+    assert [f.name for f in fox.fields][:2] == ["elevation", "occupancy"]
+    assert (fox.column_count, len(fox.data)) == (grid.shape[1], grid.height.size * 9)
+    packed = np.frombuffer(bytes(fox.data), dtype=np.uint8).reshape(*grid.shape, 9)
+    assert (packed[..., 4].view(np.int8) == values).all()
     assert occupancy.info.resolution == pytest.approx(grid.resolution)
     assert (occupancy.info.origin.position.x, occupancy.info.origin.position.y) == \
         pytest.approx(tuple(grid.origin))
@@ -112,6 +117,7 @@ def test_shifted_map_gets_a_local_frame_and_alte_reads_its_own_file(tmp_path: Pa
                                 FrameSpec(origin=(500_010.0, 5_400_010.0, 110.0)))
     assert counts["/tf_static"] == 1 and any(result.info.local_origin)
     _, messages = read_back(target)
+    assert messages["/tf_static"][0][0] == messages["/alte/pose"][0][0]  # at the start
     tf = messages["/tf_static"][0][1].transforms[0]
     assert (tf.header.frame_id, tf.child_frame_id) == ("map", "alte_local")
     assert tf.transform.translation.x == result.info.local_origin[0]
@@ -126,8 +132,8 @@ def test_registration_export_and_refusals(terrains: dict[str, Path], tmp_path: P
     reg = prepare(open_input(terrains["sim_lan_2"]))
     target = tmp_path / "reg.mcap"
     counts = export_registered(reg, target, options=ExportOptions(scans=False))
-    assert counts == {"/alte/pose": FRAMES, "/tf": FRAMES, "/alte/trajectory": 1,
-                      "/alte/cloud": 1}
+    assert counts == {"/alte/pose": FRAMES, "/tf": FRAMES, "/alte/trajectory": 2,
+                      "/alte/cloud": 2}
     size = target.stat().st_size
     with pytest.raises(AlteError, match="already exists"):
         export_registered(reg, target)

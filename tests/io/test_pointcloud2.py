@@ -9,7 +9,7 @@ import pytest
 from rosbags.typesys import Stores, get_typestore
 
 from alte.errors import BagError
-from alte.io.pointcloud2 import decode_pointcloud2, encode_pointcloud2
+from alte.io.pointcloud2 import decode_pointcloud2, decode_timed, encode_pointcloud2
 
 TS = get_typestore(Stores.ROS2_HUMBLE)
 
@@ -157,3 +157,36 @@ def test_encode_rejects_bad_shapes():
         encode_pointcloud2(np.zeros((4, 2)), 0, "velodyne", TS)
     with pytest.raises(BagError, match=r"extra field 'intensity' must be N=12"):
         encode_pointcloud2(PTS, 0, "velodyne", TS, extra_fields={"intensity": np.zeros(3)})
+
+
+STAMP = 1_630_577_808_570_040_832
+SWEEP = np.linspace(0.0, 0.099, len(PTS))
+
+
+@pytest.mark.parametrize(("name", "values"), [
+    ("t", (SWEEP * 1e9).astype(np.uint32)),                       # Ouster: ns from the stamp
+    ("time", SWEEP.astype(np.float32)),                           # Velodyne: s from the stamp
+    ("timestamp", STAMP * 1e-9 + SWEEP),                          # Hesai: absolute s
+    ("offset_time", (SWEEP * 1e9).astype(np.int32))])              # Livox: ns
+def test_per_point_time_in_seconds_from_the_stamp(name, values):
+    msg = encode_pointcloud2(PTS, STAMP, "lidar", TS, extra_fields={name: values})
+    points, times, dropped = decode_timed(msg, STAMP)
+    assert dropped == 0 and np.allclose(points, PTS, atol=1e-4)
+    assert times is not None and np.allclose(times, SWEEP, atol=2e-6)
+    assert decode_timed(encode_pointcloud2(PTS, STAMP, "lidar", TS), STAMP)[1] is None
+
+
+def test_per_point_time_follows_dropped_points():
+    pts = PTS.copy()
+    pts[3] = np.nan
+    msg = encode_pointcloud2(pts, STAMP, "lidar", TS, extra_fields={"time": SWEEP})
+    points, times, dropped = decode_timed(msg, STAMP)
+    assert dropped == 1 and times is not None and len(times) == len(points) == len(PTS) - 1
+    assert np.allclose(times, np.delete(SWEEP, 3))
+
+
+def test_per_point_time_in_an_unknown_unit_is_an_error():
+    micro = (SWEEP * 1e6).astype(np.float64)  # microseconds in a float field
+    msg = encode_pointcloud2(PTS, STAMP, "lidar", TS, extra_fields={"time": micro})
+    with pytest.raises(BagError, match=r"/points: per-point time field 'time' spans 0\.\.99000"):
+        decode_timed(msg, STAMP, "/points")

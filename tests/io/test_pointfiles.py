@@ -16,6 +16,7 @@ from alte.io.pointfiles import (
     local_origin,
     read_points,
     read_points_info,
+    storable,
     write_points,
 )
 from alte.paths import realdata_dir
@@ -220,17 +221,42 @@ def test_unknown_extension_lists_supported(tmp_path):
         (
             "f.pcd",
             pcd_header(5, "binary") + b"\0" * 12,
-            "unreadable",
+            r"truncated binary PCD: 12 of the 60 bytes \(1 of 5 rows\) its header announces",
         ),
         (
             "g.pcd",
             pcd_header(1, "binary_compressed") + b"\1",
-            "truncated",
+            "truncated binary_compressed PCD: 1 bytes after the header",
         ),
         (
             "h.pcd",
             pcd_header(1, "binary_compressed") + np.array([3, 99], "<u4").tobytes() + b"abc",
-            "sizes do not match",
+            "sizes do not match the header: the body unpacks to 99 bytes, 1 rows need 12",
+        ),
+        (
+            "h2.pcd",
+            pcd_header(9, "binary_compressed") + np.array([40, 108], "<u4").tobytes() + b"abc",
+            r"truncated binary_compressed PCD: 3 of the 40 compressed bytes \(9 rows\)",
+        ),
+        (
+            "h3.pcd",
+            pcd_header(4, "ascii") + b"1 2 3\n4 5 6\n",
+            "truncated ascii PCD: 2 of the 4 rows its header announces",
+        ),
+        (
+            "h4.pcd",
+            pcd_header(2, "ascii") + b"1 2 3\n4 5\n",
+            "truncated ascii PCD: its last row has 2 of 3 values",
+        ),
+        (
+            "h5.pcd",
+            pcd_header(3, "ascii"),
+            "truncated ascii PCD: 0 of the 3 rows",
+        ),
+        (
+            "h6.pcd",
+            pcd_header(4, "binary").replace(b"HEIGHT 1", b"HEIGHT 2") + b"\0" * 96,
+            r"PCD header says WIDTH 4 x HEIGHT 2 = 8 points but POINTS 4",
         ),
         (
             "i.pcd",
@@ -385,3 +411,51 @@ def test_octomap_scan_count_matches_sources():
 def test_nebula_reference_pcd_count_matches_sources():
     points = read_points(_realdata("vlp16_packets", "reference_decoded.pcd"))
     assert points.shape == (14_831, 3)
+
+
+# ------------------------------------------------------------------ other fields
+
+
+def _fields(n: int) -> dict[str, np.ndarray]:
+    rng = np.random.default_rng(3)
+    return {"intensity": rng.integers(0, 65535, n).astype(np.uint16),
+            "colors": rng.integers(0, 256, (n, 3)).astype(np.uint8),
+            "label": rng.integers(-5, 1000, n).astype(np.int32),
+            "range": rng.uniform(0, 100, n).astype(np.float32)}
+
+
+@pytest.mark.parametrize("suffix", [".pcd", ".ply", ".npz", ".las", ".laz"])
+def test_fields_survive_the_formats_that_hold_them(tmp_path, cloud, suffix):
+    fields = _fields(len(cloud))
+    back = read_points_info(write_points(tmp_path / f"f{suffix}", cloud, fields=fields))
+    assert set(back.fields) == set(fields)
+    for name, values in fields.items():
+        np.testing.assert_array_equal(back.fields[name], values, err_msg=name)
+
+
+def test_fields_a_format_cannot_hold_are_named(tmp_path, cloud):
+    fields = {**_fields(len(cloud)), "intensity": np.linspace(0, 1, len(cloud))}
+    kept, dropped = storable(".las", fields)
+    assert dropped == {"intensity": "LAS intensity holds integers 0..65535"}
+    assert set(kept) == {"colors", "label", "range"}
+    assert storable(".xyz", fields)[1]["label"] == "plain text holds x y z only"
+    back = read_points_info(write_points(tmp_path / "f.xyz", cloud, fields=fields))
+    assert back.fields == {}
+    with pytest.raises(PointFileError, match=r"fields \['label'\] do not have one row per point"):
+        write_points(tmp_path / "g.pcd", cloud, fields={"label": np.zeros(3)})
+
+
+def test_pcd_fields_rgb_and_nan_rows(tmp_path):
+    rgb = np.array([0xFF0000, 0x00FF00, 0x0000FF], "<u4").view("<f4")
+    data = np.zeros(3, [("x", "<f4"), ("y", "<f4"), ("z", "<f4"), ("rgb", "<f4"),
+                        ("label", "<u4")])
+    data["x"], data["rgb"], data["label"] = [1, np.nan, 3], rgb, [7, 8, 9]
+    head = pcd_header(3, "binary", fields="x y z rgb label", sizes="4 4 4 4 4",
+                      types="F F F F U", counts="1 1 1 1 1")
+    (tmp_path / "c.pcd").write_bytes(head + data.tobytes())
+    info = read_points_info(tmp_path / "c.pcd")
+    assert info.nonfinite == 1 and info.fields["label"].tolist() == [7, 9]
+    assert info.fields["colors"].tolist() == [[255, 0, 0], [0, 0, 255]]
+    out = write_points(tmp_path / "d.pcd", info.points, fields=info.fields)
+    assert b"FIELDS x y z rgb label" in out.read_bytes()[:200]
+    assert read_points_info(out).fields["colors"].tolist() == [[255, 0, 0], [0, 0, 255]]

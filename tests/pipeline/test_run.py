@@ -78,6 +78,11 @@ def test_quadtree_fed_by_frames_equals_its_batch_build(terrain: Path) -> None:
     _same_map(batch, frames)
     assert batch.log.insert_s[:-1].sum() == 0 and batch.log.insert_s[-1] > 0
     assert (frames.log.insert_s > 0).all()
+    # CPU seconds beside the wall seconds, for the build only when batch-fed
+    assert batch.log.insert_cpu_s[:-1].sum() == 0 and batch.cpu_s == batch.log.insert_cpu_s[-1]
+    assert (frames.log.insert_cpu_s >= 0).all() and frames.cpu_s > 0
+    summary = frames.summary()
+    assert summary["cost"] == frames.mapper.cost > 0 and summary["cost_unit"] == "cell updates"
 
 
 def test_snapshots_end_with_the_final_map(terrain: Path) -> None:

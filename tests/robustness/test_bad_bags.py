@@ -297,3 +297,14 @@ def test_far_points_never_occupy_octomap_cells(bags, capsys, tmp_path):
     with np.load(tmp_path / "o.npz") as cells:
         occupied = cells["centers"][cells["occupied"]]
     assert len(occupied) > 0 and np.abs(occupied).max() < 60.0
+
+
+def test_pose_topic_on_another_clock_recovers_with_odometry(bags, capsys, tmp_path):
+    """Poses an hour after the scans: the error names the flags, --poses odometry maps."""
+    scans = [(10 + k) * bags.NS for k in range(4)]
+    poses = [(3600 + k) * bags.NS for k in range(6)]
+    bag = bags.write_ros2(tmp_path / "clock", bags.mission(scan_stamps=scans, pose_stamps=poses))
+    line = _fails(bags, capsys, "register", bag, tmp_path)
+    assert "different clocks? Use --poses odometry" in line and "--pose-file" in line
+    out = _register(bags, capsys, bag, tmp_path, "--poses", "odometry", "--odometry", "plane")
+    assert "poses: odometry (point-to-plane" in out

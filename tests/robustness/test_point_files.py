@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
@@ -61,3 +63,54 @@ def test_only_nonfinite_points(bags, capsys, tmp_path):
     code, _, err = bags.run_cli(capsys, "map", path, "--mapper", "alte2d")
     assert code == 2
     assert f"{path}: no finite points (2 rows)" in bags.one_line_error(err, "map")
+
+
+def _ascii_pcd(path, rows, points, width=None):
+    body = "".join(f"{x} {y} {z}\n" for x, y, z in CLOUD[:rows])
+    path.write_text("VERSION 0.7\nFIELDS x y z\nSIZE 8 8 8\nTYPE F F F\nCOUNT 1 1 1\n"
+                    f"WIDTH {width or points}\nHEIGHT 1\nPOINTS {points}\nDATA ascii\n{body}")
+    return path
+
+
+@pytest.mark.parametrize("command", ["map", "register"])
+def test_truncated_ascii_pcd_is_refused_with_the_row_counts(bags, capsys, tmp_path, command):
+    """Half the rows of an ascii PCD: PCL refuses it, so does alte (it used to read 1000)."""
+    path = _ascii_pcd(tmp_path / "half.pcd", 1000, 2000)
+    extra = ["--mapper", "alte2d"] if command == "map" else ["--out", tmp_path / "c.ply"]
+    code, out, err = bags.run_cli(capsys, command, path, *extra)
+    assert code == 2, out
+    assert f"{path}: truncated ascii PCD: 1000 of the 2000 rows its header announces" in \
+        bags.one_line_error(err, command)
+    assert not (tmp_path / "c.ply").exists()
+
+
+@pytest.mark.parametrize(("encoding", "message"), [
+    ("binary", r"truncated binary PCD: 24000 of the 48000 bytes \(1000 of 2000 rows\)"),
+    ("binary_compressed", "binary_compressed sizes do not match the header: the body unpacks "
+                          "to 24000 bytes, 2000 rows need 48000"),
+])
+def test_a_header_claiming_more_points_than_rows_is_refused(bags, capsys, tmp_path, encoding,
+                                                            message):
+    path = write_points(tmp_path / "c.pcd", CLOUD[:1000])
+    blob = path.read_bytes().replace(b"WIDTH 1000", b"WIDTH 2000").replace(b"POINTS 1000",
+                                                                           b"POINTS 2000")
+    if encoding == "binary_compressed":  # literal-only LZF of the same 1000 rows, field-major
+        head, body = blob.split(b"DATA binary\n")
+        raw = np.frombuffer(body, "<f8").reshape(-1, 3).T.copy().tobytes()
+        lzf = b"".join(bytes([len(raw[i:i + 32]) - 1]) + raw[i:i + 32]
+                       for i in range(0, len(raw), 32))
+        blob = head + b"DATA binary_compressed\n" + np.array(
+            [len(lzf), len(raw)], "<u4").tobytes() + lzf
+    path.write_bytes(blob)
+    code, out, err = bags.run_cli(capsys, "map", path, "--mapper", "alte2d")
+    assert code == 2, out
+    line = bags.one_line_error(err, "map")
+    assert str(path) in line and re.search(message, line), line
+
+
+def test_width_times_height_must_match_points(bags, capsys, tmp_path):
+    path = _ascii_pcd(tmp_path / "w.pcd", 10, 10, width=12)
+    code, _, err = bags.run_cli(capsys, "map", path, "--mapper", "alte2d")
+    assert code == 2
+    assert "PCD header says WIDTH 12 x HEIGHT 1 = 12 points but POINTS 10" in \
+        bags.one_line_error(err, "map")

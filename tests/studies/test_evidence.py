@@ -87,10 +87,29 @@ def test_seeds_that_disagree_or_a_single_seed_leave_it_uncertain():
 
 
 def test_similar_within_the_band():
-    # 2D-ALTE's thesis setting has ~127 basis functions, Quadtree's (max_points=150) ~6,667
+    # equal sizes at the thesis' settings: similar; Quadtree's 50x larger: not similar
+    check = Compare("lan", "alte2d", "quadtree", "basis_functions", "thesis_point",
+                    relation="similar")
+    table = synthetic_tradeoff()
+    same = table["mapper"] == "alte2d"
+    setting = '{"kappa": 0.05, "max_res": 4, "min_pts": 100}'
+    quad = (table["mapper"] == "quadtree") & (table["params"] == '{"max_points": 150}')
+    table.loc[same & (table["params"] == setting), "basis_functions"] = int(
+        table.loc[quad, "basis_functions"].iloc[0] * 1.1)
+    assert evaluate(_claim(check), table).verdict == "holds"
+    assert evaluate(_claim(check), synthetic_tradeoff()).verdict == "does not hold"
+
+
+def test_similar_times_cannot_hold_within_their_spread():
+    # 2D-ALTE's thesis setting has ~127 basis functions, Quadtree's (max_points=150) ~6,667:
+    # equal times, each known within x1.28 (the floor), cannot be shown within 25 % ...
     same_time = Curve(seconds=0.01 * 6667 / 127.4)
     check = Compare("lan", "alte2d", "quadtree", "elapsed_s", "thesis_point", relation="similar")
-    assert evaluate(_claim(check), synthetic_tradeoff({"alte2d": same_time})).verdict == "holds"
+    found = evaluate(_claim(check), synthetic_tradeoff({"alte2d": same_time}))
+    assert (found.verdict, found.depends_on) == ("depends", "uncertainty")
+    assert found.time_check.startswith("CPU time, within its spread")
+    assert "mapping CPU time [s], 2D-ALTE / Quadtree" in found.evidence
+    # ... but times 50x apart are not similar whatever the spread
     assert evaluate(_claim(check), synthetic_tradeoff()).verdict == "does not hold"
 
 

@@ -37,7 +37,8 @@ def test_comparison_tables_read_both_cases_at_the_stated_sizes():
     assert (wide["alte2d"] < wide["quadtree"]).all() and len(wide) == 3
     assert set(at_size.loc[at_size["case"] == "nav", "metric"]) == {
         "mhd_m", "accuracy_mean_m", "completeness"}  # no height RMSE for 3D maps
-    assert set(at_fidelity["metric"]) == {"basis_functions", "memory_bytes", "elapsed_s"}
+    assert set(at_fidelity["metric"]) == {"basis_functions", "memory_bytes", "elapsed_s",
+                                          "map_cpu_s"}
     assert (at_fidelity["seeds"] == 3).all()
 
 

@@ -14,7 +14,9 @@ from alte.cli import main
 from alte.errors import ParameterError
 from alte.mappers.domain import Domain
 from alte.metrics.maps import TruthOptions
-from alte.studies.experiments import CACHE_DIR, ground_truth, measure, sweep, terrain
+from alte.pipeline import MapSpec
+from alte.studies import experiments
+from alte.studies.experiments import CACHE_DIR, ground_truth, measure, sweep, terrain, timed_run
 
 FRAMES = 4
 TRUTH = TruthOptions(n_samples=5000, grid_step=0.5)
@@ -57,6 +59,20 @@ def test_measure_times_and_measures_2d_maps(lan, mapper: str, params: dict) -> N
     assert m.hd_minus_mhd_m == pytest.approx(m.hd_m - m.mhd_m)
     assert m.truth is not None and 0 <= m.truth.unknown_share <= 1
     assert m.truth.completeness > 0.3 and m.truth.height_rmse_m < 1.0
+
+
+def test_a_cheap_map_is_timed_as_the_median_of_repeated_runs(lan, monkeypatch) -> None:
+    result, timing = timed_run(lan, MapSpec("alte2d", {"max_res": 5}))
+    assert timing.repeats == experiments.REPEATS == 3
+    assert timing.cpu_s > 0 and timing.elapsed_s > 0 and timing.cpu_spread >= 0
+    m = measure(lan, "alte2d", {"max_res": 5}).metrics
+    assert (m.time_repeats, m.cost) == (3, result.mapper.cost) and m.map_cpu_s > 0
+    # a map dearer than the threshold is timed once: no spread measured
+    monkeypatch.setattr(experiments, "REPEAT_BELOW_S", 0.0)
+    once = timed_run(lan, MapSpec("alte2d", {"max_res": 5}))[1]
+    assert once.repeats == 1 and np.isnan(once.cpu_spread)
+    with pytest.raises(ParameterError, match="repeats=0: expected at least 1"):
+        timed_run(lan, MapSpec("alte2d"), repeats=0)
 
 
 def test_measure_without_truth_has_only_thesis_metrics(lan) -> None:
@@ -111,8 +127,10 @@ def test_cli_on_the_terrain_folder_reproduces_the_table_row(
     assert main(["map", str(data.source.path), "--mapper", mapper, *sets, "--metrics",
                  "--json"]) == 0
     cli = json.loads(capsys.readouterr().out)
-    ours = {k: v for k, v in row.metrics.as_dict().items() if k != "elapsed_s"}
-    theirs = {k: v for k, v in cli["metrics"].items() if k != "elapsed_s"}
+    timing = {"elapsed_s", "elapsed_spread", "map_cpu_s", "map_cpu_spread", "time_repeats"}
+    ours = {k: v for k, v in row.metrics.as_dict().items() if k not in timing}
+    theirs = {k: v for k, v in cli["metrics"].items() if k not in timing}
+    assert cli["metrics"]["time_repeats"] == 1 and cli["metrics"]["map_cpu_s"] > 0
     assert json.loads(json.dumps(ours)) == theirs
     assert cli["basis_functions"] == row.metrics.basis_functions
     assert cli["domain"] == (None if row.run.info.domain is None

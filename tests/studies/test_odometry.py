@@ -1,4 +1,4 @@
-"""The odometry study: rigid alignment, ATE, and the table on a small mission."""
+"""The pose benchmark: its table on a small simulated mission and its figures on balm_seq."""
 
 from __future__ import annotations
 
@@ -7,45 +7,63 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
-from scipy.spatial.transform import Rotation
 
+from alte.cli import main
 from alte.errors import AlteError, ParameterError
-from alte.studies.odometry import align_rigid, ate, odometry_table, write_odometry_table
+from alte.paths import realdata_dir
+from alte.studies.odometry import (
+    COLUMNS,
+    bench_input,
+    odometry_table,
+    pose_benchmark,
+    write_odometry_table,
+)
 
-
-def test_align_rigid_recovers_a_rotation_and_translation() -> None:
-    rng = np.random.default_rng(0)
-    points = rng.normal(0, 5, (50, 3))
-    rotation = Rotation.from_euler("zyx", [40, -10, 5], degrees=True).as_matrix()
-    moved = points @ rotation.T + [3.0, -2.0, 1.0]
-    found, shift = align_rigid(points, moved)
-    assert np.allclose(found, rotation) and np.allclose(shift, [3.0, -2.0, 1.0])
-    assert ate(points, moved) == pytest.approx(0.0, abs=1e-9)
-
-
-def test_ate_is_the_rms_of_what_no_rigid_motion_explains() -> None:
-    line = np.column_stack([np.arange(8.0), np.zeros(8), np.zeros(8)])
-    bent = line.copy()
-    bent[:, 2] = 0.1 * np.array([1, -1, -1, 1, -1, 1, 1, -1])  # zero mean, uncorrelated with x
-    assert ate(line, bent) == pytest.approx(0.1, rel=1e-6)
-    mirror = np.diag([1.0, 1.0, -1.0])
-    cloud = np.random.default_rng(1).normal(0, 1, (30, 3))
-    found, _ = align_rigid(cloud, cloud @ mirror)  # no reflection allowed
-    assert np.linalg.det(found) == pytest.approx(1.0)
-    with pytest.raises(ParameterError, match="align_rigid: need two matched sets"):
-        align_rigid(line[:2], line[:2])
+BALM = realdata_dir() / "balm_seq"
 
 
 def test_table_on_a_small_mission(tmp_path: Path) -> None:
-    table = odometry_table(["exp_nav_2"], tmp_path / "data", frames=8, progress=False)
-    row = table.iloc[0]
-    assert row["terrain"] == "exp_nav_2" and row["frames_selected"] == 8
-    for key in ("recorded", "odometry", "kiss", "refine"):
-        assert row[f"frames_{key}"] >= 7 and np.isfinite(row[f"ate_{key}_m"])
-        assert 0 < row[f"mesh_{key}_m"] < 5
+    table = odometry_table(["exp_nav_2"], data_dir=tmp_path / "data", frames=8,
+                           sources=["recorded", "kiss", "refine"], progress=False)
+    assert list(table.columns) == list(COLUMNS)
+    assert table["source"].tolist() == ["recorded", "kiss", "refine"]
+    for row in table.itertuples():
+        assert row.frames >= 7 and np.isfinite(row.ate_m) and 0 < row.mesh_mean_m < 5
+        assert 0 <= row.cloud_median_m <= row.cloud_p90_m
+    refine = table.iloc[2]
+    assert refine.corrected + refine.kept == refine.frames
     path = write_odometry_table(table, tmp_path / "tables")
     assert pd.read_csv(path).shape == table.shape
     with pytest.raises(AlteError, match="already exists"):
         write_odometry_table(table, tmp_path / "tables")
-    with pytest.raises(ParameterError, match="unknown terrain"):
-        odometry_table(["moon"], tmp_path / "data")
+
+
+def test_benchmark_errors_are_typed(tmp_path: Path, capsys) -> None:
+    with pytest.raises(ParameterError, match="moon: neither a simulated terrain"):
+        odometry_table(["moon"], data_dir=tmp_path / "data", progress=False)
+    with pytest.raises(ParameterError, match="--reference: exp_nav_2 is a simulated terrain"):
+        bench_input("exp_nav_2", reference=tmp_path / "poses.txt", data_dir=tmp_path)
+    assert main(["odometry", "exp_nav_2", "--sources", "kiss,icp"]) == 2
+    assert "--sources 'kiss,icp': valid sources are recorded, kiss" in capsys.readouterr().err
+    assert main(["odometry", "exp_nav_2", "--odometry-set", "kiss:min_gain=0.5"]) == 2
+    assert "--odometry-set kiss:min_gain: not a setting of kiss" in capsys.readouterr().err
+    assert main(["odometry", "exp_nav_2", "--reference", str(tmp_path / "no.txt")]) == 2
+    assert "--reference" in capsys.readouterr().err
+
+
+@pytest.mark.slow
+@pytest.mark.realdata
+def test_balm_seq_figures(tmp_path: Path) -> None:
+    """The real sequence with its BALM poses: KISS-ICP's defaults within 35 mm (median) of
+    the reference-pose cloud (measured 31.6 mm; the 20 mm goal is not met yet), refinement
+    within 1.1x of the recorded poses (measured: every scan kept, 1.0x; README, "Poses")."""
+    if not BALM.exists():
+        pytest.skip("../shared/realdata/balm_seq absent")
+    item = bench_input(BALM / "bag")  # its /lidar_pose topic as the reference
+    table = pose_benchmark(item, ["recorded", "kiss", "refine"]).set_index("source")
+    recorded, kiss, refine = (table.loc[k] for k in ("recorded", "kiss", "refine"))
+    assert recorded.ate_m < 1e-3 and recorded.frames == 77
+    assert kiss.cloud_median_m < 0.035 and kiss.ate_m < 0.05
+    assert kiss.rpe_trans_pct < 5 and kiss.rpe_rot_deg_m < 0.5
+    assert refine.cloud_median_m <= 1.1 * recorded.cloud_median_m
+    assert refine.corrected + refine.kept == 77

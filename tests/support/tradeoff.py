@@ -3,8 +3,8 @@
 Each mapper gets a parameter grid (>= 10 settings, the thesis' chosen settings
 included); map size follows from the setting, MHD from the size through a power law
 ``scale * (size / 1000) ** -slope``, with a few percent of seeded noise per seed. The
-other metrics follow from those two, so a test controls who wins by choosing the scales
-and slopes (:class:`Curve`).
+other metrics follow from those two (time and machine-independent cost in proportion to
+the size), so a test controls who wins by choosing the scales and slopes (:class:`Curve`).
 """
 
 from __future__ import annotations
@@ -69,6 +69,9 @@ def _row(terrain: str, mapper: str, p: Mapping[str, float], seed: int, *, curve:
         "terrain": terrain, "mapper": mapper, "params": json.dumps(p, sort_keys=True),
         "seed": seed, "basis_functions": round(size), "occupied_cells": round(occupied),
         "memory_bytes": round(size * 64), "elapsed_s": curve.seconds * size / 1000.0,
+        "elapsed_spread": 0.2, "map_cpu_s": curve.seconds * size / 1000.0,
+        "map_cpu_spread": 0.05, "time_repeats": 3, "cost": round(size * 50),
+        "cost_unit": "ray steps" if mapper == "octomap" else "cell updates",
         "mhd_m": mhd, "hd_m": 4.0 + 0.5 * rng.normal(), "mh_ab_m": mhd, "mh_ba_m": 0.5 * mhd,
         "accuracy_mean_m": 0.2 * mhd, "completeness": 1.0 - mhd / 5.0,
         "size_octaves": 5.0 if mapper.startswith("alte") else 2.0,

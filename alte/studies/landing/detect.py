@@ -20,9 +20,9 @@ import pandas as pd
 from scipy import ndimage
 
 from alte.errors import ParameterError
-from alte.ground import fit_plane_msac
+from alte.ground.surface import ground_obstacles, planar, plane_features
 from alte.studies.landing.params import LandingParams
-from alte.studies.landing.raster import Grid, plane_features
+from alte.studies.landing.raster import Grid
 
 __all__ = ["SITE_COLUMNS", "Centres", "Detection", "detect_sites", "feasible_centres",
            "map_obstacles", "rank_sites"]
@@ -30,7 +30,6 @@ __all__ = ["SITE_COLUMNS", "Centres", "Detection", "detect_sites", "feasible_cen
 #: Columns of the site table, best site first.
 SITE_COLUMNS = ("rank", "x", "y", "height", "area_m2", "clearance_m", "slope_deg",
                 "roughness_m", "score", "chosen")
-_MAX_FIT_PIXELS = 50_000
 
 
 @dataclass(frozen=True)
@@ -78,24 +77,9 @@ def map_obstacles(height: np.ndarray, grid: Grid, params: LandingParams,
     """Known pixels more than ``obstacle_height`` above or below the ground.
 
     ``ground`` is a height (m); None fits the ground plane with MSAC (thesis 2.1.4)
-    to the known pixels (at most 50 000 of them, drawn with a seeded generator).
+    to the known pixels (:func:`alte.ground.surface.ground_obstacles`).
     """
-    known: np.ndarray = np.isfinite(height)
-    if ground is not None:
-        return known & (np.abs(np.where(known, height, ground) - ground) > params.obstacle_height)
-    if known.sum() < 3:
-        return np.zeros(height.shape, dtype=bool)
-    xy = grid.centers()[known.ravel()]
-    pts = np.column_stack([xy, height[known]])
-    if len(pts) > _MAX_FIT_PIXELS:
-        pts = pts[np.random.default_rng(seed).choice(len(pts), _MAX_FIT_PIXELS, replace=False)]
-    plane = fit_plane_msac(pts, threshold=params.obstacle_height / 2, seed=seed,
-                           reference_normal=np.array([0.0, 0.0, 1.0]), max_angle_deg=30.0)
-    all_xy = grid.centers()
-    above = (all_xy @ plane.normal[:2] + height.ravel() * plane.normal[2] + plane.d)
-    obstacles: np.ndarray = known & (np.abs(np.nan_to_num(above.reshape(grid.shape)))
-                                     > params.obstacle_height)
-    return obstacles
+    return ground_obstacles(height, grid.centers(), params.obstacle_height, ground, seed)
 
 
 def feasible_centres(height: np.ndarray, obstacle: np.ndarray, step: float,
@@ -110,10 +94,8 @@ def feasible_centres(height: np.ndarray, obstacle: np.ndarray, step: float,
     known_dist = _distance_to(~known, step, pad_true=True)
     obstacle_dist = _distance_to(obstacle & known, step, pad_true=False)
     feats = plane_features(height, step, params.disk)
-    with np.errstate(invalid="ignore"):
-        planar = (feats.slope_deg <= params.max_slope_deg) & \
-                 (feats.roughness <= params.max_roughness)
-    feasible = known & planar & (known_dist > params.disk) & (obstacle_dist > params.keep_out)
+    flat = planar(feats, params.surface)
+    feasible = known & flat & (known_dist > params.disk) & (obstacle_dist > params.keep_out)
     return Centres(feasible, known_dist, obstacle_dist, feats.slope_deg, feats.roughness,
                    obstacle & known)
 

@@ -23,6 +23,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from alte.errors import ParameterError
+from alte.ground.surface import SurfaceRule
 from alte.params import Record, param
 
 __all__ = ["LAB", "QUADROTOR", "LandingParams", "landing_params"]
@@ -60,6 +61,14 @@ class LandingParams(Record):
     def disk(self) -> float:
         """Radius (m) of the disk that must be known, planar and obstacle-free."""
         return self.radius + self.margin
+
+    @property
+    def surface(self) -> SurfaceRule:
+        """The landing criterion of :mod:`alte.ground.surface` these limits give (window:
+        the disk; ground: the MSAC plane)."""
+        return SurfaceRule(window=self.disk, max_slope_deg=self.max_slope_deg,
+                           max_roughness=self.max_roughness,
+                           obstacle_height=self.obstacle_height, ground="plane")
 
     @property
     def keep_out(self) -> float:

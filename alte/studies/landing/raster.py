@@ -4,10 +4,8 @@ Landing tests need the same question answered at every candidate centre ("is the
 disk around here known, planar, free?"), which is cheap on a regular grid with
 image filters. :func:`rasterise` samples a map's cells at the pixel centres (each
 pixel takes the height of the cell holding it; NaN where no cell with a height
-does: unknown). :func:`plane_features` fits ``z = a x + b y + c`` by least squares
-over a square window around every pixel at once: the window sums of the moments
-``1, x, y, z, x^2, xy, y^2, xz, yz, z^2`` of the known pixels come from
-``scipy.ndimage.uniform_filter``, so the fit costs ten filters whatever the window.
+does: unknown). :func:`plane_features` (the local plane fit of the landing
+criterion) lives in :mod:`alte.ground.surface`, shared with the map export.
 """
 
 from __future__ import annotations
@@ -15,9 +13,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import ndimage
 
 from alte.errors import ParameterError
+from alte.ground.surface import PlaneFeatures, pixel_centres, plane_features
 from alte.mappers.base import Cells
 from alte.metrics import cell_at_xy
 
@@ -55,9 +53,7 @@ class Grid:
 
     def centers(self) -> np.ndarray:
         """Pixel centres (ny * nx, 2), row-major (y slow, x fast)."""
-        xs, ys = self.axes()
-        gx, gy = np.meshgrid(xs, ys, indexing="xy")
-        return np.column_stack([gx.ravel(), gy.ravel()])
+        return pixel_centres(self.origin, self.step, self.shape)
 
     def index(self, xy: np.ndarray) -> np.ndarray:
         """(row, col) of the pixels holding points ``xy`` (N, 2) (not clipped)."""
@@ -80,47 +76,3 @@ def rasterise(cells: Cells, grid: Grid) -> np.ndarray:
     height = np.where(idx >= 0, centers[np.maximum(idx, 0), 2] if len(centers) else np.nan,
                       np.nan)
     return height.reshape(grid.shape)
-
-
-@dataclass(frozen=True)
-class PlaneFeatures:
-    """Per pixel: plane tilt ``slope_deg``, residual std ``roughness`` (m), known ``count``.
-
-    NaN where the window's known pixels do not fix a plane (fewer than 3, collinear).
-    """
-
-    slope_deg: np.ndarray
-    roughness: np.ndarray
-    count: np.ndarray
-
-
-def plane_features(height: np.ndarray, step: float, radius: float) -> PlaneFeatures:
-    """Least-squares plane over the square window of half-side ``radius`` (m) at every pixel."""
-    known = np.isfinite(height)
-    half = max(int(np.ceil(radius / step - 1e-9)), 1)
-    size = 2 * half + 1
-    ny, nx = height.shape
-    y, x = np.meshgrid((np.arange(ny) - ny / 2) * step, (np.arange(nx) - nx / 2) * step,
-                       indexing="ij")
-    w = known.astype(np.float64)
-    z = np.where(known, height - np.median(height[known]), 0.0) if known.any() else w
-
-    def mean(values: np.ndarray) -> np.ndarray:
-        return ndimage.uniform_filter(values * w, size=size, mode="constant", cval=0.0)
-
-    s1 = mean(np.ones_like(z))
-    with np.errstate(invalid="ignore", divide="ignore"):
-        mx, my, mz = mean(x) / s1, mean(y) / s1, mean(z) / s1
-        cxx = mean(x * x) / s1 - mx * mx
-        cyy = mean(y * y) / s1 - my * my
-        cxy = mean(x * y) / s1 - mx * my
-        cxz = mean(x * z) / s1 - mx * mz
-        cyz = mean(y * z) / s1 - my * mz
-        czz = mean(z * z) / s1 - mz * mz
-        det = cxx * cyy - cxy * cxy
-        ok = (s1 * size * size >= 2.5) & (det > 1e-6 * step**4)
-        a = np.where(ok, (cyy * cxz - cxy * cyz) / det, np.nan)
-        b = np.where(ok, (cxx * cyz - cxy * cxz) / det, np.nan)
-        residual = np.maximum(czz - a * cxz - b * cyz, 0.0)
-    slope = np.degrees(np.arctan(np.hypot(a, b)))
-    return PlaneFeatures(slope, np.sqrt(residual), np.rint(s1 * size * size).astype(np.int64))

@@ -26,6 +26,7 @@ from tqdm.auto import tqdm
 from alte.errors import ParameterError, SimulationError
 from alte.pipeline import FrameSpec, open_input, prepare
 from alte.sim import ensure_terrain
+from alte.sim.profile import PROFILES
 from alte.studies.experiments import CACHE_DIR
 from alte.studies.sweep.spec import SweepRun, SweepSettings, SweepSpec, plan_runs, plan_variants
 from alte.studies.sweep.store import finished_ids, load_results, write_row
@@ -61,11 +62,11 @@ class SweepResult:
                             "params": dict(r.params), "error": msg} for r, msg in self.failed]}
 
 
-def _ensure(item: tuple[str, int | None, int, float | None], data_dir: str) -> str:
+def _ensure(item: tuple[str, int | None, int, float | None, str, bool], data_dir: str) -> str:
     """Simulate the terrain if needed and register it into the cache (once per item)."""
-    terrain, frames, seed, voxel = item
-    folder = ensure_terrain(terrain, data_dir, seed, frames)
-    prepare(open_input(folder), FrameSpec(frames=frames, voxel=voxel),
+    terrain, frames, seed, voxel, sensor, deskew = item
+    folder = ensure_terrain(terrain, data_dir, seed, frames, profile=PROFILES[sensor])
+    prepare(open_input(folder), FrameSpec(frames=frames, voxel=voxel, deskew=deskew),
             cache=Path(data_dir) / CACHE_DIR)
     return str(folder)
 
@@ -125,7 +126,8 @@ def _executor(scheduler: str, workers: int) -> Iterator[MapUnordered]:
 
 def _ensure_all(pool: MapUnordered, runs: Sequence[SweepRun], data_dir: str,
                 progress: bool) -> None:
-    items = sorted({(r.terrain, r.frames, r.seed, r.voxel) for r in runs}, key=str)
+    items = sorted({(r.terrain, r.frames, r.seed, r.voxel, r.sensor, r.deskew) for r in runs},
+                   key=str)
     bar = tqdm(total=len(items), desc="terrains", unit="terrain", disable=not progress)
     with bar:
         for i, _, err in pool(_ensure, items, data_dir):

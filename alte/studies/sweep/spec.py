@@ -89,10 +89,13 @@ class SweepRun:
     truth: TruthOptions = field(default_factory=TruthOptions)
     domain: str = "auto"
     set_b: str = "corners"
+    sensor: str = "thesis"
+    deskew: bool = True
 
     def key(self) -> dict[str, Any]:
-        """Everything that determines the run's result, JSON-ready (``domain`` and
-        ``set_b`` only when not the default, so earlier runs keep their ids)."""
+        """Everything that determines the run's result, JSON-ready (``domain``, ``set_b``,
+        ``sensor`` and ``deskew`` only when not the default, so earlier runs keep their
+        ids)."""
         key = {"terrain": self.terrain, "frames": self.frames, "seed": self.seed,
                "mapper": self.mapper, "params": dict(sorted(self.params.items())),
                "voxel": self.voxel, "truth": dataclasses.asdict(self.truth)}
@@ -100,6 +103,10 @@ class SweepRun:
             key["domain"] = self.domain
         if self.set_b != "corners":
             key["set_b"] = self.set_b
+        if self.sensor != "thesis":
+            key["sensor"] = self.sensor
+        if not self.deskew:
+            key["deskew"] = False
         return key
 
     @property
@@ -260,7 +267,8 @@ def _variant_runs(spec: SweepSpec, variant: Variant) -> list[SweepRun]:
     terrains = variant.terrains or spec.terrains
     return [SweepRun(terrain, spec.frames, seed, grid.mapper,
                      variant.params_for(grid.mapper, params), spec.voxel, spec.truth,
-                     variant.domain_for(grid.mapper), variant.set_b_for(grid.mapper))
+                     variant.domain_for(grid.mapper), variant.set_b_for(grid.mapper),
+                     variant.sensor, variant.deskew)
             for seed in spec.seeds for terrain in spec.terrains if terrain in terrains
             for grid in spec.mappers if terrain in grid.terrains for params in grid.rows]
 

@@ -24,8 +24,10 @@ __all__ = ["KEY_COLUMNS", "TIMING_COLUMNS", "finished_ids", "load_results", "wri
 
 #: Columns identifying a run (then ``p_<param>`` columns, then the metrics).
 KEY_COLUMNS = ("run_id", "terrain", "frames_requested", "seed", "mapper", "params_json")
-#: Timing columns: the only ones that differ between repeated runs.
-TIMING_COLUMNS = ("elapsed_s", "wall_s", "cpu_s")
+#: Timing columns: the only ones that differ between repeated runs (the map's time and
+#: its spreads, :class:`alte.metrics.timing.Timing`; the whole run's wall and CPU seconds).
+TIMING_COLUMNS = ("elapsed_s", "elapsed_spread", "map_cpu_s", "map_cpu_spread", "wall_s",
+                  "cpu_s")
 
 _PREFIX, _SUFFIX = "run-", ".parquet"
 

@@ -3,8 +3,11 @@
 A spec's ``variants`` maps a name to what it changes against the grid as written (the
 ``base`` variant): the map's root cell (``domain``: ``auto``, ``control`` or ``data``,
 see :class:`alte.pipeline.DomainPolicy`), the definition of set B in HD/MHD (``set_b``,
-see :data:`alte.metrics.maps.SET_B`) or some mappers' parameters (``params``: mapper ->
-{parameter: value}), optionally on fewer ``terrains``. A variant runs only the maps it
+see :data:`alte.metrics.maps.SET_B`), some mappers' parameters (``params``: mapper ->
+{parameter: value}) or the simulated sensor (``sensor``: a profile of
+:data:`alte.sim.profile.PROFILES`, its terrains simulated into ``NAME-PROFILE``; with
+``deskew: false`` its swept scans are registered as taken), optionally on fewer
+``terrains``. A variant runs only the maps it
 changes: a run whose effective settings equal a base run's (a mapper the variant does
 not touch, or Octomap under another domain, which it does not use) *is* that run, once.
 """
@@ -19,6 +22,7 @@ from alte.errors import AlteError, ParameterError
 from alte.mappers import DomainUse, make_mapper, mapper_class
 from alte.metrics.maps import SET_B
 from alte.pipeline import DomainPolicy
+from alte.sim.profile import PROFILES
 
 __all__ = ["BASE", "DOMAINS", "Variant", "parse_variants"]
 
@@ -26,7 +30,7 @@ __all__ = ["BASE", "DOMAINS", "Variant", "parse_variants"]
 BASE = "base"
 #: Valid ``domain`` values.
 DOMAINS = tuple(p.value for p in DomainPolicy)
-_KEYS = ("text", "domain", "set_b", "params", "terrains")
+_KEYS = ("text", "domain", "set_b", "params", "terrains", "sensor", "deskew")
 
 
 @dataclass(frozen=True)
@@ -39,6 +43,8 @@ class Variant:
     set_b: str = "corners"
     params: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)
     terrains: tuple[str, ...] = ()
+    sensor: str = "thesis"
+    deskew: bool = True
 
     def domain_for(self, mapper: str) -> str:
         """The domain policy a run of ``mapper`` gets (``auto`` where it uses none)."""
@@ -63,6 +69,12 @@ def _choice(source: str, key: str, value: Any, valid: tuple[str, ...]) -> str:
     if value not in valid:
         raise _fail(source, key, f"{value!r}: expected one of {', '.join(valid)}")
     return str(value)
+
+
+def _flag(source: str, key: str, value: Any) -> bool:
+    if not isinstance(value, bool):
+        raise _fail(source, key, f"{value!r}: expected true or false")
+    return value
 
 
 def _params(source: str, key: str, value: Any, mappers: tuple[str, ...]
@@ -104,9 +116,11 @@ def _variant(source: str, name: str, body: Any, terrains: tuple[str, ...],
         _choice(source, f"{key}.domain", body.get("domain", "auto"), DOMAINS),
         _choice(source, f"{key}.set_b", body.get("set_b", "corners"), SET_B),
         _params(source, f"{key}.params", body.get("params", {}), mappers),
-        tuple(dict.fromkeys(own)))
-    if variant.domain == "auto" and variant.set_b == "corners" and not variant.params:
-        raise _fail(source, key, "changes nothing (give domain, set_b or params)")
+        tuple(dict.fromkeys(own)),
+        _choice(source, f"{key}.sensor", body.get("sensor", "thesis"), tuple(PROFILES)),
+        _flag(source, f"{key}.deskew", body.get("deskew", True)))
+    if variant == Variant(variant.name, variant.text, terrains=variant.terrains):
+        raise _fail(source, key, "changes nothing (give domain, set_b, params or sensor)")
     return variant
 
 

@@ -4,8 +4,10 @@ Runs of one terrain, scans, seed and mapper whose settings differ only in the ma
 view parameters (:attr:`alte.mappers.Mapper.view_params`: 3D-ALTE's ``min_pts``,
 ``min_pts_split``, ``occupancy_level``; 2D-ALTE's ``kappa``, ``min_pts``; Quadtree's
 occupancy rule) or in set B make the same stored map: a :class:`MapGroup`.
-:func:`run_group` feeds it once through the pipeline (its time is every run's
-``elapsed_s``: the same calls on the same data), then per run reads it with the run's
+:func:`run_group` feeds it through the pipeline as one run would be
+(:func:`~alte.studies.experiments.timed_run`: repeated when cheap; its
+:class:`~alte.metrics.timing.Timing` and ``cost`` are every run's: the same calls on
+the same data), then per run reads it with the run's
 parameters (:meth:`~alte.mappers.Mapper.reread`) and measures it against the input's
 :class:`~alte.metrics.reference.Reference` (the cloud's grids and the truth prepared
 once per process and input). A run's row holds the values a run of its own would
@@ -26,11 +28,12 @@ from typing import Any
 from alte.mappers import mapper_class
 from alte.metrics.maps import TruthOptions, measure_map
 from alte.metrics.reference import Reference
+from alte.metrics.timing import Timing
 from alte.pipeline import DomainPolicy, FrameSpec, MapRun, MapSpec, Registered, open_input
 from alte.pipeline import prepare as prepare_input
-from alte.pipeline import run as run_pipeline
 from alte.sim import terrain_folder
-from alte.studies.experiments import CACHE_DIR, ground_truth
+from alte.sim.profile import PROFILES
+from alte.studies.experiments import CACHE_DIR, ground_truth, timed_run
 from alte.studies.sweep.spec import SweepRun
 
 __all__ = ["MapGroup", "RunOutcome", "group_runs", "run_group", "run_one"]
@@ -73,47 +76,56 @@ def group_runs(runs: Iterable[SweepRun]) -> list[MapGroup]:
 
 
 @functools.lru_cache(maxsize=2)
-def _dataset(folder: str, frames: int | None, voxel: float | None, data_dir: str) -> Registered:
+def _dataset(folder: str, frames: int | None, voxel: float | None, data_dir: str,
+             deskew: bool = True) -> Registered:
     """Per-process memo over the on-disk registration cache (``DATA_DIR/.cache``)."""
-    return prepare_input(open_input(folder), FrameSpec(frames=frames, voxel=voxel),
+    return prepare_input(open_input(folder),
+                         FrameSpec(frames=frames, voxel=voxel, deskew=deskew),
                          cache=Path(data_dir) / CACHE_DIR)
 
 
+#: What :func:`_dataset` takes: terrain folder, scans, voxel, data folder, deskew.
+InputKey = tuple[str, int | None, float | None, str, bool]
+
+
 @functools.lru_cache(maxsize=2)
-def _reference(folder: str, frames: int | None, voxel: float | None, data_dir: str,
-               truth: TruthOptions) -> Reference:
+def _reference(key: InputKey, truth: TruthOptions) -> Reference:
     """Per-process memo of the input's prepared cloud and truth (one per truth options)."""
-    data = _dataset(folder, frames, voxel, data_dir)
+    data = _dataset(*key)
     return Reference(data.cloud, ground_truth(data), truth)
 
 
 def _inputs(run: SweepRun, data_dir: str) -> tuple[Registered, Reference]:
-    folder = str(terrain_folder(data_dir, run.terrain, run.frames, run.seed))
-    data = _dataset(folder, run.frames, run.voxel, data_dir)
-    return data, _reference(folder, run.frames, run.voxel, data_dir, run.truth).fresh()
+    """The run's registered input and its reference (a fresh per-leaf memory)."""
+    key: InputKey = (str(terrain_folder(data_dir, run.terrain, run.frames, run.seed,
+                                        PROFILES[run.sensor])),
+                     run.frames, run.voxel, data_dir, run.deskew)
+    return _dataset(*key), _reference(key, run.truth).fresh()
 
 
-def _row(run: SweepRun, data: Registered, metrics: dict[str, Any], elapsed_s: float,
+def _row(run: SweepRun, data: Registered, metrics: dict[str, Any],
          cost: tuple[float, float]) -> dict[str, Any]:
     return {
         "run_id": run.run_id, "terrain": run.terrain, "frames_requested": run.frames or 0,
         "seed": run.seed, "mapper": run.mapper,
         "params_json": json.dumps(dict(run.params), sort_keys=True),
         **{f"p_{k}": v for k, v in run.params.items()},
-        "domain": run.domain, "set_b": run.set_b,
+        "domain": run.domain, "set_b": run.set_b, "sensor": run.sensor, "deskew": run.deskew,
         "frames": len(data), "points": len(data.cloud),
         **{k: v for k, v in metrics.items() if k != "elapsed_s"},
-        "elapsed_s": float(elapsed_s), "wall_s": cost[0], "cpu_s": cost[1],
+        "cost_unit": mapper_class(run.mapper).cost_unit.value,
+        "elapsed_s": float(metrics["elapsed_s"]), "wall_s": cost[0], "cpu_s": cost[1],
     }
 
 
-def _measure(made: MapRun, run: SweepRun, data: Registered, reference: Reference
-             ) -> dict[str, Any]:
-    """The metrics of ``made`` read with ``run``'s parameters."""
-    fed, mine = made.mapper.params.as_dict(), _resolved(run)
+def _measure(made: tuple[MapRun, Timing], run: SweepRun, data: Registered,
+             reference: Reference) -> dict[str, Any]:
+    """The metrics of the map ``made`` (and its time) read with ``run``'s parameters."""
+    result, timing = made
+    fed, mine = result.mapper.params.as_dict(), _resolved(run)
     changes = {k: mine[k] for k in mapper_class(run.mapper).view_params if mine[k] != fed[k]}
-    mapper = made.mapper.reread(**changes) if changes else made.mapper
-    return measure_map(mapper, data.cloud, elapsed_s=made.elapsed_s, truth=reference.truth,
+    mapper = result.mapper.reread(**changes) if changes else result.mapper
+    return measure_map(mapper, data.cloud, elapsed_s=timing, truth=reference.truth,
                        options=run.truth, set_b=run.set_b, reference=reference).flat()
 
 
@@ -124,8 +136,8 @@ def run_group(group: MapGroup, data_dir: str) -> list[RunOutcome]:
     first = group.runs[0]
     try:
         data, reference = _inputs(first, data_dir)
-        made = run_pipeline(data, MapSpec(first.mapper, dict(first.params),
-                                          domain=DomainPolicy(first.domain)))
+        made = timed_run(data, MapSpec(first.mapper, dict(first.params),
+                                       domain=DomainPolicy(first.domain)))
     except Exception as err:  # a failed map fails its runs; the sweep goes on
         return [(r.run_id, None, err) for r in group.runs]
     share = ((time.perf_counter() - start) / len(group), (time.process_time() - cpu) / len(group))
@@ -138,7 +150,7 @@ def run_group(group: MapGroup, data_dir: str) -> list[RunOutcome]:
             out.append((run.run_id, None, err))
             continue
         cost = (share[0] + time.perf_counter() - start, share[1] + time.process_time() - cpu)
-        out.append((run.run_id, _row(run, data, metrics, made.elapsed_s, cost), None))
+        out.append((run.run_id, _row(run, data, metrics, cost), None))
     return out
 
 

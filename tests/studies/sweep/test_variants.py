@@ -93,6 +93,9 @@ def test_variant_helpers():
     ({"v": {"set_b": "centers", "terrains": ["exp_lan_1"]}},
      "variants.v.terrains: .* the sweep's terrains"),
     ({"v": {"set_b": "centers", "terrains": []}}, "variants.v.terrains: .* non-empty list"),
+    ({"v": {"sensor": "lidar"}}, "variants.v.sensor: 'lidar': expected one of thesis, uav"),
+    ({"v": {"sensor": "uav", "deskew": "no"}}, "variants.v.deskew: 'no': expected true or false"),
+    ({"v": {"sensor": "thesis"}}, "variants.v: changes nothing"),
 ])
 def test_bad_variants_name_the_key(variants, match):
     with pytest.raises(ParameterError, match=match):
@@ -124,3 +127,16 @@ def test_variant_table_repeats_shared_runs_per_variant(tmp_path):
     assert (occ.loc["quadtree", "mhd_m"] != base.loc["quadtree", "mhd_m"]).all()
     pd.testing.assert_series_equal(occ.loc["alte2d", "mhd_m"], base.loc["alte2d", "mhd_m"])
     assert variant_table(spec, result.table.iloc[:0]).empty
+
+
+def test_a_sensor_variant_reruns_every_map_on_that_sensor():
+    spec = parse_spec(_raw(variants={"uav": {"sensor": "uav", "terrains": ["sim_nav_1"]},
+                                     "raw": {"sensor": "uav", "deskew": False,
+                                             "terrains": ["sim_nav_1"]}}))
+    pairs = plan_variants(spec)
+    base = {r.run_id for n, r in pairs if n == "base"}
+    for name, deskew in (("uav", True), ("raw", False)):
+        mine = [r for n, r in pairs if n == name]
+        assert len(mine) == 2 * 4  # two seeds x the four maps of sim_nav_1
+        assert all(r.sensor == "uav" and r.deskew is deskew for r in mine)
+        assert not base & {r.run_id for r in mine}

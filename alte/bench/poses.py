@@ -1,0 +1,115 @@
+"""Row 12: odometry and refinement per real scan, beside KISS-ICP's own pipeline.
+
+On the real ``balm_seq`` scans (about 73,000 points each, ``../shared/realdata``) on one
+core: alte's default odometry (``odometry_frames``, KISS-ICP behind alte's frame stream)
+and refinement (``refine_frames`` from the recorded poses) against ``kiss_icp``'s own
+``KissICP`` with its default configuration, fed the same scans in the same run. The
+figure is the median per-scan time of the pose step (the thread's CPU time, steadier than
+wall time on a shared machine; wall medians are in the detail). Targets: ours within 1.2x
+of the peer, and under 100 ms per scan (a 10 Hz sensor) for odometry and refinement each.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Iterable
+from dataclasses import replace
+
+import numpy as np
+
+from alte.bench.core import LIMITS, Context, Result
+from alte.bench.timing import one_core
+from alte.paths import realdata_dir
+from alte.types import Frame
+
+__all__ = ["pose_speed"]
+
+#: Sensor period (ms): the budget of one scan.
+BUDGET_MS = 100.0
+
+
+def _scans(ctx: Context) -> list[Frame]:
+    from alte.io.bag import read_frames
+
+    bag = realdata_dir() / "balm_seq" / "bag"
+    limit = 20 if ctx.config.quick else None
+    return ctx.memo("balm_frames", lambda: read_frames(bag, frames=None).frames[:limit])
+
+
+class _Clock:
+    """Per-scan CPU and wall times of a frame stream's steps."""
+
+    def __init__(self) -> None:
+        self.cpu: list[float] = []
+        self.wall: list[float] = []
+
+    def timed(self, frames: Iterable[Frame]) -> Iterable[Frame]:
+        """Time each step of ``frames`` (the work done before the frame is yielded)."""
+        it = iter(frames)
+        while True:
+            cpu, wall = time.thread_time(), time.perf_counter()
+            frame = next(it, None)
+            if frame is None:
+                return
+            self.cpu.append(1e3 * (time.thread_time() - cpu))
+            self.wall.append(1e3 * (time.perf_counter() - wall))
+            yield frame
+
+
+def _peer(frames: list[Frame], clock: _Clock) -> None:
+    from kiss_icp.config import KISSConfig
+    from kiss_icp.kiss_icp import KissICP
+
+    config = KISSConfig()
+    config.data.deskew = False  # the scans carry no per-point time
+    config.mapping.voxel_size = config.data.max_range / 100.0
+    config.registration.max_num_threads = 1
+    pipeline = KissICP(config)
+    for frame in frames:
+        cpu, wall = time.thread_time(), time.perf_counter()
+        pipeline.register_frame(frame.points, np.zeros(len(frame.points)))
+        clock.cpu.append(1e3 * (time.thread_time() - cpu))
+        clock.wall.append(1e3 * (time.perf_counter() - wall))
+
+
+def _ours(frames: list[Frame], refine: bool, clock: _Clock) -> None:
+    from alte.registration.odometry import (
+        OdometryParams,
+        PoseCounts,
+        odometry_frames,
+        refine_frames,
+    )
+    from alte.types import Mount
+
+    stream: Callable[..., Iterable[Frame]] = refine_frames if refine else odometry_frames
+    bare = [replace(f, times=None) for f in frames]
+    for _ in clock.timed(stream(bare, Mount(), counts=PoseCounts(), params=OdometryParams())):
+        pass
+
+
+def pose_speed(ctx: Context) -> list[Result]:
+    """Row 12 (module docstring); no result without ``../shared/realdata/balm_seq``."""
+    if not (realdata_dir() / "balm_seq" / "bag").exists():
+        return []
+    frames = _scans(ctx)
+    clocks = {name: _Clock() for name in ("kiss-icp", "odometry", "refine")}
+    with one_core():
+        for _ in range(max(1, ctx.config.repeats // 5)):
+            _peer(frames, clocks["kiss-icp"])
+            _ours(frames, False, clocks["odometry"])
+            _ours(frames, True, clocks["refine"])
+    med = {k: float(np.median(c.cpu)) for k, c in clocks.items()}
+    detail = {"scans": len(frames), "points_per_scan": int(np.median([len(f.points)
+                                                                      for f in frames])),
+              "cpu_ms_median": med,
+              "wall_ms_median": {k: float(np.median(c.wall)) for k, c in clocks.items()},
+              "cpu_ms_p90": {k: float(np.percentile(c.cpu, 90)) for k, c in clocks.items()}}
+    peer = med["kiss-icp"]
+    return [
+        Result(12, f"odometry per real scan vs kiss-icp pipeline, balm_seq ({len(frames)} scans)",
+               med["odometry"], peer, "ms", f"ratio <= {LIMITS[12]:g}, < {BUDGET_MS:g} ms",
+               bool(med["odometry"] <= LIMITS[12] * peer and med["odometry"] < BUDGET_MS),
+               detail),
+        Result(12, f"refinement per real scan vs kiss-icp pipeline, balm_seq ({len(frames)} "
+                   "scans)", med["refine"], peer, "ms", f"< {BUDGET_MS:g} ms",
+               bool(med["refine"] < BUDGET_MS), detail)]

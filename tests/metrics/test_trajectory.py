@@ -1,0 +1,84 @@
+"""ATE / RPE (evo) against independent computations, and the cloud distance."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from alte.errors import MetricsError
+from alte.metrics.trajectory import cloud_distance, trajectory_errors
+
+N = 41
+
+
+def _kabsch_ate(source: np.ndarray, target: np.ndarray) -> float:
+    """RMSE after the best rigid motion (an independent Kabsch, no reflection)."""
+    mu_s, mu_d = source.mean(axis=0), target.mean(axis=0)
+    u, _, vt = np.linalg.svd((target - mu_d).T @ (source - mu_s))
+    sign = np.sign(np.linalg.det(u @ vt))
+    rotation = u @ np.diag([1.0, 1.0, sign]) @ vt
+    moved = (source - mu_s) @ rotation.T + mu_d
+    return float(np.sqrt(np.mean(np.sum((moved - target) ** 2, axis=1))))
+
+
+def _line() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A 20 m path, 0.5 m a step, bending gently (an exactly straight one has no unique
+    alignment)."""
+    stamps = np.arange(N, dtype=np.int64) * 500_000_000
+    x = np.linspace(0, 20, N)
+    positions = np.column_stack([x, 0.001 * x**2, 0.0005 * x**2])
+    return stamps, positions, np.tile([0.0, 0.0, 0.0, 1.0], (N, 1))
+
+
+def test_a_rigidly_moved_trajectory_has_no_error() -> None:
+    stamps, positions, quats = _line()
+    turn = Rotation.from_euler("zyx", [40, -10, 5], degrees=True)
+    moved = turn.apply(positions) + np.array([3.0, -2.0, 1.0])
+    errors = trajectory_errors(stamps, moved, (turn * Rotation.from_quat(quats)).as_quat(),
+                               positions, quats)
+    assert errors.ate_m == pytest.approx(0.0, abs=1e-9)
+    assert errors.rpe_trans_pct == pytest.approx(0.0, abs=1e-6)
+    assert errors.rpe_rot_deg_m == pytest.approx(0.0, abs=1e-6)
+
+
+def test_ate_matches_an_independent_kabsch() -> None:
+    stamps, positions, quats = _line()
+    rng = np.random.default_rng(0)
+    noisy = positions + rng.normal(0, 0.05, positions.shape) + [0.0, 0.0, 0.5]
+    errors = trajectory_errors(stamps, noisy, quats, positions, quats)
+    assert errors.ate_m == pytest.approx(_kabsch_ate(noisy, positions), rel=1e-6)
+
+
+def test_rpe_is_per_cent_and_degrees_per_metre() -> None:
+    stamps, positions, quats = _line()   # 1 m segments are 2 steps
+    stretched = positions * 1.02         # 2 % too long everywhere
+    errors = trajectory_errors(stamps, stretched, quats, positions, quats)
+    assert errors.rpe_trans_pct == pytest.approx(2.0, rel=1e-3)
+    assert errors.rpe_rot_deg_m == pytest.approx(0.0, abs=1e-9)
+    assert N - 4 <= errors.segments <= N - 2
+    yawing = Rotation.from_euler("z", 0.3 * positions[:, :1], degrees=True).as_quat()
+    turned = trajectory_errors(stamps, positions, yawing, positions, quats)
+    assert turned.rpe_rot_deg_m == pytest.approx(0.3, rel=1e-3)   # 0.3 deg per metre
+
+
+def test_short_and_straight_paths_and_bad_input() -> None:
+    stamps, positions, quats = _line()
+    straight = positions * [1.0, 0.0, 0.0]
+    beside = straight + np.array([0.0, 0.2, 0.0])
+    shifted = trajectory_errors(stamps, beside, quats, straight, quats)
+    assert shifted.ate_m == pytest.approx(0.0, abs=1e-9)  # aligned at the first pose
+    short = trajectory_errors(stamps[:3], positions[:3] * 0.1, quats[:3], positions[:3] * 0.1,
+                              quats[:3])
+    assert np.isnan(short.rpe_trans_pct) and short.segments == 0
+    with pytest.raises(MetricsError, match="need >= 3 matched poses"):
+        trajectory_errors(stamps[:2], positions[:2], quats[:2], positions[:2], quats[:2])
+
+
+def test_cloud_distance_median_and_p90() -> None:
+    reference = np.column_stack([np.arange(100.0), np.zeros(100), np.zeros(100)])
+    cloud = reference + np.column_stack([np.zeros(100), np.zeros(100),
+                                         np.linspace(0.0, 0.099, 100)])
+    found = cloud_distance(cloud, reference)
+    assert found.median_m == pytest.approx(np.median(np.linspace(0.0, 0.099, 100)))
+    assert found.p90_m == pytest.approx(np.percentile(np.linspace(0.0, 0.099, 100), 90))
