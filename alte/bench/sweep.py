@@ -119,11 +119,11 @@ def measure_sample(spec: Any, data_dir: str, *, seed: int = 0, strata: int | Non
 
     every = stratified_groups(spec, seed)
     chosen = _thinned(every, strata)
-    prepared: dict[tuple[str, int], float] = {}
+    prepared: dict[tuple[Any, ...], float] = {}
     rows, runs, cpu, estimate = [], 0, 0.0, 0.0
     for group, in_grid in tqdm(chosen, desc="sweep sample", unit="map", disable=not progress):
         first = group.runs[0]
-        key = (first.terrain, first.seed)
+        key = (first.terrain, first.seed, first.frames, first.voxel, first.sensor, first.deskew)
         if key not in prepared:
             prepared[key] = _prepare_input(first, data_dir)
         start = time.process_time()
