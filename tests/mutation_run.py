@@ -11,7 +11,9 @@ another module's tests nor loses its results when another selection changes.
 Each run records its wall time and the machine's load average (sampled every 10 s) in
 ``mutants/<name>/run.json``; ``tests/mutation_score.py`` prints the score per module.
 A second run continues where the last stopped (mutmut keeps every result and re-tests
-only the functions whose code changed). Usage, from the repository::
+only the functions whose code changed); a run narrowed to some mutants re-tests those
+and keeps the others' earlier results (``mutants/<name>/results.json``). Usage, from
+the repository::
 
     .venv/bin/python tests/mutation_run.py [NAME ...] [--mutants GLOB ...] [--max-children 2]
 
@@ -109,10 +111,33 @@ class _Load:
         self._thread.join()
 
 
+def _meta(name: str) -> Path:
+    return WORK / name / "mutants" / (MODULES[name][0] + ".meta")
+
+
+def _keep_results(name: str) -> None:
+    """Carry every mutant's latest result over runs in ``results.json``.
+
+    A run narrowed to some mutants (``--mutants``) leaves the others unchecked in mutmut's
+    ``.meta``; their earlier results (from tests that are all still there) are put back,
+    and a mutant run again gets its new result.
+    """
+    meta, kept = _meta(name), WORK / name / "results.json"
+    if not meta.exists():
+        return
+    data = json.loads(meta.read_text())
+    codes = json.loads(kept.read_text()) if kept.exists() else {}
+    codes.update({k: v for k, v in data["exit_code_by_key"].items() if v is not None})
+    kept.write_text(json.dumps(codes, indent=0, sort_keys=True) + "\n")
+    data["exit_code_by_key"] = {k: codes.get(k) for k in data["exit_code_by_key"]}
+    meta.write_text(json.dumps(data))
+
+
 def run(names: list[str], globs: list[str], children: int) -> int:
     """Each module in a fresh process; its time and load written to ``run.json``."""
     failed = 0
     for name in names:
+        _keep_results(name)
         argv = [sys.executable, __file__, "--one", name, "--max-children", str(children),
                 *(f"--mutants={g}" for g in globs)]
         start = time.monotonic()
@@ -125,6 +150,7 @@ def run(names: list[str], globs: list[str], children: int) -> int:
                   "load_mean": round(sum(load.samples) / len(load.samples), 1),
                   "load_max": round(max(load.samples), 1), "cores": os.cpu_count()}
         (WORK / name / "run.json").write_text(json.dumps(record, indent=1) + "\n")
+        _keep_results(name)
         print(f"{name}: exit {code}, {record['wall_s']:.0f} s, load average "
               f"{record['load_mean']} (max {record['load_max']}) on {os.cpu_count()} cores")
         failed |= code != 0
