@@ -12,12 +12,14 @@ bounds are known exactly (identical seeds give a zero-width interval).
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 
 import numpy as np
 import pandas as pd
 import pytest
 from support.tradeoff import Curve, synthetic_tradeoff
 
+from alte.studies.checks import NoDataError
 from alte.studies.claims import (
     Agreement,
     AllOf,
@@ -29,6 +31,7 @@ from alte.studies.claims import (
     Summary,
     Trend,
 )
+from alte.studies.comparisons import measure_compare
 from alte.studies.evidence import EvidenceOptions, evaluate, evaluate_all
 
 #: 2D-ALTE's MHD curve lies at a fifth of Quadtree's: it wins every fidelity metric at
@@ -98,6 +101,19 @@ def test_the_difference_is_oriented_and_named_by_the_direction(win):
                                    "equal_fidelity")), win)
     assert "basis functions, Quadtree / 2D-ALTE for equal MHD [m]" in size.evidence
     assert size.cells["unit"].eq("x").all() and lower.cells["unit"].eq("m").all()
+
+
+def test_a_point_read_needs_no_size_or_fidelity_column(win):
+    """Only equal-size reads need the size column, only equal-fidelity ones the fidelity
+    column: a table without either still judges a comparison at the thesis' settings."""
+    bare = win.assign(occupied_cells=np.nan, mhd_m=np.nan)
+    check = Compare("lan", "alte2d", "quadtree", "memory_bytes", "thesis_point",
+                    size="occupied_cells")
+    assert _verdict(check, bare) == "holds"
+    with pytest.raises(NoDataError, match="occupied_cells"):
+        measure_compare(replace(check, at="equal_size"), bare)
+    with pytest.raises(NoDataError, match=r"column\(s\) mhd_m"):
+        measure_compare(replace(check, at="equal_fidelity"), bare)
 
 
 def test_each_view_states_where_it_reads(win):
