@@ -170,6 +170,16 @@ def test_almost_the_same_is_a_band_around_one():
     narrow = Compare("lan", "alte2d", "quadtree", "basis_functions", "equal_fidelity",
                      relation="similar", tolerance=0.05)
     assert _verdict(narrow, curves(1.02)) == "does not hold"
+    # the shown factor is the first named mapper's over the second's, whichever is larger
+    apart = evaluate(_claim(check), curves(1.2))
+    assert "basis functions, 2D-ALTE / Quadtree" in apart.evidence
+    assert (apart.cells["estimate"] > 1.5).all()
+    # a tolerance of 1.0 on a ratio is "within a factor 2" (not e): x1.6 holds, x2.4 not
+    wide = Compare("lan", "alte2d", "quadtree", "basis_functions", "equal_fidelity",
+                   relation="similar", tolerance=1.0)
+    assert _verdict(wide, curves(1.15)) == "holds"
+    assert _verdict(wide, curves(1.3)) == "does not hold"
+    assert (evaluate(_claim(wide), curves(1.3)).cells["estimate"].between(2.1, 2.6)).all()
 
 
 def test_times_known_within_their_spread_cannot_be_shown_equal():
