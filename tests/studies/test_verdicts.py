@@ -33,6 +33,8 @@ from alte.studies.claims import (
 )
 from alte.studies.comparisons import measure_compare
 from alte.studies.evidence import EvidenceOptions, evaluate, evaluate_all
+from alte.studies.measures import measure_check
+from alte.studies.tradeoff import prepare
 
 #: 2D-ALTE's MHD curve lies at a fifth of Quadtree's: it wins every fidelity metric at
 #: every size, and needs fewer basis functions, less memory and less time for any MHD.
@@ -114,6 +116,29 @@ def test_a_point_read_needs_no_size_or_fidelity_column(win):
         measure_compare(replace(check, at="equal_size"), bare)
     with pytest.raises(NoDataError, match=r"column\(s\) mhd_m"):
         measure_compare(replace(check, at="equal_fidelity"), bare)
+
+
+def test_how_each_comparison_is_to_be_read(win):
+    """What a comparison hands the verdict rule: ratio or difference, its unit, the
+    claimed factor (ratios only), the band, the kind of level, and whether a time (or the
+    rule's time-dependent pick) decides which values are read."""
+    ready = prepare(win)
+
+    def read(metric, at, **kw):
+        m = measure_check(Compare("lan", "alte2d", "quadtree", metric, at, **kw), ready)
+        return (m.ratio, m.unit, round(m.threshold, 9), round(m.band, 9), m.level_kind,
+                m.time, m.read_from_times)
+
+    log2, log15 = round(float(np.log(2.0)), 9), round(float(np.log1p(0.5)), 9)
+    assert read("mhd_m", "thesis_point", factor=2.0, tolerance=0.5) == (
+        False, "m", 0.0, 0.5, "", "", False)
+    assert read("mhd_m", "rule", tolerance=0.1) == (False, "m", 0.0, 0.1, "", "", True)
+    assert read("mhd_m", "equal_size", tolerance=0.1) == (False, "m", 0.0, 0.1, "size", "",
+                                                          False)
+    assert read("basis_functions", "equal_fidelity", factor=2.0, tolerance=0.5) == (
+        True, "x", log2, log15, "fidelity", "", False)
+    assert read("elapsed_s", "thesis_point", tolerance=0.1) == (
+        True, "x", 0.0, round(float(np.log1p(0.1)), 9), "", "cpu", True)
 
 
 def test_each_view_states_where_it_reads(win):
