@@ -129,3 +129,17 @@ def test_seen_mask_and_the_3d_metrics_by_hand() -> None:
     assert got["accuracy_mean_m"] == pytest.approx(0.0, abs=1e-5)
     assert "completeness_by_class" not in ground_truth_metrics(
         cells, _scene(), dims=3, cloud=cloud_west, tolerance=0.1, n_samples=1000)
+
+
+def test_the_height_grid_starts_half_a_step_inside_the_bounds() -> None:
+    """Grid points at x = 0.25, 0.75, .. 5.75 and y = 2.25, .. 4.75 (step 0.5 inside
+    x 0-6, y 2-5); a map over x < a, y < b knows the points below both cuts."""
+    surf = _scene()
+    bounds = np.array([[0.0, 2.0, -1.0], [6.0, 5.0, 5.0]])
+
+    def unknown(a: float, b: float) -> float:
+        cells = _cells([[a / 2, b / 2, 0.0]], [[a, b, 0.0]])
+        return height_metrics_2d(cells, surf, bounds, 0.5, 0.1)["unknown_share"]
+
+    assert unknown(4.6, 3.6) == pytest.approx(1 - (9 / 12) * (3 / 6))   # x to 4.25, y to 3.25
+    assert unknown(4.2, 3.2) == pytest.approx(1 - (8 / 12) * (2 / 6))   # x to 3.75, y to 2.75
