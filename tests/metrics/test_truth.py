@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from alte.errors import MetricsError
 from alte.mappers.base import Cells
 from alte.metrics import TrueSurface, ground_truth_metrics, height_metrics_2d
 from alte.metrics.surface import SurfaceSamples
@@ -135,7 +136,7 @@ def test_the_height_grid_starts_half_a_step_inside_the_bounds() -> None:
     """Grid points at x = 0.25, 0.75, .. 5.75 and y = 2.25, .. 4.75 (step 0.5 inside
     x 0-6, y 2-5); a map over x < a, y < b knows the points below both cuts."""
     surf = _scene()
-    bounds = np.array([[0.0, 2.0, -1.0], [6.0, 5.0, 5.0]])
+    bounds = np.array([[0.0, 2.0, -1.0], [6.0, 5.0, 3.0]])
 
     def unknown(a: float, b: float) -> float:
         cells = _cells([[a / 2, b / 2, 0.0]], [[a, b, 0.0]])
@@ -143,3 +144,10 @@ def test_the_height_grid_starts_half_a_step_inside_the_bounds() -> None:
 
     assert unknown(4.6, 3.6) == pytest.approx(1 - (9 / 12) * (3 / 6))   # x to 4.25, y to 3.25
     assert unknown(4.2, 3.2) == pytest.approx(1 - (8 / 12) * (2 / 6))   # x to 3.75, y to 2.75
+    one = height_metrics_2d(_cells([[0.5, 0.5, 0.0]], [[1.0, 1.0, 0.0]]), surf,
+                            np.array([[0.0, 0.0, -1.0], [1.0, 1.0, 3.0]]), 1.0, 0.1)
+    assert one == {"height_rmse_m": pytest.approx(0.0, abs=1e-6), "unknown_share": 0.0,
+                   "completeness": 1.0}                                # a single point
+    with pytest.raises(MetricsError, match="leaves no grid"):           # no row of points
+        height_metrics_2d(_cells([[0.5, 0.5, 0.0]], [[1.0, 1.0, 0.0]]), surf,
+                          np.array([[0.0, 0.0, -1.0], [10.0, 0.1, 3.0]]), 0.2, 0.1)
