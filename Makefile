@@ -39,12 +39,14 @@ test: bootstrap
 reference: bootstrap
 	$(PY) -m pytest tests/reference -p no:cacheprovider --update-reference -q
 
-# Mutation testing of the verdict logic and the metrics (tests/README.md): mutmut
-# ([tool.mutmut] in pyproject.toml) caches results in mutants/ and reruns only what
-# changed; MUTANTS='alte.studies.evidence*' narrows it; rm -rf mutants starts afresh.
+# Mutation testing of the verdict logic and the metrics (tests/README.md): mutmut, one
+# module at a time with its own tests (tests/mutation_run.py); results in mutants/<name>/,
+# a rerun retests only what changed; MODULES='checks truth' picks modules,
+# MUTANTS='alte.studies.evidence.x__outcome*' narrows them; rm -rf mutants starts afresh.
 MUTANTS ?=
+MODULES ?=
 mutants: bootstrap
-	$(PY) -m mutmut run --max-children 2 $(MUTANTS)
+	$(PY) tests/mutation_run.py $(MODULES) --max-children 2 $(if $(MUTANTS),--mutants='$(MUTANTS)')
 	$(PY) tests/mutation_score.py
 
 bench: bootstrap

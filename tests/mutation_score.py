@@ -6,11 +6,14 @@ selected test calls the mutated function; *not checked* when the run has not rea
 it. The score is killed / (killed + survived + no tests) over the checked mutants; the
 mutants listed in ``mutation_equivalent.txt`` beside this file (equivalent to the
 original: no test can tell them apart) are left out of it. Run from the repository:
-``.venv/bin/python tests/mutation_score.py [--survivors]``.
+``.venv/bin/python tests/mutation_score.py [--survivors | --diff]`` (``--diff``: each
+surviving mutant's changed lines).
 """
 
 from __future__ import annotations
 
+import ast
+import difflib
 import json
 import sys
 from collections import Counter
@@ -38,7 +41,9 @@ def results(root: Path = ROOT) -> dict[str, dict[str, str]]:
     for meta in sorted((root / "mutants").rglob("*.py.meta")):
         codes = json.loads(meta.read_text())["exit_code_by_key"]
         if codes:
+            # mutants/<name>/mutants/alte/x.py.meta (tests/mutation_run.py) -> alte/x.py
             module = str(meta.relative_to(root / "mutants")).removesuffix(".meta")
+            module = module.split("/mutants/")[-1]
             out[module] = {k: _STATUS.get(v, "survived") for k, v in codes.items()}
     return out
 
@@ -58,6 +63,33 @@ def table(found: dict[str, dict[str, str]], skip: set[str]) -> list[str]:
     return lines
 
 
+def _functions(mutated: Path) -> dict[str, str]:
+    """Every function of a mutated module (mutmut's copy), by name, as source."""
+    tree = ast.parse(mutated.read_text())
+    out = {}
+    for node in ast.walk(tree):
+        if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef):
+            name, node.name = node.name, "f"   # the same first line for every variant
+            out[name] = ast.unparse(node)
+    return out
+
+
+def diffs(root: Path = ROOT) -> dict[str, str]:
+    """Mutant name -> the changed lines against the original function (what survived)."""
+    out: dict[str, str] = {}
+    for meta in sorted((root / "mutants").rglob("*.py.meta")):
+        found = _functions(meta.with_suffix(""))
+        for name in json.loads(meta.read_text())["exit_code_by_key"]:
+            short = name.rsplit(".", 1)[-1]
+            original = found.get(short.rsplit("__mutmut_", 1)[0] + "__mutmut_orig", "")
+            lines = difflib.unified_diff(original.splitlines(),
+                                         found.get(short, "").splitlines(), n=0,
+                                         lineterm="")
+            out[name] = "\n".join(f"    {line}" for line in lines
+                                  if line[:1] in "+-" and line[:3] not in ("+++", "---"))
+    return out
+
+
 def main(argv: list[str]) -> int:
     found = results()
     if not found:
@@ -65,10 +97,12 @@ def main(argv: list[str]) -> int:
         return 1
     skip = equivalent()
     print("\n".join(table(found, skip)))
-    if "--survivors" in argv:
+    if "--survivors" in argv or "--diff" in argv:
+        changes = diffs() if "--diff" in argv else {}
         for names in found.values():
-            print("\n".join(f"  survived: {n}" for n, s in names.items()
-                            if s == "survived" and n not in skip))
+            for n, status in names.items():
+                if status == "survived" and n not in skip:
+                    print(f"  survived: {n}" + (f"\n{changes[n]}" if n in changes else ""))
     return 0
 
 

@@ -104,3 +104,63 @@ def test_rigid_alignment_of_a_straight_path_and_bad_input() -> None:
     assert np.allclose(found[:3, :3], np.eye(3)) and np.allclose(found[:3, 3], [0, -0.2, 0])
     with pytest.raises(MetricsError, match=r"rigid alignment needs matched positions"):
         rigid_alignment(positions[:3], positions[:4])
+
+
+def _flat(n: int) -> np.ndarray:
+    return np.tile([0.0, 0.0, 0.0, 1.0], (n, 1))
+
+
+def test_a_known_ate_on_a_hand_made_circle() -> None:
+    """Eight poses 45 degrees apart on a 10 m circle, each estimate 0.1 m above or below it,
+    alternately: the errors have no mean and no correlation with the path, so the best
+    rigid alignment is the identity and the ATE is exactly 0.1 m. The poses are 7.65 m
+    apart, so no two are one 1 m segment apart: no RPE."""
+    turn = np.radians(np.arange(8) * 45.0)
+    reference = np.column_stack([10 * np.cos(turn), 10 * np.sin(turn), np.zeros(8)])
+    estimate = reference + np.column_stack([np.zeros((8, 2)), 0.1 * (-1.0) ** np.arange(8)])
+    got = trajectory_errors(np.arange(8) * 10**9, estimate, _flat(8), reference, _flat(8))
+    assert got.ate_m == pytest.approx(0.1, abs=1e-12)
+    assert np.isnan(got.rpe_trans_pct) and np.isnan(got.rpe_rot_deg_m)
+    assert (got.delta_m, got.segments) == (1.0, 0)
+    # integer input (a hand-typed trajectory) reads the same as floats
+    moved = trajectory_errors(list(range(8)), (estimate * 10).round().astype(int),
+                              _flat(8).astype(int), (reference * 10).round().astype(int),
+                              _flat(8).astype(int))
+    assert moved.ate_m == pytest.approx(_kabsch_ate((estimate * 10).round(),
+                                                    (reference * 10).round()), rel=1e-9)
+
+
+def test_rpe_over_two_metre_segments() -> None:
+    stamps, positions, quats = _line()   # 0.5 m steps: a 2 m segment is 4 steps
+    stretched = trajectory_errors(stamps, positions * 1.02, quats, positions, quats,
+                                  delta_m=2.0)
+    assert stretched.delta_m == 2.0
+    assert stretched.rpe_trans_pct == pytest.approx(2.0, rel=1e-3)   # still 2 %
+    assert N - 6 <= stretched.segments <= N - 4
+    yawing = Rotation.from_euler("z", 0.3 * positions[:, :1], degrees=True).as_quat()
+    turned = trajectory_errors(stamps, positions, yawing, positions, quats, delta_m=2.0)
+    assert turned.rpe_rot_deg_m == pytest.approx(0.3, rel=1e-3)   # 0.6 deg per 2 m
+
+
+def test_rpe_needs_one_and_a_half_segments_of_path() -> None:
+    """RPE is measured from 1.5 segments of reference path on (the boundary included),
+    wherever the path lies."""
+    far = np.array([100.0, 50.0, 10.0])
+    stamps = np.arange(13, dtype=np.int64) * 10**8
+
+    def path(step: float) -> np.ndarray:
+        return far + np.column_stack([np.arange(13) * step, 1e-3 * np.arange(13) ** 2,
+                                      np.zeros(13)])
+
+    short = path(0.08)        # about 0.96 m: short of 1.5 segments
+    got = trajectory_errors(stamps, short + np.array([0.0, 0.0, 0.02]), _flat(13), short,
+                            _flat(13))
+    assert np.isnan(got.rpe_trans_pct) and got.segments == 0
+    assert got.ate_m == pytest.approx(0.0, abs=1e-9) and got.delta_m == 1.0
+    exact = far + np.column_stack([np.arange(13) * 0.125, np.zeros((13, 2))])  # 1.5 m exactly
+    longer = trajectory_errors(stamps, exact, _flat(13), exact, _flat(13))
+    assert longer.segments > 0 and longer.rpe_trans_pct == pytest.approx(0.0, abs=1e-6)
+    two = far + np.column_stack([np.arange(13) * 0.2, 1e-3 * np.arange(13) ** 2,
+                                 np.zeros(13)])   # 2.4 m: under 1.5 segments of 2 m
+    halved = trajectory_errors(stamps, two, _flat(13), two, _flat(13), delta_m=2.0)
+    assert np.isnan(halved.rpe_rot_deg_m) and halved.segments == 0

@@ -43,6 +43,27 @@ def test_register_frame_hand_case():
     np.testing.assert_allclose(sensor_origin(frame, mount), [1.0, 2.1, 3.0], atol=1e-12)
 
 
+def test_registered_cloud_of_two_hand_posed_frames() -> None:
+    """Two frames with poses written by hand, merged on a 1 m grid: every expected point
+    is worked out on paper (a 90 degree yaw sends sensor (x, y) to world (-y, x))."""
+    yaw90 = Rotation.from_euler("z", 90, degrees=True).as_quat()
+    still = make_frame([[0.2, 0.2, 0.2], [0.4, 0.4, 0.4]])
+    turned = make_frame([[0.2, -0.5, 0.3],    # -> (5.5, 0.2, 0.3)
+                         [0.4, -0.7, 0.1],    # -> (5.7, 0.4, 0.1)
+                         [0.6, 4.7, 0.5]],    # -> (0.3, 0.6, 0.5), in the first cell
+                        position=(5.0, 0.0, 0.0), quat=yaw90, stamp=1)
+    reg = register([still, turned], Mount(np.zeros(3)), voxel=1.0)
+    # cell (0, 0, 0): the mean of its three points; cell (5, 0, 0): of its two
+    np.testing.assert_allclose(reg.points, [[0.3, 0.4, 1.1 / 3], [5.6, 0.3, 0.2]],
+                               atol=1e-12)
+    np.testing.assert_allclose(np.asarray(reg.origins), [[0.0, 0.0, 0.0], [5.0, 0.0, 0.0]],
+                               atol=1e-12)
+    raw = register([still, turned], Mount(np.array([0.0, 0.0, -0.5])))  # sensor 0.5 m below
+    np.testing.assert_allclose(raw.points, [[0.2, 0.2, -0.3], [0.4, 0.4, -0.1],
+                                            [5.5, 0.2, -0.2], [5.7, 0.4, -0.4],
+                                            [0.3, 0.6, 0.0]], atol=1e-12)
+
+
 def test_thesis_mount_looks_forward_and_30_deg_down():
     frame = make_frame([[0.0, 1.0, 0.0]])
     mount = thesis_mount()

@@ -12,12 +12,14 @@ bounds are known exactly (identical seeds give a zero-width interval).
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 
 import numpy as np
 import pandas as pd
 import pytest
 from support.tradeoff import Curve, synthetic_tradeoff
 
+from alte.studies.checks import NoDataError
 from alte.studies.claims import (
     Agreement,
     AllOf,
@@ -29,7 +31,10 @@ from alte.studies.claims import (
     Summary,
     Trend,
 )
+from alte.studies.comparisons import measure_compare
 from alte.studies.evidence import EvidenceOptions, evaluate, evaluate_all
+from alte.studies.measures import measure_check
+from alte.studies.tradeoff import prepare
 
 #: 2D-ALTE's MHD curve lies at a fifth of Quadtree's: it wins every fidelity metric at
 #: every size, and needs fewer basis functions, less memory and less time for any MHD.
@@ -100,6 +105,42 @@ def test_the_difference_is_oriented_and_named_by_the_direction(win):
     assert size.cells["unit"].eq("x").all() and lower.cells["unit"].eq("m").all()
 
 
+def test_a_point_read_needs_no_size_or_fidelity_column(win):
+    """Only equal-size reads need the size column, only equal-fidelity ones the fidelity
+    column: a table without either still judges a comparison at the thesis' settings."""
+    bare = win.assign(occupied_cells=np.nan, mhd_m=np.nan)
+    check = Compare("lan", "alte2d", "quadtree", "memory_bytes", "thesis_point",
+                    size="occupied_cells")
+    assert _verdict(check, bare) == "holds"
+    with pytest.raises(NoDataError, match="occupied_cells"):
+        measure_compare(replace(check, at="equal_size"), bare)
+    with pytest.raises(NoDataError, match=r"column\(s\) mhd_m"):
+        measure_compare(replace(check, at="equal_fidelity"), bare)
+
+
+def test_how_each_comparison_is_to_be_read(win):
+    """What a comparison hands the verdict rule: ratio or difference, its unit, the
+    claimed factor (ratios only), the band, the kind of level, and whether a time (or the
+    rule's time-dependent pick) decides which values are read."""
+    ready = prepare(win)
+
+    def read(metric, at, **kw):
+        m = measure_check(Compare("lan", "alte2d", "quadtree", metric, at, **kw), ready)
+        return (m.ratio, m.unit, round(m.threshold, 9), round(m.band, 9), m.level_kind,
+                m.time, m.read_from_times)
+
+    log2, log15 = round(float(np.log(2.0)), 9), round(float(np.log1p(0.5)), 9)
+    assert read("mhd_m", "thesis_point", factor=2.0, tolerance=0.5) == (
+        False, "m", 0.0, 0.5, "", "", False)
+    assert read("mhd_m", "rule", tolerance=0.1) == (False, "m", 0.0, 0.1, "", "", True)
+    assert read("mhd_m", "equal_size", tolerance=0.1) == (False, "m", 0.0, 0.1, "size", "",
+                                                          False)
+    assert read("basis_functions", "equal_fidelity", factor=2.0, tolerance=0.5) == (
+        True, "x", log2, log15, "fidelity", "", False)
+    assert read("elapsed_s", "thesis_point", tolerance=0.1) == (
+        True, "x", 0.0, round(float(np.log1p(0.1)), 9), "", "cpu", True)
+
+
 def test_each_view_states_where_it_reads(win):
     texts = {at: evaluate(_claim(Compare("lan", "alte2d", "quadtree", "mhd_m", at)), win).evidence
              for at in ("thesis_point", "rule", "equal_size")}
@@ -154,6 +195,16 @@ def test_almost_the_same_is_a_band_around_one():
     narrow = Compare("lan", "alte2d", "quadtree", "basis_functions", "equal_fidelity",
                      relation="similar", tolerance=0.05)
     assert _verdict(narrow, curves(1.02)) == "does not hold"
+    # the shown factor is the first named mapper's over the second's, whichever is larger
+    apart = evaluate(_claim(check), curves(1.2))
+    assert "basis functions, 2D-ALTE / Quadtree" in apart.evidence
+    assert (apart.cells["estimate"] > 1.5).all()
+    # a tolerance of 1.0 on a ratio is "within a factor 2" (not e): x1.6 holds, x2.4 not
+    wide = Compare("lan", "alte2d", "quadtree", "basis_functions", "equal_fidelity",
+                   relation="similar", tolerance=1.0)
+    assert _verdict(wide, curves(1.15)) == "holds"
+    assert _verdict(wide, curves(1.3)) == "does not hold"
+    assert (evaluate(_claim(wide), curves(1.3)).cells["estimate"].between(2.1, 2.6)).all()
 
 
 def test_times_known_within_their_spread_cannot_be_shown_equal():
@@ -361,7 +412,8 @@ def test_too_few_seeds_are_inconclusive_whatever_the_values():
 
 def test_undecided_and_similar_bounds_are_closed():
     """Neither better: holds when the interval contains 0, its ends included; similar:
-    holds when the interval lies within the band, its ends included."""
+    holds when the interval lies within the band, its ends included; an infinite end is
+    an unbounded side (the other end still decides), a NaN end decides nothing."""
     from alte.studies.evidence import _outcome
     from alte.studies.measures import CheckValues
 
@@ -381,7 +433,7 @@ def test_undecided_and_similar_bounds_are_closed():
              (better, 0.1, 0.5, "inconclusive"), (better, 0.1, 0.49, "does not hold"),
              (better, np.nan, 0.9, "inconclusive"), (better, 0.6, np.nan, "inconclusive"),
              (better, 0.6, np.inf, "holds"), (better, -np.inf, 0.4, "does not hold"),
-             (better, -np.inf, 0.9, "inconclusive")]
+             (better, -np.inf, 0.9, "inconclusive"), (better, -np.inf, np.inf, "inconclusive")]
     got = [_outcome(low, high, 3, m, 2) for m, low, high, _ in cases]
     assert got == [expected for *_, expected in cases]
     assert _outcome(0.6, 0.9, 1, better, 2) == "inconclusive"
