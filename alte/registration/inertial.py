@@ -7,7 +7,7 @@ up and gravity is ``(0, 0, -9.81)`` m/s^2. The IMU reads body rates ``w`` and sp
 instants the state follows the samples (each held over the half-intervals around its stamp,
 so a sample is centred on the motion it measured):
 
-    R <- R Exp((w - bg) dt);  v <- v + (R (f - ba) + g) dt;  p <- p + v dt + (R (f - ba) + g) dt^2 / 2
+    a = R (f - ba) + g;  R <- R Exp((w - bg) dt);  v <- v + a dt;  p <- p + v dt + a dt^2 / 2
 
 and the 15-dimensional error (rotation in the IMU frame, position, velocity, biases) carries
 a covariance propagated with the continuous-time noise densities of Kalibr's model
@@ -85,7 +85,7 @@ def _steps(stamps: np.ndarray, start: int, end: int) -> tuple[np.ndarray, np.nda
 
 
 def integrate(state: NavState, end: int, stamps: np.ndarray, gyro: np.ndarray,
-              accel: np.ndarray, visit: Callable[[NavState, np.ndarray, np.ndarray, float],
+              accel: np.ndarray, *, visit: Callable[[NavState, np.ndarray, np.ndarray, float],
                                                  None] | None = None) -> NavState:
     """The nominal state carried from ``state.stamp`` to ``end`` (ns) by the samples
     (module docstring); ``visit(state, w, f, dt)`` sees each step before it is applied."""
@@ -135,7 +135,8 @@ class InertialFilter:
     def predict(self, end: int, stamps: np.ndarray, gyro: np.ndarray,
                 accel: np.ndarray) -> None:
         """Carry state and covariance to ``end`` (ns) with the IMU samples."""
-        self.state = integrate(self.state, end, stamps, gyro, accel, self._covariance_step)
+        self.state = integrate(self.state, end, stamps, gyro, accel,
+                               visit=self._covariance_step)
 
     def apply(self, delta: np.ndarray, base: NavState) -> NavState:
         """``base`` moved by the 15-dimensional error ``delta``."""

@@ -19,7 +19,7 @@ else level from the accelerometer), gravity along -z. Two PyPI packages were tri
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
@@ -28,13 +28,13 @@ from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation
 
 from alte.errors import RegistrationError
-from alte.registration.inertial import ImuNoise, InertialFilter, NavState, hat
+from alte.registration.inertial import ImuNoise, InertialFilter, NavState
 from alte.types import Frame, Mount
 
 if TYPE_CHECKING:
     from alte.io.imu import ImuSamples
 
-__all__ = ["LioSettings", "LocalMap", "LioOdometry", "check_overlap"]
+__all__ = ["LioOdometry", "LioSettings", "LocalMap", "check_overlap", "lio_frames"]
 
 
 @dataclass(frozen=True)
@@ -56,12 +56,18 @@ def _matrix(position: np.ndarray, rotation: Rotation) -> np.ndarray:
     return out
 
 
+def _cells(points: np.ndarray, voxel: float) -> np.ndarray:
+    """One int64 key per ``voxel`` cell (21 bits an axis: +-500 km at 0.25 m)."""
+    index = np.floor(points / voxel).astype(np.int64) + (1 << 20)
+    keys: np.ndarray = (index[:, 0] << 42) | (index[:, 1] << 21) | index[:, 2]
+    return keys
+
+
 def _voxel_first(points: np.ndarray, voxel: float) -> np.ndarray:
     """One point per ``voxel`` cell (the first): a cheap, deterministic down-sampling."""
     if len(points) == 0:
         return points
-    keys = np.floor(points / voxel).astype(np.int64)
-    _, first = np.unique(keys, axis=0, return_index=True)
+    _, first = np.unique(_cells(points, voxel), return_index=True)
     return points[np.sort(first)]
 
 
@@ -71,23 +77,34 @@ class LocalMap:
     def __init__(self, voxel: float, radius: float, thickness: float = 0.05) -> None:
         self.voxel, self.radius, self.thickness = voxel, radius, thickness
         self.points = np.empty((0, 3))
+        self.keys = np.empty(0, np.int64)
         self.tree: cKDTree | None = None
 
     def add(self, points: np.ndarray, centre: np.ndarray) -> None:
-        """Merge ``points`` (world) and drop what lies beyond ``radius`` of ``centre``."""
-        merged = _voxel_first(np.vstack([self.points, points]), self.voxel)
+        """Add ``points`` (world) in cells not yet filled; drop what lies beyond ``radius``
+        of ``centre``."""
+        new = _voxel_first(points, self.voxel)
+        keys = _cells(new, self.voxel)
+        at = np.clip(np.searchsorted(self.keys, keys), 0, max(len(self.keys) - 1, 0))
+        fresh = ~(self.keys[at] == keys) if len(self.keys) else np.ones(len(keys), bool)
+        merged = np.vstack([self.points, new[fresh]])
+        cells = np.r_[self.keys, keys[fresh]]
         near = np.linalg.norm(merged - centre, axis=1) <= self.radius
-        self.points = merged[near]
-        self.tree = cKDTree(self.points) if len(self.points) >= 5 else None
+        order = np.argsort(cells[near], kind="stable")
+        self.points, self.keys = merged[near][order], cells[near][order]
+        self.tree = cKDTree(self.points, balanced_tree=False, compact_nodes=False) \
+            if len(self.points) >= 5 else None
 
     def planes(self, query: np.ndarray, max_distance: float
                ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """For each query point with five map neighbours within ``max_distance`` lying on
-        a plane (thinner than ``thickness``, and not a line: a ring's points are): its index, the plane's unit normal and a point of the plane."""
+        a plane (thinner than ``thickness``, and not a line as a ring's points are): its
+        index, the plane's unit normal and a point of the plane."""
         if self.tree is None or len(query) == 0:
             return np.empty(0, np.int64), np.empty((0, 3)), np.empty((0, 3))
-        dist, idx = self.tree.query(query, k=5, distance_upper_bound=max_distance)
-        ok = np.isfinite(dist).all(axis=1)
+        dist, found = self.tree.query(query, k=5, distance_upper_bound=max_distance)
+        idx = np.asarray(found, dtype=np.int64).reshape(-1, 5)
+        ok = np.isfinite(np.asarray(dist)).reshape(-1, 5).all(axis=1)
         nbrs = self.points[idx[ok]]
         centre = nbrs.mean(axis=1)
         centred = nbrs - centre[:, None, :]
@@ -117,7 +134,8 @@ class LioOdometry:
         self.body_imu = _matrix(imu_mount.translation, imu_mount.rotation)
         self.imu_lidar = np.linalg.inv(self.body_imu) @ _matrix(lidar.translation,
                                                                 lidar.rotation)
-        body = _matrix(start[0], Rotation.from_quat(start[1])) if start is not None else self._level(first)
+        body = self._level(first) if start is None \
+            else _matrix(start[0], Rotation.from_quat(start[1]))
         world_imu = body @ self.body_imu
         state = NavState(first, Rotation.from_matrix(world_imu[:3, :3]), world_imu[:3, 3],
                          np.zeros(3), np.zeros(3), np.zeros(3))
@@ -145,7 +163,7 @@ class LioOdometry:
         state = self.filter.state
         lidar = points @ self.imu_lidar[:3, :3].T + self.imu_lidar[:3, 3]
         if times is None or len(times) == 0 or np.ptp(times) <= 0:
-            return lidar
+            return np.asarray(lidar)
         span = self._window(state.stamp, state.stamp + int(float(np.max(times)) * 1e9))
         gyro = self.imu.angular_velocity[span].mean(axis=0) - state.gyro_bias
         force = self.imu.linear_acceleration[span].mean(axis=0) - state.accel_bias
@@ -156,7 +174,8 @@ class LioOdometry:
         moved: np.ndarray = rot.apply(lidar) + shift
         return moved
 
-    def _residuals(self, scan: np.ndarray) -> object:
+    def _residuals(self, scan: np.ndarray) -> Callable[[NavState],
+                                                       tuple[np.ndarray, np.ndarray]]:
         settings = self.settings
 
         def residuals(state: NavState) -> tuple[np.ndarray, np.ndarray]:
