@@ -5,9 +5,9 @@ velocity ``v`` (world) and the gyroscope / accelerometer biases; the world's z a
 up and gravity is ``(0, 0, -9.81)`` m/s^2. The IMU reads body rates ``w`` and specific force
 ``f = R^T (a - g)`` (at rest and level: ``+9.81`` along z, the ROS convention). Between two
 instants the state follows the samples (each held over the half-intervals around its stamp,
-so a sample is centred on the motion it measured):
+so a sample is centred on the motion it measured; ``R'`` the rotation mid-step):
 
-    a = R (f - ba) + g;  R <- R Exp((w - bg) dt);  v <- v + a dt;  p <- p + v dt + a dt^2 / 2
+    a = R' (f - ba) + g;  R <- R Exp((w - bg) dt);  v <- v + a dt;  p <- p + v dt + a dt^2 / 2
 
 and the 15-dimensional error (rotation in the IMU frame, position, velocity, biases) carries
 a covariance propagated with the continuous-time noise densities of Kalibr's model
@@ -98,10 +98,12 @@ def integrate(state: NavState, end: int, stamps: np.ndarray, gyro: np.ndarray,
         w, f = gyro[k] - out.gyro_bias, accel[k] - out.accel_bias
         if visit is not None:
             visit(out, w, f, dt)
-        acc = out.rotation.apply(f) + GRAVITY
+        turned = out.rotation * Rotation.from_rotvec(w * dt)
+        mid = out.rotation * Rotation.from_rotvec(0.5 * w * dt)
+        acc = mid.apply(f) + GRAVITY  # the force turns with the body over the step
         out.position = out.position + out.velocity * dt + 0.5 * acc * dt * dt
         out.velocity = out.velocity + acc * dt
-        out.rotation = out.rotation * Rotation.from_rotvec(w * dt)
+        out.rotation = turned
     out.stamp = int(end)
     return out
 
