@@ -71,7 +71,7 @@ def test_imu_on_another_clock_is_a_typed_error():
     (what made a package's trial count zero IMU samples per scan), so it is refused."""
     stamps = np.arange(10, dtype=np.int64) * 5_000 + T0 // 1000
     imu = ImuSamples(stamps, np.zeros((10, 3)), np.tile(-GRAVITY, (10, 1)))
-    with pytest.raises(RegistrationError, match="outside the IMU topic.*another clock or unit"):
+    with pytest.raises(RegistrationError, match=r"outside the IMU topic.*another clock or unit"):
         check_overlap(imu, T0)
     check_overlap(ImuSamples(stamps * 1000, np.zeros((10, 3)), np.zeros((10, 3))), T0)
 
@@ -127,7 +127,7 @@ def test_auto_is_lio_with_an_imu_and_lio_without_one_is_refused():
     assert resolve_method(odometry_params("plane"), True).method == "plane"
     with pytest.raises(ParameterError, match="--odometry lio needs an IMU topic"):
         list(odometry_frames([], Mount(), counts=PoseCounts(), params=odometry_params("lio")))
-    with pytest.raises(ParameterError, match="plane_sigma=-1.0 out of range"):
+    with pytest.raises(ParameterError, match=r"plane_sigma=-1\.0 out of range"):
         odometry_params("lio", {"plane_sigma": "-1"})
 
 
