@@ -157,3 +157,22 @@ def test_lio_flies_the_first_five_seconds_of_the_uav_mission(uav_mission):
     assert errors.ate_m < 0.3
     final = np.linalg.norm(frames[-1].position - truth.positions[j[-1]])
     assert final < 0.6
+
+
+def test_the_pipeline_picks_lio_for_a_bag_with_an_imu_and_says_so(tmp_path, capsys):
+    """``--poses odometry`` on the uav profile's bag (it has /imu) runs LIO unasked; on the
+    thesis profile's bag (no IMU) KISS-ICP; ``alte register`` prints which."""
+    from alte.cli import main
+    from alte.pipeline import FrameSpec, PoseSource, open_input, prepare
+
+    uav = ensure_terrain("sim_lan_2", tmp_path, frames=3, profile=PROFILES["uav"])
+    thesis = ensure_terrain("sim_lan_2", tmp_path, frames=3)
+    spec = FrameSpec(poses=PoseSource.ODOMETRY)
+    lio, kiss = (prepare(open_input(f), spec).counts for f in (uav, thesis))
+    assert lio.poses.method == "lio" and lio.poses.deskewed == 3
+    assert any("LiDAR-inertial odometry (lidar-inertial, IMU imu_link at 200 Hz)" in n
+               for n in lio.notes)
+    assert kiss.poses.method == "kiss" and not any("inertial" in n for n in kiss.notes)
+    assert main(["register", str(uav), "--poses", "odometry", "--out",
+                 str(tmp_path / "cloud.ply")]) == 0
+    assert "odometry (lidar-inertial" in capsys.readouterr().out
