@@ -92,10 +92,12 @@ class OdometryParams(Record):
                                   "m; refine: a larger correction is not applied")
     max_correction_deg: float = param(20.0, _positive, "> 0",
                                       "deg; refine: a larger correction is not applied")
-    plane_sigma: float = param(0.05, _positive, "> 0",
+    plane_sigma: float = param(0.15, _positive, "> 0",
                                "m; lio: point-to-plane noise (Cauchy kernel width)")
-    plane_reach: float = param(2.0, _positive, "> 0",
+    plane_reach: float = param(3.0, _positive, "> 0",
                                "m; lio: farthest map neighbour of a plane fit")
+    plane_points: int = param(20, lambda v: v >= 3, ">= 3",
+                              "lio: map points a plane is fitted to")
     imu_topic: str | None = param(None, bool, "a topic name",
                                   "lio: the IMU topic (default: the bag's only "
                                   "sensor_msgs/msg/Imu)")
@@ -107,7 +109,8 @@ KEYS: dict[str, tuple[str, ...]] = {
     "kiss": ("max_range", "min_range", "voxel", "single_downsample", "fixed_threshold",
              "initial_threshold", "min_motion_th", "max_points_per_voxel", "deskew", "threads"),
     "plane": ("max_range", "voxel", "rebuild", "min_fitness"),
-    "lio": ("max_range", "min_range", "voxel", "plane_sigma", "plane_reach", "imu_topic"),
+    "lio": ("max_range", "min_range", "voxel", "plane_sigma", "plane_reach", "plane_points",
+            "imu_topic"),
     "refine": ("max_range", "voxel", "rebuild", "min_fitness", "min_constraint", "min_gain",
                "max_correction", "max_correction_deg", "threads"),
 }
@@ -190,7 +193,7 @@ def lio_settings(params: OdometryParams) -> LioSettings:
     return LioSettings(voxel=params.voxel or base.voxel,
                        max_range=params.max_range or base.max_range,
                        min_range=params.min_range, plane_sigma=params.plane_sigma,
-                       max_distance=params.plane_reach)
+                       max_distance=params.plane_reach, neighbours=params.plane_points)
 
 
 def _rate(previous: Frame | None, quaternion: np.ndarray, stamp: int) -> float:
