@@ -38,6 +38,10 @@ def miss_note(result: Result) -> str:
     if result.unit == "exponent":
         return f"row {result.row} {result.case}: exponent {result.ours:.2f} vs n log n's " \
                f"{result.peer:.2f}"
+    if "grid_wall_h" in result.detail:
+        return (f"row {result.row} {result.case}: the grid's estimated wall time "
+                f"{result.detail['grid_wall_h']:.2f} h on {result.detail['workers']} cores, "
+                f"{result.target}")
     bound = float(result.detail.get("limit", LIMITS[result.row]))
     return (f"row {result.row} {result.case}: ratio {result.ratio:.3g}, target <= {bound:.3g} "
             f"(missed by {result.ratio / bound:.2f}x)")
@@ -86,6 +90,18 @@ def _row7(results: list[Result]) -> list[str]:
     return (["", "Row 7 timings (plot: bench_scaling.png):", "", *out]) if out else []
 
 
+def _row13(results: list[Result]) -> list[str]:
+    out = [f"- {r.case}: {d['sample_runs']} runs in {d['sample_cpu_s']:.1f} CPU s, inputs "
+           f"prepared in {d['prepare_cpu_s_per_input']:.1f} CPU s each; the grid's "
+           f"{d['grid_runs']:,} runs on {d['grid_inputs']} inputs: {d['grid_cpu_h']:.2f} CPU h, "
+           f"{d['grid_wall_h']:.2f} h on {d['workers']} cores ({d['grid_runs_per_core_s']:.2f} "
+           f"runs per core-second); today's path run by run: {d['peer_runs']} runs in "
+           f"{d['peer_cpu_s']:.1f} CPU s"
+           for r in results if r.row == 13 for d in (r.detail,)]
+    return (["", "Row 13 estimates (stratified sample of map groups, CPU seconds):", "",
+             *out]) if out else []
+
+
 def render_markdown(bench: Bench) -> str:
     """The report: machine, the table, missed targets, failed rows, row 7/8 details."""
     lines = ["# alte benchmark", "", *_machine(bench), "",
@@ -99,7 +115,8 @@ def render_markdown(bench: Bench) -> str:
     if bench.errors:
         lines += ["", "Rows that failed:", ""]
         lines += [f"- row {n} ({ROWS[n][0]}): {msg}" for n, msg in bench.errors.items()]
-    return "\n".join([*lines, *_row7(bench.results), *_row8(bench.results), ""])
+    return "\n".join([*lines, *_row7(bench.results), *_row8(bench.results),
+                      *_row13(bench.results), ""])
 
 
 def plot_scaling(results: list[Result], path: Path) -> Path | None:

@@ -24,6 +24,7 @@ from alte.bench.memory import map_memory
 from alte.bench.poses import pose_speed
 from alte.bench.scaling import scaling
 from alte.bench.stream import scan_peer, streaming_chain
+from alte.bench.sweep import sweep_throughput
 from alte.bench.timing import machine_info, peak_rss_bytes
 from alte.bench.wall import report_wall_time
 from alte.errors import ParameterError
@@ -46,6 +47,8 @@ ROWS: dict[int, tuple[str, Row]] = {
     10: ("alte map BAG: wall time vs mission time, per-frame latency", streaming_chain),
     11: ("Octomap native vs DUFOMap (UFOMap) scan integration", scan_peer),
     12: ("odometry / refinement per real scan vs kiss-icp's pipeline", pose_speed),
+    13: ("sweep runs per core-second (20 scans, whole missions) and the grid's time",
+         sweep_throughput),
 }
 
 

@@ -3,7 +3,14 @@
 from __future__ import annotations
 
 import argparse
+import shlex
+import time
+from datetime import UTC, datetime
 from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from alte.studies.sweep import SweepResult, SweepSpec
 
 __all__ = ["add_parser", "run"]
 
@@ -30,8 +37,43 @@ def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) 
                         help="simulation seeds, overriding the spec's seed(s)")
     parser.add_argument("--data", type=Path, default=None,
                         help="terrain folder, overriding the spec's data_dir")
+    parser.add_argument("--evidence", type=Path, default=None, metavar="FOLDER",
+                        help="once every run is done, write the grid's claims, equal-size and "
+                             "equal-fidelity tables, fronts and provenance there (the "
+                             "whole-mission evidence make report reads, e.g. "
+                             "notebooks/sweeps/tradeoff-full)")
     parser.add_argument("--no-progress", action="store_true", help="hide progress bars")
     parser.set_defaults(func=run)
+
+
+def _command(args: argparse.Namespace) -> str:
+    """The command line that reproduces ``args``."""
+    words = ["alte", "sweep", str(args.spec), "--scheduler", args.scheduler]
+    if args.scheduler == "local":
+        words += ["--workers", str(args.workers)]
+    for flag, value in (("--frames", args.frames), ("--data", args.data), ("--out", args.out),
+                        ("--evidence", args.evidence)):
+        if value is not None:
+            words += [flag, str(value)]
+    if args.seeds is not None:
+        words += ["--seeds", *map(str, args.seeds)]
+    return shlex.join(words)
+
+
+def _evidence(args: argparse.Namespace, spec: SweepSpec, result: SweepResult, started: str,
+              seconds: float) -> None:
+    from alte.bench.timing import machine_info
+    from alte.studies.grid import grid_of
+    from alte.studies.missions import Provenance, git_commit, write_mission_evidence
+
+    grid = grid_of(spec, result, seconds)
+    provenance = Provenance(
+        command=_command(args), commit=git_commit(), spec=str(args.spec), runs=grid.runs,
+        ran=result.ran, frames=spec.frames, seeds=list(spec.seeds), cpu_s=round(grid.cpu_s, 1),
+        wall_s=round(seconds, 1), started=started,
+        finished=datetime.now(UTC).isoformat(timespec="seconds"), machine=machine_info())
+    folder = write_mission_evidence(grid.table, args.evidence, provenance)
+    print(f"evidence of {grid.runs} runs written to {folder}")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -45,10 +87,18 @@ def run(args: argparse.Namespace) -> int:
         spec = override(spec, data_dir=str(args.data))
     if args.seeds is not None:
         spec = override(spec, seeds=args.seeds)
+    started, start = datetime.now(UTC).isoformat(timespec="seconds"), time.perf_counter()
     result = run_sweep(spec, scheduler=args.scheduler, workers=args.workers, output=args.out,
                        progress=not args.no_progress)
+    seconds = time.perf_counter() - start
     for failed, message in result.failed:
         print(f"failed: {failed.terrain} {failed.mapper} {dict(failed.params)}: {message}")
     print(f"sweep {spec.name}: {result.ran} run, {result.skipped} already done, "
           f"{len(result.failed)} failed; {len(result.table)} rows in {result.output}")
-    return 1 if result.failed else 0
+    if result.failed:
+        if args.evidence is not None:
+            print(f"evidence not written to {args.evidence}: rerun to retry the failed runs")
+        return 1
+    if args.evidence is not None:
+        _evidence(args, spec, result, started, seconds)
+    return 0

@@ -13,12 +13,14 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
+import numba
 import numpy as np
 
 from alte.errors import MapperError
-from alte.mappers._raycast import TREE_DEPTH, TREE_MAX_VAL, morton_decode
+from alte.mappers._raycast import TREE_DEPTH, TREE_MAX_VAL, _compact, morton_decode
 
-__all__ = ["Leaves", "check_origin", "leaf_geometry", "prune", "prune_voxels", "write_bt"]
+__all__ = ["Leaves", "check_origin", "leaf_boxes", "leaf_geometry", "prune", "prune_voxels",
+           "write_bt"]
 
 _THREE = np.uint64(3)
 
@@ -45,23 +47,46 @@ def check_origin(origin: object, owner: str) -> np.ndarray:
     return arr
 
 
+@numba.njit(cache=True)
+def _collapse_sorted(keys: np.ndarray, values: np.ndarray
+                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """One pass over sorted keys: (kept keys, their values, parents whose 8 children all
+    hold the same value, that value). Arrays allocated here, untouched beyond use."""
+    n = keys.shape[0]
+    kept_k, kept_v = np.empty(n, keys.dtype), np.empty(n, values.dtype)
+    par_k, par_v = np.empty(n // 8 + 1, keys.dtype), np.empty(n // 8 + 1, values.dtype)
+    kept = parents = 0
+    i = 0
+    while i < n:
+        parent = keys[i] >> np.uint64(3)
+        j = i + 1
+        low = high = values[i]
+        while j < n and keys[j] >> np.uint64(3) == parent:
+            low, high = min(low, values[j]), max(high, values[j])
+            j += 1
+        if j - i == 8 and low == high:
+            par_k[parents], par_v[parents] = parent, low
+            parents += 1
+        else:
+            for t in range(i, j):
+                kept_k[kept], kept_v[kept] = keys[t], values[t]
+                kept += 1
+        i = j
+    return kept_k[:kept], kept_v[:kept], par_k[:parents], par_v[:parents]
+
+
 def _collapse(keys: np.ndarray, values: np.ndarray, depth: int) -> tuple[Leaves, Leaves]:
     """One depth of pruning over sorted ``keys``: the leaves kept at ``depth`` and the
     parents (at ``depth - 1``) whose 8 children all hold the same value."""
-    parent = keys >> _THREE
-    starts = np.flatnonzero(np.r_[True, parent[1:] != parent[:-1]])
-    counts = np.diff(np.r_[starts, parent.size])
-    vmin = np.minimum.reduceat(values, starts)
-    collapse = (counts == 8) & (vmin == np.maximum.reduceat(values, starts))
-    keep = ~np.repeat(collapse, counts)
-    kept = keys[keep]
-    return (Leaves(kept, np.full(kept.size, depth, dtype=np.int64), values[keep]),
-            Leaves(parent[starts[collapse]], np.empty(0, np.int64), vmin[collapse]))
+    kept, kept_values, parents, parent_values = _collapse_sorted(
+        np.ascontiguousarray(keys, np.uint64), np.ascontiguousarray(values))
+    return (Leaves(kept, np.full(kept.size, depth, dtype=np.int64), kept_values),
+            Leaves(parents, np.empty(0, np.int64), parent_values))
 
 
 def _joined(out: list[Leaves]) -> Leaves:
     return Leaves(np.concatenate([lv.prefix for lv in out]),
-                  np.concatenate([lv.depth for lv in out]).astype(np.int64),
+                  np.concatenate([lv.depth for lv in out]).astype(np.int64, copy=False),
                   np.concatenate([lv.value for lv in out]))
 
 
@@ -106,6 +131,32 @@ def prune_voxels(keys: np.ndarray, values: np.ndarray) -> Leaves:
         out.append(kept)
     out.append(Leaves(nodes.prefix, np.zeros(len(nodes), np.int64), nodes.value))
     return _joined(out)
+
+
+@numba.njit(cache=True)
+def _boxes(prefix: np.ndarray, depth: np.ndarray, voxel: float
+           ) -> tuple[np.ndarray, np.ndarray]:
+    """Centres and sizes (metres) of leaves, one pass: :func:`leaf_geometry`'s centres and
+    ``side * voxel`` per axis, the same operations without its temporaries."""
+    n = prefix.shape[0]
+    centers, sizes = np.empty((n, 3)), np.empty((n, 3))
+    for i in range(n):
+        shift = np.uint64(TREE_DEPTH - depth[i])
+        code = prefix[i] << (np.uint64(3) * shift)
+        side = 1 << (TREE_DEPTH - depth[i])
+        half = side / 2.0
+        size = side * voxel
+        for a in range(3):
+            key = np.int64(_compact(code >> np.uint64(a)))
+            centers[i, a] = ((key - TREE_MAX_VAL) + half) * voxel
+            sizes[i, a] = size
+    return centers, sizes
+
+
+def leaf_boxes(leaves: Leaves, voxel: float) -> tuple[np.ndarray, np.ndarray]:
+    """Centre (K, 3) and size (K, 3) of each leaf in metres."""
+    return _boxes(np.ascontiguousarray(leaves.prefix, np.uint64),
+                  np.ascontiguousarray(leaves.depth, np.int64), float(voxel))
 
 
 def leaf_geometry(leaves: Leaves, voxel: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

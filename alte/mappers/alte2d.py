@@ -79,6 +79,9 @@ class Alte2D(QuadMap):
 
     name: ClassVar[str] = "alte2d"
     Params: ClassVar[type[Record]] = Alte2DParams
+    #: The cells' statistics do not depend on the split rule's thresholds, and neither
+    #: does an insertion's work (the same touched cells get new flags).
+    view_params: ClassVar[frozenset[str]] = frozenset({"kappa", "min_pts"})
 
     @property
     def depth(self) -> int:

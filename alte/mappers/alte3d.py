@@ -22,6 +22,7 @@ z axis is cut into layers of ``cell_height`` metres from the domain's zmin.
 
 from __future__ import annotations
 
+import copy
 from dataclasses import dataclass
 from pathlib import Path
 from typing import ClassVar
@@ -30,7 +31,8 @@ import numpy as np
 
 from alte.errors import MapperError
 from alte.mappers._octree import check_origin
-from alte.mappers.base import CellCounts, Cells, Cost, Feed, check_points
+from alte.mappers._rows import unique_rows
+from alte.mappers.base import CellCounts, Cells, Cost, Feed, check_points, check_view
 from alte.mappers.domain import Domain, DomainUse, check_domain
 from alte.params import Record, param
 from alte.types import Box
@@ -84,6 +86,10 @@ class Alte3D:
     default_feed: ClassVar[Feed] = Feed.FRAMES
     exports: ClassVar[frozenset[str]] = frozenset({".npz"})
     free_space: ClassVar[bool] = False
+    #: Splits and occupancy are read off the per-level counts, which depend on
+    #: ``max_res`` (and the variant) only.
+    view_params: ClassVar[frozenset[str]] = frozenset({"min_pts", "min_pts_split",
+                                                       "occupancy_level"})
     cost_unit: ClassVar[Cost] = Cost.CELL_UPDATES
     Params: ClassVar[type[Record]] = Alte3DParams
 
@@ -100,6 +106,8 @@ class Alte3D:
         levels = self._params["max_res"] + 1
         self._keys = [np.empty(0, dtype=np.int64) for _ in range(levels)]
         self._counts = [np.empty(0, dtype=np.int64) for _ in range(levels)]
+        self._cells: Cells | None = None  # the leaves, until the next insert or build
+        self._shared = False  # the count tables are shared with a re-read copy
         self._cost = 0
 
     @property
@@ -140,7 +148,21 @@ class Alte3D:
         self.points_outside = 0
         self._add(pts)
 
+    def reread(self, **changes: object) -> Alte3D:
+        """This map read with other ``min_pts``, ``min_pts_split``, ``occupancy_level``
+        (:meth:`alte.mappers.base.Mapper.reread`)."""
+        check_view(self, changes)
+        record = self._record.replace(**changes)
+        other = copy.copy(self)
+        other._record, other._params, other._cells = record, record.as_dict(), None
+        self._shared = other._shared = True
+        return other
+
     def _add(self, pts: np.ndarray) -> None:
+        if self._shared:
+            raise MapperError("alte3d: this map was re-read with other parameters and shares "
+                              "its counts with the copy; build it afresh to add points")
+        self._cells = None
         finest = self._finest_keys(pts)
         if finest.size == 0:
             return
@@ -202,7 +224,13 @@ class Alte3D:
         return CellCounts.of(self.cells())
 
     def cells(self) -> Cells:
-        """Leaves: centre, size, point count, occupied flag and level."""
+        """Leaves: centre, size, point count, occupied flag and level (derived from the
+        counts once per state of the map)."""
+        if self._cells is None:
+            self._cells = self._make_cells()
+        return self._cells
+
+    def _make_cells(self) -> Cells:
         if self._domain is None:
             empty = np.empty((0, 3))
             return Cells(empty, empty, np.empty(0), np.empty(0, bool), np.empty(0, np.int64))
@@ -248,7 +276,7 @@ class Alte3D:
         size = cells.sizes[cells.occupied]
         offsets = np.array([[i >> 2 & 1, i >> 1 & 1, i & 1] for i in range(8)], dtype=np.float64)
         corners = (lo[:, None, :] + offsets[None] * size[:, None, :]).reshape(-1, 3)
-        return np.unique(corners, axis=0)
+        return unique_rows(corners)
 
 
 def _children(keys: np.ndarray, variant: str) -> np.ndarray:

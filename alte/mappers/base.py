@@ -8,6 +8,7 @@ real-time loop does) or a whole cloud at once with :meth:`Mapper.build`.
 from __future__ import annotations
 
 import enum
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import ClassVar, Protocol, runtime_checkable
@@ -19,7 +20,7 @@ from alte.mappers.domain import Domain, DomainUse
 from alte.params import Record
 from alte.types import as_points
 
-__all__ = ["CellCounts", "Cells", "Cost", "Feed", "Mapper", "check_points"]
+__all__ = ["CellCounts", "Cells", "Cost", "Feed", "Mapper", "check_points", "check_view"]
 
 
 @dataclass(frozen=True)
@@ -93,8 +94,9 @@ class Mapper(Protocol):
     Capabilities are class attributes the pipeline reads (never probed with hasattr):
     ``dims``, ``incremental``, ``domain_use``, ``default_feed`` (the thesis' protocol:
     Quadtree ran once on the final cloud), ``exports`` (file suffixes it writes),
-    ``free_space`` (its unoccupied cells were observed free) and ``cost_unit`` (what
-    :attr:`cost` counts).
+    ``free_space`` (its unoccupied cells were observed free), ``cost_unit`` (what
+    :attr:`cost` counts) and ``view_params`` (the parameters :meth:`reread` can
+    change).
     """
 
     name: ClassVar[str]
@@ -108,6 +110,10 @@ class Mapper(Protocol):
     exports: ClassVar[frozenset[str]]
     #: True when unoccupied cells are observed free space (ray casting), not just "not hit".
     free_space: ClassVar[bool]
+    #: Parameters that only decide how the stored map is read (which cells split, which
+    #: are occupied), not what ``insert``/``build`` store nor the work they do: a map
+    #: re-read with other values of these equals the map made with them.
+    view_params: ClassVar[frozenset[str]]
     #: The unit of :attr:`cost`.
     cost_unit: ClassVar[Cost]
 
@@ -167,7 +173,24 @@ class Mapper(Protocol):
         """Write the map in its own format (the non-``.npz`` suffix of ``exports``)."""
         ...
 
+    def reread(self, **changes: object) -> Mapper:
+        """This map read with other values of ``view_params`` (a sweep's settings that
+        differ in those only share one feed). The copy shares the stored map: from then
+        on neither takes more points until a ``build`` starts it afresh."""
+        ...
+
 
 def check_points(points: object, owner: str, name: str = "points") -> np.ndarray:
     """Return finite float64 (N, 3) points or raise :class:`MapperError` naming the problem."""
     return as_points(points, name, owner=owner, error=MapperError, finite=True)
+
+
+def check_view(mapper: Mapper, changes: Mapping[str, object]) -> None:
+    """Raise :class:`MapperError` when ``changes`` (what :meth:`Mapper.reread` takes)
+    name a parameter outside ``mapper.view_params``, naming the ones that can change;
+    their values are checked by the parameter record."""
+    stored = sorted(set(changes) - mapper.view_params)
+    if stored:
+        can = ", ".join(sorted(mapper.view_params)) or "none"
+        raise MapperError(f"{mapper.name}: {', '.join(stored)} change(s) what the map stores; "
+                          f"a map can be re-read with other {can} only")

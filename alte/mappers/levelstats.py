@@ -19,6 +19,7 @@ when an insertion needs them.
 
 from __future__ import annotations
 
+import copy
 import mmap
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -111,6 +112,7 @@ class LevelStats:
         self._index: list[np.ndarray | None] = [None for _ in levels]  # None: to rebuild
         self._defer = 0
         self._source: tuple[Sorted, float] | None = None  # see build_tree
+        self._shared = False  # cells shared with a branch: no more points (see branch)
         #: Cell statistics written so far, every level (the maps' machine-free cost).
         self.updates = 0
         self.keys = _PerLevel(self, self._k)
@@ -139,6 +141,7 @@ class LevelStats:
     def add(self, fine_keys: np.ndarray, values: np.ndarray) -> list[np.ndarray] | None:
         """Add points given by finest-level keys and (N, nv) values; the rows touched per
         level, or None when the map was empty (every row is new)."""
+        self._check_own()
         self.complete()
         was_empty = not any(self._n)
         keys, order = sort_keys(np.asarray(fine_keys, np.int64), 2 * self.depth)
@@ -180,6 +183,25 @@ class LevelStats:
         self.add(packed >> shift, values)
         for level in range(self.depth):
             self._s[level] = self._r[level][:, 0] > split_above
+
+    def branch(self) -> LevelStats:
+        """A copy sharing the cells (keys and statistics) that owns its split flags, so a
+        map can be read with another split rule. Neither takes points afterwards: an
+        insertion would change the shared cells under the other."""
+        for level in range(self.depth + 1):
+            self.fold(level)
+        other = copy.copy(self)
+        other._k, other._r, other._s = list(self._k), list(self._r), [s.copy() for s in self._s]
+        other._n, other._sorted, other._index = list(self._n), list(self._sorted), list(self._index)
+        other.keys, other.rows = _PerLevel(other, other._k), _PerLevel(other, other._r)
+        other.split = _PerLevel(other, other._s)
+        self._shared = other._shared = True
+        return other
+
+    def _check_own(self) -> None:
+        if self._shared:
+            raise MapperError("this map was re-read with other parameters and shares its cells "
+                              "with the copy; build it afresh to add points")
 
     def _set_level(self, level: int, keys: np.ndarray, rows: np.ndarray,
                    split: np.ndarray) -> None:

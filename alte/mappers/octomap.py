@@ -23,9 +23,10 @@ import numpy as np
 from alte.errors import MapperError, ParameterError
 from alte.fsutil import atomic_path
 from alte.mappers._octomap_backends import NativeTree, ReferenceTree, SensorModel, tree_leaves
-from alte.mappers._octree import Leaves, check_origin, leaf_geometry
+from alte.mappers._octree import Leaves, check_origin, leaf_boxes, leaf_geometry
 from alte.mappers._raycast import TREE_DEPTH, TREE_MAX_VAL
-from alte.mappers.base import CellCounts, Cells, Cost, Feed, check_points
+from alte.mappers._rows import unique_rows
+from alte.mappers.base import CellCounts, Cells, Cost, Feed, check_points, check_view
 from alte.mappers.domain import Domain, DomainUse
 from alte.params import Record, param
 from alte.types import rows_all
@@ -128,6 +129,8 @@ class Octomap:
     default_feed: ClassVar[Feed] = Feed.FRAMES
     exports: ClassVar[frozenset[str]] = frozenset({".npz", ".bt"})
     free_space: ClassVar[bool] = True
+    #: Every parameter changes the log-odds the tree stores.
+    view_params: ClassVar[frozenset[str]] = frozenset()
     cost_unit: ClassVar[Cost] = Cost.RAY_STEPS
     Params: ClassVar[type[Record]] = OctomapParams
 
@@ -138,6 +141,12 @@ class Octomap:
         self._record = OctomapParams.parse(given)
         self._tree = self._new_tree()
         self.points_outside = 0
+        self._cells: tuple[Leaves, Cells] | None = None  # the cells of those leaves
+
+    def reread(self, **changes: object) -> Octomap:
+        """Octomap has no view parameters: the map itself (any change raises)."""
+        check_view(self, changes)
+        return self
 
     def _new_tree(self) -> _Backend:
         rec = self._record
@@ -199,7 +208,13 @@ class Octomap:
         return self._tree.leaves()
 
     def cells(self) -> Cells:
-        return leaves_to_cells(self.leaves(), self.voxel_size, self._tree.model.occupied)
+        """The leaves as cells (kept while the leaves are: a flight at 0.1 m has tens of
+        millions, seconds to convert)."""
+        leaves = self.leaves()
+        if self._cells is None or self._cells[0] is not leaves:
+            self._cells = (leaves, leaves_to_cells(leaves, self.voxel_size,
+                                                   self._tree.model.occupied))
+        return self._cells[1]
 
     def cell_counts(self) -> CellCounts:
         """Leaves and occupied leaves, from the leaf values alone (no centres or sizes)."""
@@ -231,7 +246,7 @@ class Octomap:
         min_keys, side, _ = leaf_geometry(_subset(leaves, occ), self.voxel_size)
         offsets = np.array([[i >> 2 & 1, i >> 1 & 1, i & 1] for i in range(8)])
         grid = (min_keys[:, None, :] + offsets[None] * side[:, None, None]).reshape(-1, 3)
-        return (np.unique(grid, axis=0) - TREE_MAX_VAL) * self.voxel_size
+        return (unique_rows(grid) - TREE_MAX_VAL) * self.voxel_size
 
     def write_native(self, path: Path, overwrite: bool = False) -> Path:
         """The OctoMap binary tree (``.bt``), see :meth:`write_bt`."""
@@ -252,9 +267,8 @@ def _subset(leaves: Leaves, mask: np.ndarray) -> Leaves:
 def leaves_to_cells(leaves: Leaves, voxel: float,
                     occupied_log_odds: float | np.float32) -> Cells:
     """Cells of pruned leaves: centres, cubic sizes, probability, occupied flag, depth."""
-    _, side, centers = leaf_geometry(leaves, voxel)
+    centers, sizes = leaf_boxes(leaves, voxel)
     value = 1.0 - 1.0 / (1.0 + np.exp(leaves.value.astype(np.float64)))
-    sizes = np.repeat((side * voxel)[:, None], 3, axis=1).astype(np.float64)
     return Cells(centers, sizes, value, leaves.value > occupied_log_odds, leaves.depth.copy())
 
 

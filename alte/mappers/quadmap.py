@@ -17,13 +17,15 @@ a batch build with ``domain`` set to the grown root (:attr:`QuadMap.square`).
 
 from __future__ import annotations
 
+import copy
 from pathlib import Path
-from typing import ClassVar
+from typing import ClassVar, Self
 
 import numpy as np
 
 from alte.errors import MapperError
-from alte.mappers.base import CellCounts, Cells, Cost, Feed, check_points
+from alte.mappers._rows import unique_rows
+from alte.mappers.base import CellCounts, Cells, Cost, Feed, check_points, check_view
 from alte.mappers.domain import Domain, DomainUse, check_domain
 from alte.mappers.levelstats import LevelStats
 from alte.mappers.quadgrid import Square
@@ -39,7 +41,7 @@ def rectangle_corners(cells: Cells, mask: np.ndarray) -> np.ndarray:
     signs = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]], dtype=np.float64)
     xy = (c[:, None, :2] + signs[None] * half[:, None]).reshape(-1, 2)
     pts = np.column_stack([xy, np.repeat(c[:, 2], 4)])
-    return np.unique(pts, axis=0) if len(pts) else np.empty((0, 3))
+    return unique_rows(pts)
 
 
 class QuadMap:
@@ -54,6 +56,7 @@ class QuadMap:
     free_space: ClassVar[bool] = False
     cost_unit: ClassVar[Cost] = Cost.CELL_UPDATES
     Params: ClassVar[type[Record]] = Record
+    view_params: ClassVar[frozenset[str]] = frozenset()
     _NVALUES: ClassVar[int] = 1
 
     def __init__(self, domain: Domain | None = None, **given: object) -> None:
@@ -147,6 +150,19 @@ class QuadMap:
         self._reset(square)
         if len(pts):
             self._add(pts, batch=True)
+
+    def reread(self, **changes: object) -> Self:
+        """This map read with other ``view_params`` (:meth:`alte.mappers.base.Mapper.reread`):
+        the cells' statistics are shared, the split flags recomputed from them, which
+        gives the flags an insertion with those values would have left (a cell's rule
+        reads its own final statistics)."""
+        check_view(self, changes)
+        record = self._record.replace(**changes)
+        other = copy.copy(self)
+        other._record, other._params, other._cells = record, record.as_dict(), None
+        other.stats = self.stats.branch()
+        other._update_splits(None)
+        return other
 
     def _grow(self, xy: np.ndarray) -> None:
         assert self.square is not None  # callers set the root square first

@@ -112,6 +112,9 @@ class Quadtree(QuadMap):
     name: ClassVar[str] = "quadtree"
     default_feed: ClassVar[Feed] = Feed.BATCH
     Params: ClassVar[type[Record]] = QuadtreeParams
+    #: The leaves keep the mean and the maximum height above the plane: the rule and the
+    #: threshold only read them.
+    view_params: ClassVar[frozenset[str]] = frozenset({"occupancy", "height_threshold"})
     _NVALUES: ClassVar[int] = 2  # z, height above the plane
 
     def __init__(self, domain: Domain | None = None, **given: object) -> None:

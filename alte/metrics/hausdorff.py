@@ -20,7 +20,7 @@ import numpy as np
 from alte.errors import MetricsError
 from alte.metrics._gridnn import nearest_distances
 
-__all__ = ["HausdorffResult", "directed_distances", "hausdorff"]
+__all__ = ["HausdorffResult", "directed_distances", "hausdorff", "summarise"]
 
 
 @dataclass(frozen=True)
@@ -65,8 +65,12 @@ def hausdorff(a: object, b: object) -> HausdorffResult:
     """HD and MHD between point sets ``a`` (N, 3) and ``b`` (M, 3); empty sets raise."""
     set_a = _as_set(a, "A")
     set_b = _as_set(b, "B")
-    d_ab = nearest_distances(set_a, set_b)
-    d_ba = nearest_distances(set_b, set_a)
+    return summarise(nearest_distances(set_a, set_b), nearest_distances(set_b, set_a))
+
+
+def summarise(d_ab: np.ndarray, d_ba: np.ndarray) -> HausdorffResult:
+    """HD, MHD and the directed values from the distances of every point of A to B
+    (``d_ab``) and of B to A (``d_ba``), both non-empty."""
     h_ab, h_ba = float(d_ab.max()), float(d_ba.max())
     # A mean never exceeds the maximum; clamp the last-ulp rounding of summation.
     mh_ab, mh_ba = min(float(d_ab.mean()), h_ab), min(float(d_ba.mean()), h_ba)

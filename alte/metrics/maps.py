@@ -23,6 +23,7 @@ from alte.params import Record, param
 
 if TYPE_CHECKING:
     from alte.mappers.base import Cells, Mapper
+    from alte.metrics.reference import Reference
     from alte.metrics.surface import TrueSurface
     from alte.types import Box
 
@@ -126,8 +127,8 @@ class MapMetrics:
 
 def _size_spread(cells: Cells) -> tuple[float, float, float]:
     """Cell edge range of the known cells: the "adaptability" of tables 5.1-5.2."""
-    known = np.isfinite(cells.centers).all(axis=1)
-    edge = cells.sizes[known, 0]
+    finite = np.isfinite(cells.centers)
+    edge = cells.sizes[:, 0] if finite.all() else cells.sizes[finite.all(axis=1), 0]
     if edge.size == 0:
         return _NAN, _NAN, _NAN
     lo, hi = float(edge.min()), float(edge.max())
@@ -148,31 +149,40 @@ def set_b_points(mapper: Mapper, cells: Cells, rule: str = "corners") -> np.ndar
     return np.asarray(cells.centers[keep], dtype=np.float64)
 
 
-def _thesis(points: np.ndarray, cloud: np.ndarray) -> dict[str, float]:
+def _thesis(points: np.ndarray, cloud: np.ndarray,
+            reference: Reference | None = None) -> dict[str, float]:
     """HD/MHD between the cloud and set B; NaN when set B is empty (nothing occupied)."""
     names = ("hd_m", "mhd_m", "hd_minus_mhd_m", "h_ab_m", "h_ba_m", "mh_ab_m", "mh_ba_m")
     if len(points) == 0 or len(cloud) == 0:  # undefined, not zero
         return dict.fromkeys(names, _NAN)
-    hd = hausdorff(cloud, points)
+    hd = hausdorff(cloud, points) if reference is None else reference.hausdorff(points)
     return dict(zip(names, (hd.hd, hd.mhd, hd.hd - hd.mhd, hd.h_ab, hd.h_ba, hd.mh_ab,
                             hd.mh_ba), strict=True))
 
 
 def measure_map(mapper: Mapper, cloud: np.ndarray, *, elapsed_s: float | Timing,
                 truth: GroundTruth | None = None, options: TruthOptions | None = None,
-                set_b: str = "corners", cells: Cells | None = None) -> MapMetrics:
+                set_b: str = "corners", reference: Reference | None = None,
+                cells: Cells | None = None) -> MapMetrics:
     """Every metric of ``mapper`` against the registered ``cloud`` (and ``truth``);
     ``elapsed_s``: the mapping's time (one wall reading, or a :class:`Timing`);
-    ``set_b`` defines the map's points of HD/MHD (:data:`SET_B`). ``cells``: the map's
-    cells when the caller has listed them already (a large Octomap's leaves take
-    seconds to list)."""
+    ``set_b`` defines the map's points of HD/MHD (:data:`SET_B`). ``reference``: the
+    same ``cloud``, ``truth`` and ``options`` prepared once for many maps
+    (:class:`~alte.metrics.reference.Reference`): the same values, with the work the
+    maps of one input share done once. ``cells``: the map's cells when the caller has
+    listed them already (a large Octomap's leaves take seconds to list)."""
     timing = elapsed_s if isinstance(elapsed_s, Timing) else Timing(float(elapsed_s))
     if set_b not in SET_B:
         raise MetricsError(f"set B {set_b!r}: expected one of {', '.join(SET_B)}")
-    cells = mapper.cells() if cells is None else cells
+    if reference is not None and not reference.matches(cloud, truth, options):
+        raise MetricsError("measure_map: the reference was prepared from another cloud, "
+                           "truth or truth options")
+    cells = mapper.cells() if cells is None else cells  # listed once
     lo, hi, octaves = _size_spread(cells)
     truth_metrics = None
-    if truth is not None:
+    if truth is not None and reference is not None:
+        truth_metrics = TruthMetrics(**reference.truth_metrics(cells, mapper.dims))
+    elif truth is not None:
         from alte.metrics.truth import ground_truth_metrics
 
         opts = options or TruthOptions()
@@ -187,5 +197,6 @@ def measure_map(mapper: Mapper, cloud: np.ndarray, *, elapsed_s: float | Timing,
         basis_functions=int(mapper.basis_functions),
         memory_bytes=int(mapper.memory_bytes),
         occupied_cells=int(np.count_nonzero(cells.occupied)), cell_min_m=lo, cell_max_m=hi,
-        size_octaves=octaves, **_thesis(set_b_points(mapper, cells, set_b), cloud),
+        size_octaves=octaves,
+        **_thesis(set_b_points(mapper, cells, set_b), cloud, reference),
         truth=truth_metrics)

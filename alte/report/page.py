@@ -34,11 +34,13 @@ from alte.report.plan import PLAN
 from alte.report.tableview import TableView, cell_text, header, table_view
 from alte.studies.claims.questions import QUESTIONS, question
 
-__all__ = ["CLAIMS_CSV", "ClaimGroup", "ClaimRow", "FigureItem", "RunPage", "RunSection",
-           "TableItem", "run_page"]
+__all__ = ["CLAIMS_CSV", "MISSIONS_CSV", "ClaimGroup", "ClaimRow", "FigureItem", "RunPage",
+           "RunSection", "TableItem", "run_page"]
 
 #: The claims table a run's chapter 5 notebook writes into ``tables/``.
 CLAIMS_CSV = "claims.csv"
+#: Its verdicts beside the committed whole-mission ones (``alte.studies.missions``).
+MISSIONS_CSV = "claims_missions.csv"
 #: Tables up to this many rows are shown inline; longer ones are linked.
 INLINE_ROWS = 60
 _VERDICT_CSS = {"holds": "holds", "does not hold": "fails", "depends": "depends"}
@@ -46,7 +48,9 @@ _VERDICT_CSS = {"holds": "holds", "does not hold": "fails", "depends": "depends"
 
 @dataclass(frozen=True)
 class ClaimRow:
-    """One claim with its verdict (``css``: the verdict's style class)."""
+    """One claim with its verdict (``css``: the verdict's style class) and, where the
+    whole-mission evidence is committed, its verdict on whole missions (``whole``,
+    ``whole_css``, ``whole_depends_on``) and whether the two differ."""
 
     section: str
     claim: str
@@ -57,6 +61,10 @@ class ClaimRow:
     reading: str
     condition: str = ""
     question: str = ""
+    whole: str = ""
+    whole_css: str = ""
+    whole_depends_on: str = ""
+    differs: bool = False
 
 
 @dataclass(frozen=True)
@@ -192,17 +200,34 @@ def _section(run: Mapping[str, Any], run_dir: Path) -> RunSection:
                       _results(data), _figures(run_dir, name, params, own or {}))
 
 
+def _whole_missions(tables_dir: Path) -> dict[str, Mapping[Any, Any]]:
+    """Per claim id, its row of ``claims_missions.csv`` (empty without that table)."""
+    path = tables_dir / MISSIONS_CSV
+    if not path.is_file():
+        return {}
+    frame = pd.read_csv(path, keep_default_na=False)
+    return {str(r["id"]): r for r in frame.to_dict(orient="records")}
+
+
 def _claims(tables_dir: Path) -> list[ClaimRow]:
     path = tables_dir / CLAIMS_CSV
     if not path.is_file():
         return []
     frame = pd.read_csv(path, keep_default_na=False)
-    return [ClaimRow(str(r.get("section", "")), str(r["claim"]), str(r["verdict"]),
-                     _VERDICT_CSS.get(str(r["verdict"]), "untested"),
-                     str(r.get("depends_on", "")), str(r.get("evidence", "")),
-                     str(r.get("reading", "")), str(r.get("condition", "")),
-                     str(r.get("question", "")) or _question(str(r.get("id", ""))))
-            for r in frame.to_dict(orient="records")]
+    whole = _whole_missions(tables_dir)
+    rows = []
+    for r in frame.to_dict(orient="records"):
+        other = whole.get(str(r.get("id", "")), {})
+        verdict = str(other.get("verdict_whole_missions", ""))
+        rows.append(ClaimRow(
+            str(r.get("section", "")), str(r["claim"]), str(r["verdict"]),
+            _VERDICT_CSS.get(str(r["verdict"]), "untested"), str(r.get("depends_on", "")),
+            str(r.get("evidence", "")), str(r.get("reading", "")), str(r.get("condition", "")),
+            str(r.get("question", "")) or _question(str(r.get("id", ""))), verdict,
+            _VERDICT_CSS.get(verdict, "untested") if verdict else "",
+            str(other.get("depends_on_whole_missions", "")),
+            bool(verdict) and verdict != str(r["verdict"])))
+    return rows
 
 
 def _question(claim_id: str) -> str:
@@ -267,7 +292,7 @@ def run_page(record: Mapping[str, Any], run_dir: str | os.PathLike[str],
     by_name = {t.stem: t for t in tables}
     page.key_tables = [_table(by_name[k.name], run_dir, k) for k in KEY_TABLES
                        if k.name in by_name]
-    keyed = {k.name for k in KEY_TABLES} | {Path(CLAIMS_CSV).stem}
+    keyed = {k.name for k in KEY_TABLES} | {Path(CLAIMS_CSV).stem, Path(MISSIONS_CSV).stem}
     page.tables = [_table(t, run_dir, KeyTable(t.stem, t.name, "", key=False, rows=INLINE_ROWS))
                    for t in tables if t.stem not in keyed]
     return page

@@ -8,7 +8,9 @@ the claim's threshold ("undecided") or both maps read the same on every seed ("e
 and on a terrain where the outcome changes with
 size (or MHD), the levels at which each outcome holds. Terrain sets that are all the
 simulated (urban-scale) or all the experimental (lab-scale) terrains of the claim's case
-are named as such.
+are named as such. A part read from times (a CPU time, the thesis' rule's picks) that
+leaves a cell undecided names no terrain or size (:data:`TIMES_UNDECIDED`): which of its
+cells a run decides moves with the readings, as its verdict's "uncertainty" says.
 """
 
 from __future__ import annotations
@@ -31,7 +33,7 @@ from alte.studies.evidence import Finding
 from alte.studies.thesis import TERRAIN_CASE
 from alte.studies.tradeoff import MAPPER_NAMES, METRICS, label
 
-__all__ = ["condition", "conditions", "part_label", "terrain_names"]
+__all__ = ["TIMES_UNDECIDED", "condition", "conditions", "part_label", "terrain_names"]
 
 _WORDS = {"holds": "holds", "does not hold": "does not hold", "inconclusive": "undecided",
           "equal": "equal (no difference)"}
@@ -111,7 +113,15 @@ def _outcomes(cells: pd.DataFrame) -> pd.DataFrame:
     return cells.assign(outcome=cells["outcome"].where(~same, "equal"))
 
 
+#: A part read from times with an undecided cell (see :mod:`alte.studies.evidence`).
+TIMES_UNDECIDED = ("undecided within the times' spread (which of its reads a run decides "
+                   "moves with the readings)")
+
+
 def _part_text(cells: pd.DataFrame, check: Check) -> str:
+    if ("from_times" in cells and cells["from_times"].fillna(False).astype(bool).any()
+            and (cells["outcome"] == "inconclusive").any()):
+        return TIMES_UNDECIDED
     cells = _outcomes(cells) if {"low", "high"} <= set(cells.columns) else cells
     whole: dict[str, list[str]] = {}
     mixed = []

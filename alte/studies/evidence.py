@@ -56,7 +56,7 @@ CLAIM_COLUMNS = ["claim", "section", "verdict", "evidence", "depends_on", "readi
                  "time_check"]
 #: Columns of :func:`cells_table`.
 CELL_COLUMNS = ["id", "part", "what", "terrain", "level", "seeds", "estimate", "low", "high",
-                "unit", "outcome"]
+                "unit", "outcome", "from_times"]
 _HOLDS, _FAILS, _DEPENDS = VERDICTS[:3]
 _DIMS = {"at": "view", "better": "mapper", "other": "mapper", "mapper": "mapper",
          "case": "case", "x": "parameter", "param": "parameter"}
@@ -246,7 +246,8 @@ def _one(check: Check, table: pd.DataFrame, options: EvidenceOptions,
         depends = "uncertainty"  # which of its cells are decided moves with the readings
     scale = np.exp if m.ratio else (lambda v: v)
     shown = cells.assign(what=m.what, unit=m.unit, estimate=scale(cells["estimate"]),
-                         low=scale(cells["low"]), high=scale(cells["high"]))
+                         low=scale(cells["low"]), high=scale(cells["high"]),
+                         from_times=m.read_from_times)
     text = _check_text(m, cells) + _crosscheck_text(m, cells, options)
     return verdict, depends, text, shown, _time_check(m)
 

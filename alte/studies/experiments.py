@@ -42,10 +42,11 @@ from alte.pipeline import (
 from alte.studies.thesis import SWEEPS, sweep_table
 
 if TYPE_CHECKING:  # the obstacle study builds on the landing study, which builds on this one
+    from alte.mappers.base import Cells
     from alte.studies.obstacles import ObstacleOptions, ObstacleScores
 
 __all__ = ["CACHE_DIR", "REPEATS", "REPEAT_BELOW_S", "Measured", "ground_truth", "measure",
-           "sweep", "terrain", "timed_run"]
+           "obstacle_scores", "sweep", "terrain", "timed_run"]
 
 #: Where registrations are cached, inside the data folder (``DATA_DIR/.cache``).
 CACHE_DIR = ".cache"
@@ -145,14 +146,20 @@ def measure(data: Registered, mapper: str, params: Mapping[str, object] | None =
     metrics = measure_map(result.mapper, data.cloud, elapsed_s=timing,
                           truth=ground_truth(data) if truth is not None else None,
                           options=truth, set_b=set_b, cells=cells)
-    scores = None
-    if obstacles is not None and ground_truth(data) is not None:
-        from alte.studies.obstacles import identify, map_raster, terrain_obstacles
-
-        known = terrain_obstacles(str(data.source.path), obstacles)
-        scores = identify(map_raster(cells, result.mapper.dims, known.grid,
-                                     obstacles.min_height), known)
+    scores = obstacle_scores(data, cells, result.mapper.dims, obstacles)
     return Measured(result, metrics, scores)
+
+
+def obstacle_scores(data: Registered, cells: Cells, dims: int,
+                    options: ObstacleOptions | None) -> ObstacleScores | None:
+    """The map ``cells``' identification of the terrain's true obstacles
+    (:mod:`alte.studies.obstacles`); None without ``options`` or off a simulated terrain."""
+    if options is None or ground_truth(data) is None:
+        return None
+    from alte.studies.obstacles import identify, map_raster, terrain_obstacles
+
+    known = terrain_obstacles(str(data.source.path), options)
+    return identify(map_raster(cells, dims, known.grid, options.min_height), known)
 
 
 def sweep(data: Registered, table: int, rows: Sequence[int] | None = None, *,

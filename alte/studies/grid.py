@@ -32,13 +32,21 @@ from alte.studies.claims import CLAIMS, Claim
 from alte.studies.evidence import EvidenceOptions, cells_table, evaluate_all
 from alte.studies.evidence_tables import EQUAL_SIZE, SIZES, ablation_verdicts
 from alte.studies.obstacles import OBJECTS_COLUMN, write_obstacle_tables
-from alte.studies.sweep import BASE, SweepSpec, load_spec, override, run_sweep, variant_table
+from alte.studies.sweep import (
+    BASE,
+    SweepResult,
+    SweepSpec,
+    load_spec,
+    override,
+    run_sweep,
+    variant_table,
+)
 from alte.studies.tables import write_csv
 from alte.studies.thesis import CASE_MAPPERS, SWEEPS, TERRAIN_CASE
 from alte.studies.tradeoff import equal_size, matching, prepare
 
 __all__ = ["OCCUPIED_SIZE", "THESIS_ROWS", "TRADEOFF_COLUMNS", "Grid", "GridTables", "ablations",
-           "front_order", "run_grid",
+           "front_order", "grid_of", "run_grid",
            "thesis_rows", "tradeoff_table", "write_grid"]
 
 #: The columns tradeoff.csv starts with (then the parameters as ``p_*`` and the rest).
@@ -105,7 +113,12 @@ def run_grid(spec_path: str | os.PathLike[str], *, scheduler: str = "local", wor
     start = time.perf_counter()
     result = run_sweep(spec, scheduler=scheduler, workers=workers,
                        output=Path(output) if output is not None else None, progress=progress)
-    seconds = time.perf_counter() - start
+    return grid_of(spec, result, time.perf_counter() - start)
+
+
+def grid_of(spec: SweepSpec, result: SweepResult, seconds: float) -> Grid:
+    """The :class:`Grid` of a finished :func:`~alte.studies.sweep.run_sweep` of ``spec``
+    that took ``seconds``."""
     failed = [f"{r.terrain} seed {r.seed} {r.mapper} {dict(r.params)}: {msg}"
               for r, msg in result.failed]
     variants = tradeoff_table(variant_table(spec, result.table))

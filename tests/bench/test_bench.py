@@ -179,7 +179,7 @@ def quick_bench(tmp_path_factory):
 @pytest.mark.slow
 def test_quick_bench_runs_every_row_and_writes_its_outputs(quick_bench):
     assert quick_bench.errors == {}
-    rows = set(range(1, 13)) if (REALDATA / "balm_seq").exists() else set(range(1, 12))
+    rows = set(range(1, 14)) if (REALDATA / "balm_seq").exists() else set(range(1, 12)) | {13}
     assert {r.row for r in quick_bench.results} == rows
     for r in quick_bench.results:
         if r.row != 8:
@@ -199,6 +199,13 @@ def test_quick_bench_runs_every_row_and_writes_its_outputs(quick_bench):
     assert [r.detail["frames"] for r in quick_bench.results if r.row == 11] == [3]
     poses = [r for r in quick_bench.results if r.row == 12]
     assert all(r.detail["scans"] == 20 and r.peer > 0 for r in poses)
+    sweeps = [r for r in quick_bench.results if r.row == 13]
+    assert [r.case.split(" (")[0] for r in sweeps] == [
+        "sweep runs per core-second, 20 scans", "sweep runs per core-second, whole missions"]
+    for r in sweeps:  # grouped runs beat today's run-by-run path; the grid is estimated
+        assert r.ours > r.peer and r.detail["grid_cpu_h"] > 0 and r.met is None
+        assert r.detail["grid_runs"] > r.detail["sample_runs"] >= 12
+        assert len(r.detail["per_stratum"]) == 12
     paths = write_outputs(quick_bench, quick_bench.config.reports_dir)
     record = json.loads(paths["json"].read_text())
     assert record["machine"]["cpu"] and len(record["results"]) == len(quick_bench.results)

@@ -6,7 +6,7 @@ import pytest
 
 from alte.cli import main
 from alte.studies.sweep import load_results
-from alte.studies.sweep import runner as sweep_runner
+from alte.studies.sweep import work as sweep_work
 
 SPEC = """\
 name: cli
@@ -62,11 +62,24 @@ def test_failed_runs_exit_1(spec_file, capsys, monkeypatch):
     def broken(*args, **kwargs):
         raise RuntimeError("mapper crashed")
 
-    monkeypatch.setattr(sweep_runner, "measure", broken)
+    monkeypatch.setattr(sweep_work, "timed_run", broken)
     assert main(["sweep", str(spec_file), "--scheduler", "serial", "--no-progress"]) == 1
     out = capsys.readouterr().out
     assert "failed: sim_lan_1 quadtree {'max_points': 300}: RuntimeError: mapper crashed" in out
     assert "0 run, 0 already done, 3 failed" in out
+
+
+def test_evidence_is_not_written_while_runs_fail(spec_file, tmp_path, capsys, monkeypatch):
+    def broken(*args, **kwargs):
+        raise RuntimeError("mapper crashed")
+
+    monkeypatch.setattr(sweep_work, "timed_run", broken)
+    folder = tmp_path / "evidence"
+    assert main(["sweep", str(spec_file), "--scheduler", "serial", "--no-progress",
+                 "--evidence", str(folder)]) == 1
+    assert f"evidence not written to {folder}: rerun to retry the failed runs" in \
+        capsys.readouterr().out
+    assert not folder.exists()
 
 
 @pytest.mark.parametrize(("args", "message"), [

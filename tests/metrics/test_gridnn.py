@@ -82,13 +82,19 @@ def test_crowded_targets_go_to_the_kdtree(monkeypatch):
     assert build_grid(targets, 1.0, box).load > MAX_LOAD
     calls = []
 
-    def counted(q: np.ndarray, t: np.ndarray) -> np.ndarray:
-        calls.append(len(q))
-        return np.asarray(KDTree(t).query(q, k=1)[0])
+    class Counted(KDTree):
+        def query(self, q: np.ndarray, k: int = 1) -> tuple[np.ndarray, np.ndarray]:
+            calls.append(len(q))
+            return super().query(q, k=k)
 
-    monkeypatch.setattr(_gridnn, "_kdtree", counted)
+    monkeypatch.setattr(_gridnn, "KDTree", Counted)
     assert np.array_equal(nearest_distances(queries, targets), _reference(queries, targets))
     assert calls == [2000]
+    index = _gridnn.NearestIndex(targets)  # the tree is built once, then kept
+    index.distances(queries[:10])
+    tree = index._tree
+    assert np.array_equal(index.distances(queries), _reference(queries, targets))
+    assert index._tree is tree and calls == [2000, 10, 2000]
 
 
 def test_grid_cells_hold_their_points():

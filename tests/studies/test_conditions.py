@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 
 import pandas as pd
 from support.tradeoff import Curve, synthetic_tradeoff
 
 from alte.studies.claims import AllOf, Claim, Compare, Contrast, Summary, Trend, claim
-from alte.studies.conditions import condition, part_label, terrain_names
+from alte.studies.conditions import TIMES_UNDECIDED, condition, part_label, terrain_names
 from alte.studies.evidence import evaluate, evaluate_all
 from alte.studies.evidence_tables import write_evidence
 
@@ -119,3 +120,14 @@ def test_two_maps_that_read_the_same_on_every_seed_are_equal_not_undecided():
     found = evaluate(_claim(check), table)
     assert found.verdict == "depends"
     assert condition(found).startswith("equal (no difference) on the simulated terrains")
+
+
+def test_a_part_read_from_times_with_an_undecided_cell_names_no_terrain():
+    found = evaluate(_claim(MHD_AT_SIZE), _split())
+    cells = found.cells.copy()
+    cells.loc[cells.index[0], "outcome"] = "inconclusive"
+    timed = dataclasses.replace(found, cells=cells.assign(from_times=True))
+    assert condition(timed) == TIMES_UNDECIDED
+    # the same cells read from anything but times keep their terrains and sizes
+    untimed = dataclasses.replace(found, cells=cells.assign(from_times=False))
+    assert "sim_lan_2" in condition(untimed) and "undecided" in condition(untimed)

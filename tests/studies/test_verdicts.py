@@ -380,7 +380,8 @@ def test_undecided_and_similar_bounds_are_closed():
              (better, 0.5, 0.9, "inconclusive"), (better, 0.51, 0.9, "holds"),
              (better, 0.1, 0.5, "inconclusive"), (better, 0.1, 0.49, "does not hold"),
              (better, np.nan, 0.9, "inconclusive"), (better, 0.6, np.nan, "inconclusive"),
-             (better, 0.6, np.inf, "inconclusive")]
+             (better, 0.6, np.inf, "holds"), (better, -np.inf, 0.4, "does not hold"),
+             (better, -np.inf, 0.9, "inconclusive")]
     got = [_outcome(low, high, 3, m, 2) for m, low, high, _ in cases]
     assert got == [expected for *_, expected in cases]
     assert _outcome(0.6, 0.9, 1, better, 2) == "inconclusive"

@@ -5,10 +5,11 @@ Every claim is evaluated on a checked-in trade-off grid of the full report
 (``data/tradeoff_grid.csv.gz``: ``tradeoff.csv`` of ``alte report --only ch5_analysis``,
 the columns the claims read) and again with every time moved within its spread
 (:func:`alte.studies.uncertainty.time_spreads`): the claims table must not change but
-for the evidence's numbers. A control moves one mapper's times far beyond their spread
-and sees verdicts move, so the comparison can fail. (No decision on a continuous value
-can be invariant to every perturbation: a cell exactly at its threshold flips under any.
-The widening by the spread keeps the real grid's cells clear of that, which this checks.)
+for the evidence's numbers (verdicts, what they depend on, and each depends' condition).
+A control moves one mapper's times far beyond their spread and sees verdicts move, so the
+comparison can fail. (No decision on a continuous value can be invariant to every
+perturbation: a cell exactly at its threshold flips under any. The widening by the spread
+keeps the real grid's cells clear of that, which this checks.)
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ import pandas as pd
 import pytest
 
 from alte.studies.claims import CLAIMS
+from alte.studies.conditions import conditions
 from alte.studies.evidence import claims_table, evaluate_all
 from alte.studies.uncertainty import time_spreads
 
@@ -33,9 +35,15 @@ def grid() -> pd.DataFrame:
     return pd.read_csv(GRID)
 
 
+def _claims(grid: pd.DataFrame) -> pd.DataFrame:
+    """The claims table of ``grid`` with each claim's condition (where it holds, where not)."""
+    findings = evaluate_all(CLAIMS, grid)
+    return claims_table(findings).assign(condition=conditions(findings))
+
+
 @pytest.fixture(scope="module")
 def claims(grid: pd.DataFrame) -> pd.DataFrame:
-    return claims_table(evaluate_all(CLAIMS, grid))
+    return _claims(grid)
 
 
 def _moved(grid: pd.DataFrame, shift: np.ndarray) -> pd.DataFrame:
@@ -63,7 +71,8 @@ def test_times_moved_within_their_spread_move_no_verdict(grid: pd.DataFrame,
     # of the same commit reads them (between two runs: 5 % median, 17 % at the 95th
     # percentile; the spread is at least 28 %)
     shift = np.random.default_rng(seed).uniform(-1.0, 1.0, len(grid)) * time_spreads(grid)
-    again = claims_table(evaluate_all(CLAIMS, _moved(grid, shift)))
+    again = _claims(_moved(grid, shift))
+    assert claims["condition"].str.len().gt(0).sum() >= 10  # conditions compared, not blanks
     pd.testing.assert_frame_equal(_stable(again), _stable(claims))
 
 

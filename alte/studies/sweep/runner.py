@@ -3,19 +3,18 @@
 Data flows one way: spec -> runs (minus those already stored) -> terrains ensured
 (one task per distinct terrain and seed: it simulates the folder if needed and
 registers it once into the cache ``DATA_DIR/.cache``, so no two workers simulate or
-register the same data) -> one task per run on the workers (:func:`run_one`: load the
-cached registration, map, measure, return a flat row) -> the client writes each
-finished row to its own Parquet file. The client is the only writer; workers only
-read terrain folders and the registration cache.
+register the same data) -> one task per map the runs share on the workers
+(:func:`~alte.studies.sweep.work.run_group`: load the cached registration, feed the map
+once, measure it for each of its runs, return their flat rows), ordered by seed and
+terrain so that each worker prepares an input once -> the client writes each finished
+row to its own Parquet file, with a progress bar over runs and its ETA. The client is
+the only writer; workers only read terrain folders and the registration cache.
 """
 
 from __future__ import annotations
 
 import contextlib
 import dataclasses
-import functools
-import json
-import time
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -25,14 +24,13 @@ import pandas as pd
 from tqdm.auto import tqdm
 
 from alte.errors import ParameterError, SimulationError
-from alte.mappers import mapper_class
-from alte.pipeline import DomainPolicy, FrameSpec, MapSpec, Registered, open_input, prepare
-from alte.sim import ensure_terrain, terrain_folder
+from alte.pipeline import FrameSpec, open_input, prepare
+from alte.sim import ensure_terrain
 from alte.sim.profile import PROFILES
-from alte.studies.experiments import CACHE_DIR, measure
-from alte.studies.obstacles import obstacle_columns, obstacle_options
+from alte.studies.experiments import CACHE_DIR
 from alte.studies.sweep.spec import SweepRun, SweepSettings, SweepSpec, plan_runs, plan_variants
 from alte.studies.sweep.store import finished_ids, load_results, write_row
+from alte.studies.sweep.work import MapGroup, group_runs, run_group, run_one
 
 __all__ = ["SERIAL", "SweepResult", "override", "run_one", "run_sweep", "variant_table"]
 
@@ -62,41 +60,6 @@ class SweepResult:
                 "skipped": self.skipped,
                 "failed": [{"run_id": r.run_id, "terrain": r.terrain, "mapper": r.mapper,
                             "params": dict(r.params), "error": msg} for r, msg in self.failed]}
-
-
-@functools.lru_cache(maxsize=2)
-def _dataset(folder: str, frames: int | None, voxel: float | None, data_dir: str,
-             deskew: bool = True) -> Registered:
-    """Per-process memo over the on-disk registration cache (``DATA_DIR/.cache``)."""
-    return prepare(open_input(folder), FrameSpec(frames=frames, voxel=voxel, deskew=deskew),
-                   cache=Path(data_dir) / CACHE_DIR)
-
-
-def run_one(run: SweepRun, data_dir: str) -> dict[str, Any]:
-    """Map one run's terrain and return its flat row (keys, ``p_*`` params, metrics, the
-    map's time and machine-independent ``cost`` with its ``cost_unit``, and the whole
-    run's cost: ``wall_s`` and ``cpu_s``, the CPU seconds of every thread of the process,
-    which other load on the machine does not inflate)."""
-    start, cpu = time.perf_counter(), time.process_time()
-    folder = terrain_folder(data_dir, run.terrain, run.frames, run.seed, PROFILES[run.sensor])
-    data = _dataset(str(folder), run.frames, run.voxel, data_dir, run.deskew)
-    spec = MapSpec(run.mapper, dict(run.params), domain=DomainPolicy(run.domain))
-    found = measure(data, run.mapper, truth=run.truth, spec=spec, set_b=run.set_b,
-                    obstacles=obstacle_options(run.terrain) if run.obstacles else None)
-    metrics = found.metrics.flat()
-    return {
-        "run_id": run.run_id, "terrain": run.terrain, "frames_requested": run.frames or 0,
-        "seed": run.seed, "mapper": run.mapper,
-        "params_json": json.dumps(dict(run.params), sort_keys=True),
-        **{f"p_{k}": v for k, v in run.params.items()},
-        "domain": run.domain, "set_b": run.set_b, "sensor": run.sensor, "deskew": run.deskew,
-        "frames": len(data), "points": len(data.cloud),
-        **{k: v for k, v in metrics.items() if k != "elapsed_s"},
-        **obstacle_columns(found.obstacles),
-        "cost_unit": mapper_class(run.mapper).cost_unit.value,
-        "elapsed_s": float(metrics["elapsed_s"]), "wall_s": time.perf_counter() - start,
-        "cpu_s": time.process_time() - cpu,
-    }
 
 
 def _ensure(item: tuple[str, int | None, int, float | None, str, bool], data_dir: str) -> str:
@@ -174,16 +137,29 @@ def _ensure_all(pool: MapUnordered, runs: Sequence[SweepRun], data_dir: str,
             bar.update()
 
 
+def _by_input(runs: Sequence[SweepRun]) -> list[MapGroup]:
+    """The runs' map groups, those of one seed and terrain side by side (in spec order)."""
+    order = {key: i for i, key in enumerate(dict.fromkeys((r.seed, r.terrain) for r in runs))}
+    return sorted(group_runs(runs), key=lambda g: order[(g.runs[0].seed, g.runs[0].terrain)])
+
+
 def _map_all(pool: MapUnordered, runs: Sequence[SweepRun], data_dir: str, out: Path,
              progress: bool) -> list[tuple[SweepRun, str]]:
     failed = []
-    with tqdm(total=len(runs), desc="runs", unit="run", disable=not progress) as bar:
-        for i, row, err in pool(run_one, runs, data_dir):
-            if err is None:
-                write_row(out, row)
-            else:
-                failed.append((runs[i], f"{type(err).__name__}: {err}"))
-            bar.update()
+    groups = _by_input(runs)
+    by_id = {r.run_id: r for r in runs}
+    # smoothing 0: the ETA from the mean rate so far (maps of one input differ widely)
+    with tqdm(total=len(runs), desc="runs", unit="run", disable=not progress,
+              smoothing=0) as bar:
+        for i, done, err in pool(run_group, groups, data_dir):
+            # err: the task itself failed (e.g. a lost worker), so did each of its runs
+            outcomes = done if err is None else [(r.run_id, None, err) for r in groups[i].runs]
+            for run_id, row, error in outcomes:
+                if error is None and row is not None:
+                    write_row(out, row)
+                else:
+                    failed.append((by_id[run_id], f"{type(error).__name__}: {error}"))
+            bar.update(len(outcomes))
     return failed
 
 

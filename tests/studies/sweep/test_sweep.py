@@ -22,6 +22,7 @@ from alte.studies.sweep import (
     write_row,
 )
 from alte.studies.sweep import runner as sweep_runner
+from alte.studies.sweep import work as sweep_work
 
 
 def _raw(**changes):
@@ -203,7 +204,10 @@ def test_serial_sweep_writes_rows_and_resumes(spec, tmp_path):
     assert list(table["mapper"]) == ["alte2d"] * 4 + ["quadtree"] * 2
     assert table["frames"].eq(4).all() and table["frames_requested"].eq(4).all()
     assert table[["hd_m", "mhd_m", "basis_functions", "completeness"]].notna().all().all()
-    assert (table["elapsed_s"] > 0).all() and (table["wall_s"] >= table["elapsed_s"]).all()
+    # runs sharing a map share its feed: each one's cost holds its share of it
+    assert (table["elapsed_s"] > 0).all()
+    shares = table.groupby("elapsed_s")["wall_s"].sum()
+    assert (shares >= shares.index).all()
     assert list(table.columns[-len(TIMING_COLUMNS):]) == list(TIMING_COLUMNS)
     assert (table["cpu_s"] > 0).all()
     # max_res 4 refines more than max_res 3: more basis functions
@@ -219,19 +223,19 @@ def test_serial_sweep_writes_rows_and_resumes(spec, tmp_path):
 
 
 def test_failed_runs_are_reported_not_written_and_retried(spec, tmp_path, monkeypatch):
-    real = sweep_runner.measure
+    real = sweep_work.measure_map
 
-    def flaky(data, name, params=None, **kw):
-        if name == "quadtree":
+    def flaky(mapper, cloud, **kw):
+        if mapper.name == "quadtree":
             raise MemoryError("boom")
-        return real(data, name, params, **kw)
+        return real(mapper, cloud, **kw)
 
-    monkeypatch.setattr(sweep_runner, "measure", flaky)
+    monkeypatch.setattr(sweep_work, "measure_map", flaky)
     result = run_sweep(spec, scheduler="serial", output=tmp_path, progress=False)
     assert result.ran == 4 and len(result.table) == 4
     assert [(r.mapper, msg) for r, msg in result.failed] == [("quadtree", "MemoryError: boom")] * 2
     assert result.summary()["failed"][0]["params"] == {"max_points": 100}
-    monkeypatch.setattr(sweep_runner, "measure", real)
+    monkeypatch.setattr(sweep_work, "measure_map", real)
     retry = run_sweep(spec, scheduler="serial", output=tmp_path, progress=False)
     assert (retry.ran, retry.skipped, retry.failed) == (2, 4, [])
 

@@ -1,0 +1,47 @@
+"""Distinct rows of a point array in lexicographic order, fast.
+
+``np.unique(points, axis=0)`` sorts the rows as records, field by field, with a generic
+comparison: on the corners of a large map (hundreds of thousands of rows, most of them
+shared by neighbouring cells) it was a tenth of the time a sweep spends measuring one
+map. Here each column is ranked (one numeric sort per column), the three ranks become one
+integer key, and one integer sort orders and de-duplicates the rows. The result is the
+same array, value for value and in the same order (``x``, then ``y``, then ``z``);
+``-0.0`` is written as ``0.0``, which ``np.unique`` counts as the same value.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["unique_rows", "unique_sorted"]
+
+
+def unique_sorted(values: np.ndarray) -> np.ndarray:
+    """The distinct values of a 1D array, ascending (a sort and one comparison pass)."""
+    ordered = np.sort(values)
+    keep = np.empty(len(ordered), bool)
+    keep[:1] = True
+    np.not_equal(ordered[1:], ordered[:-1], out=keep[1:])
+    return ordered[keep]
+
+
+def unique_rows(points: np.ndarray) -> np.ndarray:
+    """The distinct rows of ``points`` (N, 3), sorted lexicographically: what
+    ``np.unique(points, axis=0)`` returns, for finite floats or integers."""
+    pts = np.asarray(points)
+    if pts.dtype.kind == "f":
+        pts = pts + 0.0  # -0.0 == 0.0: one value, one rank
+    if len(pts) == 0:
+        return pts.reshape(0, 3)
+    axes = [unique_sorted(pts[:, a]) for a in range(3)]
+    if float(len(axes[0])) * len(axes[1]) * len(axes[2]) >= 2.0**62:  # keys would overflow
+        return np.unique(pts, axis=0)
+    key = np.zeros(len(pts), np.int64)
+    for a, values in enumerate(axes):
+        key = key * len(values) + np.searchsorted(values, pts[:, a])
+    key = unique_sorted(key)
+    out = np.empty((len(key), 3), dtype=pts.dtype)
+    for a in (2, 1, 0):
+        key, rank = np.divmod(key, len(axes[a]))
+        out[:, a] = axes[a][rank]
+    return out
