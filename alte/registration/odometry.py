@@ -94,9 +94,9 @@ class OdometryParams(Record):
                                       "deg; refine: a larger correction is not applied")
     plane_sigma: float = param(0.15, _positive, "> 0",
                                "m; lio: point-to-plane noise (Cauchy kernel width)")
-    plane_reach: float = param(3.0, _positive, "> 0",
+    plane_reach: float = param(2.0, _positive, "> 0",
                                "m; lio: farthest map neighbour of a plane fit")
-    plane_points: int = param(20, lambda v: v >= 3, ">= 3",
+    plane_points: int = param(5, lambda v: v >= 3, ">= 3",
                               "lio: map points a plane is fitted to")
     imu_topic: str | None = param(None, bool, "a topic name",
                                   "lio: the IMU topic (default: the bag's only "
