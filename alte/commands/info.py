@@ -16,7 +16,8 @@ from alte.io.baginfo import BagInfo, inspect_bag
 from alte.io.pointfiles import describe_points
 from alte.pipeline import InputKind, Source, open_input
 
-__all__ = ["add_parser", "format_info", "format_points", "pose_source", "run"]
+__all__ = ["add_parser", "format_info", "format_points", "imu_topics", "odometry_choice",
+           "pose_source", "run"]
 
 
 def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -37,14 +38,30 @@ def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) 
     p.set_defaults(func=run)
 
 
+def imu_topics(info: BagInfo) -> list[str]:
+    """The bag's ``sensor_msgs/msg/Imu`` topics."""
+    from alte.io.imu import IMU_TYPE
+
+    return [name for name, (kind, _) in info.topics.items() if kind == IMU_TYPE]
+
+
+def odometry_choice(info: BagInfo) -> str:
+    """Which odometry ``--poses odometry`` runs by default (``--odometry auto``)."""
+    from alte.registration.odometry import OdometryParams, odometry_label, resolve_method
+
+    imus = imu_topics(info)
+    label = odometry_label(resolve_method(OdometryParams(), bool(imus)))
+    if imus:
+        return f"LiDAR-inertial odometry ({label}, IMU {imus[0]})"
+    return f"LiDAR odometry ({label})"
+
+
 def pose_source(info: BagInfo) -> str:
     """What ``alte map``/``register`` use for poses by default (``--poses`` unset)."""
     if info.pose_topic:
-        return f"recorded ({info.pose_topic})"
-    from alte.registration.odometry import OdometryParams, odometry_label
-
-    return (f"odometry (no pose topic: LiDAR odometry, {odometry_label(OdometryParams())} "
-            "unless --odometry says otherwise, in the first scan's body frame)")
+        return f"recorded ({info.pose_topic}); --poses odometry: {odometry_choice(info)}"
+    return (f"odometry (no pose topic: {odometry_choice(info)} unless --odometry says "
+            "otherwise, in the first scan's body frame)")
 
 
 def format_info(info: BagInfo) -> list[str]:

@@ -65,8 +65,10 @@ def add_frame_options(p: argparse.ArgumentParser, *, origin: bool = False) -> No
 def add_odometry_options(p: argparse.ArgumentParser) -> None:
     """``--odometry`` and ``--odometry-set`` (the backend and its settings)."""
     p.add_argument("--odometry", choices=METHODS, default=None,
-                   help="LiDAR odometry backend for --poses odometry: kiss (KISS-ICP, the "
-                        "default) or plane (point-to-plane scan-to-map ICP)")
+                   help="odometry backend for --poses odometry: auto (the default: lio when "
+                        "the bag has an IMU topic, else kiss), kiss (KISS-ICP), plane "
+                        "(point-to-plane scan-to-map ICP) or lio (LiDAR-inertial: the bag's "
+                        "IMU and the scans in one filter)")
     p.add_argument("--odometry-set", action="append", default=[], metavar="KEY=VALUE",
                    dest="odometry_sets",
                    help="odometry / refinement setting (repeatable), e.g. --odometry-set "

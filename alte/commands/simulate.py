@@ -43,7 +43,8 @@ def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) 
     p.add_argument("--sensor-set", action="append", default=[], metavar="KEY=VALUE",
                    dest="sensor_sets",
                    help="change one setting of the profile (repeatable): "
-                        + "; ".join(f"{k}: {v}" for k, v in SensorProfile.help().items()))
+                        + "; ".join(f"{k}: {v}" for k, v in SensorProfile.help().items())
+                        .replace("%", "%%"))
     p.set_defaults(func=run)
 
 

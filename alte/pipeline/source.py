@@ -24,16 +24,19 @@ import numpy as np
 
 from alte.errors import BagError, ParameterError, PointFileError, PoseError, TopicError
 from alte.io.bag import NO_POSE_NOTE, FrameStream, ReadCounts
+from alte.io.imu import ImuSamples, imu_topic, read_imu
 from alte.io.pose import POSE_TYPES
 from alte.pipeline.spec import FrameSpec, PoseSource
 from alte.registration.deskew import DeskewCounts, deskew_frames
 from alte.registration.grid import GridAccumulator, grid_average
 from alte.registration.odometry import (
     KEYS,
+    OdometryParams,
     PoseCounts,
     odometry_frames,
     odometry_label,
     refine_frames,
+    resolve_method,
 )
 from alte.registration.register import RegistrationCounts, crop_mask, register_frames
 from alte.types import Box, Frame, RegisteredFrame
@@ -158,9 +161,21 @@ def _start(probe: FrameStream, stamp: int) -> tuple[np.ndarray, np.ndarray] | No
     return (at.positions[0], at.quaternions[0]) if at.valid[0] else None
 
 
+def _imu(stream: FrameStream, params: OdometryParams) -> ImuSamples | None:
+    """The bag's IMU samples when LiDAR-inertial odometry will run (``auto`` with an IMU
+    topic, or ``lio``), else None."""
+    if params.method not in ("auto", "lio"):
+        return None
+    topic = imu_topic(stream.path, params.imu_topic)
+    if topic is None:
+        return None
+    return read_imu(stream.path, topic)
+
+
 def _odometry(stream: FrameStream, probe: FrameStream, spec: FrameSpec,
               counts: PoseCounts) -> Iterator[Frame]:
-    """KISS-ICP poses, anchored at the recorded pose of the first scan when there is one."""
+    """Odometry poses (LiDAR-inertial when the bag has an IMU and the method is ``auto``
+    or ``lio``), anchored at the recorded pose of the first scan when there is one."""
     frames = iter(stream)
     first = next(frames, None)
     if first is None:
@@ -168,10 +183,14 @@ def _odometry(stream: FrameStream, probe: FrameStream, spec: FrameSpec,
     start = _start(probe, first.stamp)
     anchor = f"the recorded pose of the first scan ({probe.pose_topic})" if start is not None \
         else "the first scan's body frame"
-    stream.notes.append(f"poses from LiDAR odometry ({odometry_label(spec.odometry)}), "
+    imu = _imu(stream, spec.odometry)
+    params = resolve_method(spec.odometry, imu is not None)
+    kind = "LiDAR-inertial odometry" if imu is not None else "LiDAR odometry"
+    with_imu = f", IMU {imu.frame_id} at {imu.rate_hz:.0f} Hz" if imu is not None else ""
+    stream.notes.append(f"poses from {kind} ({odometry_label(params)}{with_imu}), "
                         f"anchored at {anchor}")
     yield from odometry_frames(itertools.chain([first], frames), stream.mount, counts=counts,
-                               params=spec.odometry, start=start)
+                               params=params, start=start, imu=imu)
 
 
 def _deskewed(stream: FrameStream, spec: FrameSpec, counts: DeskewCounts) -> Iterator[Frame]:

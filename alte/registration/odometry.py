@@ -3,8 +3,11 @@
 * :func:`odometry_frames`: scan-by-scan LiDAR odometry as the frames stream, anchored
   at ``start`` (the first scan's body pose: identity, or the recorded pose there),
   with one of the backends of :mod:`alte.registration.backends` (``kiss``: KISS-ICP
-  with its own defaults, the default; ``plane``: point-to-plane scan-to-map ICP).
-  Scans that carry per-point time are deskewed by KISS-ICP.
+  with its own defaults; ``plane``: point-to-plane scan-to-map ICP) or LiDAR-inertial
+  odometry (``lio``, :mod:`alte.registration.lio`) with the bag's IMU. ``auto``, the
+  default, is ``lio`` when the bag has an IMU topic and ``kiss`` otherwise
+  (:func:`resolve_method`). Scans that carry per-point time are deskewed (KISS-ICP's
+  own deskew, or the IMU's motion over the sweep).
 * :func:`~alte.registration.refine.refine_frames`: recorded poses aligned scan-to-map,
   a correction applied only when it is well constrained and clearly better.
 
@@ -18,7 +21,7 @@ from __future__ import annotations
 import time
 from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import dataclass, field, replace
-from typing import ClassVar
+from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -26,14 +29,18 @@ from scipy.spatial.transform import Rotation
 from alte.errors import ParameterError
 from alte.params import Record, param
 from alte.registration.backends import Kiss, Plane
+from alte.registration.lio import LioSettings, lio_frames
 from alte.registration.refine import refine_frames
 from alte.types import Frame, Mount
 
-__all__ = ["KEYS", "METHODS", "OdometryParams", "PoseCounts", "odometry_frames",
-           "odometry_label", "odometry_params", "pose_matrix", "refine_frames"]
+if TYPE_CHECKING:
+    from alte.io.imu import ImuSamples
+
+__all__ = ["KEYS", "METHODS", "OdometryParams", "PoseCounts", "lio_settings", "odometry_frames",
+           "odometry_label", "odometry_params", "pose_matrix", "refine_frames", "resolve_method"]
 
 #: Odometry backends (module docstring).
-METHODS = ("kiss", "plane")
+METHODS = ("auto", "kiss", "plane", "lio")
 
 
 def _positive(value: float) -> bool:
@@ -50,7 +57,8 @@ class OdometryParams(Record):
     from KISS-ICP's defaults or the first scan's ranges (:mod:`~alte.registration.backends`)."""
 
     OWNER: ClassVar[str] = "odometry"
-    method: str = param("kiss", lambda v: v in METHODS, "kiss|plane", "odometry backend")
+    method: str = param("auto", lambda v: v in METHODS, "|".join(METHODS),
+                        "odometry backend (auto: lio with an IMU topic, else kiss)")
     max_range: float | None = param(None, _positive, "> 0",
                                     "m; points beyond are not used (kiss: 100, plane: 1.2 x "
                                     "the 99th percentile range of the first scan)")
@@ -58,7 +66,7 @@ class OdometryParams(Record):
                                                             "(kiss)")
     voxel: float | None = param(None, _positive, "> 0",
                                 "m; map voxel (kiss: max_range / 100; plane and refine: the "
-                                "median range of the first scan / 70)")
+                                "median range of the first scan / 70; lio: 0.5)")
     single_downsample: bool = param(False, help="kiss: register the 0.5-voxel cloud (sparse "
                                                 "sensors' advice)")
     fixed_threshold: float | None = param(None, _positive, "> 0",
@@ -84,6 +92,15 @@ class OdometryParams(Record):
                                   "m; refine: a larger correction is not applied")
     max_correction_deg: float = param(20.0, _positive, "> 0",
                                       "deg; refine: a larger correction is not applied")
+    plane_sigma: float = param(0.15, _positive, "> 0",
+                               "m; lio: point-to-plane noise (Cauchy kernel width)")
+    plane_reach: float = param(2.0, _positive, "> 0",
+                               "m; lio: farthest map neighbour of a plane fit")
+    plane_points: int = param(5, lambda v: v >= 3, ">= 3",
+                              "lio: map points a plane is fitted to")
+    imu_topic: str | None = param(None, bool, "a topic name",
+                                  "lio: the IMU topic (default: the bag's only "
+                                  "sensor_msgs/msg/Imu)")
 
 
 #: The settings each backend reads (``refine`` is ``--poses refine``); ``threads`` and the
@@ -92,9 +109,12 @@ KEYS: dict[str, tuple[str, ...]] = {
     "kiss": ("max_range", "min_range", "voxel", "single_downsample", "fixed_threshold",
              "initial_threshold", "min_motion_th", "max_points_per_voxel", "deskew", "threads"),
     "plane": ("max_range", "voxel", "rebuild", "min_fitness"),
+    "lio": ("max_range", "min_range", "voxel", "plane_sigma", "plane_reach", "plane_points",
+            "imu_topic"),
     "refine": ("max_range", "voxel", "rebuild", "min_fitness", "min_constraint", "min_gain",
                "max_correction", "max_correction_deg", "threads"),
 }
+KEYS["auto"] = tuple(dict.fromkeys(KEYS["kiss"] + KEYS["lio"]))
 
 
 def odometry_params(method: str | None = None, settings: Mapping[str, object] | None = None,
@@ -118,7 +138,8 @@ def odometry_params(method: str | None = None, settings: Mapping[str, object] | 
 
 def odometry_label(params: OdometryParams) -> str:
     """``kiss-icp`` or ``point-to-plane``, with the settings that differ from the defaults."""
-    name = {"kiss": "kiss-icp", "plane": "point-to-plane"}[params.method]
+    name = {"auto": "auto", "kiss": "kiss-icp", "plane": "point-to-plane",
+            "lio": "lidar-inertial"}[params.method]
     default = OdometryParams(method=params.method).as_dict()
     changed = [f"{k}={v}" for k, v in params.as_dict().items()
                if v != default[k] and k in KEYS[params.method]]
@@ -159,6 +180,22 @@ def pose_matrix(position: np.ndarray, quaternion: np.ndarray) -> np.ndarray:
     return out
 
 
+def resolve_method(params: OdometryParams, has_imu: bool) -> OdometryParams:
+    """``auto`` made concrete: ``lio`` when the bag has an IMU topic, else ``kiss``."""
+    if params.method != "auto":
+        return params
+    return replace(params, method="lio" if has_imu else "kiss")
+
+
+def lio_settings(params: OdometryParams) -> LioSettings:
+    """What :mod:`alte.registration.lio` reads of ``params`` (unset: its defaults)."""
+    base = LioSettings()
+    return LioSettings(voxel=params.voxel or base.voxel,
+                       max_range=params.max_range or base.max_range,
+                       min_range=params.min_range, plane_sigma=params.plane_sigma,
+                       max_distance=params.plane_reach, neighbours=params.plane_points)
+
+
 def _rate(previous: Frame | None, quaternion: np.ndarray, stamp: int) -> float:
     """Body angular rate (rad/s) from the previous odometry pose (0 for the first)."""
     if previous is None or stamp == previous.stamp:
@@ -167,12 +204,47 @@ def _rate(previous: Frame | None, quaternion: np.ndarray, stamp: int) -> float:
     return float(turn.magnitude() / abs(stamp - previous.stamp) * 1e9)
 
 
+def _posed(frame: Frame, body: np.ndarray, previous: Frame | None) -> Frame:
+    """``frame`` with the body pose ``body`` (4x4) and the rate since ``previous``."""
+    quaternion = Rotation.from_matrix(body[:3, :3]).as_quat()
+    return replace(frame, position=body[:3, 3].copy(), quaternion=quaternion,
+                   pose_offset_s=0.0, angular_rate=_rate(previous, quaternion, frame.stamp))
+
+
+def _lio_frames(frames: Iterable[Frame], mount: Mount, imu: ImuSamples | None, *,
+                counts: PoseCounts, params: OdometryParams,
+                start: tuple[np.ndarray, np.ndarray] | None) -> Iterator[Frame]:
+    """``frames`` posed by LiDAR-inertial odometry (:mod:`alte.registration.lio`)."""
+    if imu is None:
+        raise ParameterError("--odometry lio needs an IMU topic (sensor_msgs/msg/Imu) in the "
+                             "bag; use --odometry kiss")
+    previous: Frame | None = None
+    steps = lio_frames(frames, mount, imu, lio_settings(params), start)
+    while True:
+        began, cpu = time.perf_counter(), time.thread_time()
+        item = next(steps, None)
+        if item is None:
+            return
+        counts.seconds += time.perf_counter() - began
+        counts.cpu_seconds += time.thread_time() - cpu
+        counts.frames += 1
+        frame, body = item
+        counts.deskewed += int(frame.times is not None and len(frame.times) > 0)
+        previous = _posed(frame, body, previous)
+        yield previous
+
+
 def odometry_frames(frames: Iterable[Frame], mount: Mount, *, counts: PoseCounts,
                     params: OdometryParams | None = None,
-                    start: tuple[np.ndarray, np.ndarray] | None = None) -> Iterator[Frame]:
-    """``frames`` with body poses from LiDAR odometry, anchored at ``start``."""
-    params = params or OdometryParams()
+                    start: tuple[np.ndarray, np.ndarray] | None = None,
+                    imu: ImuSamples | None = None) -> Iterator[Frame]:
+    """``frames`` with body poses from LiDAR (or LiDAR-inertial, with ``imu``) odometry,
+    anchored at ``start``."""
+    params = resolve_method(params or OdometryParams(), imu is not None)
     counts.method, counts.settings = params.method, params.as_dict()
+    if params.method == "lio":
+        yield from _lio_frames(frames, mount, imu, counts=counts, params=params, start=start)
+        return
     body_sensor = pose_matrix(mount.translation, mount.quaternion)
     sensor_body = np.linalg.inv(body_sensor)
     anchor = (pose_matrix(*start) if start is not None else np.eye(4)) @ body_sensor
@@ -190,8 +262,5 @@ def odometry_frames(frames: Iterable[Frame], mount: Mount, *, counts: PoseCounts
         counts.cpu_seconds += time.thread_time() - cpu
         counts.frames += 1
         counts.deskewed += int(isinstance(odometry, Kiss) and odometry.deskews(frame.times))
-        quaternion = Rotation.from_matrix(body[:3, :3]).as_quat()
-        previous = replace(frame, position=body[:3, 3].copy(), quaternion=quaternion,
-                           pose_offset_s=0.0,
-                           angular_rate=_rate(previous, quaternion, frame.stamp))
+        previous = _posed(frame, body, previous)
         yield previous

@@ -1,8 +1,9 @@
 """The realistic UAV sensor against the thesis' instantaneous scan, per terrain.
 
 For each UAV mission (or any terrain) the ``uav`` sensor profile's bag is registered
-with recorded poses as taken, recorded poses + deskew and LiDAR-only odometry, beside
-the thesis profile's bag with recorded poses (the chapters' reference), and scored
+with recorded poses as taken, recorded poses + deskew, LiDAR-only odometry (KISS-ICP) and
+LiDAR-inertial odometry (:mod:`alte.registration.lio`, the bag's IMU), beside the thesis
+profile's bag with recorded poses (the chapters' reference), and scored
 against the simulator's truth: ATE and RPE (translation, % of 1 m segments) as evo reports
 them (:mod:`alte.metrics.trajectory`) and the merged cloud's mean distance to the true
 mesh, with the time per scan.
@@ -20,15 +21,17 @@ import pandas as pd
 
 from alte.metrics.trajectory import trajectory_errors
 from alte.pipeline import FrameSpec, PoseSource, open_input, prepare
+from alte.registration.odometry import odometry_params
 
 __all__ = ["RUNS", "sensor_row", "sensor_table"]
 
-#: Column key -> (profile, pose source, deskew).
-RUNS: dict[str, tuple[str, PoseSource, bool]] = {
-    "thesis": ("thesis", PoseSource.RECORDED, True),
-    "recorded": ("uav", PoseSource.RECORDED, False),
-    "deskew": ("uav", PoseSource.RECORDED, True),
-    "lidar": ("uav", PoseSource.ODOMETRY, True),
+#: Column key -> (profile, pose source, deskew, odometry backend).
+RUNS: dict[str, tuple[str, PoseSource, bool, str]] = {
+    "thesis": ("thesis", PoseSource.RECORDED, True, "auto"),
+    "recorded": ("uav", PoseSource.RECORDED, False, "auto"),
+    "deskew": ("uav", PoseSource.RECORDED, True, "auto"),
+    "lidar": ("uav", PoseSource.ODOMETRY, True, "kiss"),
+    "lio": ("uav", PoseSource.ODOMETRY, True, "lio"),
 }
 
 
@@ -40,14 +43,17 @@ class _Score:
     ms_per_scan: float
 
 
-def _score(folder: Path, name: str, run: tuple[PoseSource, bool], seed: int,
+def _score(folder: Path, name: str, run: tuple[PoseSource, bool, str], seed: int,
            cache: Path | None) -> _Score:
     from alte.sim import get_terrain, load_ground_truth, mesh_distance, true_poses
 
-    pose, deskew = run
+    pose, deskew, method = run
+    spec = FrameSpec(poses=pose, deskew=deskew, odometry=odometry_params(method))
     start = time.perf_counter()
-    reg = prepare(open_input(folder), FrameSpec(poses=pose, deskew=deskew), cache=cache)
+    reg = prepare(open_input(folder), spec, cache=cache)
     seconds = time.perf_counter() - start
+    if pose is PoseSource.ODOMETRY:  # the pose step alone, as `alte register` reports it
+        seconds = reg.counts.poses.seconds
     truth = true_poses(get_terrain(name), seed)
     traj = reg.trajectory
     index = np.searchsorted(truth.stamps, traj.stamps)
@@ -60,13 +66,15 @@ def _score(folder: Path, name: str, run: tuple[PoseSource, bool], seed: int,
 def sensor_row(name: str, data_dir: str | os.PathLike[str] = "data", seed: int = 0,
                cache: Path | None = None) -> dict[str, object]:
     """One terrain's row (module docstring); terrains are simulated when absent."""
-    from alte.sim import ensure_terrain
+    from alte.sim import ensure_terrain, get_terrain, true_poses
     from alte.sim.profile import PROFILES
 
-    row: dict[str, object] = {"terrain": name}
-    for key, (profile, pose, deskew) in RUNS.items():
+    truth = true_poses(get_terrain(name), seed).positions
+    row: dict[str, object] = {"terrain": name, "path_m": float(
+        np.linalg.norm(np.diff(truth, axis=0), axis=1).sum())}
+    for key, (profile, pose, deskew, method) in RUNS.items():
         folder = ensure_terrain(name, data_dir, seed, profile=PROFILES[profile])
-        score = _score(folder, name, (pose, deskew), seed, cache)
+        score = _score(folder, name, (pose, deskew, method), seed, cache)
         row |= {f"ate_{key}_m": score.ate_m, f"rpe_{key}_pct": score.rpe_pct,
                 f"mesh_{key}_m": score.mesh_m, f"ms_per_scan_{key}": score.ms_per_scan}
     return row

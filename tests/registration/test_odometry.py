@@ -113,7 +113,8 @@ def test_pose_errors_are_typed(unposed, tmp_path: Path) -> None:
 
 
 def test_odometry_settings_errors_name_the_flag() -> None:
-    with pytest.raises(ParameterError, match=r"--odometry icp: unknown backend; valid: kiss"):
+    with pytest.raises(ParameterError,
+                       match=r"--odometry icp: unknown backend; valid: auto, kiss, plane, lio"):
         odometry_params("icp")
     with pytest.raises(ParameterError, match=r"--odometry-set fixed_threshold: not a setting "
                                              r"of --odometry plane"):
@@ -130,7 +131,7 @@ def test_cli_odometry_flags(unposed, tmp_path: Path, capsys) -> None:
     out = tmp_path / "cloud.ply"
     assert main(["register", str(bag), "--out", str(out), "--frames", "5",
                  "--odometry-set", "kapa=1"]) == 2
-    assert "--odometry-set kapa: not a setting of --odometry kiss" in capsys.readouterr().err
+    assert "--odometry-set kapa: not a setting of --odometry auto" in capsys.readouterr().err
     assert main(["register", str(bag), "--out", str(out), "--frames", "5",
                  "--pose-file", str(tmp_path / "none.txt")]) == 2
     assert "--pose-file" in capsys.readouterr().err and not out.exists()

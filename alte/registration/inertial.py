@@ -1,0 +1,180 @@
+"""Inertial navigation for LiDAR-inertial odometry: an error-state Kalman filter on the IMU.
+
+The nominal state is the IMU's pose in the world (rotation ``R``, position ``p``), its
+velocity ``v`` (world) and the gyroscope / accelerometer biases; the world's z axis points
+up and gravity is ``(0, 0, -9.81)`` m/s^2. The IMU reads body rates ``w`` and specific force
+``f = R^T (a - g)`` (at rest and level: ``+9.81`` along z, the ROS convention). Between two
+instants the state follows the samples (each held over the half-intervals around its stamp,
+so a sample is centred on the motion it measured; ``R'`` the rotation mid-step):
+
+    a = R' (f - ba) + g;  R <- R Exp((w - bg) dt);  v <- v + a dt;  p <- p + v dt + a dt^2 / 2
+
+and the 15-dimensional error (rotation in the IMU frame, position, velocity, biases) carries
+a covariance propagated with the continuous-time noise densities of Kalibr's model
+(:class:`ImuNoise`). :meth:`InertialFilter.update` is an iterated (Gauss-Newton) update of
+the pose with a batch of linearised residuals, as FAST-LIO's iterated EKF: what the LiDAR
+does not constrain (flat ground says nothing of x, y and yaw) stays with the IMU.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+__all__ = ["GRAVITY", "ImuNoise", "InertialFilter", "NavState", "hat", "integrate"]
+
+GRAVITY = np.array([0.0, 0.0, -9.81])
+
+
+def hat(v: np.ndarray) -> np.ndarray:
+    """Skew-symmetric matrix of a 3-vector (``hat(a) @ b == cross(a, b)``)."""
+    return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
+
+
+@dataclass(frozen=True)
+class ImuNoise:
+    """Continuous-time noise densities: white noise (rad/s/sqrt(Hz), m/s^2/sqrt(Hz)) and
+    bias random walk (rad/s^2/sqrt(Hz), m/s^3/sqrt(Hz)); turn-on bias sigmas (rad/s, m/s^2)."""
+
+    gyro: float = 3.39e-4
+    accel: float = 4.0e-3
+    gyro_walk: float = 3.88e-5
+    accel_walk: float = 6.0e-3
+    gyro_bias: float = 8.73e-3
+    accel_bias: float = 0.196
+
+
+@dataclass
+class NavState:
+    """The nominal state at ``stamp`` (ns): IMU rotation (world from IMU), position,
+    velocity, gyroscope and accelerometer biases."""
+
+    stamp: int
+    rotation: Rotation
+    position: np.ndarray
+    velocity: np.ndarray
+    gyro_bias: np.ndarray
+    accel_bias: np.ndarray
+
+    def copy(self) -> NavState:
+        """An independent copy."""
+        return NavState(self.stamp, Rotation.from_quat(self.rotation.as_quat()),
+                        self.position.copy(), self.velocity.copy(), self.gyro_bias.copy(),
+                        self.accel_bias.copy())
+
+    def matrix(self) -> np.ndarray:
+        """The IMU pose as a 4x4 transform (world from IMU)."""
+        out = np.eye(4)
+        out[:3, :3] = self.rotation.as_matrix()
+        out[:3, 3] = self.position
+        return out
+
+
+def _steps(stamps: np.ndarray, start: int, end: int) -> tuple[np.ndarray, np.ndarray]:
+    """Sub-intervals of ``[start, end]`` (ns) split at the midpoints between samples, and the
+    index of the sample that covers each (the one whose stamp is nearest its middle)."""
+    mids = (stamps[:-1] + stamps[1:]) // 2
+    inside = mids[(mids > start) & (mids < end)]
+    bounds = np.r_[start, inside, end].astype(np.int64)
+    centre = (bounds[:-1] + bounds[1:]) // 2
+    index = np.clip(np.searchsorted(mids, centre, side="right"), 0, len(stamps) - 1)
+    return bounds, index
+
+
+def integrate(state: NavState, end: int, stamps: np.ndarray, gyro: np.ndarray,
+              accel: np.ndarray, *, visit: Callable[[NavState, np.ndarray, np.ndarray, float],
+                                                 None] | None = None) -> NavState:
+    """The nominal state carried from ``state.stamp`` to ``end`` (ns) by the samples
+    (module docstring); ``visit(state, w, f, dt)`` sees each step before it is applied."""
+    out = state.copy()
+    if end <= out.stamp or len(stamps) == 0:
+        return out
+    bounds, index = _steps(stamps, out.stamp, end)
+    for k, dt_ns in zip(index, np.diff(bounds), strict=True):
+        dt = dt_ns * 1e-9
+        w, f = gyro[k] - out.gyro_bias, accel[k] - out.accel_bias
+        if visit is not None:
+            visit(out, w, f, dt)
+        turned = out.rotation * Rotation.from_rotvec(w * dt)
+        mid = out.rotation * Rotation.from_rotvec(0.5 * w * dt)
+        acc = mid.apply(f) + GRAVITY  # the force turns with the body over the step
+        out.position = out.position + out.velocity * dt + 0.5 * acc * dt * dt
+        out.velocity = out.velocity + acc * dt
+        out.rotation = turned
+    out.stamp = int(end)
+    return out
+
+
+class InertialFilter:
+    """Error-state Kalman filter of :class:`NavState` (module docstring)."""
+
+    def __init__(self, state: NavState, noise: ImuNoise, *, velocity_sigma: float = 1.0,
+                 attitude_sigma: float = 0.02) -> None:
+        self.state, self.noise = state, noise
+        diag = np.r_[np.full(3, attitude_sigma**2), np.full(3, 1e-6),
+                     np.full(3, velocity_sigma**2), np.full(3, noise.gyro_bias**2),
+                     np.full(3, noise.accel_bias**2)]
+        self.cov = np.diag(diag)
+
+    def _covariance_step(self, state: NavState, w: np.ndarray, f: np.ndarray,
+                         dt: float) -> None:
+        """Propagate the error covariance over one step (state before the step)."""
+        n = self.noise
+        rot = state.rotation.as_matrix()
+        jac = np.eye(15)
+        jac[0:3, 0:3] = Rotation.from_rotvec(-w * dt).as_matrix()
+        jac[0:3, 9:12] = -np.eye(3) * dt
+        jac[3:6, 6:9] = np.eye(3) * dt
+        jac[6:9, 0:3] = -rot @ hat(f) * dt
+        jac[6:9, 12:15] = -rot * dt
+        q = np.r_[np.full(3, n.gyro**2 * dt), np.zeros(3), np.full(3, n.accel**2 * dt),
+                  np.full(3, n.gyro_walk**2 * dt), np.full(3, n.accel_walk**2 * dt)]
+        self.cov = jac @ self.cov @ jac.T + np.diag(q)
+
+    def predict(self, end: int, stamps: np.ndarray, gyro: np.ndarray,
+                accel: np.ndarray) -> None:
+        """Carry state and covariance to ``end`` (ns) with the IMU samples."""
+        self.state = integrate(self.state, end, stamps, gyro, accel,
+                               visit=self._covariance_step)
+
+    def apply(self, delta: np.ndarray, base: NavState) -> NavState:
+        """``base`` moved by the 15-dimensional error ``delta``."""
+        out = base.copy()
+        out.rotation = base.rotation * Rotation.from_rotvec(delta[0:3])
+        out.position = base.position + delta[3:6]
+        out.velocity = base.velocity + delta[6:9]
+        out.gyro_bias = base.gyro_bias + delta[9:12]
+        out.accel_bias = base.accel_bias + delta[12:15]
+        return out
+
+    def update(self, residuals: Callable[[NavState], tuple[np.ndarray, np.ndarray]],
+               sigma: float, iterations: int = 5, tolerance: float = 1e-4) -> int:
+        """Iterated update with ``residuals(state) -> (r (M,), J (M, 6))``: residuals and
+        their Jacobian in (rotation, position) of the IMU, of noise ``sigma``, down-weighted
+        beyond ``sigma`` by a Cauchy kernel (outliers: planes fitted across two objects).
+        Returns the count of residuals of the last iteration (0: no update)."""
+        prior = self.state
+        info_prior = np.linalg.inv(self.cov)
+        delta = np.zeros(15)
+        count = 0
+        for _ in range(iterations):
+            r, jac = residuals(self.apply(delta, prior))
+            count = len(r)
+            if count < 6:
+                return 0
+            h = np.zeros((count, 15))
+            h[:, :6] = jac
+            weight = 1.0 / (1.0 + (r / sigma) ** 2) / sigma**2
+            info = info_prior + h.T @ (h * weight[:, None])
+            rhs = h.T @ (weight * (h @ delta - r))
+            new = np.linalg.solve(info, rhs)
+            step, delta = new - delta, new
+            if np.linalg.norm(step[:6]) < tolerance:
+                break
+        self.state = self.apply(delta, prior)
+        self.cov = np.linalg.inv(info)
+        self.cov = 0.5 * (self.cov + self.cov.T)
+        return count
