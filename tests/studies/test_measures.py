@@ -2,12 +2,10 @@
 
 from __future__ import annotations
 
-import json
-
 import numpy as np
 import pandas as pd
 import pytest
-from support.tradeoff import synthetic_tradeoff
+from support.tradeoff import sweep_rows, synthetic_tradeoff
 
 from alte.errors import ParameterError
 from alte.studies.claims import (
@@ -25,16 +23,7 @@ from alte.studies.tradeoff import prepare, thesis_setting
 
 def _table(mapper: str, xs: list[float], metric: dict[str, list[float]], *, param: str = "x",
            seeds: tuple[int, ...] = (0, 1), terrain: str = "sim_lan_1") -> pd.DataFrame:
-    rows = []
-    for seed in seeds:
-        for i, x in enumerate(xs):
-            row = {"terrain": terrain, "mapper": mapper, "params": json.dumps({param: x}),
-                   "seed": seed, "basis_functions": 100 * (i + 1), "occupied_cells": 50,
-                   "memory_bytes": 1000, "elapsed_s": 1.0, "mhd_m": 1.0, "hd_m": 5.0,
-                   "accuracy_mean_m": 0.1, "completeness": 0.9}
-            row.update({k: v[i] for k, v in metric.items()})
-            rows.append(row)
-    return prepare(pd.DataFrame(rows))
+    return prepare(sweep_rows(mapper, xs, metric, param=param, seeds=seeds, terrain=terrain))
 
 
 def test_trend_is_spearman_rho_of_the_level_means_times_the_stated_sign():

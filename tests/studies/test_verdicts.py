@@ -17,7 +17,7 @@ from dataclasses import replace
 import numpy as np
 import pandas as pd
 import pytest
-from support.tradeoff import Curve, synthetic_tradeoff
+from support.tradeoff import Curve, sweep_rows, synthetic_tradeoff
 
 from alte.studies.checks import NoDataError
 from alte.studies.claims import (
@@ -223,19 +223,7 @@ def test_times_known_within_their_spread_cannot_be_shown_equal():
 # ---------------------------------------------------------------- other kinds of check
 
 
-def _sweep(mapper: str, xs, columns: dict[str, list[float]], *, param: str = "x",
-           seeds=(0, 1, 2), terrain: str = "sim_lan_1", jitter: float = 0.0) -> pd.DataFrame:
-    """One mapper's sweep over ``param``; ``columns`` override the constant defaults."""
-    rows = []
-    for seed in seeds:
-        for i, x in enumerate(xs):
-            row = {"terrain": terrain, "mapper": mapper, "params": json.dumps({param: x}),
-                   "seed": seed, "basis_functions": 100 * (i + 1), "occupied_cells": 50,
-                   "memory_bytes": 1000, "elapsed_s": 1.0, "mhd_m": 1.0, "hd_m": 5.0,
-                   "accuracy_mean_m": 0.1, "completeness": 0.9}
-            row.update({k: v[i] * (1 + jitter * seed) for k, v in columns.items()})
-            rows.append(row)
-    return pd.DataFrame(rows)
+_sweep = sweep_rows
 
 
 @pytest.mark.parametrize("sign", [+1, -1])

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-__all__ = ["GRIDS", "Curve", "synthetic_tradeoff"]
+__all__ = ["GRIDS", "Curve", "sweep_rows", "synthetic_tradeoff"]
 
 _QT = [{"max_points": v} for v in (10, 25, 50, 100, 150, 200, 300, 500, 750, 1000)]
 _A2 = [{"kappa": k, "max_res": r, "min_pts": p}
@@ -95,4 +95,21 @@ def synthetic_tradeoff(curves: Mapping[str, Curve] | None = None, seeds: Sequenc
             for mapper, curve in chosen.items()
             for terrain in (terrains or _CASE).get(mapper, _CASE[mapper])
             for seed in seeds for p in GRIDS[mapper]]
+    return pd.DataFrame(rows)
+
+
+def sweep_rows(mapper: str, xs: Sequence[float], columns: Mapping[str, Sequence[float]], *,
+               param: str = "x", seeds: Sequence[int] = (0, 1, 2), terrain: str = "sim_lan_1",
+               jitter: float = 0.0) -> pd.DataFrame:
+    """One mapper's sweep over ``param`` with constant metrics but ``columns`` (per value
+    of ``xs``; scaled by ``1 + jitter * seed``); size 100, 200, ... basis functions."""
+    rows = []
+    for seed in seeds:
+        for i, x in enumerate(xs):
+            row = {"terrain": terrain, "mapper": mapper, "params": json.dumps({param: x}),
+                   "seed": seed, "basis_functions": 100 * (i + 1), "occupied_cells": 50,
+                   "memory_bytes": 1000, "elapsed_s": 1.0, "mhd_m": 1.0, "hd_m": 5.0,
+                   "accuracy_mean_m": 0.1, "completeness": 0.9}
+            row.update({k: v[i] * (1 + jitter * seed) for k, v in columns.items()})
+            rows.append(row)
     return pd.DataFrame(rows)
