@@ -4,7 +4,7 @@ The values are read at the thesis' chosen settings, at the rows the thesis' rule
 from our sweep (every row of a tie: :func:`alte.studies.tables.rule_picks`) or off the
 Pareto fronts at equal size or equal fidelity. Each seed's value carries bounds: a tie
 spans its rows, and a time (the mapper's CPU time, for the thesis' elapsed time) its
-spread (:func:`alte.studies.uncertainty.time_spreads`; a time for a fidelity:
+spread (:func:`alte.studies.uncertainty.run_time_spreads`; a time for a fidelity:
 :mod:`alte.studies.timefronts`, where a censored read is an upper bound); the
 statistic's bounds follow (log ratio or difference, :func:`oriented`), so a comparison
 is decided only where the difference exceeds them.
@@ -20,7 +20,7 @@ from alte.studies.claims.types import SIZE_COLUMNS, Compare
 from alte.studies.tables import TIME_COLUMN, rule_criteria, rule_picks
 from alte.studies.timefronts import time_at_fidelity
 from alte.studies.tradeoff import equal_fidelity, equal_size, label, matching, thesis_setting
-from alte.studies.uncertainty import time_spreads
+from alte.studies.uncertainty import run_time_spreads
 
 __all__ = ["RATIO_METRICS", "measure_compare", "oriented"]
 
@@ -34,7 +34,7 @@ def _bounded(chosen: pd.DataFrame, metric: str) -> tuple[float, float, float]:
     values = chosen[metric].to_numpy(dtype=np.float64)
     low = high = values
     if metric == TIME_COLUMN:
-        spread = time_spreads(chosen)
+        spread = run_time_spreads(chosen)
         low, high = values * np.exp(-spread), values * np.exp(spread)
     if not np.isfinite(values).any():
         return np.nan, np.nan, np.nan
@@ -81,7 +81,7 @@ def _read_bounds(reads: pd.DataFrame, table: pd.DataFrame, metric: str) -> pd.Da
     the most uncertain time of the mapper's maps on that terrain and seed."""
     if metric != TIME_COLUMN or reads.empty:
         return reads.assign(low=reads["value"], high=reads["value"])
-    worst = table.assign(_spread=time_spreads(table)).groupby(
+    worst = table.assign(_spread=run_time_spreads(table)).groupby(
         ["terrain", "seed", "mapper"])["_spread"].max().rename("_u").reset_index()
     out = reads.merge(worst, on=["terrain", "seed", "mapper"], how="left")
     factor = np.exp(out.pop("_u").to_numpy(dtype=np.float64))

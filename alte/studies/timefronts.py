@@ -6,7 +6,7 @@ would depend on which maps a run's readings put on the time front and which one 
 (where reads start), both moved by noise. So the time a mapper needs for a fidelity
 level is the least time among *its maps that reach the level*: a set fixed by the
 fidelities alone. Each time is known within its spread
-(:func:`alte.studies.uncertainty.time_spreads`), so the least time within the least of
+(:func:`alte.studies.uncertainty.run_time_spreads`), so the least time within the least of
 the maps' lower and of their upper bounds. The levels are those the (basis functions,
 fidelity) fronts are read at, unless a check fixes them.
 """
@@ -19,7 +19,7 @@ import numpy as np
 import pandas as pd
 
 from alte.studies.tradeoff import equal_fidelity
-from alte.studies.uncertainty import time_spreads
+from alte.studies.uncertainty import run_time_spreads
 
 __all__ = ["READ_COLUMNS", "time_at_fidelity"]
 
@@ -33,7 +33,7 @@ def _least(maps: pd.DataFrame, time: str, fidelity: str, levels: np.ndarray,
     (signed fidelity at most the level); NaN where none does."""
     x = maps[time].to_numpy(dtype=np.float64)
     y = sign * maps[fidelity].to_numpy(dtype=np.float64)
-    u = time_spreads(maps)
+    u = run_time_spreads(maps)
     ok = np.isfinite(x) & (x > 0) & np.isfinite(y)
     x, y, u = x[ok], y[ok], u[ok]
     reach = y[None, :] <= sign * levels[:, None]

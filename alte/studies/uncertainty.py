@@ -25,14 +25,20 @@ import numpy as np
 import pandas as pd
 from scipy.stats import bootstrap
 
-__all__ = ["CONFIDENCE", "TIME_SPREAD_FLOOR", "Interval", "bootstrap_bounds", "bootstrap_ci",
-           "bootstrap_columns", "time_spreads"]
+__all__ = ["CONFIDENCE", "RUN_TIME_SPREAD", "TIME_SPREAD_FLOOR", "Interval", "bootstrap_bounds",
+           "bootstrap_ci", "bootstrap_columns", "run_time_spreads", "time_spreads"]
 
 #: Confidence level of every interval in the report.
 CONFIDENCE = 0.95
 #: Least spread of a map's time (half the log of max/min; 0.25: within a factor 1.28 of
 #: the middle), from the run-to-run differences of the grid's CPU times (README, "Time").
 TIME_SPREAD_FLOOR = 0.25
+#: Spread of a time compared between mappers (a claim on two mappers' times): the
+#: run-to-run spread of the same maps' CPU times between four whole chapter 5 grids run at
+#: load averages 1 to 16 (95 % of 1,344 maps within exp(2 x 0.16-0.32) between any two),
+#: for every map alike: a map's own repeats say how loaded the machine was in that second,
+#: and verdicts that followed them moved between runs (README, "Time").
+RUN_TIME_SPREAD = 0.35
 
 
 @dataclass(frozen=True)
@@ -110,3 +116,9 @@ def time_spreads(table: pd.DataFrame, spread: str = "map_cpu_spread") -> np.ndar
         return np.full(len(table), TIME_SPREAD_FLOOR)
     values = pd.to_numeric(table[spread], errors="coerce").to_numpy(dtype=np.float64)
     return np.asarray(np.fmax(np.nan_to_num(values, nan=0.0), TIME_SPREAD_FLOOR))
+
+
+def run_time_spreads(table: pd.DataFrame) -> np.ndarray:
+    """:data:`RUN_TIME_SPREAD` for every row: the band within which two mappers' times are
+    compared, whatever the maps' own repeats read."""
+    return np.full(len(table), RUN_TIME_SPREAD)
