@@ -18,6 +18,7 @@ from alte.studies.evidence import (
     CELL_COLUMNS,
     VERDICTS,
     EvidenceOptions,
+    Finding,
     cells_table,
     claims_table,
     evaluate,
@@ -199,3 +200,45 @@ def test_a_time_comparison_left_undecided_somewhere_depends_on_uncertainty_alone
     found = evaluate(_claim(check), table)
     assert (found.verdict, found.depends_on) == ("depends", "uncertainty")
     assert found.time_check.startswith("CPU time")
+
+
+def _finding(claim_id: str, verdict: str, cells: pd.DataFrame) -> Finding:
+    claim = Claim(claim_id, f"section of {claim_id}", f"quote of {claim_id}",
+                  NotMeasurable("r"), reading=f"reading of {claim_id}")
+    return Finding(claim, verdict, f"depends of {claim_id}", f"evidence of {claim_id}", cells,
+                   time_check=f"times of {claim_id}")
+
+
+def _cells(claim_id: str, n: int) -> pd.DataFrame:
+    return pd.DataFrame([dict.fromkeys(CELL_COLUMNS, "") | {"id": claim_id, "level": i}
+                         for i in range(n)], columns=CELL_COLUMNS, index=[7] * n)
+
+
+def test_the_claims_table_puts_every_field_of_a_finding_in_its_named_column():
+    findings = [_finding("a", "holds", _cells("a", 2)), _finding("b", "depends", _cells("b", 0))]
+    out = claims_table(findings)
+    assert list(out.columns) == ["claim", "section", "verdict", "evidence", "depends_on",
+                                 "reading", "id", "time_check"]
+    assert out.to_dict("records")[1] == {
+        "claim": "quote of b", "section": "section of b", "verdict": "depends",
+        "evidence": "evidence of b", "depends_on": "depends of b", "reading": "reading of b",
+        "id": "b", "time_check": "times of b"}
+    assert list(claims_table([]).columns) == list(out.columns)
+
+
+def test_the_cells_table_stacks_the_findings_cells_with_a_fresh_index():
+    findings = [_finding("a", "holds", _cells("a", 2)), _finding("b", "x", _cells("b", 0)),
+                _finding("c", "holds", _cells("c", 3))]
+    out = cells_table(findings)
+    assert list(out.columns) == CELL_COLUMNS
+    assert list(out.index) == [0, 1, 2, 3, 4]
+    assert list(out["id"]) == ["a", "a", "c", "c", "c"] and list(out["level"]) == [0, 1, 0, 1, 2]
+    empty = cells_table([findings[1]])
+    assert empty.empty and list(empty.columns) == CELL_COLUMNS
+
+
+def test_parts_of_different_kinds_that_disagree_depend_on_the_metric():
+    table = synthetic_tradeoff({"alte2d": Curve(scale=0.5)})
+    refuted = Property("incremental", (), ("octomap",))
+    found = evaluate(_claim(AllOf((MHD_AT_SIZE, refuted))), table)
+    assert (found.verdict, found.depends_on) == ("depends", "metric")
