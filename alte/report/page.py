@@ -50,7 +50,8 @@ _VERDICT_CSS = {"holds": "holds", "does not hold": "fails", "depends": "depends"
 class ClaimRow:
     """One claim with its verdict (``css``: the verdict's style class) and, where the
     whole-mission evidence is committed, its verdict on whole missions (``whole``,
-    ``whole_css``, ``whole_depends_on``) and whether the two differ."""
+    ``whole_css``, ``whole_depends_on``), whether the two differ and what moved
+    (``whole_why``: the cells' outcomes per terrain on each side)."""
 
     section: str
     claim: str
@@ -65,6 +66,7 @@ class ClaimRow:
     whole_css: str = ""
     whole_depends_on: str = ""
     differs: bool = False
+    whole_why: str = ""
 
 
 @dataclass(frozen=True)
@@ -226,7 +228,7 @@ def _claims(tables_dir: Path) -> list[ClaimRow]:
             str(r.get("question", "")) or _question(str(r.get("id", ""))), verdict,
             _VERDICT_CSS.get(verdict, "untested") if verdict else "",
             str(other.get("depends_on_whole_missions", "")),
-            bool(verdict) and verdict != str(r["verdict"])))
+            bool(verdict) and verdict != str(r["verdict"]), str(other.get("why", ""))))
     return rows
 
 

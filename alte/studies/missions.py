@@ -9,6 +9,7 @@ missions:
 * ``claims.csv`` (every claim's verdict), ``equal_size.csv``, ``equal_fidelity.csv``;
 * ``fronts.csv``: the fronts' points (each map on a mapper's Pareto front of basis
   functions against each metric read at equal size, per terrain and seed);
+* ``claims_cells.csv``: every cell (terrain, size or fidelity level) behind the verdicts;
 * ``provenance.json``: the command and commit that made them, the runs, their CPU
   seconds and wall time, the machine.
 
@@ -16,7 +17,8 @@ missions:
 (:func:`write_mission_evidence`). ``make report`` never recomputes it: the chapter 5
 notebook reads it (:func:`load_mission_evidence`) and writes ``claims_missions.csv``
 (:func:`compare_verdicts`): per claim the 20-scan verdict and the whole-mission one,
-each with what it depends on, and ``differs`` where they are not the same.
+each with what it depends on, ``differs`` where they are not the same, and ``why``: for
+a differing claim, the outcomes of its cells per terrain on each side (what moved).
 """
 
 from __future__ import annotations
@@ -37,19 +39,23 @@ from alte.studies.evidence_tables import EQUAL_SIZE, write_evidence
 from alte.studies.tables import write_csv
 from alte.studies.tradeoff import fronts, prepare
 
-__all__ = ["EVIDENCE_TABLES", "PROVENANCE", "WHOLE_MISSIONS", "MissionEvidence", "Provenance",
-           "compare_verdicts", "front_points", "git_commit", "load_mission_evidence",
-           "write_comparison", "write_mission_evidence"]
+__all__ = ["CELLS", "EVIDENCE_TABLES", "PROVENANCE", "WHOLE_MISSIONS", "MissionEvidence",
+           "Provenance", "compare_verdicts", "front_points", "git_commit", "load_mission_evidence",
+           "outcome_summary", "write_comparison", "write_mission_evidence"]
 
 #: Where the whole-mission evidence is committed (relative to the repository root).
 WHOLE_MISSIONS = Path("notebooks/sweeps/tradeoff-full")
 #: The tables of the evidence folder (CSV stems).
 EVIDENCE_TABLES = ("claims", "equal_size", "equal_fidelity", "fronts")
+#: The cells behind the verdicts (CSV stem; folders written before it existed lack it).
+CELLS = "claims_cells"
 #: The provenance file of the evidence folder.
 PROVENANCE = "provenance.json"
 #: The comparison table ``make report`` writes.
 COMPARISON = "claims_missions"
-_WRITTEN_TOO = ("claims_cells", "key_equal_size", "key_equal_fidelity")  # not kept
+_WRITTEN_TOO = ("key_equal_size", "key_equal_fidelity")  # not kept
+#: A cell's outcome as counted in ``why``.
+_OUTCOME_WORDS = {"holds": "hold", "does not hold": "do not hold", "inconclusive": "undecided"}
 
 
 @dataclass(frozen=True)
@@ -83,6 +89,7 @@ class MissionEvidence:
     equal_fidelity: pd.DataFrame
     fronts: pd.DataFrame
     provenance: Provenance
+    cells: pd.DataFrame
 
 
 def git_commit(where: str | os.PathLike[str] = ".") -> str:
@@ -155,13 +162,38 @@ def load_mission_evidence(folder: str | os.PathLike[str]) -> MissionEvidence:
         raise ReportError(f"whole-mission evidence {root / PROVENANCE}: unreadable "
                           f"({err})") from err
     claims, at_size, at_fidelity, points = (_read(root, n) for n in EVIDENCE_TABLES)
-    return MissionEvidence(root, claims, at_size, at_fidelity, points, provenance)
+    cells = _read(root, CELLS) if (root / f"{CELLS}.csv").is_file() else pd.DataFrame()
+    return MissionEvidence(root, claims, at_size, at_fidelity, points, provenance, cells)
 
 
-def compare_verdicts(short: pd.DataFrame, whole: pd.DataFrame) -> pd.DataFrame:
+def outcome_summary(cells: pd.DataFrame) -> str:
+    """A claim's cells as outcome counts per terrain, e.g. ``sim_lan_1: 3 hold, 1 undecided;
+    sim_nav_1: 2 do not hold`` (empty without cells)."""
+    if cells.empty or "terrain" not in cells:
+        return ""
+    parts = []
+    for terrain, group in cells.groupby("terrain", sort=True):
+        counts = group["outcome"].value_counts()
+        words = [f"{counts[o]} {_OUTCOME_WORDS.get(o, o)}" for o in
+                 (*_OUTCOME_WORDS, *sorted(set(counts.index) - set(_OUTCOME_WORDS)))
+                 if o in counts]
+        parts.append(f"{terrain}: {', '.join(words)}")
+    return "; ".join(parts)
+
+
+def _why(claim_id: str, short_cells: pd.DataFrame, whole_cells: pd.DataFrame) -> str:
+    """What moved between the two grids for one claim: its cells' outcomes on each side."""
+    sides = [(label, outcome_summary(cells[cells["id"] == claim_id]) if "id" in cells else "")
+             for label, cells in (("20 scans", short_cells), ("whole missions", whole_cells))]
+    return " | ".join(f"{label}: {text}" for label, text in sides if text)
+
+
+def compare_verdicts(short: pd.DataFrame, whole: pd.DataFrame,
+                     short_cells: pd.DataFrame | None = None,
+                     whole_cells: pd.DataFrame | None = None) -> pd.DataFrame:
     """Per claim (``id``) of the short-mission claims table: section, claim, the verdict and
-    what it depends on in each, and ``differs``; a claim only one table has shows
-    ``absent`` in the other."""
+    what it depends on in each, ``differs`` and ``why`` (module docstring; from the claims'
+    cells when given); a claim only one table has shows ``absent`` in the other."""
     keep = ["id", "verdict", "depends_on"]
     only_whole = whole.loc[~whole["id"].isin(short["id"]), ["id", "section", "claim"]]
     both = pd.concat([short[["id", "section", "claim", *keep[1:]]], only_whole],
@@ -171,8 +203,12 @@ def compare_verdicts(short: pd.DataFrame, whole: pd.DataFrame) -> pd.DataFrame:
         both[f"verdict{side}"] = both[f"verdict{side}"].fillna("absent")
         both[f"depends_on{side}"] = both[f"depends_on{side}"].fillna("")
     both["differs"] = both["verdict_20_scans"] != both["verdict_whole_missions"]
+    empty = pd.DataFrame()
+    both["why"] = [_why(i, empty if short_cells is None else short_cells,
+                        empty if whole_cells is None else whole_cells) if moved else ""
+                   for i, moved in zip(both["id"], both["differs"], strict=True)]
     order = ["id", "section", "claim", "verdict_20_scans", "verdict_whole_missions", "differs",
-             "depends_on_20_scans", "depends_on_whole_missions"]
+             "depends_on_20_scans", "depends_on_whole_missions", "why"]
     return both[order].reset_index(drop=True)
 
 
@@ -183,6 +219,9 @@ def write_comparison(short: pd.DataFrame, folder: str | os.PathLike[str] | None,
     evidence is committed there."""
     if folder is None or not (Path(folder) / PROVENANCE).is_file():
         return compare_verdicts(short.iloc[:0], short.iloc[:0])
-    table = compare_verdicts(short, load_mission_evidence(folder).claims)
+    found = load_mission_evidence(folder)
+    own = Path(tables_dir) / f"{CELLS}.csv"
+    short_cells = pd.read_csv(own, keep_default_na=False) if own.is_file() else None
+    table = compare_verdicts(short, found.claims, short_cells, found.cells)
     write_csv(table, tables_dir, COMPARISON, overwrite=True)
     return table

@@ -27,12 +27,17 @@ def test_whole_mission_column_and_marks(tmp_path: Path) -> None:
     whole.loc[0, "verdict"] = "does not hold" if short["verdict"][0] != "does not hold" \
         else "holds"
     whole.loc[0, "depends_on"] = "terrain (whole)"
-    compare_verdicts(short, whole).to_csv(tables / "claims_missions.csv", index=False)
+    cells = pd.DataFrame({"id": [short["id"][0]] * 2, "terrain": ["sim_lan_1", "sim_nav_2"],
+                          "outcome": ["holds", "does not hold"]})
+    compare_verdicts(short, whole, None, cells).to_csv(tables / "claims_missions.csv",
+                                                       index=False)
     page = run_index_html(record, tmp_path, sorted(tables.glob("*.csv")))
     table = page[page.index('id="whole-missions"'):page.index('id="tradeoffs"')]
     assert "<th>Whole missions</th>" in table and "1\nof 12 differ" in table
     assert table.count('<tr class="differs">') == 1 and table.count("&ne;") == 2
     assert "depends on: terrain (whole)" in table
+    assert ("what moved: whole missions: sim_lan_1: 1 hold; sim_nav_2: 1 do not hold"
+            in table) and table.count("what moved:") == 1
     assert "claims_missions.csv" not in page[page.index('id="tables"'):]  # shown, not listed
 
 

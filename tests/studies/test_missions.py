@@ -14,10 +14,12 @@ from alte.cli import main
 from alte.errors import ReportError
 from alte.studies.claims import CLAIMS
 from alte.studies.missions import (
+    CELLS,
     EVIDENCE_TABLES,
     PROVENANCE,
     compare_verdicts,
     load_mission_evidence,
+    outcome_summary,
     write_comparison,
 )
 
@@ -55,7 +57,7 @@ def evidence(tmp_path_factory) -> Path:
 
 def test_sweep_writes_the_evidence_folder_with_its_provenance(evidence: Path) -> None:
     assert sorted(p.name for p in evidence.iterdir()) == sorted(
-        [f"{n}.csv" for n in EVIDENCE_TABLES] + [PROVENANCE])
+        [f"{n}.csv" for n in (*EVIDENCE_TABLES, CELLS)] + [PROVENANCE])
     found = load_mission_evidence(evidence)
     made = found.provenance
     assert made.command.startswith("alte sweep ") and f"--evidence {evidence}" in made.command
@@ -68,6 +70,7 @@ def test_sweep_writes_the_evidence_folder_with_its_provenance(evidence: Path) ->
     assert {"mhd_m", "height_rmse_m", "completeness"} <= set(found.fronts["metric"])
     assert set(found.fronts["mapper"]) == {"quadtree", "alte2d", "octomap", "alte3d"}
     assert not found.equal_size.empty and not found.equal_fidelity.empty
+    assert set(found.cells["id"]) <= set(found.claims["id"]) and len(found.cells) > 0
     # each front point is one map: no two points of a front share a size with one better
     for _, front in found.fronts.groupby(["terrain", "mapper", "seed", "metric"]):
         assert front["basis_functions"].is_unique
@@ -123,3 +126,42 @@ def test_incomplete_evidence_is_named(evidence: Path, tmp_path) -> None:
     (copy / PROVENANCE).write_text(json.dumps({"command": "x"}))
     with pytest.raises(ReportError, match=r"provenance.json: unreadable"):
         load_mission_evidence(copy)
+
+
+def _cells(rows: list[tuple[str, str, str]]) -> pd.DataFrame:
+    return pd.DataFrame(rows, columns=["id", "terrain", "outcome"])
+
+
+def test_outcomes_are_counted_per_terrain() -> None:
+    cells = _cells([("a", "sim_nav_1", "does not hold"), ("a", "sim_lan_1", "holds"),
+                    ("a", "sim_lan_1", "inconclusive"), ("a", "sim_lan_1", "holds"),
+                    ("a", "sim_nav_1", "equal")])
+    assert outcome_summary(cells) == ("sim_lan_1: 2 hold, 1 undecided; "
+                                      "sim_nav_1: 1 do not hold, 1 equal")
+    assert outcome_summary(cells.iloc[:0]) == ""
+
+
+def test_a_differing_claim_says_what_moved_on_each_side() -> None:
+    short = pd.DataFrame({"id": ["a", "b"], "section": ["5.1", "5.2"], "claim": ["A", "B"],
+                          "verdict": ["holds", "depends"], "depends_on": ["", "terrain"]})
+    whole = short.assign(verdict=["does not hold", "depends"])
+    short_cells = _cells([("a", "sim_lan_1", "holds"), ("b", "sim_lan_1", "holds")])
+    whole_cells = _cells([("a", "sim_lan_1", "does not hold"), ("a", "sim_lan_1", "holds"),
+                          ("b", "sim_lan_2", "holds")])
+    table = compare_verdicts(short, whole, short_cells, whole_cells)
+    assert table["why"].tolist() == [
+        "20 scans: sim_lan_1: 1 hold | whole missions: sim_lan_1: 1 hold, 1 do not hold", ""]
+    assert compare_verdicts(short, whole)["why"].tolist() == ["", ""]
+
+
+def test_the_comparison_reads_the_reports_own_cells(evidence: Path, tmp_path) -> None:
+    found = load_mission_evidence(evidence)
+    short = found.claims.assign(verdict="holds")
+    own = found.cells.assign(outcome="holds")
+    own.to_csv(tmp_path / f"{CELLS}.csv", index=False)
+    table = write_comparison(short, evidence, tmp_path)
+    moved = table[table["differs"]]
+    assert len(moved) > 0
+    for claim_id, why in zip(moved["id"], moved["why"], strict=True):
+        if (found.cells["id"] == claim_id).any():
+            assert why.startswith("20 scans: ") and " | whole missions: " in why
