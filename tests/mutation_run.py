@@ -55,7 +55,7 @@ MODULES: dict[str, tuple[str, tuple[str, ...]]] = {
         "tests/studies/test_evidence.py")),
     "evidence": ("alte/studies/evidence.py", (
         "tests/studies/test_verdicts.py", "tests/studies/test_evidence.py",
-        "tests/studies/test_evidence_tables.py")),
+        "tests/studies/test_evidence_tables.py", "tests/studies/test_conditions.py")),
     "tradeoff": ("alte/studies/tradeoff.py", (
         "tests/studies/test_tradeoff.py", "tests/studies/test_verdicts.py",
         "tests/studies/test_measures.py")),

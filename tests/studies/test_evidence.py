@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import pandas as pd
 import pytest
 from support.tradeoff import Curve, synthetic_tradeoff
@@ -19,6 +21,8 @@ from alte.studies.evidence import (
     VERDICTS,
     EvidenceOptions,
     Finding,
+    _combine,
+    _level_text,
     cells_table,
     claims_table,
     evaluate,
@@ -242,3 +246,41 @@ def test_parts_of_different_kinds_that_disagree_depend_on_the_metric():
     refuted = Property("incremental", (), ("octomap",))
     found = evaluate(_claim(AllOf((MHD_AT_SIZE, refuted))), table)
     assert (found.verdict, found.depends_on) == ("depends", "metric")
+
+
+def test_intervals_are_reproducible_and_widen_with_the_level():
+    table = synthetic_tradeoff({"alte2d": Curve(scale=0.8, noise=0.2)})
+    first, again = (evaluate(_claim(MHD_AT_SIZE), table) for _ in range(2))
+    pd.testing.assert_frame_equal(first.cells, again.cells)
+    narrow = evaluate(_claim(MHD_AT_SIZE), table, EvidenceOptions(level=0.5)).cells
+    wide = evaluate(_claim(MHD_AT_SIZE), table, EvidenceOptions(level=0.99)).cells
+    assert (wide["low"] < narrow["low"]).all() and (wide["high"] > narrow["high"]).all()
+    assert (first.cells["low"] <= wide["high"]).all()
+
+
+def test_a_property_lists_every_mapper_it_reads():
+    found = evaluate(_claim(Property("incremental", ("octomap",), ("quadtree",))),
+                     synthetic_tradeoff())
+    assert re.search(r"our implementations: Octomap: incremental = (True|False), "
+                     r"Quadtree: incremental = (True|False)$", found.evidence)
+
+
+def test_what_tells_parts_apart_is_listed_by_priority_view_before_mapper():
+    table = synthetic_tradeoff({"alte2d": Curve(scale=0.5)})
+    at_point = Compare("lan", "alte2d", "quadtree", "mhd_m", "thesis_point")  # loses
+    swapped = Compare("lan", "quadtree", "alte2d", "mhd_m", "equal_size")  # loses
+    found = evaluate(_claim(AllOf((MHD_AT_SIZE, at_point, swapped))), table)
+    assert (found.verdict, found.depends_on) == ("depends", "view, mapper")
+
+
+def test_what_parts_depend_on_is_merged_once_each():
+    empty = pd.DataFrame()
+    results = [("holds", "", "", empty, ""), ("depends", "terrain, size", "", empty, ""),
+               ("depends", "size", "", empty, "")]
+    assert _combine((MHD_AT_SIZE,) * 3, results) == ("depends", "terrain, size")
+
+
+def test_a_level_of_a_column_without_a_display_name_is_shown_with_its_name():
+    assert _level_text(1500.0, "p_kappa") == " at 1,500 p_kappa"
+    assert _level_text(0.25, "mhd_m") == " at 0.25 m"
+    assert _level_text(float("nan"), "mhd_m") == ""
