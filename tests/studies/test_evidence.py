@@ -21,6 +21,7 @@ from alte.studies.evidence import (
     VERDICTS,
     EvidenceOptions,
     Finding,
+    _cell_verdict,
     _combine,
     _level_text,
     cells_table,
@@ -284,3 +285,39 @@ def test_a_level_of_a_column_without_a_display_name_is_shown_with_its_name():
     assert _level_text(1500.0, "p_kappa") == " at 1,500 p_kappa"
     assert _level_text(0.25, "mhd_m") == " at 0.25 m"
     assert _level_text(float("nan"), "mhd_m") == ""
+
+
+@pytest.mark.parametrize(("check", "criterion"), [
+    (MHD_AT_SIZE, "supports the claim where the interval lies above +0 m)"),
+    (Compare("lan", "alte2d", "quadtree", "mhd_m", "equal_size", relation="undecided"),
+     "supports the claim where the interval contains 0)"),
+    (Compare("lan", "alte2d", "quadtree", "basis_functions", "thesis_point",
+             relation="similar"),
+     "supports the claim where the interval lies within x0.8 .. x1.25)"),
+    (Compare("lan", "alte2d", "quadtree", "mhd_m", "thesis_point", relation="similar"),
+     "supports the claim where the interval lies within -0.25 .. +0.25 m)"),
+])
+def test_the_evidence_states_the_criterion_of_each_relation(check, criterion):
+    found = evaluate(_claim(check), synthetic_tradeoff({"alte2d": Curve(scale=0.5)}))
+    assert criterion in found.evidence
+
+
+def _outcomes(*rows: tuple[str, float, str]) -> pd.DataFrame:
+    return pd.DataFrame(rows, columns=["terrain", "level", "outcome"])
+
+
+@pytest.mark.parametrize(("cells", "kind", "expected"), [
+    (_outcomes(("a", 1, "holds"), ("b", 1, "holds")), "size", ("holds", "")),
+    (_outcomes(("a", 1, "does not hold"), ("a", 2, "does not hold")), "size",
+     ("does not hold", "")),
+    (_outcomes(("a", 1, "holds"), ("a", 2, "inconclusive")), "size", ("depends", "uncertainty")),
+    (_outcomes(("a", 1, "holds"), ("b", 1, "does not hold"), ("b", 2, "inconclusive")), "size",
+     ("depends", "terrain")),
+    (_outcomes(("a", 1, "holds"), ("a", 2, "does not hold"), ("b", 1, "holds")), "size",
+     ("depends", "size")),
+    (_outcomes(("a", 1, "holds"), ("a", 2, "does not hold")), "", ("depends", "setting")),
+    (_outcomes(("a", 1, "holds"), ("a", 2, "does not hold"), ("b", 1, "holds"),
+               ("c", 1, "does not hold")), "fidelity", ("depends", "terrain, fidelity")),
+])
+def test_the_cells_decide_the_verdict_and_what_it_depends_on(cells, kind, expected):
+    assert _cell_verdict(cells, kind) == expected
