@@ -37,7 +37,7 @@ def test_whole_mission_column_and_marks(tmp_path: Path) -> None:
     assert table.count('<tr class="differs">') == 1 and table.count("&ne;") == 2
     assert "depends on: terrain (whole)" in table
     assert ("what moved: whole missions: sim_lan_1: 1 hold; sim_nav_2: 1 do not hold"
-            in table) and table.count("what moved:") == 1
+            in table) and table.count("what moved: ") == 1
     assert "claims_missions.csv" not in page[page.index('id="tables"'):]  # shown, not listed
 
 
