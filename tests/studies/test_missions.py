@@ -17,6 +17,7 @@ from alte.studies.missions import (
     CELLS,
     EVIDENCE_TABLES,
     PROVENANCE,
+    WHOLE_MISSIONS,
     compare_verdicts,
     load_mission_evidence,
     outcome_summary,
@@ -165,3 +166,16 @@ def test_the_comparison_reads_the_reports_own_cells(evidence: Path, tmp_path) ->
     for claim_id, why in zip(moved["id"], moved["why"], strict=True):
         if (found.cells["id"] == claim_id).any():
             assert why.startswith("20 scans: ") and " | whole missions: " in why
+
+
+def test_the_committed_whole_mission_evidence_covers_the_catalogue() -> None:
+    folder = Path(__file__).resolve().parents[2] / WHOLE_MISSIONS
+    found = load_mission_evidence(folder)
+    made = found.provenance
+    assert made.spec == "notebooks/sweeps/tradeoff-full.yaml" and made.frames is None
+    assert made.runs == 45_680 and made.seeds == [0, 1, 2, 3, 4]
+    assert list(found.claims["id"]) == [c.id for c in CLAIMS]
+    assert set(found.cells["id"]) <= set(found.claims["id"])
+    assert set(found.fronts["terrain"]) == {"sim_nav_1", "sim_nav_2", "sim_lan_1", "sim_lan_2",
+                                            "exp_nav_1", "exp_nav_2", "exp_lan_1", "exp_lan_2"}
+    assert set(found.fronts["seed"]) == {0, 1, 2, 3, 4}
