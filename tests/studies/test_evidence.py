@@ -321,3 +321,19 @@ def _outcomes(*rows: tuple[str, float, str]) -> pd.DataFrame:
 ])
 def test_the_cells_decide_the_verdict_and_what_it_depends_on(cells, kind, expected):
     assert _cell_verdict(cells, kind) == expected
+
+
+@pytest.mark.parametrize(("check", "what", "unit"), [
+    (MHD_AT_SIZE, "MHD [m], Quadtree minus 2D-ALTE at equal basis functions", "m"),
+    (Compare("lan", "alte2d", "quadtree", "basis_functions", "equal_fidelity"),
+     "basis functions, Quadtree / 2D-ALTE for equal MHD [m]", "x"),
+])
+def test_a_single_checks_cells_say_what_they_read_in_which_unit(check, what, unit):
+    cells = evaluate(_claim(check), synthetic_tradeoff({"alte2d": Curve(scale=0.5)})).cells
+    assert list(cells.index) == list(range(len(cells))) and len(cells) == 6
+    assert (cells["part"] == 1).all() and (cells["id"] == "test").all()
+    assert (cells["what"] == what).all() and (cells["unit"] == unit).all()
+    assert not cells["from_times"].any() and (cells["seeds"] == 3).all()
+    assert (cells["low"] <= cells["estimate"]).all() and (cells["estimate"] <= cells["high"]).all()
+    if unit == "x":  # factors: Quadtree needs several times 2D-ALTE's basis functions
+        assert (cells["low"] > 1).all()
