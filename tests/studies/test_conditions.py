@@ -5,13 +5,17 @@ from __future__ import annotations
 import dataclasses
 import json
 
+import numpy as np
 import pandas as pd
+import pytest
 from support.tradeoff import Curve, synthetic_tradeoff
 
 from alte.studies.claims import AllOf, Claim, Compare, Contrast, Summary, Trend, claim
 from alte.studies.conditions import TIMES_UNDECIDED, condition, part_label, terrain_names
 from alte.studies.evidence import evaluate, evaluate_all
 from alte.studies.evidence_tables import write_evidence
+from alte.studies.measures import NoDataError, measure_check
+from alte.studies.tradeoff import prepare
 
 MHD_AT_SIZE = Compare("lan", "alte2d", "quadtree", "mhd_m", "equal_size")
 
@@ -131,3 +135,42 @@ def test_a_part_read_from_times_with_an_undecided_cell_names_no_terrain():
     # the same cells read from anything but times keep their terrains and sizes
     untimed = dataclasses.replace(found, cells=cells.assign(from_times=False))
     assert "sim_lan_2" in condition(untimed) and "undecided" in condition(untimed)
+
+
+def _by_hand(values: pd.Series, agg: str) -> float:
+    """Median or coefficient of variation (population std over mean), as the thesis' tables
+    aggregate a mapper's settings."""
+    data = values.to_numpy(float)
+    return float(data.std() / data.mean()) if agg == "cv" else float(np.median(data))
+
+
+@pytest.mark.parametrize(("agg", "higher", "text", "unit"), [
+    ("cv", False, "coefficient of variation of MHD [m] over 3D-ALTE's settings, "
+                  "min_pts_per_leaf minus the grid as specified", ""),
+    ("median", True, "median of MHD [m] over 3D-ALTE's settings, the grid as specified minus "
+                     "min_pts_per_leaf", "m"),
+])
+def test_a_contrast_is_the_variants_aggregate_minus_the_bases_per_terrain_and_seed(
+        agg, higher, text, unit):
+    table = synthetic_tradeoff()
+    both = prepare(_variants(table, 2.0).assign(
+        mhd_m=lambda t: t["mhd_m"] + 0.5 * (t["variant"] != "base")))
+    found = measure_check(Contrast("nav", "alte3d", "mhd_m", agg, "min_pts_per_leaf",
+                                   higher_is_better=higher), both)
+    assert (found.what, found.unit) == (text, unit)
+    mine = both[both["mapper"] == "alte3d"]
+    for row in found.stats.itertuples():
+        at = mine[(mine["terrain"] == row.terrain) & (mine["seed"] == row.seed)]
+        base, other = (_by_hand(at.loc[at["variant"] == v, "mhd_m"], agg)
+                       for v in ("base", "min_pts_per_leaf"))
+        assert row.value == pytest.approx((base - other) if higher else (other - base))
+    assert set(found.stats["terrain"]) == set(mine["terrain"])
+
+
+def test_a_contrast_names_what_it_lacks():
+    table = synthetic_tradeoff()
+    elsewhere = _variants(table, 2.0).query("variant == 'base' or terrain != terrain")
+    with pytest.raises(NoDataError, match=r"no 3D-ALTE rows of variant 'min_pts_per_leaf' on "
+                                          r"the nav terrains"):
+        measure_check(Contrast("nav", "alte3d", "mhd_m", "cv", "min_pts_per_leaf"),
+                      prepare(elsewhere))
