@@ -52,7 +52,8 @@ MODULES: dict[str, tuple[str, tuple[str, ...]]] = {
         "tests/studies/test_evidence.py")),
     "measures": ("alte/studies/measures.py", (
         "tests/studies/test_verdicts.py", "tests/studies/test_measures.py",
-        "tests/studies/test_evidence.py", "tests/studies/test_conditions.py")),
+        "tests/studies/test_evidence.py", "tests/studies/test_conditions.py",
+        "tests/studies/test_measures_cases.py")),
     "evidence": ("alte/studies/evidence.py", (
         "tests/studies/test_verdicts.py", "tests/studies/test_evidence.py",
         "tests/studies/test_evidence_tables.py", "tests/studies/test_conditions.py")),
