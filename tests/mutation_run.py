@@ -59,7 +59,7 @@ MODULES: dict[str, tuple[str, tuple[str, ...]]] = {
         "tests/studies/test_evidence_tables.py", "tests/studies/test_conditions.py")),
     "tradeoff": ("alte/studies/tradeoff.py", (
         "tests/studies/test_tradeoff.py", "tests/studies/test_verdicts.py",
-        "tests/studies/test_measures.py")),
+        "tests/studies/test_measures.py", "tests/studies/test_tradeoff_cases.py")),
     "claims": ("alte/studies/claims/__init__.py", ("tests/studies/test_claims.py",)),
 }
 
