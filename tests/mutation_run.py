@@ -49,7 +49,7 @@ MODULES: dict[str, tuple[str, tuple[str, ...]]] = {
         "tests/studies/test_measures.py", "tests/studies/test_evidence.py")),
     "comparisons": ("alte/studies/comparisons.py", (
         "tests/studies/test_verdicts.py", "tests/studies/test_measures.py",
-        "tests/studies/test_evidence.py")),
+        "tests/studies/test_evidence.py", "tests/studies/test_comparisons_cases.py")),
     "measures": ("alte/studies/measures.py", (
         "tests/studies/test_verdicts.py", "tests/studies/test_measures.py",
         "tests/studies/test_evidence.py", "tests/studies/test_conditions.py",
