@@ -41,7 +41,8 @@ MODULES: dict[str, tuple[str, tuple[str, ...]]] = {
     "hausdorff": ("alte/metrics/hausdorff.py", (
         "tests/metrics/test_metrics.py", "-k", "hausdorff or directed or to_the_last_bit")),
     "truth": ("alte/metrics/truth.py", (
-        "tests/metrics/test_metrics.py", "tests/metrics/test_truth.py", "-k",
+        "tests/metrics/test_metrics.py", "tests/metrics/test_truth.py",
+        "tests/metrics/test_truth_cases.py", "-k",
         "not hausdorff and not directed and not to_the_last_bit")),
     "trajectory": ("alte/metrics/trajectory.py", ("tests/metrics/test_trajectory.py",)),
     "checks": ("alte/studies/checks.py", (
