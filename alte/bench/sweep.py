@@ -102,7 +102,7 @@ def _prepare_input(run: Any, data_dir: str) -> float:
     from alte.studies.sweep.work import _inputs
 
     start = time.process_time()
-    _ensure((run.terrain, run.frames, run.seed, run.voxel, run.sensor, run.deskew), data_dir)
+    _ensure(run, data_dir)
     _, reference = _inputs(run, data_dir)
     reference.cloud_index  # noqa: B018 - prepared now, as a worker does on its first map
     if reference.truth is not None:
@@ -123,7 +123,7 @@ def measure_sample(spec: Any, data_dir: str, *, seed: int = 0, strata: int | Non
     rows, runs, cpu, estimate = [], 0, 0.0, 0.0
     for group, in_grid in tqdm(chosen, desc="sweep sample", unit="map", disable=not progress):
         first = group.runs[0]
-        key = (first.terrain, first.seed, first.frames, first.voxel, first.sensor, first.deskew)
+        key = first.input_key()
         if key not in prepared:
             prepared[key] = _prepare_input(first, data_dir)
         start = time.process_time()
@@ -177,8 +177,9 @@ def _spec(path: str, ctx: Context, data_dir: str) -> Any:
     terrains = ("sim_lan_2", "sim_nav_1")
     mappers = tuple(replace(g, terrains=tuple(t for t in g.terrains if t in terrains))
                     for g in spec.mappers)
+    # quick mode leaves out odometry variants: they pose whole missions
     variants = tuple(replace(v, terrains=tuple(t for t in v.terrains if t in terrains))
-                     for v in spec.variants)
+                     for v in spec.variants if v.poses == "recorded")
     return override(replace(spec, terrains=terrains, mappers=mappers, variants=variants),
                     frames=QUICK_FRAMES)
 

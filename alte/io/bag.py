@@ -160,7 +160,7 @@ class FrameStream:
                  allow_no_pose: bool = False, body_frame: str | None = None,
                  frames: int | None = None, max_gap_s: float = 0.5,
                  return_mode: str = "strongest", progress: bool = False,
-                 pose_file: str | Path | None = None) -> None:
+                 pose_file: str | Path | None = None, read_all: bool = False) -> None:
         if not max_gap_s > 0:
             raise ParameterError(f"max_gap_s={max_gap_s!r} must be > 0")
         self.path = Path(path)
@@ -173,8 +173,12 @@ class FrameStream:
             self.scans = int(reader.topics[self.cloud_topic].msgcount)
         if pose_file is not None:
             self._use_pose_file(Path(pose_file), pose_topic)
-        self.options = ReadOptions(max_gap_s, return_mode, evenly_spaced(self.scans, frames),
-                                   progress)
+        #: The scans ``frames`` selects (None: all); with ``read_all`` every scan is still
+        #: read (odometry needs them) and :attr:`selection` only says which go on.
+        self.selection = evenly_spaced(self.scans, frames)
+        self.read_all = read_all and self.selection is not None
+        self.options = ReadOptions(max_gap_s, return_mode,
+                                   None if self.read_all else self.selection, progress)
         self.counts = self._new_counts()
 
     def _use_pose_file(self, pose_file: Path, pose_topic: str | None) -> None:
@@ -194,9 +198,8 @@ class FrameStream:
 
     @property
     def selected(self) -> int:
-        """Scans this stream reads (after frame selection)."""
-        select = self.options.select
-        return self.scans if select is None else len(select)
+        """Scans this stream selects (all it reads unless ``read_all``)."""
+        return self.scans if self.selection is None else len(self.selection)
 
     def __iter__(self) -> Iterator[Frame]:
         self.counts = counts = self._new_counts()
@@ -242,8 +245,9 @@ def _scan_frames(reader: AnyReader, stream: FrameStream, counts: ReadCounts,
     """Stream the cloud topic, yielding posed frames and counting what is dropped."""
     opts, topic = stream.options, stream.cloud_topic
     messages = read_messages(reader, topic, stream.path, opts.select)
-    for log_time, msgtype, msg in tqdm(messages, total=stream.selected, desc=topic,
-                                       unit="scan", disable=not opts.progress):
+    total = stream.scans if opts.select is None else len(opts.select)
+    for log_time, msgtype, msg in tqdm(messages, total=total, desc=topic, unit="scan",
+                                       disable=not opts.progress):
         if msg is None:
             counts.scans_skipped += 1
             continue

@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import enum
 import hashlib
-import itertools
 import json
 from collections.abc import Iterator
 from dataclasses import dataclass, field, replace
@@ -22,22 +21,14 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from alte.errors import BagError, ParameterError, PointFileError, PoseError, TopicError
+from alte.errors import BagError, ParameterError, PointFileError, TopicError
 from alte.io.bag import NO_POSE_NOTE, FrameStream, ReadCounts
-from alte.io.imu import ImuSamples, imu_topic, read_imu
 from alte.io.pose import POSE_TYPES
+from alte.pipeline.posing import odometry_poses
 from alte.pipeline.spec import FrameSpec, PoseSource
 from alte.registration.deskew import DeskewCounts, deskew_frames
 from alte.registration.grid import GridAccumulator, grid_average
-from alte.registration.odometry import (
-    KEYS,
-    OdometryParams,
-    PoseCounts,
-    odometry_frames,
-    odometry_label,
-    refine_frames,
-    resolve_method,
-)
+from alte.registration.odometry import KEYS, PoseCounts, refine_frames
 from alte.registration.register import RegistrationCounts, crop_mask, register_frames
 from alte.types import Box, Frame, RegisteredFrame
 
@@ -143,54 +134,12 @@ class StreamCounts:
 
 
 def _open(source: Source, spec: FrameSpec, pose_topic: str | None, progress: bool,
-          allow_no_pose: bool = True) -> FrameStream:
+          read_all: bool = False) -> FrameStream:
     pose_file = spec.pose_file if pose_topic != "" else None
     return FrameStream(source.bag or source.path, cloud_topic=spec.cloud_topic,
-                       pose_topic=pose_topic, mount=spec.mount, allow_no_pose=allow_no_pose,
-                       frames=spec.frames, progress=progress, pose_file=pose_file)
-
-
-def _start(probe: FrameStream, stamp: int) -> tuple[np.ndarray, np.ndarray] | None:
-    """The recorded pose at the first scan, or None (no track, or one on another clock)."""
-    if probe.track is None:
-        return None
-    try:
-        at = probe.track.interpolate([stamp], probe.options.max_gap_s)
-    except PoseError:  # stamps in another unit: odometry does without the anchor
-        return None
-    return (at.positions[0], at.quaternions[0]) if at.valid[0] else None
-
-
-def _imu(stream: FrameStream, params: OdometryParams) -> ImuSamples | None:
-    """The bag's IMU samples when LiDAR-inertial odometry will run (``auto`` with an IMU
-    topic, or ``lio``), else None."""
-    if params.method not in ("auto", "lio"):
-        return None
-    topic = imu_topic(stream.path, params.imu_topic)
-    if topic is None:
-        return None
-    return read_imu(stream.path, topic)
-
-
-def _odometry(stream: FrameStream, probe: FrameStream, spec: FrameSpec,
-              counts: PoseCounts) -> Iterator[Frame]:
-    """Odometry poses (LiDAR-inertial when the bag has an IMU and the method is ``auto``
-    or ``lio``), anchored at the recorded pose of the first scan when there is one."""
-    frames = iter(stream)
-    first = next(frames, None)
-    if first is None:
-        return
-    start = _start(probe, first.stamp)
-    anchor = f"the recorded pose of the first scan ({probe.pose_topic})" if start is not None \
-        else "the first scan's body frame"
-    imu = _imu(stream, spec.odometry)
-    params = resolve_method(spec.odometry, imu is not None)
-    kind = "LiDAR-inertial odometry" if imu is not None else "LiDAR odometry"
-    with_imu = f", IMU {imu.frame_id} at {imu.rate_hz:.0f} Hz" if imu is not None else ""
-    stream.notes.append(f"poses from {kind} ({odometry_label(params)}{with_imu}), "
-                        f"anchored at {anchor}")
-    yield from odometry_frames(itertools.chain([first], frames), stream.mount, counts=counts,
-                               params=params, start=start, imu=imu)
+                       pose_topic=pose_topic, mount=spec.mount, allow_no_pose=True,
+                       frames=spec.frames, progress=progress, pose_file=pose_file,
+                       read_all=read_all)
 
 
 def _deskewed(stream: FrameStream, spec: FrameSpec, counts: DeskewCounts) -> Iterator[Frame]:
@@ -228,9 +177,15 @@ def _posed(source: Source, spec: FrameSpec, counts: PoseCounts, progress: bool,
         counts.source = PoseSource.RECORDED.value
         return probe, _deskewed(probe, spec, deskew)
     counts.source = PoseSource.ODOMETRY.value
-    stream = probe if probe.track is None else _open(source, spec, "", progress)
+    # Odometry reads every scan (it cannot align scans seconds apart); only the scans
+    # ``spec.frames`` selects go on to registration.
+    every = probe.track is None and probe.selection is None
+    stream = probe if every else _open(source, spec, "", progress, read_all=True)
     stream.notes[:] = [n for n in stream.notes if n != NO_POSE_NOTE]
-    return stream, _odometry(stream, probe, spec, counts)
+    if stream.read_all:
+        stream.notes.append(f"odometry over all {stream.scans} scans; {stream.selected} of "
+                            "them (evenly spaced) registered")
+    return stream, odometry_poses(stream, probe, spec, counts)
 
 
 def _bag_frames(source: Source, spec: FrameSpec, counts: StreamCounts,

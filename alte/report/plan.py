@@ -38,6 +38,8 @@ QUICK_TERRAINS: tuple[str, ...] = ("sim_nav_1", "sim_lan_1")
 #: Scans per terrain in quick mode, the same in every notebook: the simulated terrain
 #: (cached per frame count by ``ensure_terrain``) is then made once and shared.
 QUICK_FRAMES = 40
+#: The simulated UAV missions (the realistic sensor's table in chapter 5).
+UAV_MISSIONS: tuple[str, ...] = ("sim_nav_1", "sim_nav_2", "sim_lan_1", "sim_lan_2")
 #: Parameters the runner sets itself (output locations); users cannot override them.
 RUNNER_PARAMETERS: tuple[str, ...] = ("OUT_DIR", "TABLES_DIR", "DATA_DIR")
 
@@ -84,7 +86,8 @@ PLAN: tuple[Entry, ...] = (
     *(_ch4(terrain) for terrain in TERRAINS),
     Entry("ch5_analysis", "ch5_analysis.ipynb", {"FRAMES": QUICK_FRAMES},
           {"FRAMES": None, "ROWS": None, "GRID_SPEC": "notebooks/sweeps/tradeoff.yaml",
-           "SCHEDULER": "local", "WORKERS": 2},
+           "SCHEDULER": "local", "WORKERS": 2, "SENSOR_TERRAINS": list(UAV_MISSIONS),
+           "SENSOR_RUNS": None, "SENSOR_FRAMES": None},
           terrains=("sim_nav_1", "sim_lan_2", "sim_nav_2")),
     Entry("ch7_sensitivity", "ch7_sensitivity.ipynb", {"FRAMES": QUICK_FRAMES},
           {"FRAMES": None, "SPEC": "notebooks/sweeps/report.yaml", "SCHEDULER": "local"},

@@ -13,17 +13,19 @@ from __future__ import annotations
 
 import os
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
+from alte.errors import ParameterError
 from alte.metrics.trajectory import trajectory_errors
 from alte.pipeline import FrameSpec, PoseSource, open_input, prepare
 from alte.registration.odometry import odometry_params
 
-__all__ = ["RUNS", "sensor_row", "sensor_table"]
+__all__ = ["RUNS", "RUN_TEXT", "sensor_row", "sensor_table", "sensor_view"]
 
 #: Column key -> (profile, pose source, deskew, odometry backend).
 RUNS: dict[str, tuple[str, PoseSource, bool, str]] = {
@@ -43,17 +45,15 @@ class _Score:
     ms_per_scan: float
 
 
-def _score(folder: Path, name: str, run: tuple[PoseSource, bool, str], seed: int,
+def _score(folder: Path, name: str, spec: FrameSpec, seed: int,
            cache: Path | None) -> _Score:
     from alte.sim import get_terrain, load_ground_truth, mesh_distance, true_poses
 
-    pose, deskew, method = run
-    spec = FrameSpec(poses=pose, deskew=deskew, odometry=odometry_params(method))
     start = time.perf_counter()
     reg = prepare(open_input(folder), spec, cache=cache)
     seconds = time.perf_counter() - start
-    if pose is PoseSource.ODOMETRY:  # the pose step alone, as `alte register` reports it
-        seconds = reg.counts.poses.seconds
+    if spec.poses is PoseSource.ODOMETRY:  # the pose step alone, as `alte register` says
+        seconds = reg.counts.poses.seconds / max(reg.counts.poses.frames, 1) * len(reg)
     truth = true_poses(get_terrain(name), seed)
     traj = reg.trajectory
     index = np.searchsorted(truth.stamps, traj.stamps)
@@ -63,24 +63,70 @@ def _score(folder: Path, name: str, run: tuple[PoseSource, bool, str], seed: int
     return _Score(errors.ate_m, errors.rpe_trans_pct, mesh, 1e3 * seconds / max(len(reg), 1))
 
 
-def sensor_row(name: str, data_dir: str | os.PathLike[str] = "data", seed: int = 0,
-               cache: Path | None = None) -> dict[str, object]:
-    """One terrain's row (module docstring); terrains are simulated when absent."""
+def sensor_row(name: str, data_dir: str | os.PathLike[str] = "data", seed: int = 0, *,
+               cache: Path | None = None, runs: Sequence[str] | None = None,
+               frames: int | None = None) -> dict[str, object]:
+    """One terrain's row (module docstring) for the ``runs`` named (keys of :data:`RUNS`,
+    None: all);
+    terrains are simulated when absent. ``frames``: that many evenly spaced scans (None:
+    the whole mission); odometry still poses every scan of the whole mission (it aligns
+    consecutive scans) and keeps those."""
     from alte.sim import ensure_terrain, get_terrain, true_poses
     from alte.sim.profile import PROFILES
 
+    runs = tuple(RUNS) if runs is None else runs
+    unknown = sorted(set(runs) - set(RUNS))
+    if unknown:
+        raise ParameterError(f"sensor runs {', '.join(unknown)}: valid: {', '.join(RUNS)}")
     truth = true_poses(get_terrain(name), seed).positions
     row: dict[str, object] = {"terrain": name, "path_m": float(
         np.linalg.norm(np.diff(truth, axis=0), axis=1).sum())}
-    for key, (profile, pose, deskew, method) in RUNS.items():
-        folder = ensure_terrain(name, data_dir, seed, profile=PROFILES[profile])
-        score = _score(folder, name, (pose, deskew, method), seed, cache)
+    for key in runs:
+        profile, pose, deskew, method = RUNS[key]
+        whole = pose is PoseSource.ODOMETRY
+        folder = ensure_terrain(name, data_dir, seed, None if whole else frames,
+                                profile=PROFILES[profile])
+        spec = FrameSpec(frames=frames, poses=pose, deskew=deskew,
+                         odometry=odometry_params(method))
+        score = _score(folder, name, spec, seed, cache)
         row |= {f"ate_{key}_m": score.ate_m, f"rpe_{key}_pct": score.rpe_pct,
                 f"mesh_{key}_m": score.mesh_m, f"ms_per_scan_{key}": score.ms_per_scan}
     return row
 
 
-def sensor_table(names: list[str], data_dir: str | os.PathLike[str] = "data",
-                 seed: int = 0) -> pd.DataFrame:
-    """Rows of :func:`sensor_row` for ``names``."""
-    return pd.DataFrame([sensor_row(n, data_dir, seed) for n in names])
+def sensor_table(names: Sequence[str], data_dir: str | os.PathLike[str] = "data",
+                 seed: int = 0, *, runs: Sequence[str] | None = None,
+                 frames: int | None = None, progress: bool = False) -> pd.DataFrame:
+    """Rows of :func:`sensor_row` for ``names`` (with a progress bar over terrains)."""
+    from tqdm.auto import tqdm
+
+    return pd.DataFrame([sensor_row(n, data_dir, seed, runs=runs, frames=frames)
+                         for n in tqdm(names, desc="sensor", unit="terrain",
+                                       disable=not progress)])
+
+
+#: What each run of :data:`RUNS` is, in words (the report's table).
+RUN_TEXT = {
+    "thesis": "thesis sensor (instantaneous scan), recorded poses",
+    "recorded": "UAV sensor, recorded poses, scans as taken",
+    "deskew": "UAV sensor, recorded poses, scans deskewed",
+    "lidar": "UAV sensor, LiDAR odometry (KISS-ICP)",
+    "lio": "UAV sensor, LiDAR-inertial odometry (the bag's IMU)",
+}
+
+
+def sensor_view(table: pd.DataFrame) -> pd.DataFrame:
+    """:func:`sensor_table` one row per terrain and run, with units in the column names,
+    rounded to what the measures resolve (mm, 0.1 mm on the mesh, 0.1 ms)."""
+    rows = []
+    for _, row in table.iterrows():
+        for key, text in RUN_TEXT.items():
+            if f"ate_{key}_m" not in row:
+                continue
+            ate = float(row[f"ate_{key}_m"])
+            rows.append({"terrain": row["terrain"], "run": text, "ATE (m)": round(ate, 3),
+                         "ATE (% of path)": round(100 * ate / float(row["path_m"]), 2),
+                         "RPE (% per m)": round(float(row[f"rpe_{key}_pct"]), 2),
+                         "cloud to true mesh, mean (m)": round(float(row[f"mesh_{key}_m"]), 4),
+                         "time per scan (ms)": round(float(row[f"ms_per_scan_{key}"]), 1)})
+    return pd.DataFrame(rows)

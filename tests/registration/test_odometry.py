@@ -59,10 +59,17 @@ def test_bag_without_poses_maps_with_odometry(unposed, capsys) -> None:
 
 
 def test_auto_poses_fall_back_to_odometry(unposed) -> None:
+    """Without a pose topic ``auto`` is odometry, over every scan even when ``frames``
+    keeps five of them: their poses are those of the run over all 60."""
     bag, _, _ = unposed
     cloud, counts = merged_cloud(open_input(bag), FrameSpec(frames=5))
     assert counts.poses.source == "odometry" and len(cloud) > 0
     assert any("anchored at the first scan's body frame" in n for n in counts.notes)
+    assert (counts.scans, counts.selected, counts.poses.frames) == (SCANS, 5, SCANS)
+    some, every = (prepare(open_input(bag), FrameSpec(frames=n)) for n in (5, None))
+    index = np.searchsorted(every.trajectory.stamps, some.trajectory.stamps)
+    assert index.tolist() == [0, 15, 30, 44, 59]  # evenly spaced over the 60 scans
+    np.testing.assert_allclose(some.trajectory.positions, every.trajectory.positions[index])
 
 
 def test_refine_improves_a_desynchronised_mission(tmp_path: Path) -> None:

@@ -24,7 +24,7 @@ import pandas as pd
 from tqdm.auto import tqdm
 
 from alte.errors import ParameterError, SimulationError
-from alte.pipeline import FrameSpec, open_input, prepare
+from alte.pipeline import open_input, prepare
 from alte.sim import ensure_terrain
 from alte.sim.profile import PROFILES
 from alte.studies.experiments import CACHE_DIR
@@ -62,12 +62,12 @@ class SweepResult:
                             "params": dict(r.params), "error": msg} for r, msg in self.failed]}
 
 
-def _ensure(item: tuple[str, int | None, int, float | None, str, bool], data_dir: str) -> str:
-    """Simulate the terrain if needed and register it into the cache (once per item)."""
-    terrain, frames, seed, voxel, sensor, deskew = item
-    folder = ensure_terrain(terrain, data_dir, seed, frames, profile=PROFILES[sensor])
-    prepare(open_input(folder), FrameSpec(frames=frames, voxel=voxel, deskew=deskew),
-            cache=Path(data_dir) / CACHE_DIR)
+def _ensure(run: SweepRun, data_dir: str) -> str:
+    """Simulate the run's terrain if needed and register it into the cache (once per
+    :meth:`~SweepRun.input_key`)."""
+    folder = ensure_terrain(run.terrain, data_dir, run.seed, run.simulated_frames,
+                            profile=PROFILES[run.sensor])
+    prepare(open_input(folder), run.frame_spec(), cache=Path(data_dir) / CACHE_DIR)
     return str(folder)
 
 
@@ -126,14 +126,15 @@ def _executor(scheduler: str, workers: int) -> Iterator[MapUnordered]:
 
 def _ensure_all(pool: MapUnordered, runs: Sequence[SweepRun], data_dir: str,
                 progress: bool) -> None:
-    items = sorted({(r.terrain, r.frames, r.seed, r.voxel, r.sensor, r.deskew) for r in runs},
-                   key=str)
+    inputs = {r.input_key(): r for r in runs}
+    items = [inputs[key] for key in sorted(inputs, key=str)]
     bar = tqdm(total=len(items), desc="terrains", unit="terrain", disable=not progress)
     with bar:
         for i, _, err in pool(_ensure, items, data_dir):
             if err is not None:
-                raise SimulationError(f"sweep: terrain {items[i][0]} (frames={items[i][1]}) "
-                                      f"could not be simulated: {err}") from err
+                raise SimulationError(f"sweep: terrain {items[i].terrain} (frames="
+                                      f"{items[i].frames}) could not be simulated: {err}"
+                                      ) from err
             bar.update()
 
 

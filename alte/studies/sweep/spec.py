@@ -26,6 +26,7 @@ from alte.errors import AlteError, ParameterError
 from alte.mappers import make_mapper
 from alte.metrics.maps import TruthOptions
 from alte.params import Record, param
+from alte.pipeline.spec import FrameSpec, PoseSource
 from alte.sim import TERRAINS
 from alte.studies.sweep.variants import Variant, parse_variants
 
@@ -94,11 +95,12 @@ class SweepRun:
     sensor: str = "thesis"
     deskew: bool = True
     obstacles: bool = False
+    poses: str = "recorded"
 
     def key(self) -> dict[str, Any]:
         """Everything that determines the run's result, JSON-ready (``domain``, ``set_b``,
-        ``sensor``, ``deskew`` and ``obstacles`` only when not the default, so earlier
-        runs keep their ids)."""
+        ``sensor``, ``deskew``, ``obstacles`` and ``poses`` only when not the default, so
+        earlier runs keep their ids)."""
         key = {"terrain": self.terrain, "frames": self.frames, "seed": self.seed,
                "mapper": self.mapper, "params": dict(sorted(self.params.items())),
                "voxel": self.voxel, "truth": dataclasses.asdict(self.truth)}
@@ -112,7 +114,27 @@ class SweepRun:
             key["deskew"] = False
         if self.obstacles:
             key["obstacles"] = True
+        if self.poses != "recorded":
+            key["poses"] = self.poses
         return key
+
+    def input_key(self) -> tuple[str, int | None, int, float | None, str, bool, str]:
+        """What decides the run's registered input (terrain, scans, seed, voxel, sensor,
+        deskew, poses): runs with equal keys share one simulation and registration."""
+        return (self.terrain, self.frames, self.seed, self.voxel, self.sensor, self.deskew,
+                self.poses)
+
+    @property
+    def simulated_frames(self) -> int | None:
+        """Scans the terrain is simulated with: the whole mission when odometry poses it
+        (it aligns consecutive scans; the run's ``frames`` are then picked from them)."""
+        return None if self.poses == "odometry" else self.frames
+
+    def frame_spec(self) -> FrameSpec:
+        """How the run's terrain becomes registered frames (odometry: the backend
+        ``auto`` picks, LiDAR-inertial when the bag has an IMU)."""
+        return FrameSpec(frames=self.frames, voxel=self.voxel, deskew=self.deskew,
+                         poses=PoseSource(self.poses))
 
     @property
     def run_id(self) -> str:
@@ -275,7 +297,7 @@ def _variant_runs(spec: SweepSpec, variant: Variant) -> list[SweepRun]:
     return [SweepRun(terrain, spec.frames, seed, grid.mapper,
                      variant.params_for(grid.mapper, params), spec.voxel, spec.truth,
                      variant.domain_for(grid.mapper), variant.set_b_for(grid.mapper),
-                     variant.sensor, variant.deskew, spec.obstacles)
+                     variant.sensor, variant.deskew, spec.obstacles, variant.poses)
             for seed in spec.seeds for terrain in spec.terrains if terrain in terrains
             for grid in spec.mappers if terrain in grid.terrains for params in grid.rows]
 

@@ -29,6 +29,9 @@ KEY_COLUMNS = ("run_id", "terrain", "frames_requested", "seed", "mapper", "param
 TIMING_COLUMNS = ("elapsed_s", "elapsed_spread", "map_cpu_s", "map_cpu_spread", "wall_s",
                   "cpu_s")
 
+#: Values of columns added later, for rows stored before them.
+FILLED = {"poses": "recorded"}
+
 _PREFIX, _SUFFIX = "run-", ".parquet"
 
 
@@ -86,6 +89,9 @@ def load_results(out: str | os.PathLike[str], order: Iterable[str] | None = None
     table = pa.concat_tables([_read(p) for p in files], promote_options="permissive")
     frame: pd.DataFrame = table.to_pandas(types_mapper={pa.int64(): pd.Int64Dtype()}.get)
     frame = frame[_ordered_columns(frame.columns)]
+    for column, value in FILLED.items():
+        if column in frame:
+            frame[column] = frame[column].fillna(value)
     if order is None:
         return frame.sort_values("run_id", kind="stable").reset_index(drop=True)
     rank = {run_id: i for i, run_id in enumerate(order)}

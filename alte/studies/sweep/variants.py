@@ -6,8 +6,10 @@ see :class:`alte.pipeline.DomainPolicy`), the definition of set B in HD/MHD (``s
 see :data:`alte.metrics.maps.SET_B`), some mappers' parameters (``params``: mapper ->
 {parameter: value}) or the simulated sensor (``sensor``: a profile of
 :data:`alte.sim.profile.PROFILES`, its terrains simulated into ``NAME-PROFILE``; with
-``deskew: false`` its swept scans are registered as taken), optionally on fewer
-``terrains``. A variant runs only the maps it
+``deskew: false`` its swept scans are registered as taken) or where the poses come
+from (``poses: odometry``: the whole mission is simulated and posed by the odometry
+``auto`` picks, LiDAR-inertial when the bag has an IMU, and the sweep's ``frames`` are
+then picked from it), optionally on fewer ``terrains``. A variant runs only the maps it
 changes: a run whose effective settings equal a base run's (a mapper the variant does
 not touch, or Octomap under another domain, which it does not use) *is* that run, once.
 """
@@ -24,13 +26,15 @@ from alte.metrics.maps import SET_B
 from alte.pipeline import DomainPolicy
 from alte.sim.profile import PROFILES
 
-__all__ = ["BASE", "DOMAINS", "Variant", "parse_variants"]
+__all__ = ["BASE", "DOMAINS", "POSES", "Variant", "parse_variants"]
 
 #: The name of the grid as written (no change).
 BASE = "base"
 #: Valid ``domain`` values.
 DOMAINS = tuple(p.value for p in DomainPolicy)
-_KEYS = ("text", "domain", "set_b", "params", "terrains", "sensor", "deskew")
+_KEYS = ("text", "domain", "set_b", "params", "terrains", "sensor", "deskew", "poses")
+#: Valid ``poses`` values.
+POSES = ("recorded", "odometry")
 
 
 @dataclass(frozen=True)
@@ -45,6 +49,7 @@ class Variant:
     terrains: tuple[str, ...] = ()
     sensor: str = "thesis"
     deskew: bool = True
+    poses: str = "recorded"
 
     def domain_for(self, mapper: str) -> str:
         """The domain policy a run of ``mapper`` gets (``auto`` where it uses none)."""
@@ -118,9 +123,10 @@ def _variant(source: str, name: str, body: Any, terrains: tuple[str, ...],
         _params(source, f"{key}.params", body.get("params", {}), mappers),
         tuple(dict.fromkeys(own)),
         _choice(source, f"{key}.sensor", body.get("sensor", "thesis"), tuple(PROFILES)),
-        _flag(source, f"{key}.deskew", body.get("deskew", True)))
+        _flag(source, f"{key}.deskew", body.get("deskew", True)),
+        _choice(source, f"{key}.poses", body.get("poses", "recorded"), POSES))
     if variant == Variant(variant.name, variant.text, terrains=variant.terrains):
-        raise _fail(source, key, "changes nothing (give domain, set_b, params or sensor)")
+        raise _fail(source, key, "changes nothing (give domain, set_b, params, sensor or poses)")
     return variant
 
 

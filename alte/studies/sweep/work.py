@@ -77,16 +77,13 @@ def group_runs(runs: Iterable[SweepRun]) -> list[MapGroup]:
 
 
 @functools.lru_cache(maxsize=2)
-def _dataset(folder: str, frames: int | None, voxel: float | None, data_dir: str,
-             deskew: bool = True) -> Registered:
+def _dataset(folder: str, spec: FrameSpec, data_dir: str) -> Registered:
     """Per-process memo over the on-disk registration cache (``DATA_DIR/.cache``)."""
-    return prepare_input(open_input(folder),
-                         FrameSpec(frames=frames, voxel=voxel, deskew=deskew),
-                         cache=Path(data_dir) / CACHE_DIR)
+    return prepare_input(open_input(folder), spec, cache=Path(data_dir) / CACHE_DIR)
 
 
-#: What :func:`_dataset` takes: terrain folder, scans, voxel, data folder, deskew.
-InputKey = tuple[str, int | None, float | None, str, bool]
+#: What :func:`_dataset` takes: terrain folder, frame spec, data folder.
+InputKey = tuple[str, FrameSpec, str]
 
 
 @functools.lru_cache(maxsize=2)
@@ -98,9 +95,9 @@ def _reference(key: InputKey, truth: TruthOptions) -> Reference:
 
 def _inputs(run: SweepRun, data_dir: str) -> tuple[Registered, Reference]:
     """The run's registered input and its reference (a fresh per-leaf memory)."""
-    key: InputKey = (str(terrain_folder(data_dir, run.terrain, run.frames, run.seed,
+    key: InputKey = (str(terrain_folder(data_dir, run.terrain, run.simulated_frames, run.seed,
                                         PROFILES[run.sensor])),
-                     run.frames, run.voxel, data_dir, run.deskew)
+                     run.frame_spec(), data_dir)
     return _dataset(*key), _reference(key, run.truth).fresh()
 
 
@@ -112,6 +109,7 @@ def _row(run: SweepRun, data: Registered, metrics: dict[str, Any],
         "params_json": json.dumps(dict(run.params), sort_keys=True),
         **{f"p_{k}": v for k, v in run.params.items()},
         "domain": run.domain, "set_b": run.set_b, "sensor": run.sensor, "deskew": run.deskew,
+        "poses": run.poses,
         "frames": len(data), "points": len(data.cloud),
         **{k: v for k, v in metrics.items() if k != "elapsed_s"},
         "cost_unit": mapper_class(run.mapper).cost_unit.value,

@@ -184,6 +184,14 @@ def test_store_unifies_columns_orders_and_never_overwrites(tmp_path):
         write_row(out, {"run_id": "a", "hd_m": 3.0})
 
 
+def test_rows_stored_before_the_poses_column_read_as_recorded(tmp_path):
+    out = tmp_path / "runs"
+    write_row(out, {"run_id": "old", "hd_m": 1.0})
+    write_row(out, {"run_id": "new", "hd_m": 2.0, "poses": "odometry"})
+    assert load_results(out).set_index("run_id")["poses"].to_dict() == {
+        "new": "odometry", "old": "recorded"}
+
+
 def test_store_errors(tmp_path):
     (tmp_path / "file").write_text("x")
     with pytest.raises(AlteError, match="is a file, not a Parquet dataset folder"):

@@ -96,6 +96,8 @@ def test_variant_helpers():
     ({"v": {"sensor": "lidar"}}, "variants.v.sensor: 'lidar': expected one of thesis, uav"),
     ({"v": {"sensor": "uav", "deskew": "no"}}, "variants.v.deskew: 'no': expected true or false"),
     ({"v": {"sensor": "thesis"}}, "variants.v: changes nothing"),
+    ({"v": {"poses": "lio"}}, "variants.v.poses: 'lio': expected one of recorded, odometry"),
+    ({"v": {"poses": "recorded"}}, "variants.v: changes nothing"),
 ])
 def test_bad_variants_name_the_key(variants, match):
     with pytest.raises(ParameterError, match=match):
@@ -140,3 +142,26 @@ def test_a_sensor_variant_reruns_every_map_on_that_sensor():
         assert len(mine) == 2 * 4  # two seeds x the four maps of sim_nav_1
         assert all(r.sensor == "uav" and r.deskew is deskew for r in mine)
         assert not base & {r.run_id for r in mine}
+
+
+def test_an_odometry_variant_poses_the_whole_mission_then_keeps_the_sweeps_scans():
+    """``poses: odometry`` simulates the whole mission (odometry aligns consecutive scans)
+    and registers the sweep's ``frames`` of it with the odometry ``auto`` picks."""
+    from alte.pipeline import PoseSource
+    from alte.registration.odometry import OdometryParams
+
+    spec = parse_spec(_raw(variants={"lio": {"sensor": "uav", "poses": "odometry",
+                                             "terrains": ["sim_nav_1"]}}))
+    pairs = plan_variants(spec)
+    base = [r for n, r in pairs if n == "base"]
+    mine = [r for n, r in pairs if n == "lio"]
+    assert len(mine) == 2 * 4 and not {r.run_id for r in base} & {r.run_id for r in mine}
+    run = mine[0]
+    assert run.poses == "odometry" and run.key()["poses"] == "odometry"
+    assert "poses" not in base[0].key() and base[0].simulated_frames == 4
+    assert run.simulated_frames is None and run.frames == 4
+    frames = run.frame_spec()
+    assert (frames.frames, frames.poses, frames.odometry) == (4, PoseSource.ODOMETRY,
+                                                              OdometryParams())
+    assert base[0].frame_spec().poses is PoseSource.RECORDED
+    assert run.input_key() != base[0].input_key()

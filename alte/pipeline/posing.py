@@ -1,0 +1,84 @@
+"""The pipeline's odometry step: scans posed by LiDAR (or LiDAR-inertial) odometry.
+
+Odometry aligns consecutive scans, so it reads every scan of the bag even when
+``FrameSpec.frames`` keeps fewer (:attr:`alte.io.bag.FrameStream.read_all`); only the
+scans the selection keeps go on, posed as in a run over all of them.
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Iterator
+
+import numpy as np
+
+from alte.errors import PoseError
+from alte.io.bag import FrameStream
+from alte.io.imu import ImuSamples, imu_topic, read_imu
+from alte.pipeline.spec import FrameSpec
+from alte.registration.odometry import (
+    OdometryParams,
+    PoseCounts,
+    odometry_frames,
+    odometry_label,
+    resolve_method,
+)
+from alte.types import Frame
+
+__all__ = ["odometry_poses"]
+
+
+def _start(probe: FrameStream, stamp: int) -> tuple[np.ndarray, np.ndarray] | None:
+    """The recorded pose at the first scan, or None (no track, or one on another clock)."""
+    if probe.track is None:
+        return None
+    try:
+        at = probe.track.interpolate([stamp], probe.options.max_gap_s)
+    except PoseError:  # stamps in another unit: odometry does without the anchor
+        return None
+    return (at.positions[0], at.quaternions[0]) if at.valid[0] else None
+
+
+def _imu(stream: FrameStream, params: OdometryParams) -> ImuSamples | None:
+    """The bag's IMU samples when LiDAR-inertial odometry will run (``auto`` with an IMU
+    topic, or ``lio``), else None."""
+    if params.method not in ("auto", "lio"):
+        return None
+    topic = imu_topic(stream.path, params.imu_topic)
+    if topic is None:
+        return None
+    return read_imu(stream.path, topic)
+
+
+def odometry_poses(stream: FrameStream, probe: FrameStream, spec: FrameSpec,
+                   counts: PoseCounts) -> Iterator[Frame]:
+    """The selected scans of ``stream`` posed by odometry (LiDAR-inertial when the bag has
+    an IMU and the method is ``auto`` or ``lio``), anchored at the recorded pose of the
+    first scan when ``probe`` (the stream with the pose topic) has one."""
+    chosen: set[int] = set()
+    frames = _tagged(stream, chosen)
+    first = next(frames, None)
+    if first is None:
+        return
+    start = _start(probe, first.stamp)
+    anchor = f"the recorded pose of the first scan ({probe.pose_topic})" if start is not None \
+        else "the first scan's body frame"
+    imu = _imu(stream, spec.odometry)
+    params = resolve_method(spec.odometry, imu is not None)
+    kind = "LiDAR-inertial odometry" if imu is not None else "LiDAR odometry"
+    with_imu = f", IMU {imu.frame_id} at {imu.rate_hz:.0f} Hz" if imu is not None else ""
+    stream.notes.append(f"poses from {kind} ({odometry_label(params)}{with_imu}), "
+                        f"anchored at {anchor}")
+    posed = odometry_frames(itertools.chain([first], frames), stream.mount, counts=counts,
+                            params=params, start=start, imu=imu)
+    yield from (frame for frame in posed if frame.stamp in chosen)
+
+
+def _tagged(stream: FrameStream, chosen: set[int]) -> Iterator[Frame]:
+    """The scans ``stream`` reads; the stamps of those its selection keeps (by index on the
+    cloud topic: all unless it reads every scan) go to ``chosen``."""
+    for frame in stream:
+        index = stream.counts.scans_read + stream.counts.scans_skipped - 1
+        if not stream.read_all or index in (stream.selection or ()):
+            chosen.add(frame.stamp)
+        yield frame
