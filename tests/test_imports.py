@@ -1,4 +1,5 @@
-"""The streaming path stays light: ``alte map BAG`` does not load the heavy optional stacks.
+"""The streaming path stays light: ``alte map BAG`` does not load the heavy optional stacks;
+and the package has no import cycle.
 
 open3d (~200 MB resident), pyvista/VTK and the odometry libraries are imported on
 first use; a module-level import of one of them in a stage module would put it in
@@ -7,9 +8,15 @@ every ``alte map`` process and in the peak-RSS bench row (map plus a few frames)
 
 from __future__ import annotations
 
+import ast
 import json
 import subprocess
 import sys
+from pathlib import Path
+
+import numpy as np
+from scipy.sparse import csr_array
+from scipy.sparse.csgraph import connected_components
 
 #: Modules ``alte map BAG`` imports before it reads a scan.
 MAP_PATH = ["alte.cli", "alte.commands.map", "alte.pipeline", "alte.io", "alte.registration",
@@ -34,3 +41,56 @@ def test_map_path_imports_no_heavy_stack() -> None:
     """Nothing heavy after the map path; the check itself sees open3d once a study module
     that uses it at import time is loaded."""
     assert _loaded(MAP_PATH, ["alte.studies.landing.truth"]) == [[], ["open3d"]]
+
+
+def _imports(package: Path) -> dict[str, set[str]]:
+    """Module -> the package's modules it imports, anywhere in its body (function-level
+    and ``TYPE_CHECKING`` imports included; ``from pkg import name`` counts ``pkg.name``
+    when that is a module, else ``pkg``)."""
+    modules = {".".join(p.relative_to(package.parent).with_suffix("").parts)
+               .removesuffix(".__init__"): p for p in package.rglob("*.py")}
+
+    def known(name: str) -> str:
+        while name not in modules:
+            name = name.rpartition(".")[0]
+        return name
+
+    graph: dict[str, set[str]] = {m: set() for m in modules}
+    for module, path in modules.items():
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+                names = [f"{node.module}.{a.name}" for a in node.names]
+            elif isinstance(node, ast.Import):
+                names = [a.name for a in node.names]
+            else:
+                continue
+            graph[module] |= {known(n) for n in names if n.split(".")[0] == package.name}
+        graph[module].discard(module)
+    return graph
+
+
+def _cycles(graph: dict[str, set[str]]) -> list[list[str]]:
+    """The strongly connected groups of more than one module (each an import cycle)."""
+    names = sorted(graph)
+    index = {n: i for i, n in enumerate(names)}
+    rows = [index[a] for a in names for _ in graph[a]]
+    cols = [index[b] for a in names for b in sorted(graph[a])]
+    matrix = csr_array((np.ones(len(rows)), (rows, cols)), shape=(len(names), len(names)))
+    _, labels = connected_components(matrix, connection="strong")
+    groups = [[n for n in names if labels[index[n]] == label] for label in set(labels)]
+    return sorted(g for g in groups if len(g) > 1)
+
+
+def test_no_import_cycle_in_alte() -> None:
+    """Data flows one way: no module of ``alte`` imports, at any depth and in any function,
+    one that imports it back."""
+    import alte
+
+    graph = _imports(Path(alte.__file__).parent)
+    assert "alte.pipeline.feed" in graph["alte.pipeline.run"]  # the graph is read
+    assert _cycles(graph) == []
+
+
+def test_the_cycle_check_finds_a_cycle() -> None:
+    assert _cycles({"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}) == [["a", "b", "c"]]
+    assert _cycles({"a": {"b"}, "b": set()}) == []

@@ -52,16 +52,14 @@ def workload_dir(data_dir: str | Path, quick: bool) -> Path:
 
 
 def load_workload(terrain: str, data_dir: str | Path, *, quick: bool = False,
-                  frames: int | None = None, progress: bool = False) -> Workload:
-    """Simulate ``terrain`` if missing, register it through the pipeline (cached under
-    ``DATA_DIR/.cache``); ``frames`` keeps that many scans evenly."""
-    from alte.pipeline import FrameSpec, open_input, prepare
-    from alte.sim import ensure_terrain
+                  progress: bool = False) -> Workload:
+    """Simulate ``terrain`` if missing and register it through the pipeline as the studies
+    do (:func:`alte.studies.experiments.terrain`, cached beside the terrains); quick mode
+    simulates :data:`QUICK_FRAMES` scans evenly spaced over the mission."""
+    from alte.studies.experiments import terrain as registered_terrain
 
-    folder = ensure_terrain(terrain, workload_dir(data_dir, quick),
-                            frames=QUICK_FRAMES if quick else None, progress=progress)
-    data = prepare(open_input(folder), FrameSpec(frames=frames),
-                   cache=Path(data_dir) / ".cache", progress=progress)
+    data = registered_terrain(terrain, workload_dir(data_dir, quick),
+                              frames=QUICK_FRAMES if quick else None, progress=progress)
     scans = [(np.array(f.points), np.asarray(f.origin, float)) for f in data.frames()]
     box = data.spec.crop if data.spec.crop is not None else data.bounds()
     assert data.spec.voxel is not None, "a terrain folder gives its registration voxel"

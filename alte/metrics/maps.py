@@ -18,14 +18,12 @@ import numpy as np
 from alte.errors import MetricsError
 from alte.mappers.quadmap import rectangle_corners
 from alte.metrics.hausdorff import hausdorff
+from alte.metrics.options import GroundTruth, TruthOptions
 from alte.metrics.timing import Timing
-from alte.params import Record, param
 
 if TYPE_CHECKING:
     from alte.mappers.base import Cells, Mapper
     from alte.metrics.reference import Reference
-    from alte.metrics.surface import TrueSurface
-    from alte.types import Box
 
 __all__ = ["SET_B", "GroundTruth", "MapMetrics", "TruthMetrics", "TruthOptions", "measure_map",
            "set_b_points"]
@@ -37,29 +35,6 @@ _NAN = float("nan")
 #: corners of the cells the mapper marks occupied (2D: Quadtree's height-above-ground
 #: rule; every known cell of 2D-ALTE; 3D: the same as ``corners``).
 SET_B = ("corners", "centers", "occupied")
-
-
-@dataclass(frozen=True)
-class TruthOptions(Record):
-    """Ground-truth metric settings (see :mod:`alte.metrics.truth`), a parameter record."""
-
-    OWNER = "truth"
-
-    tolerance: float = param(0.2, lambda v: v > 0, "tolerance > 0",
-                             "how close a map must come to a true surface to map it (m)")
-    n_samples: int = param(100_000, lambda v: v >= 1, "n_samples >= 1",
-                           "surface samples drawn (3D)")
-    grid_step: float = param(0.2, lambda v: v > 0, "grid_step > 0",
-                             "x/y probe spacing of the 2D metrics (m)")
-    seed: int = param(0, lambda v: v >= 0, "seed >= 0", "sampling seed")
-
-
-@dataclass(frozen=True, eq=False)
-class GroundTruth:
-    """The true surface of a simulated terrain and its control volume."""
-
-    surface: TrueSurface
-    bounds: Box
 
 
 @dataclass(frozen=True)

@@ -33,6 +33,7 @@ from scipy.spatial import cKDTree
 from alte.metrics._gridnn import NearestIndex
 from alte.metrics.hausdorff import HausdorffResult, _as_set, summarise
 from alte.metrics.leaves import LeafTruth
+from alte.metrics.options import GroundTruth, TruthOptions
 from alte.metrics.truth import (
     cell_at_xy,
     completeness_by_class,
@@ -43,7 +44,6 @@ from alte.metrics.truth import (
 
 if TYPE_CHECKING:
     from alte.mappers.base import Cells
-    from alte.metrics.maps import GroundTruth, TruthOptions
     from alte.metrics.surface import SurfaceSamples
 
 __all__ = ["Reference"]
@@ -61,8 +61,6 @@ class Reference:
 
     def __init__(self, cloud: np.ndarray, truth: GroundTruth | None = None,
                  options: TruthOptions | None = None) -> None:
-        from alte.metrics.maps import TruthOptions
-
         self.cloud = cloud
         self.truth = truth
         self.options = options or TruthOptions()

@@ -6,6 +6,8 @@ an input once for several maps (:mod:`~alte.pipeline.prepare`); the specificatio
 and their policies are in :mod:`~alte.pipeline.spec`.
 """
 
+from alte.pipeline.feed import resolve_domain
+from alte.pipeline.maprun import FrameLog, FrameObserver, MapRun, RunInfo, Snapshot
 from alte.pipeline.prepare import (
     Merged,
     Registered,
@@ -14,15 +16,7 @@ from alte.pipeline.prepare import (
     merged_cloud,
     prepare,
 )
-from alte.pipeline.run import (
-    FrameLog,
-    FrameObserver,
-    MapRun,
-    RunInfo,
-    Snapshot,
-    resolve_domain,
-    run,
-)
+from alte.pipeline.run import run
 from alte.pipeline.source import InputKind, Source, StreamCounts, open_input, stream_frames
 from alte.pipeline.spec import DomainPolicy, FrameSpec, MapSpec, PoseSource
 

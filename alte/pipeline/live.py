@@ -1,4 +1,4 @@
-"""The live path: frames streamed from the input straight into the mapper.
+"""The live path: frames streamed from the input straight into the map loop.
 
 Memory holds the map, a frame and (when asked) the merged cloud, never the input.
 When the domain must come from the data, a first pass over the frames finds their
@@ -8,28 +8,17 @@ bounds (streamed too); the frames are then read again for the map.
 from __future__ import annotations
 
 import functools
-import itertools
-import time
+from collections.abc import Iterator
 
 import numpy as np
 
-from alte.errors import RegistrationError
-from alte.mappers import Feed, make_mapper, mapper_class
-from alte.pipeline.run import (
-    Feeder,
-    FrameObserver,
-    MapRun,
-    RunInfo,
-    local_shift,
-    resolve_domain,
-)
+from alte.mappers import Feed
 from alte.pipeline.source import InputKind, Source, StreamCounts, stream_frames
-from alte.pipeline.spec import FrameSpec, MapSpec
+from alte.pipeline.spec import FrameSpec
 from alte.registration.grid import GridAccumulator
-from alte.registration.register import empty_reason
 from alte.types import Box, RegisteredFrame, Trajectory
 
-__all__ = ["bounds_pass", "run_live"]
+__all__ = ["LiveFrames", "bounds_pass"]
 
 
 def bounds_pass(source: Source, spec: FrameSpec) -> Box:
@@ -61,29 +50,38 @@ class _Cloud:
         return None
 
 
-def run_live(source: Source, frames: FrameSpec, spec: MapSpec, *, cloud: bool = False,
-             progress: bool = False, observer: FrameObserver | None = None) -> MapRun:
-    """Map ``source`` streaming its frames (``frames`` resolved against the input)."""
-    cls = mapper_class(spec.mapper)
-    feed = spec.feed or cls.default_feed
-    domain, policy = resolve_domain(cls, spec.domain, frames.crop,
-                                    lambda: bounds_pass(source, frames))
-    mapper = make_mapper(spec.mapper, spec.params, domain=domain)
-    counts = StreamCounts()
-    merged = _Cloud(frames.voxel, cloud or feed is Feed.BATCH)
-    start = time.perf_counter()
-    stream = (merged.keep(f) for f in stream_frames(source, frames, counts, merge=merged.grid,
-                                                    progress=progress))
-    first = next(stream, None)
-    if first is None:
-        raise RegistrationError(f"{source.path}: {empty_reason(counts.registration)}")
-    anchor = first.points if source.kind is InputKind.POINTS else first.origin
-    shift = local_shift(cls, lambda: np.median(np.reshape(anchor, (-1, 3)), axis=0))
-    cloud_points = functools.cache(merged.points)
-    feeder = Feeder(mapper, spec, feed, shift, counts.selected, observer=observer)
-    log = feeder.run(itertools.chain([first], stream), cloud_points, progress)
-    info = RunInfo(str(source.path), source.kind, cls.name, mapper.params,
-                   mapper.domain if domain is None else domain, policy, feed, frames,
-                   (float(shift[0]), float(shift[1]), float(shift[2])))
-    return MapRun(mapper, info, log, counts, Trajectory.of(feeder.poses), cloud_points(),
-                  time.perf_counter() - start, feeder.snapshots)
+class LiveFrames:
+    """An input's frames streamed once into the map loop (a
+    :class:`~alte.pipeline.feed.FrameInput`; ``spec`` resolved against the input)."""
+
+    key = ""
+
+    def __init__(self, source: Source, spec: FrameSpec) -> None:
+        self.source, self.spec = source, spec
+        self._counts = StreamCounts()
+        self._merged = _Cloud(spec.voxel, False)
+        self.cloud = functools.cache(self._cloud)
+
+    def bounds(self, feed: Feed) -> Box:
+        return bounds_pass(self.source, self.spec)
+
+    def frames(self, keep_cloud: bool, progress: bool) -> Iterator[RegisteredFrame]:
+        self._merged = merged = _Cloud(self.spec.voxel, keep_cloud)
+        return (merged.keep(f) for f in stream_frames(self.source, self.spec, self._counts,
+                                                      merge=merged.grid, progress=progress))
+
+    def expected(self) -> int:
+        return self._counts.selected
+
+    def anchor(self, first: RegisteredFrame) -> np.ndarray:
+        points = first.points if self.source.kind is InputKind.POINTS else first.origin
+        return np.asarray(np.median(np.reshape(points, (-1, 3)), axis=0))
+
+    def _cloud(self) -> np.ndarray | None:
+        return self._merged.points()
+
+    def counts(self) -> StreamCounts:
+        return self._counts
+
+    def trajectory(self, fed: list[RegisteredFrame]) -> Trajectory:
+        return Trajectory.of(fed)

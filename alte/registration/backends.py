@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 if TYPE_CHECKING:
-    from alte.registration.odometry import OdometryParams, PoseCounts
+    from alte.registration.settings import OdometryParams, PoseCounts
 
 __all__ = ["Kiss", "Plane", "PlaneMap", "kiss_config", "scene_scale"]
 

@@ -19,18 +19,27 @@ The defaults were chosen on the real ``balm_seq`` recording (``alte odometry``; 
 from __future__ import annotations
 
 import time
-from collections.abc import Iterable, Iterator, Mapping
-from dataclasses import dataclass, field, replace
-from typing import TYPE_CHECKING, ClassVar
+from collections.abc import Iterable, Iterator
+from dataclasses import replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
 from alte.errors import ParameterError
-from alte.params import Record, param
 from alte.registration.backends import Kiss, Plane
 from alte.registration.lio import LioSettings, lio_frames
 from alte.registration.refine import refine_frames
+from alte.registration.settings import (
+    KEYS,
+    METHODS,
+    OdometryParams,
+    PoseCounts,
+    odometry_label,
+    odometry_params,
+    pose_matrix,
+    resolve_method,
+)
 from alte.types import Frame, Mount
 
 if TYPE_CHECKING:
@@ -38,154 +47,6 @@ if TYPE_CHECKING:
 
 __all__ = ["KEYS", "METHODS", "OdometryParams", "PoseCounts", "lio_settings", "odometry_frames",
            "odometry_label", "odometry_params", "pose_matrix", "refine_frames", "resolve_method"]
-
-#: Odometry backends (module docstring).
-METHODS = ("auto", "kiss", "plane", "lio")
-
-
-def _positive(value: float) -> bool:
-    return value > 0
-
-
-def _fraction(value: float) -> bool:
-    return 0 <= value <= 1
-
-
-@dataclass(frozen=True)
-class OdometryParams(Record):
-    """How scans are aligned by odometry (``method``) and refinement; unset values come
-    from KISS-ICP's defaults or the first scan's ranges (:mod:`~alte.registration.backends`)."""
-
-    OWNER: ClassVar[str] = "odometry"
-    method: str = param("auto", lambda v: v in METHODS, "|".join(METHODS),
-                        "odometry backend (auto: lio with an IMU topic, else kiss)")
-    max_range: float | None = param(None, _positive, "> 0",
-                                    "m; points beyond are not used (kiss: 100, plane: 1.2 x "
-                                    "the 99th percentile range of the first scan)")
-    min_range: float = param(0.0, lambda v: v >= 0, ">= 0", "m; nearer points are not used "
-                                                            "(kiss)")
-    voxel: float | None = param(None, _positive, "> 0",
-                                "m; map voxel (kiss: max_range / 100; plane and refine: the "
-                                "median range of the first scan / 70; lio: 0.5)")
-    single_downsample: bool = param(False, help="kiss: register the 0.5-voxel cloud (sparse "
-                                                "sensors' advice)")
-    fixed_threshold: float | None = param(None, _positive, "> 0",
-                                          "m; kiss: fixed correspondence threshold instead "
-                                          "of the adaptive one")
-    initial_threshold: float = param(2.0, _positive, "> 0",
-                                     "m; kiss: adaptive threshold before any motion")
-    min_motion_th: float = param(0.1, _positive, "> 0",
-                                 "m; kiss: least motion that updates the adaptive threshold")
-    max_points_per_voxel: int = param(20, lambda v: v >= 1, ">= 1", "kiss: map points per voxel")
-    deskew: bool = param(True, help="kiss: deskew scans that carry per-point time")
-    threads: int = param(1, lambda v: v >= 0, ">= 0", "threads per scan (0: every core)")
-    rebuild: int = param(5, lambda v: v >= 1, ">= 1",
-                         "plane, refine: scans between local-map rebuilds")
-    min_fitness: float = param(0.3, _fraction, "0..1",
-                               "plane, refine: fewest inliers (fraction of the scan) for an "
-                               "alignment to count")
-    min_constraint: float = param(0.002, _fraction, "0..1",
-                                  "refine: smallest / largest Hessian eigenvalue to accept")
-    min_gain: float = param(0.1, _fraction, "0..1",
-                            "refine: least drop of the alignment cost to accept a correction")
-    max_correction: float = param(0.5, _positive, "> 0",
-                                  "m; refine: a larger correction is not applied")
-    max_correction_deg: float = param(20.0, _positive, "> 0",
-                                      "deg; refine: a larger correction is not applied")
-    plane_sigma: float = param(0.15, _positive, "> 0",
-                               "m; lio: point-to-plane noise (Cauchy kernel width)")
-    plane_reach: float = param(2.0, _positive, "> 0",
-                               "m; lio: farthest map neighbour of a plane fit")
-    plane_points: int = param(5, lambda v: v >= 3, ">= 3",
-                              "lio: map points a plane is fitted to")
-    imu_topic: str | None = param(None, bool, "a topic name",
-                                  "lio: the IMU topic (default: the bag's only "
-                                  "sensor_msgs/msg/Imu)")
-
-
-#: The settings each backend reads (``refine`` is ``--poses refine``); ``threads`` and the
-#: ranges are shared.
-KEYS: dict[str, tuple[str, ...]] = {
-    "kiss": ("max_range", "min_range", "voxel", "single_downsample", "fixed_threshold",
-             "initial_threshold", "min_motion_th", "max_points_per_voxel", "deskew", "threads"),
-    "plane": ("max_range", "voxel", "rebuild", "min_fitness"),
-    "lio": ("max_range", "min_range", "voxel", "plane_sigma", "plane_reach", "plane_points",
-            "imu_topic"),
-    "refine": ("max_range", "voxel", "rebuild", "min_fitness", "min_constraint", "min_gain",
-               "max_correction", "max_correction_deg", "threads"),
-}
-KEYS["auto"] = tuple(dict.fromkeys(KEYS["kiss"] + KEYS["lio"]))
-
-
-def odometry_params(method: str | None = None, settings: Mapping[str, object] | None = None,
-                    *, flag: str = "--odometry-set") -> OdometryParams:
-    """``--odometry METHOD --odometry-set KEY=VALUE ...`` checked; errors name the flag."""
-    settings = dict(settings or {})
-    if method is not None and method not in METHODS:
-        raise ParameterError(f"--odometry {method}: unknown backend; valid: "
-                             f"{', '.join(METHODS)}")
-    chosen = method or OdometryParams().method
-    valid = set(KEYS[chosen]) | set(KEYS["refine"])
-    unknown = sorted(set(settings) - valid)
-    if unknown:
-        raise ParameterError(f"{flag} {', '.join(unknown)}: not a setting of --odometry "
-                             f"{chosen} or refinement; valid: {', '.join(sorted(valid))}")
-    try:
-        return OdometryParams.parse({"method": chosen, **settings})
-    except ParameterError as err:
-        raise ParameterError(f"{flag}: {err}") from err
-
-
-def odometry_label(params: OdometryParams) -> str:
-    """``kiss-icp`` or ``point-to-plane``, with the settings that differ from the defaults."""
-    name = {"auto": "auto", "kiss": "kiss-icp", "plane": "point-to-plane",
-            "lio": "lidar-inertial"}[params.method]
-    default = OdometryParams(method=params.method).as_dict()
-    changed = [f"{k}={v}" for k, v in params.as_dict().items()
-               if v != default[k] and k in KEYS[params.method]]
-    return f"{name} {' '.join(changed)}" if changed else name
-
-
-@dataclass
-class PoseCounts:
-    """Where the poses came from, what odometry / refinement did and how long it took
-    (``seconds``: the pose step alone, wall; ``cpu_seconds``: its thread's CPU time);
-    ``scans``: refinement's decision per scan."""
-
-    source: str = "recorded"
-    method: str = ""
-    settings: dict[str, object] = field(default_factory=dict)
-    frames: int = 0
-    deskewed: int = 0
-    corrected: int = 0
-    kept: dict[str, int] = field(default_factory=dict)
-    weak_alignments: int = 0
-    max_correction_m: float = 0.0
-    max_correction_deg: float = 0.0
-    seconds: float = 0.0
-    cpu_seconds: float = 0.0
-    scans: list[dict[str, object]] = field(default_factory=list)
-
-    def as_dict(self) -> dict[str, object]:
-        """Counts by name (JSON-ready)."""
-        return {k: (dict(v) if isinstance(v, dict) else list(v) if isinstance(v, list) else v)
-                for k, v in vars(self).items()}
-
-
-def pose_matrix(position: np.ndarray, quaternion: np.ndarray) -> np.ndarray:
-    """4x4 homogeneous transform of a position and an (x, y, z, w) quaternion."""
-    out = np.eye(4)
-    out[:3, :3] = Rotation.from_quat(quaternion).as_matrix()
-    out[:3, 3] = position
-    return out
-
-
-def resolve_method(params: OdometryParams, has_imu: bool) -> OdometryParams:
-    """``auto`` made concrete: ``lio`` when the bag has an IMU topic, else ``kiss``."""
-    if params.method != "auto":
-        return params
-    return replace(params, method="lio" if has_imu else "kiss")
-
 
 def lio_settings(params: OdometryParams) -> LioSettings:
     """What :mod:`alte.registration.lio` reads of ``params`` (unset: its defaults)."""

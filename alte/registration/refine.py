@@ -34,10 +34,11 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from alte.registration.backends import scene_scale
+from alte.registration.settings import pose_matrix
 from alte.types import Frame, Mount
 
 if TYPE_CHECKING:
-    from alte.registration.odometry import OdometryParams, PoseCounts
+    from alte.registration.settings import OdometryParams, PoseCounts
 
 __all__ = ["REASONS", "DenseMap", "ScanDecision", "refine_frames"]
 
@@ -197,8 +198,6 @@ def refine_frames(frames: Iterable[Frame], mount: Mount, *, counts: PoseCounts,
                   params: OdometryParams) -> Iterator[Frame]:
     """``frames`` with each recorded pose refined when that is clearly better (module
     docstring)."""
-    from alte.registration.odometry import pose_matrix
-
     body_sensor = pose_matrix(mount.translation, mount.quaternion)
     sensor_body = np.linalg.inv(body_sensor)
     local: DenseMap | None = None

@@ -19,7 +19,6 @@ import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 import pandas as pd
 from tqdm.auto import tqdm
@@ -34,19 +33,17 @@ from alte.pipeline import (
     InputKind,
     MapRun,
     MapSpec,
+    PoseSource,
     Registered,
     open_input,
     prepare,
     run,
 )
+from alte.registration.odometry import OdometryParams
 from alte.studies.thesis import SWEEPS, sweep_table
 
-if TYPE_CHECKING:  # the obstacle study builds on the landing study, which builds on this one
-    from alte.mappers.base import Cells
-    from alte.studies.obstacles import ObstacleOptions, ObstacleScores
-
 __all__ = ["CACHE_DIR", "REPEATS", "REPEAT_BELOW_S", "Measured", "ground_truth", "measure",
-           "obstacle_scores", "sweep", "terrain", "timed_run"]
+           "sweep", "terrain", "timed_run"]
 
 #: Where registrations are cached, inside the data folder (``DATA_DIR/.cache``).
 CACHE_DIR = ".cache"
@@ -62,11 +59,10 @@ _WARM: set[tuple[str, str]] = set()
 
 @dataclass(eq=False)
 class Measured:
-    """A map run, its metrics and, when asked, its obstacle identification."""
+    """A map run and its metrics."""
 
     run: MapRun
     metrics: MapMetrics
-    obstacles: ObstacleScores | None = None
 
     @property
     def mapper(self) -> Mapper:
@@ -85,18 +81,30 @@ class Measured:
 
 
 def terrain(name: str, data_dir: str | os.PathLike[str] = "data", seed: int = 0,
-            frames: int | None = None, *, voxel: float | None = None,
+            frames: int | None = None, *, voxel: float | None = None, sensor: str = "thesis",
+            deskew: bool = True, odometry: OdometryParams | None = None,
             progress: bool = False) -> Registered:
-    """Terrain ``name`` registered (simulated first when absent; cached per spec and seed).
+    """Terrain ``name`` registered (simulated first when absent; cached per spec and seed
+    in ``DATA_DIR/.cache``): the one way a study turns a terrain into registered frames.
 
     ``frames`` keeps that many scans (a reduced mission ``NAME-Nf`` is simulated);
-    ``voxel`` overrides the terrain's registration voxel.
+    ``voxel`` overrides the terrain's registration voxel; ``sensor``: a profile of
+    :data:`alte.sim.profile.PROFILES` (its scans deskewed along the recorded poses unless
+    ``deskew`` is False); ``odometry``: pose the scans by odometry with these settings
+    instead (the whole mission is then simulated and ``frames`` of it kept).
     """
     from alte.sim import ensure_terrain
+    from alte.sim.profile import PROFILES
 
-    folder = ensure_terrain(name, data_dir, seed, frames, progress=progress)
-    return prepare(open_input(folder), FrameSpec(frames=frames, voxel=voxel),
-                   cache=Path(data_dir) / CACHE_DIR, progress=progress)
+    if sensor not in PROFILES:
+        raise ParameterError(f"sensor {sensor!r}: expected one of {', '.join(PROFILES)}")
+    folder = ensure_terrain(name, data_dir, seed, frames if odometry is None else None,
+                            progress=progress, profile=PROFILES[sensor])
+    spec = FrameSpec(frames=frames, voxel=voxel, deskew=deskew,
+                     poses=PoseSource.AUTO if odometry is None else PoseSource.ODOMETRY,
+                     odometry=odometry or OdometryParams())
+    return prepare(open_input(folder), spec, cache=Path(data_dir) / CACHE_DIR,
+                   progress=progress)
 
 
 @functools.lru_cache(maxsize=4)
@@ -133,12 +141,10 @@ def timed_run(data: Registered, spec: MapSpec, *, repeats: int = REPEATS,
 
 def measure(data: Registered, mapper: str, params: Mapping[str, object] | None = None, *,
             truth: TruthOptions | None = None, spec: MapSpec | None = None,
-            set_b: str = "corners", obstacles: ObstacleOptions | None = None,
-            progress: bool = False) -> Measured:
+            set_b: str = "corners", progress: bool = False) -> Measured:
     """Map ``data`` with ``mapper`` and ``params`` and measure it (``truth``: also against
     the true surface; ``set_b``: the map's points of HD/MHD, see
-    :data:`alte.metrics.maps.SET_B`; ``obstacles``: also identify the terrain's true
-    obstacles, :mod:`alte.studies.obstacles`, on a simulated terrain). ``spec`` replaces
+    :data:`alte.metrics.maps.SET_B`). ``spec`` replaces
     the default map specification. The map is timed by :func:`timed_run`."""
     chosen = spec or MapSpec(mapper, dict(params or {}))
     result, timing = timed_run(data, chosen, progress=progress)
@@ -146,20 +152,7 @@ def measure(data: Registered, mapper: str, params: Mapping[str, object] | None =
     metrics = measure_map(result.mapper, data.cloud, elapsed_s=timing,
                           truth=ground_truth(data) if truth is not None else None,
                           options=truth, set_b=set_b, cells=cells)
-    scores = obstacle_scores(data, cells, result.mapper.dims, obstacles)
-    return Measured(result, metrics, scores)
-
-
-def obstacle_scores(data: Registered, cells: Cells, dims: int,
-                    options: ObstacleOptions | None) -> ObstacleScores | None:
-    """The map ``cells``' identification of the terrain's true obstacles
-    (:mod:`alte.studies.obstacles`); None without ``options`` or off a simulated terrain."""
-    if options is None or ground_truth(data) is None:
-        return None
-    from alte.studies.obstacles import identify, map_raster, terrain_obstacles
-
-    known = terrain_obstacles(str(data.source.path), options)
-    return identify(map_raster(cells, dims, known.grid, options.min_height), known)
+    return Measured(result, metrics)
 
 
 def sweep(data: Registered, table: int, rows: Sequence[int] | None = None, *,

@@ -7,6 +7,7 @@ test``); these tests check what that run and ``alte report`` rely on.
 from __future__ import annotations
 
 import ast
+import json
 import os
 import shutil
 import subprocess
@@ -86,6 +87,16 @@ def test_outputs_stripped(path: Path) -> None:
              and (c.get("outputs") or c.get("execution_count") is not None)]
     assert not dirty, f"{path.name}: cells {dirty} hold outputs or execution counts"
     assert nb.metadata.get("kernelspec", {}).get("name") == "python3"
+
+
+@pytest.mark.parametrize("path", CASES)
+def test_stored_valid_with_an_id_per_cell(path: Path) -> None:
+    """nbformat 4.5 wants a unique id per cell; without one every run of the notebook
+    (``make report``, nbval) warns about it."""
+    raw = json.loads(path.read_text())
+    ids = [c.get("id") for c in raw["cells"]]
+    assert None not in ids and len(set(ids)) == len(ids), f"{path.name}: cell ids {ids}"
+    nbformat.validate(nbformat.reads(path.read_text(), as_version=4))
 
 
 @pytest.mark.parametrize("path", CASES)

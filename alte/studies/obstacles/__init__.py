@@ -17,6 +17,7 @@ from alte.studies.obstacles.identify import (
     ObstacleScores,
     identify,
     map_raster,
+    obstacle_scores,
 )
 from alte.studies.obstacles.tables import (
     OBJECTS_COLUMN,
@@ -35,7 +36,24 @@ from alte.studies.obstacles.truth import (
     true_obstacles,
 )
 
-__all__ = ["OBJECTS_COLUMN", "OBJECT_COLUMNS", "OBSTACLE_COLUMNS", "SCORE_COLUMNS", "MapRaster",
-           "ObstacleOptions", "ObstacleScores", "TrueObstacles", "identify", "map_raster",
-           "object_table", "obstacle_columns", "obstacle_options", "obstacles_table",
-           "setting_text", "terrain_obstacles", "true_obstacles", "write_obstacle_tables"]
+__all__ = [
+    "OBJECTS_COLUMN",
+    "OBJECT_COLUMNS",
+    "OBSTACLE_COLUMNS",
+    "SCORE_COLUMNS",
+    "MapRaster",
+    "ObstacleOptions",
+    "ObstacleScores",
+    "TrueObstacles",
+    "identify",
+    "map_raster",
+    "object_table",
+    "obstacle_columns",
+    "obstacle_options",
+    "obstacle_scores",
+    "obstacles_table",
+    "setting_text",
+    "terrain_obstacles",
+    "true_obstacles",
+    "write_obstacle_tables",
+]

@@ -29,11 +29,20 @@ import pandas as pd
 from scipy import ndimage
 
 from alte.mappers.base import Cells
-from alte.studies.landing import Grid
-from alte.studies.obstacles.truth import TrueObstacles
+from alte.pipeline import Registered
+from alte.studies.experiments import ground_truth
+from alte.studies.landing.raster import Grid
+from alte.studies.obstacles.truth import ObstacleOptions, TrueObstacles, terrain_obstacles
 
-__all__ = ["OBJECT_COLUMNS", "SCORE_COLUMNS", "MapRaster", "ObstacleScores", "identify",
-           "map_raster"]
+__all__ = [
+    "OBJECT_COLUMNS",
+    "SCORE_COLUMNS",
+    "MapRaster",
+    "ObstacleScores",
+    "identify",
+    "map_raster",
+    "obstacle_scores",
+]
 
 #: The scores of one map as table columns (:meth:`ObstacleScores.flat`).
 SCORE_COLUMNS = ("obstacles_true", "obstacles_found", "obstacles_map", "obstacles_map_there",
@@ -174,3 +183,13 @@ def identify(raster: MapRaster, truth: TrueObstacles) -> ObstacleScores:
         height_bias_m=float(errors.mean()) if errors.size else float("nan"),
         ground_m=ground, objects=objects, min_height=truth.options.min_height,
         hidden=truth.hidden)
+
+
+def obstacle_scores(data: Registered, cells: Cells, dims: int,
+                    options: ObstacleOptions | None) -> ObstacleScores | None:
+    """The map ``cells``' identification of the terrain's true obstacles
+    (:mod:`alte.studies.obstacles`); None without ``options`` or off a simulated terrain."""
+    if options is None or ground_truth(data) is None:
+        return None
+    known = terrain_obstacles(str(data.source.path), options)
+    return identify(map_raster(cells, dims, known.grid, options.min_height), known)

@@ -24,13 +24,9 @@ import pandas as pd
 from tqdm.auto import tqdm
 
 from alte.errors import ParameterError, SimulationError
-from alte.pipeline import open_input, prepare
-from alte.sim import ensure_terrain
-from alte.sim.profile import PROFILES
-from alte.studies.experiments import CACHE_DIR
 from alte.studies.sweep.spec import SweepRun, SweepSettings, SweepSpec, plan_runs, plan_variants
 from alte.studies.sweep.store import finished_ids, load_results, write_row
-from alte.studies.sweep.work import MapGroup, group_runs, run_group, run_one
+from alte.studies.sweep.work import MapGroup, group_runs, input_data, run_group, run_one
 
 __all__ = ["SERIAL", "SweepResult", "override", "run_one", "run_sweep", "variant_table"]
 
@@ -65,10 +61,7 @@ class SweepResult:
 def _ensure(run: SweepRun, data_dir: str) -> str:
     """Simulate the run's terrain if needed and register it into the cache (once per
     :meth:`~SweepRun.input_key`)."""
-    folder = ensure_terrain(run.terrain, data_dir, run.seed, run.simulated_frames,
-                            profile=PROFILES[run.sensor])
-    prepare(open_input(folder), run.frame_spec(), cache=Path(data_dir) / CACHE_DIR)
-    return str(folder)
+    return str(input_data(run, data_dir).source.path)
 
 
 def _serial_map(fn: Callable[..., Any], items: Sequence[Any], *args: Any) -> Iterator[Outcome]:

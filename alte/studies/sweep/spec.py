@@ -26,7 +26,6 @@ from alte.errors import AlteError, ParameterError
 from alte.mappers import make_mapper
 from alte.metrics.maps import TruthOptions
 from alte.params import Record, param
-from alte.pipeline.spec import FrameSpec, PoseSource
 from alte.sim import TERRAINS
 from alte.studies.sweep.variants import Variant, parse_variants
 
@@ -123,18 +122,6 @@ class SweepRun:
         deskew, poses): runs with equal keys share one simulation and registration."""
         return (self.terrain, self.frames, self.seed, self.voxel, self.sensor, self.deskew,
                 self.poses)
-
-    @property
-    def simulated_frames(self) -> int | None:
-        """Scans the terrain is simulated with: the whole mission when odometry poses it
-        (it aligns consecutive scans; the run's ``frames`` are then picked from them)."""
-        return None if self.poses == "odometry" else self.frames
-
-    def frame_spec(self) -> FrameSpec:
-        """How the run's terrain becomes registered frames (odometry: the backend
-        ``auto`` picks, LiDAR-inertial when the bag has an IMU)."""
-        return FrameSpec(frames=self.frames, voxel=self.voxel, deskew=self.deskew,
-                         poses=PoseSource(self.poses))
 
     @property
     def run_id(self) -> str:

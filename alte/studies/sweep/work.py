@@ -22,22 +22,19 @@ import json
 import time
 from collections.abc import Iterable
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any
 
 from alte.mappers import mapper_class
 from alte.metrics.maps import TruthOptions, measure_map
 from alte.metrics.reference import Reference
 from alte.metrics.timing import Timing
-from alte.pipeline import DomainPolicy, FrameSpec, MapRun, MapSpec, Registered, open_input
-from alte.pipeline import prepare as prepare_input
-from alte.sim import terrain_folder
-from alte.sim.profile import PROFILES
-from alte.studies.experiments import CACHE_DIR, ground_truth, obstacle_scores, timed_run
-from alte.studies.obstacles import obstacle_columns, obstacle_options
+from alte.pipeline import DomainPolicy, MapRun, MapSpec, Registered
+from alte.registration.odometry import OdometryParams
+from alte.studies.experiments import ground_truth, terrain, timed_run
+from alte.studies.obstacles import obstacle_columns, obstacle_options, obstacle_scores
 from alte.studies.sweep.spec import SweepRun
 
-__all__ = ["MapGroup", "RunOutcome", "group_runs", "run_group", "run_one"]
+__all__ = ["MapGroup", "RunOutcome", "group_runs", "input_data", "run_group", "run_one"]
 
 #: One run's result: (run id, its row or None, the exception or None).
 RunOutcome = tuple[str, dict[str, Any] | None, Exception | None]
@@ -76,29 +73,38 @@ def group_runs(runs: Iterable[SweepRun]) -> list[MapGroup]:
     return [MapGroup(tuple(members)) for members in groups.values()]
 
 
+#: What decides a run's registered input (:meth:`SweepRun.input_key`).
+InputKey = tuple[str, int | None, int, float | None, str, bool, str]
+
+
+def _registered(key: InputKey, data_dir: str) -> Registered:
+    name, frames, seed, voxel, sensor, deskew, poses = key
+    return terrain(name, data_dir, seed, frames, voxel=voxel, sensor=sensor, deskew=deskew,
+                   odometry=OdometryParams() if poses == "odometry" else None)
+
+
 @functools.lru_cache(maxsize=2)
-def _dataset(folder: str, spec: FrameSpec, data_dir: str) -> Registered:
+def _dataset(key: InputKey, data_dir: str) -> Registered:
     """Per-process memo over the on-disk registration cache (``DATA_DIR/.cache``)."""
-    return prepare_input(open_input(folder), spec, cache=Path(data_dir) / CACHE_DIR)
+    return _registered(key, data_dir)
 
 
-#: What :func:`_dataset` takes: terrain folder, frame spec, data folder.
-InputKey = tuple[str, FrameSpec, str]
+def input_data(run: SweepRun, data_dir: str) -> Registered:
+    """The run's terrain simulated when absent or out of date, and registered: every run
+    with the same :meth:`~SweepRun.input_key` shares it (the registration cache)."""
+    return _registered(run.input_key(), data_dir)
 
 
 @functools.lru_cache(maxsize=2)
-def _reference(key: InputKey, truth: TruthOptions) -> Reference:
+def _reference(key: InputKey, data_dir: str, truth: TruthOptions) -> Reference:
     """Per-process memo of the input's prepared cloud and truth (one per truth options)."""
-    data = _dataset(*key)
+    data = _dataset(key, data_dir)
     return Reference(data.cloud, ground_truth(data), truth)
 
 
 def _inputs(run: SweepRun, data_dir: str) -> tuple[Registered, Reference]:
     """The run's registered input and its reference (a fresh per-leaf memory)."""
-    key: InputKey = (str(terrain_folder(data_dir, run.terrain, run.simulated_frames, run.seed,
-                                        PROFILES[run.sensor])),
-                     run.frame_spec(), data_dir)
-    return _dataset(*key), _reference(key, run.truth).fresh()
+    return input_data(run, data_dir), _reference(run.input_key(), data_dir, run.truth).fresh()
 
 
 def _row(run: SweepRun, data: Registered, metrics: dict[str, Any],

@@ -5,6 +5,7 @@ from __future__ import annotations
 import pandas as pd
 import pytest
 
+import alte.sim
 from alte.errors import AlteError, ParameterError
 from alte.studies.sweep import (
     TIMING_COLUMNS,
@@ -262,7 +263,7 @@ def test_unknown_terrain_simulation_failure_is_named(spec, tmp_path, monkeypatch
     def broken(*args, **kwargs):
         raise OSError("disk full")
 
-    monkeypatch.setattr(sweep_runner, "ensure_terrain", broken)
+    monkeypatch.setattr(alte.sim, "ensure_terrain", broken)
     with pytest.raises(AlteError, match=r"terrain sim_lan_1 .*could not be simulated: disk full"):
         run_sweep(spec, scheduler="serial", output=tmp_path, progress=False)
 

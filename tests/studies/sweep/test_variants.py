@@ -145,23 +145,16 @@ def test_a_sensor_variant_reruns_every_map_on_that_sensor():
 
 
 def test_an_odometry_variant_poses_the_whole_mission_then_keeps_the_sweeps_scans():
-    """``poses: odometry`` simulates the whole mission (odometry aligns consecutive scans)
-    and registers the sweep's ``frames`` of it with the odometry ``auto`` picks."""
-    from alte.pipeline import PoseSource
-    from alte.registration.odometry import OdometryParams
-
+    """``poses: odometry`` changes the runs' input (the whole mission simulated and posed by
+    the odometry ``auto`` picks, :func:`alte.studies.experiments.terrain`), not the rest."""
     spec = parse_spec(_raw(variants={"lio": {"sensor": "uav", "poses": "odometry",
                                              "terrains": ["sim_nav_1"]}}))
     pairs = plan_variants(spec)
-    base = [r for n, r in pairs if n == "base"]
+    base = [r for n, r in pairs if n == "base" and r.terrain == "sim_nav_1"]
     mine = [r for n, r in pairs if n == "lio"]
     assert len(mine) == 2 * 4 and not {r.run_id for r in base} & {r.run_id for r in mine}
     run = mine[0]
     assert run.poses == "odometry" and run.key()["poses"] == "odometry"
-    assert "poses" not in base[0].key() and base[0].simulated_frames == 4
-    assert run.simulated_frames is None and run.frames == 4
-    frames = run.frame_spec()
-    assert (frames.frames, frames.poses, frames.odometry) == (4, PoseSource.ODOMETRY,
-                                                              OdometryParams())
-    assert base[0].frame_spec().poses is PoseSource.RECORDED
-    assert run.input_key() != base[0].input_key()
+    assert "poses" not in base[0].key() and base[0].poses == "recorded"
+    assert run.input_key() == ("sim_nav_1", 4, 0, None, "uav", True, "odometry")
+    assert base[0].input_key() == ("sim_nav_1", 4, 0, None, "thesis", True, "recorded")

@@ -45,8 +45,7 @@ def spec(tmp_path_factory):
 
 def _slow_row(run, data_dir: str) -> dict:
     """Today's path: a fresh map for the run alone, every metric computed from scratch."""
-    folder = ensure_terrain(run.terrain, data_dir, run.seed, run.frames)
-    data = _dataset(str(folder), run.frame_spec(), data_dir)
+    data = _dataset(run.input_key(), data_dir)
     spec = MapSpec(run.mapper, dict(run.params), domain=DomainPolicy(run.domain))
     return measure(data, run.mapper, truth=run.truth, spec=spec, set_b=run.set_b).metrics.flat()
 
