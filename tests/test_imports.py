@@ -94,3 +94,24 @@ def test_no_import_cycle_in_alte() -> None:
 def test_the_cycle_check_finds_a_cycle() -> None:
     assert _cycles({"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}) == [["a", "b", "c"]]
     assert _cycles({"a": {"b"}, "b": set()}) == []
+
+
+#: Each mapper's own modules (one module, or the Octomap package); shared code lives in
+#: alte.mappers.base / domain / _rows and the octree and quad packages.
+MAPPER_MODULES = ("alte.mappers.quadtree", "alte.mappers.alte2d", "alte.mappers.alte3d",
+                  "alte.mappers.octomap")
+
+
+def _owner(module: str) -> str | None:
+    return next((m for m in MAPPER_MODULES if module == m or module.startswith(m + ".")), None)
+
+
+def test_no_mapper_imports_another_mappers_module() -> None:
+    import alte
+
+    graph = _imports(Path(alte.__file__).parent)
+    crossing = sorted((a, b) for a, targets in graph.items() for b in targets
+                      if _owner(a) and _owner(b) and _owner(a) != _owner(b))
+    assert crossing == []
+    assert {"alte.mappers.octomap.backends", "alte.mappers.octree.tree"} <= graph[
+        "alte.mappers.octomap.mapper"]  # the family imports its own and shared modules

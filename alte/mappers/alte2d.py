@@ -39,24 +39,12 @@ from typing import ClassVar
 import numpy as np
 
 from alte.mappers.base import Cells
-from alte.mappers.quadmap import QuadMap
+from alte.mappers.quad.quadmap import QuadMap, plane_height
 from alte.params import Record, param
 
-__all__ = ["Alte2D", "Alte2DParams", "plane_height"]
+__all__ = ["Alte2D", "Alte2DParams"]
 
 CRITERIA = ("thesis", "binev")
-
-
-def plane_height(ground: float | np.ndarray, xy: np.ndarray) -> np.ndarray:
-    """Height of the ground at ``xy``: a float z, or a plane ``(a, b, c, d)``: ax+by+cz+d=0."""
-    plane = np.asarray(ground, dtype=np.float64).reshape(-1)
-    if plane.shape == (1,):
-        return np.full(len(xy), plane[0])
-    if plane.shape != (4,) or not np.isfinite(plane).all() or abs(plane[2]) < 1e-9:
-        raise ValueError(f"ground {plane.tolist()}: expected a z value or a non-vertical plane "
-                         "a,b,c,d (a x + b y + c z + d = 0)")
-    height: np.ndarray = -(plane[0] * xy[:, 0] + plane[1] * xy[:, 1] + plane[3]) / plane[2]
-    return height
 
 
 @dataclass(frozen=True)

@@ -30,10 +30,10 @@ from typing import ClassVar
 import numpy as np
 
 from alte.errors import MapperError
-from alte.mappers._octree import check_origin
 from alte.mappers._rows import unique_rows
 from alte.mappers.base import CellCounts, Cells, Cost, Feed, check_points, check_view
 from alte.mappers.domain import Domain, DomainUse, check_domain
+from alte.mappers.octree.tree import check_origin
 from alte.params import Record, param
 from alte.types import Box
 

@@ -45,10 +45,9 @@ import numpy as np
 
 from alte._numba import CLOUD_MIN, threads_for
 from alte.errors import AlteError, MapperError
-from alte.mappers.alte2d import plane_height
 from alte.mappers.base import Feed
 from alte.mappers.domain import Domain
-from alte.mappers.quadmap import QuadMap
+from alte.mappers.quad.quadmap import QuadMap, plane_height
 from alte.params import Record, param
 
 __all__ = ["Quadtree", "QuadtreeParams", "parse_ground"]

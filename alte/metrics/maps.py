@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from alte.errors import MetricsError
-from alte.mappers.quadmap import rectangle_corners
+from alte.mappers.quad.quadmap import rectangle_corners
 from alte.metrics.hausdorff import hausdorff
 from alte.metrics.options import GroundTruth, TruthOptions
 from alte.metrics.timing import Timing

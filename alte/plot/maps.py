@@ -13,8 +13,8 @@ from typing import Any, cast
 
 import numpy as np
 
-from alte.mappers.alte2d import plane_height
 from alte.mappers.base import Cells
+from alte.mappers.quad.quadmap import plane_height
 
 __all__ = [
     "UNKNOWN_COLOR",

@@ -5,7 +5,8 @@ from __future__ import annotations
 import re
 
 from alte.cli import main
-from alte.mappers import MAPPERS, Feed, _treebuild
+from alte.mappers import MAPPERS, Feed
+from alte.mappers.quad import treebuild as _treebuild
 from alte.metrics import _gridnn
 
 

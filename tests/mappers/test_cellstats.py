@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from alte.mappers._cellstats import (
+from alte.mappers.quad.cellstats import (
     aggregate_points,
     combine,
     fill_index,

@@ -10,12 +10,12 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from alte.errors import AlteError, MapperError, ParameterError
-from alte.mappers._blockset import WORDS, keys_to_blocks
-from alte.mappers._octomap_backends import logodds
-from alte.mappers._octree import Leaves, prune, prune_voxels
-from alte.mappers._raycast import morton_encode
-from alte.mappers._voxelstore import PAGE, VoxelStore
 from alte.mappers.octomap import Octomap, compare_backends, read_bt
+from alte.mappers.octomap.backends import logodds
+from alte.mappers.octomap.voxelstore import PAGE, VoxelStore
+from alte.mappers.octree.blockset import WORDS, keys_to_blocks
+from alte.mappers.octree.raycast import morton_encode
+from alte.mappers.octree.tree import Leaves, prune, prune_voxels
 from alte.paths import realdata_dir
 
 REALDATA = realdata_dir() / "octomap_scan"

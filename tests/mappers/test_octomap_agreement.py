@@ -12,9 +12,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from alte.mappers import _scan
-from alte.mappers._blockset import WORDS
 from alte.mappers.octomap import compare_backends
+from alte.mappers.octomap import scan as _scan
+from alte.mappers.octree.blockset import WORDS
 from alte.pipeline import open_input, prepare
 from alte.sim import ensure_terrain
 

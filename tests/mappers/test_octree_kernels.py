@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from alte.mappers._octree import Leaves, leaf_boxes, leaf_geometry, prune_voxels
-from alte.mappers._raycast import TREE_DEPTH
+from alte.mappers.octree.raycast import TREE_DEPTH
+from alte.mappers.octree.tree import Leaves, leaf_boxes, leaf_geometry, prune_voxels
 
 _THREE = np.uint64(3)
 

@@ -10,11 +10,11 @@ from hypothesis.extra.numpy import arrays
 from support.maps import assert_partition, same_cells
 
 from alte.errors import MapperError, ParameterError
-from alte.mappers import levelstats
-from alte.mappers.alte2d import plane_height
 from alte.mappers.domain import Domain
-from alte.mappers.levelstats import LevelStats
-from alte.mappers.quadgrid import Square, morton_decode, morton_encode
+from alte.mappers.quad import levelstats
+from alte.mappers.quad.levelstats import LevelStats
+from alte.mappers.quad.quadgrid import Square, morton_decode, morton_encode
+from alte.mappers.quad.quadmap import plane_height
 from alte.mappers.quadtree import Quadtree
 
 DOMAIN = Domain(0.0, 0.0, 0.0, 16.0)

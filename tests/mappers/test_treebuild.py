@@ -1,4 +1,4 @@
-"""Tests of the tree build's walk (``alte.mappers._treebuild``): the walk split over
+"""Tests of the tree build's walk (``alte.mappers.quad.treebuild``): the walk split over
 threads gives the single walk's cells bit for bit."""
 
 from __future__ import annotations
@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from alte.mappers._treebuild import sort_points, tree_cells
+from alte.mappers.quad.treebuild import sort_points, tree_cells
 
 
 def clustered_points(n: int, bits: int, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:

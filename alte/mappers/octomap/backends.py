@@ -16,11 +16,11 @@ from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
 
-from alte.mappers._blockset import WORDS, keys_to_blocks
-from alte.mappers._octree import Leaves, prune_voxels, write_bt
-from alte.mappers._raycast import TREE_DEPTH, TREE_MAX_VAL, morton_decode, morton_encode
-from alte.mappers._scan import ScanWork, scan_blocks, scan_cost
-from alte.mappers._voxelstore import VoxelStore
+from alte.mappers.octomap.scan import ScanWork, scan_blocks, scan_cost
+from alte.mappers.octomap.voxelstore import VoxelStore
+from alte.mappers.octree.blockset import WORDS, keys_to_blocks
+from alte.mappers.octree.raycast import TREE_DEPTH, TREE_MAX_VAL, morton_decode, morton_encode
+from alte.mappers.octree.tree import Leaves, prune_voxels, write_bt
 
 if TYPE_CHECKING:
     import pyoctomap
@@ -112,7 +112,7 @@ class NativeTree:
 
     @property
     def cost(self) -> int:
-        """Ray steps of the scans (:func:`alte.mappers._scan.scan_cost`) and voxels hit."""
+        """Ray steps of the scans (:func:`alte.mappers.octomap.scan.scan_cost`) and voxels hit."""
         return self._work.steps + self._hits
 
     def _update(self, blocks: np.ndarray, bits: np.ndarray) -> None:

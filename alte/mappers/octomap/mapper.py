@@ -22,12 +22,12 @@ import numpy as np
 
 from alte.errors import MapperError, ParameterError
 from alte.fsutil import atomic_path
-from alte.mappers._octomap_backends import NativeTree, ReferenceTree, SensorModel, tree_leaves
-from alte.mappers._octree import Leaves, check_origin, leaf_boxes, leaf_geometry
-from alte.mappers._raycast import TREE_DEPTH, TREE_MAX_VAL
 from alte.mappers._rows import unique_rows
 from alte.mappers.base import CellCounts, Cells, Cost, Feed, check_points, check_view
 from alte.mappers.domain import Domain, DomainUse
+from alte.mappers.octomap.backends import NativeTree, ReferenceTree, SensorModel, tree_leaves
+from alte.mappers.octree.raycast import TREE_DEPTH, TREE_MAX_VAL
+from alte.mappers.octree.tree import Leaves, check_origin, leaf_boxes, leaf_geometry
 from alte.params import Record, param
 from alte.types import rows_all
 
@@ -45,7 +45,7 @@ SENSOR_MODELS: dict[str, dict[str, float]] = {
 
 
 class _Backend(Protocol):
-    """What the mapper asks of a backend (:mod:`alte.mappers._octomap_backends`)."""
+    """What the mapper asks of a backend (:mod:`alte.mappers.octomap.backends`)."""
 
     model: SensorModel
 

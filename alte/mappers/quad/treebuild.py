@@ -34,7 +34,7 @@ import numpy as np
 from numba.cpython.unsafe.numbers import leading_zeros
 
 from alte._numba import CLOUD_MIN, threads_for
-from alte.mappers._cellstats import _cell_row, _parent_row, _run_starts, sort_keys
+from alte.mappers.quad.cellstats import _cell_row, _parent_row, _run_starts, sort_keys
 
 __all__ = ["Sorted", "sort_points", "tree_cells"]
 

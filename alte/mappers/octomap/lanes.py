@@ -1,7 +1,7 @@
 """Rays walked in lock-step, four at a time, by one LLVM vector loop (the native Octomap's
 hot loop), and a prefetch hint.
 
-A ray's walk (:func:`alte.mappers._raycast.flat_starts` gives its start) is OctoMap's
+A ray's walk (:func:`alte.mappers.octree.raycast.flat_starts` gives its start) is OctoMap's
 ``computeRayKeys``: pick the axis with the smallest tMax (ties go to z, then y), add
 its tDelta, move one voxel, stop at the end voxel or when min(tMax) passes the ray's
 length, or after the step limit. Its branches are as good as random (the axis changes

@@ -27,11 +27,23 @@ from alte.errors import MapperError
 from alte.mappers._rows import unique_rows
 from alte.mappers.base import CellCounts, Cells, Cost, Feed, check_points, check_view
 from alte.mappers.domain import Domain, DomainUse, check_domain
-from alte.mappers.levelstats import LevelStats
-from alte.mappers.quadgrid import Square
+from alte.mappers.quad.levelstats import LevelStats
+from alte.mappers.quad.quadgrid import Square
 from alte.params import Record
 
-__all__ = ["QuadMap", "rectangle_corners"]
+__all__ = ["QuadMap", "plane_height", "rectangle_corners"]
+
+
+def plane_height(ground: float | np.ndarray, xy: np.ndarray) -> np.ndarray:
+    """Height of the ground at ``xy``: a float z, or a plane ``(a, b, c, d)``: ax+by+cz+d=0."""
+    plane = np.asarray(ground, dtype=np.float64).reshape(-1)
+    if plane.shape == (1,):
+        return np.full(len(xy), plane[0])
+    if plane.shape != (4,) or not np.isfinite(plane).all() or abs(plane[2]) < 1e-9:
+        raise ValueError(f"ground {plane.tolist()}: expected a z value or a non-vertical plane "
+                         "a,b,c,d (a x + b y + c z + d = 0)")
+    height: np.ndarray = -(plane[0] * xy[:, 0] + plane[1] * xy[:, 1] + plane[3]) / plane[2]
+    return height
 
 
 def rectangle_corners(cells: Cells, mask: np.ndarray) -> np.ndarray:

@@ -28,14 +28,14 @@ import numpy as np
 from numpy.typing import DTypeLike
 
 from alte.errors import MapperError
-from alte.mappers._cellstats import (
+from alte.mappers.quad.cellstats import (
     aggregate_points,
     combine,
     fill_index,
     merge_cells,
     sort_keys,
 )
-from alte.mappers._treebuild import Sorted, sort_points, tree_cells
+from alte.mappers.quad.treebuild import Sorted, sort_points, tree_cells
 
 __all__ = ["MAX_DEPTH", "LevelStats"]
 

@@ -22,7 +22,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from alte.mappers._blockset import Table, local_index, row_of
+from alte.mappers.octree.blockset import Table, local_index, row_of
 
 #: A ray (or rays): origin, origin key, end(s), end key(s).
 Ray = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]

@@ -1,7 +1,7 @@
 """Pruning and the ``.bt`` format for the native Octomap.
 
 The map is, per finest (depth-16) voxel ever observed, a float32 log-odds
-(:class:`alte.mappers._voxelstore.VoxelStore`). OctoMap's pruned tree is a lossless
+(:class:`alte.mappers.octomap.voxelstore.VoxelStore`). OctoMap's pruned tree is a lossless
 compression of exactly this per-voxel state (a node collapses when its 8 children are
 leaves with bit-identical log-odds, and expands again with the same value on the next
 update), so leaves, leaf counts and the ``.bt`` file are derived from the sorted
@@ -17,7 +17,7 @@ import numba
 import numpy as np
 
 from alte.errors import MapperError
-from alte.mappers._raycast import TREE_DEPTH, TREE_MAX_VAL, _compact, morton_decode
+from alte.mappers.octree.raycast import TREE_DEPTH, TREE_MAX_VAL, _compact, morton_decode
 
 __all__ = ["Leaves", "check_origin", "leaf_boxes", "leaf_geometry", "prune", "prune_voxels",
            "write_bt"]

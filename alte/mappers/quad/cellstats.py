@@ -1,4 +1,4 @@
-"""Numba kernels of :class:`alte.mappers.levelstats.LevelStats`: sorting, aggregation, merges.
+"""Numba kernels of :class:`alte.mappers.quad.levelstats.LevelStats`: sorting, aggregation, merges.
 
 The sums reproduce numpy's, bit for bit, so that a statistic does not depend on
 which kernel computed it: :func:`aggregate_points` sums every run of points as

@@ -12,8 +12,8 @@ import numba
 import numpy as np
 from numba.cpython.unsafe.numbers import trailing_zeros
 
-from alte.mappers._blockset import EMPTY, MORTON_BIT, WORDS, find_slot, rehash
-from alte.mappers._lanes import prefetch
+from alte.mappers.octomap.lanes import prefetch
+from alte.mappers.octree.blockset import EMPTY, MORTON_BIT, WORDS, find_slot, rehash
 
 __all__ = ["PAGE", "VoxelStore"]
 
@@ -36,7 +36,7 @@ class VoxelStore:
 
     A hash table maps a block's Morton code (key >> 9) to a row; rows live in
     fixed-size pages, so adding blocks never moves the map, and a scan's update
-    (:func:`alte.mappers._scan.scan_blocks`) is applied block by block: one probe
+    (:func:`alte.mappers.octomap.scan.scan_blocks`) is applied block by block: one probe
     per block, one clamped float32 add per voxel, as OctoMap's ``updateNodeLogOdds``.
     Blocks of the observed volume are mostly full (75 % on sim_nav_1 at 0.2 m), so
     this takes less memory than a key and a value per voxel. :meth:`fold` gives the
@@ -83,7 +83,7 @@ class VoxelStore:
     def update(self, blocks: np.ndarray, bits: np.ndarray, miss: np.float32, hit: np.float32,
                clamp: tuple[np.float32, np.float32]) -> None:
         """Add ``miss`` at the free bits and ``hit`` at the occupied bits of each block
-        (rows as :func:`~alte.mappers._scan.scan_blocks` gives), clamped; a new voxel
+        (rows as :func:`~alte.mappers.octomap.scan.scan_blocks` gives), clamped; a new voxel
         starts at log-odds 0 (OctoMap's new node)."""
         if blocks.size == 0:
             return

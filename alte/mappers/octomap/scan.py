@@ -20,9 +20,17 @@ import numba
 import numpy as np
 from numba.cpython.unsafe.numbers import trailing_zeros
 
-from alte.mappers._blockset import WORDS, local_index, new_table, reserve, row_of, set_bit, union
-from alte.mappers._lanes import walk_lanes
-from alte.mappers._raycast import Ray, flat_starts, morton, prepare, walk_hashed
+from alte.mappers.octomap.lanes import walk_lanes
+from alte.mappers.octree.blockset import (
+    WORDS,
+    local_index,
+    new_table,
+    reserve,
+    row_of,
+    set_bit,
+    union,
+)
+from alte.mappers.octree.raycast import Ray, flat_starts, morton, prepare, walk_hashed
 
 __all__ = ["DENSE_ANY_WORDS", "DENSE_MAX_WORDS", "WORDS_PER_STEP", "ScanWork", "scan_blocks",
            "scan_cost"]

@@ -9,7 +9,7 @@ formula: no cancellation when heights are equal) and maximum.
 
 Adding points sorts them once at the finest level and merges aggregates upwards, so
 the arithmetic is proportional to the new points (times the depth); the statistics
-live in :class:`alte.mappers.levelstats.LevelStats`.
+live in :class:`alte.mappers.quad.levelstats.LevelStats`.
 The statistics of a cloud do not depend on how it was cut into
 frames (up to floating-point rounding of the sums), which is what makes the mappers'
 incremental insertion equal their batch build.
