@@ -6,14 +6,9 @@ into key bits (:mod:`~alte.mappers.octomap.scan`, four rays at a time in
 3D-ALTE are in :mod:`alte.mappers.octree`.
 """
 
-from alte.mappers.octomap.mapper import (
-    SENSOR_MODELS,
-    Octomap,
-    OctomapParams,
-    compare_backends,
-    occupied_voxels,
-    read_bt,
-)
+from alte.mappers.octomap.agreement import compare_backends
+from alte.mappers.octomap.cells import occupied_voxels, read_bt
+from alte.mappers.octomap.mapper import SENSOR_MODELS, Octomap, OctomapParams
 
 __all__ = ["SENSOR_MODELS", "Octomap", "OctomapParams", "compare_backends", "occupied_voxels",
            "read_bt"]

@@ -12,8 +12,7 @@ frames can be inserted one at a time with no ``domain`` parameter.
 
 from __future__ import annotations
 
-import time
-from collections.abc import Callable, Iterable
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import ClassVar, Protocol
@@ -25,14 +24,14 @@ from alte.fsutil import atomic_path
 from alte.mappers._rows import unique_rows
 from alte.mappers.base import CellCounts, Cells, Cost, Feed, check_points, check_view
 from alte.mappers.domain import Domain, DomainUse
-from alte.mappers.octomap.backends import NativeTree, ReferenceTree, SensorModel, tree_leaves
-from alte.mappers.octree.raycast import TREE_DEPTH, TREE_MAX_VAL
-from alte.mappers.octree.tree import Leaves, check_origin, leaf_boxes, leaf_geometry
+from alte.mappers.octomap.backends import NativeTree, ReferenceTree, SensorModel
+from alte.mappers.octomap.cells import leaf_subset, leaves_to_cells, occupied_voxels
+from alte.mappers.octree.raycast import TREE_MAX_VAL
+from alte.mappers.octree.tree import Leaves, check_origin, leaf_geometry
 from alte.params import Record, param
 from alte.types import rows_all
 
-__all__ = ["SENSOR_MODELS", "Octomap", "OctomapParams", "compare_backends", "occupied_voxels",
-           "read_bt"]
+__all__ = ["SENSOR_MODELS", "Octomap", "OctomapParams"]
 
 #: Sensor models: MATLAB occupancyMap3D (its free threshold 0.2 only affects MATLAB's
 #: ``checkOccupancy`` queries, not the map) and OctoMap's library defaults.
@@ -243,7 +242,7 @@ class Octomap:
         """The 8 corners of every occupied leaf, de-duplicated on the voxel grid."""
         leaves = self.leaves()
         occ = leaves.value > self._tree.model.occupied
-        min_keys, side, _ = leaf_geometry(_subset(leaves, occ), self.voxel_size)
+        min_keys, side, _ = leaf_geometry(leaf_subset(leaves, occ), self.voxel_size)
         offsets = np.array([[i >> 2 & 1, i >> 1 & 1, i & 1] for i in range(8)])
         grid = (min_keys[:, None, :] + offsets[None] * side[:, None, None]).reshape(-1, 3)
         return (unique_rows(grid) - TREE_MAX_VAL) * self.voxel_size
@@ -258,78 +257,3 @@ class Octomap:
         with atomic_path(target, overwrite=overwrite) as tmp:
             self._tree.write_bt(tmp)
         return target
-
-
-def _subset(leaves: Leaves, mask: np.ndarray) -> Leaves:
-    return Leaves(leaves.prefix[mask], leaves.depth[mask], leaves.value[mask])
-
-
-def leaves_to_cells(leaves: Leaves, voxel: float,
-                    occupied_log_odds: float | np.float32) -> Cells:
-    """Cells of pruned leaves: centres, cubic sizes, probability, occupied flag, depth."""
-    centers, sizes = leaf_boxes(leaves, voxel)
-    value = 1.0 - 1.0 / (1.0 + np.exp(leaves.value.astype(np.float64)))
-    return Cells(centers, sizes, value, leaves.value > occupied_log_odds, leaves.depth.copy())
-
-
-def occupied_voxels(leaves: Leaves, occupied_log_odds: float | np.float32) -> np.ndarray:
-    """Depth-16 Morton keys covered by occupied leaves (a leaf is a contiguous Morton range)."""
-    occ = _subset(leaves, leaves.value > occupied_log_odds)
-    span = np.uint64(1) << (np.uint64(3) * (TREE_DEPTH - occ.depth).astype(np.uint64))
-    first = occ.prefix * span
-    counts = span.astype(np.int64)
-    offsets = np.arange(counts.sum(), dtype=np.uint64) - np.repeat(
-        np.cumsum(counts) - counts, counts
-    ).astype(np.uint64)
-    return np.sort(np.repeat(first, counts) + offsets)
-
-
-def read_bt(path: str | Path) -> Cells:
-    """Cells of an OctoMap ``.bt`` file, read with the reference library."""
-    import pyoctomap
-
-    source = Path(path)
-    if not source.is_file():
-        raise MapperError(f"octomap: {source} does not exist")
-    tree = pyoctomap.OcTree(0.1)
-    if not tree.readBinary(str(source)):
-        raise MapperError(f"octomap: {source} is not a readable OctoMap binary tree (.bt)")
-    voxel = tree.getResolution()
-    threshold = np.float32(np.log(tree.getOccupancyThres() / (1 - tree.getOccupancyThres())))
-    return leaves_to_cells(tree_leaves(tree), voxel, threshold)
-
-
-def compare_backends(
-    scans: Iterable[tuple[np.ndarray, np.ndarray]], **params: float | str
-) -> dict[str, float]:
-    """Insert the same scans into both backends; Jaccard of occupied voxels, leaves, times.
-
-    Times cover every ``insert`` (pyoctomap's per-point Python-to-C++ copy is part of
-    the reference time) plus the final leaf count (native: pruning; reference: C++
-    ``getNumLeafNodes``); numba compilation is excluded by a warm-up insert.
-    """
-    native = Octomap(None, **{**params, "backend": "native"})
-    reference = Octomap(None, **{**params, "backend": "reference"})
-    warm = Octomap(None, **{**params, "backend": "native"})  # load the numba kernels untimed
-    warm.insert(np.ones((1, 3)), np.zeros(3))
-    _ = warm.basis_functions
-    times = {"native": 0.0, "reference": 0.0}
-    for points, origin in scans:
-        for key, mapper in (("native", native), ("reference", reference)):
-            start = time.perf_counter()
-            mapper.insert(points, origin)
-            times[key] += time.perf_counter() - start
-    counts = {}
-    for key, mapper in (("native", native), ("reference", reference)):
-        start = time.perf_counter()
-        counts[key] = mapper.basis_functions
-        times[key] += time.perf_counter() - start
-    a, b = native.occupied_voxels(), reference.occupied_voxels()
-    union = np.union1d(a, b).size
-    return {
-        "jaccard": np.intersect1d(a, b, assume_unique=True).size / union if union else 1.0,
-        "leaf_count_native": counts["native"],
-        "leaf_count_reference": counts["reference"],
-        "time_native_s": times["native"],
-        "time_reference_s": times["reference"],
-    }

@@ -22,15 +22,13 @@ from alte.studies.sweep.runner import (
     run_sweep,
     variant_table,
 )
+from alte.studies.sweep.runs import SweepRun, plan_runs, plan_variants
 from alte.studies.sweep.spec import (
     MapperGrid,
-    SweepRun,
     SweepSettings,
     SweepSpec,
     load_spec,
     parse_spec,
-    plan_runs,
-    plan_variants,
 )
 from alte.studies.sweep.store import (
     KEY_COLUMNS,

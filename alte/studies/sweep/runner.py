@@ -24,7 +24,8 @@ import pandas as pd
 from tqdm.auto import tqdm
 
 from alte.errors import ParameterError, SimulationError
-from alte.studies.sweep.spec import SweepRun, SweepSettings, SweepSpec, plan_runs, plan_variants
+from alte.studies.sweep.runs import SweepRun, plan_runs, plan_variants
+from alte.studies.sweep.spec import SweepSettings, SweepSpec
 from alte.studies.sweep.store import finished_ids, load_results, write_row
 from alte.studies.sweep.work import MapGroup, group_runs, input_data, run_group, run_one
 

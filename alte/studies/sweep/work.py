@@ -32,7 +32,7 @@ from alte.pipeline import DomainPolicy, MapRun, MapSpec, Registered
 from alte.registration.odometry import OdometryParams
 from alte.studies.experiments import ground_truth, terrain, timed_run
 from alte.studies.obstacles import obstacle_columns, obstacle_options, obstacle_scores
-from alte.studies.sweep.spec import SweepRun
+from alte.studies.sweep.runs import SweepRun
 
 __all__ = ["MapGroup", "RunOutcome", "group_runs", "input_data", "run_group", "run_one"]
 
