@@ -16,7 +16,8 @@ from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
 
-from alte.mappers.octomap.scan import ScanWork, scan_blocks, scan_cost
+from alte.mappers.octomap.cost import scan_cost
+from alte.mappers.octomap.scan import ScanWork, scan_blocks
 from alte.mappers.octomap.voxelstore import VoxelStore
 from alte.mappers.octree.blockset import WORDS, keys_to_blocks
 from alte.mappers.octree.raycast import TREE_DEPTH, TREE_MAX_VAL, morton_decode, morton_encode
@@ -112,7 +113,7 @@ class NativeTree:
 
     @property
     def cost(self) -> int:
-        """Ray steps of the scans (:func:`alte.mappers.octomap.scan.scan_cost`) and voxels hit."""
+        """Ray steps of the scans (:func:`alte.mappers.octomap.cost.scan_cost`) and voxels hit."""
         return self._work.steps + self._hits
 
     def _update(self, blocks: np.ndarray, bits: np.ndarray) -> None:

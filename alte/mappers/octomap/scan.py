@@ -20,6 +20,7 @@ import numba
 import numpy as np
 from numba.cpython.unsafe.numbers import trailing_zeros
 
+from alte.mappers.octomap.cost import scan_cost, skip_ray, walk_limit, walk_steps
 from alte.mappers.octomap.lanes import walk_lanes
 from alte.mappers.octree.blockset import (
     WORDS,
@@ -60,17 +61,6 @@ class ScanWork:
         self.steps = 0
 
 
-@numba.njit(cache=True, inline="always")
-def _skip(okey: np.ndarray, k: np.ndarray) -> bool:
-    """A ray is walked when its end key is valid and differs from the origin's."""
-    return bool(k[0] < 0 or (k[0] == okey[0] and k[1] == okey[1] and k[2] == okey[2]))
-
-
-@numba.njit(cache=True, inline="always")
-def _limit(okey: np.ndarray, k: np.ndarray) -> int:
-    return int(abs(k[0] - okey[0]) + abs(k[1] - okey[1]) + abs(k[2] - okey[2]) + 5)
-
-
 @numba.njit(cache=True)
 def _box(okey: np.ndarray, ekeys: np.ndarray) -> np.ndarray:
     """Block box of the origin and the valid ray ends, padded by one block: (x0, y0, z0,
@@ -85,40 +75,6 @@ def _box(okey: np.ndarray, ekeys: np.ndarray) -> np.ndarray:
     size = hi - lo + 3
     size[0] = (size[0] + 7) // 8 * 8
     return np.concatenate((lo - 1, size))
-
-
-@numba.njit(cache=True)
-def _steps(okey: np.ndarray, ekeys: np.ndarray) -> int:
-    """Voxel steps of the scan's walks (|dk|_1 of the valid ray ends)."""
-    steps = 0
-    for i in range(ekeys.shape[0]):
-        if ekeys[i, 0] >= 0:
-            steps += abs(ekeys[i, 0] - okey[0]) + abs(ekeys[i, 1] - okey[1]) + \
-                abs(ekeys[i, 2] - okey[2])
-    return steps
-
-
-@numba.njit(cache=True)
-def _cost(okey: np.ndarray, ekeys: np.ndarray) -> tuple[int, int]:
-    """The voxels a scan's walks step through (none when the origin is off the key space),
-    and its ray steps: those plus one end voxel per valid ray."""
-    ends = 0
-    for i in range(ekeys.shape[0]):
-        ends += ekeys[i, 0] >= 0
-    steps = _steps(okey, ekeys) if okey.min() >= 0 else 0
-    return steps, steps + ends
-
-
-@numba.njit(cache=True)
-def _prepared_cost(points: np.ndarray, origin: np.ndarray, res: float, max_range: float) -> int:
-    okey, _ends, ekeys, _hit = prepare(points, origin, res, max_range)
-    return int(_cost(okey, ekeys)[1])
-
-
-def scan_cost(points: np.ndarray, origin: np.ndarray, res: float, max_range: float) -> int:
-    """Ray steps of one scan (float32 ``points`` and ``origin``), as :func:`scan_blocks`
-    counts them into :attr:`ScanWork.steps`: for a backend that walks the rays itself."""
-    return int(_prepared_cost(points, origin, res, max_range))
 
 
 @numba.njit(cache=True, inline="always")
@@ -272,12 +228,13 @@ def _rays_hashed(rays: Ray, res: float, capacity: int) -> tuple[np.ndarray, np.n
     table, n_blocks = new_table(capacity), 0
     for i in range(ends.shape[0]):
         k = ekeys[i]
-        if _skip(okey, k):
+        if skip_ray(okey, k):
             continue
         blocks = (abs((k[0] >> 3) - (okey[0] >> 3)) + abs((k[1] >> 3) - (okey[1] >> 3))
                   + abs((k[2] >> 3) - (okey[2] >> 3)) + 6)  # 4 voxels cross <= 1 block more
-        table = reserve(table, n_blocks, min(_limit(okey, k), blocks))
-        n_blocks = walk_hashed((origin, okey, ends[i], k), res, _limit(okey, k), table, n_blocks)
+        limit = walk_limit(okey, k)
+        table = reserve(table, n_blocks, min(limit, blocks))
+        n_blocks = walk_hashed((origin, okey, ends[i], k), res, limit, table, n_blocks)
     return table[3][:n_blocks], table[2][:n_blocks]
 
 
@@ -309,7 +266,7 @@ def _scan(cloud: tuple[np.ndarray, np.ndarray], res: float, max_range: float,
     DENSE_ANY_WORDS, WORDS_PER_STEP). Also returns the work buffers, and the ray steps."""
     (points, origin), (capacity, most, anyway, per_step) = cloud, sizes
     okey, ends, ekeys, hit = prepare(points, origin, res, max_range)
-    steps, cost = _cost(okey, ekeys)
+    steps, cost = walk_steps(okey, ekeys)
     box = _box(okey, ekeys)
     words = 8 * box[3] * box[4] * box[5]
     if okey.min() >= 0 and words <= most and (words <= anyway or words <= per_step * steps):
