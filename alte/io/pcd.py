@@ -2,9 +2,10 @@
 field kept) and a binary writer (float64 x y z plus the other fields).
 
 Parsed here rather than with open3d, which reads 8-byte PCD fields as zeros; the LZF
-decompression of binary_compressed bodies is compiled with numba. The reader is as strict
-as PCL's: a header whose ``WIDTH x HEIGHT`` differs from ``POINTS``, or a body with fewer
-rows (or bytes) than the header announces, is refused with the counts, never read short.
+decompression of binary_compressed bodies is compiled with numba (:mod:`~alte.io.lzf`).
+The reader is as strict as PCL's: a header whose ``WIDTH x HEIGHT`` differs from
+``POINTS``, or a body with fewer rows (or bytes) than the header announces, is refused
+with the counts, never read short.
 Packed colours (``rgb``/``rgba``, PCL's float- or uint32-packed 0xAARRGGBB) become a
 ``colors`` (N, 3) uint8 field and are packed again on writing.
 """
@@ -14,11 +15,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-import numba
 import numpy as np
 import pandas as pd
 
 from alte.errors import PointFileError
+from alte.io.lzf import lzf_decompress
 
 __all__ = ["PcdHeader", "pack_rgb", "pcd_header", "read_pcd", "read_pcd_table", "read_table",
            "unpack_rgb", "write_pcd"]
@@ -26,41 +27,6 @@ __all__ = ["PcdHeader", "pack_rgb", "pcd_header", "read_pcd", "read_pcd_table", 
 _PCD_TYPES = {"F": "f", "U": "u", "I": "i"}
 _TYPE_LETTER = {"f": "F", "u": "U", "i": "I", "b": "U"}
 _RGB = ("rgb", "rgba")
-
-
-@numba.njit(cache=True)
-def _lzf_decompress(src: np.ndarray, size: int) -> np.ndarray:  # pragma: no cover - compiled
-    """liblzf decompression (PCD binary_compressed); empty result on corrupt input."""
-    out = np.empty(size, np.uint8)
-    ip, op = 0, 0
-    while ip < src.size:
-        ctrl = int(src[ip])
-        ip += 1
-        if ctrl < 32:  # literal run of ctrl + 1 bytes
-            n = ctrl + 1
-            if ip + n > src.size or op + n > size:
-                return out[:0]
-            out[op : op + n] = src[ip : ip + n]
-            ip += n
-            op += n
-            continue
-        n = ctrl >> 5  # back reference
-        if n == 7:
-            if ip >= src.size:
-                return out[:0]
-            n += int(src[ip])
-            ip += 1
-        if ip >= src.size:
-            return out[:0]
-        ref = op - ((ctrl & 0x1F) << 8) - 1 - int(src[ip])
-        ip += 1
-        n += 2
-        if ref < 0 or op + n > size:
-            return out[:0]
-        for k in range(n):  # byte by byte: the source may overlap the output
-            out[op + k] = out[ref + k]
-        op += n
-    return out[:op]
 
 
 @dataclass(frozen=True)
@@ -221,7 +187,7 @@ def _compressed(raw: bytes, head: PcdHeader, path: Path) -> np.ndarray:
     if packed > len(blob) - 8:
         raise PointFileError(f"{path}: truncated binary_compressed PCD: {len(blob) - 8} of the "
                              f"{packed} compressed bytes ({count} rows) it announces")
-    body = _lzf_decompress(np.frombuffer(blob, np.uint8, packed, 8), size)
+    body = lzf_decompress(np.frombuffer(blob, np.uint8, packed, 8), size)
     if body.size != size:
         raise PointFileError(f"{path}: corrupt LZF data in binary_compressed PCD")
     out = np.empty(count, dtype)

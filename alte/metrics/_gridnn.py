@@ -13,7 +13,8 @@ KD-tree descent with backtracking (``environment.md`` has the measurements).
 The first grid has the smallest cells keeping it within :data:`CELLS_PER_TARGET` cells
 per target (linear build, little memory). A query with no target within :data:`RINGS`
 rings of its cell goes to a grid :data:`COARSER` times coarser, and so on; once the
-targets crowd the cells (:data:`MAX_LOAD`) a pykdtree KD-tree answers the rest.
+targets crowd the cells (:data:`MAX_LOAD`) a pykdtree KD-tree answers the rest
+(:mod:`~alte.metrics.nearest` chains them).
 """
 
 from __future__ import annotations
@@ -22,13 +23,11 @@ from dataclasses import dataclass
 
 import numba
 import numpy as np
-from pykdtree.kdtree import KDTree
 
 from alte._numba import threads_for
 
 __all__ = ["CELLS_PER_TARGET", "COARSER", "MAX_LOAD", "PARALLEL_MIN", "RINGS", "Grid",
-           "NearestIndex", "bounds", "build_grid", "first_side", "nearest_distances",
-           "query_grid"]
+           "bounds", "build_grid", "first_side", "query_grid"]
 
 #: Grid cells allowed per target point: the dense cell index costs O(cells + points);
 #: fewer, fuller cells were faster on the benchmark's clouds than emptier ones.
@@ -268,52 +267,3 @@ def query_grid(grid: Grid, queries: np.ndarray, rings: int) -> tuple[np.ndarray,
     with threads_for(len(queries), PARALLEL_MIN):
         return _query(queries, grid.lo, grid.h, grid.dims, grid.start, grid.points, rings,
                       grid.scale)
-
-
-class NearestIndex:
-    """Targets (N, 3) prepared once for any number of nearest-distance queries: the first
-    grid is built at once, each coarser one (and pykdtree's tree) when a query first needs
-    it, then kept (a
-    sweep measures every map of one input against the same cloud: one build, not one per
-    map). The distances are :func:`nearest_distances`'s."""
-
-    def __init__(self, targets: np.ndarray) -> None:
-        self.targets = targets
-        self.box = bounds(targets)
-        self.grids = [build_grid(targets, first_side(self.box, len(targets)), self.box)]
-        self._tree: KDTree | None = None
-
-    def _kdtree(self, queries: np.ndarray) -> np.ndarray:
-        """The queries the grids leave to pykdtree (its tree built once, then kept)."""
-        if self._tree is None:
-            self._tree = KDTree(self.targets)
-        return np.asarray(self._tree.query(queries, k=1)[0], dtype=np.float64)
-
-    def _grid(self, i: int) -> Grid:
-        if i == len(self.grids):
-            self.grids.append(build_grid(self.targets, self.grids[-1].h * COARSER, self.box))
-        return self.grids[i]
-
-    def distances(self, queries: np.ndarray) -> np.ndarray:
-        """Distance from every query (M, 3) to its nearest target (finite float64)."""
-        grid = self.grids[0]
-        if grid.load > MAX_LOAD:
-            return self._kdtree(queries)
-        dist, settled = query_grid(grid, queries, RINGS)
-        todo = np.flatnonzero(~settled)
-        level = 0
-        while todo.size:
-            level += 1
-            grid = self._grid(level)
-            if grid.load > MAX_LOAD:
-                dist[todo] = self._kdtree(queries[todo])
-                break
-            found, settled = query_grid(grid, queries[todo], RINGS)
-            dist[todo] = found
-            todo = todo[~settled]
-        return dist
-
-
-def nearest_distances(queries: np.ndarray, targets: np.ndarray) -> np.ndarray:
-    """Distance from every query (M, 3) to its nearest target (N, 3); finite float64 sets."""
-    return NearestIndex(targets).distances(queries)

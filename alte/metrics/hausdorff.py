@@ -18,7 +18,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from alte.errors import MetricsError
-from alte.metrics._gridnn import nearest_distances
+from alte.metrics.nearest import nearest_distances
 
 __all__ = ["HausdorffResult", "directed_distances", "hausdorff", "summarise"]
 

@@ -5,7 +5,7 @@ cloud and the same true surface; :func:`alte.metrics.maps.measure_map` alone red
 map, the work those share. A :class:`Reference` does it once:
 
 * set A of HD/MHD, the cloud, validated and bucketed into its nearest-neighbour grids
-  (:class:`~alte.metrics._gridnn.NearestIndex`);
+  (:class:`~alte.metrics.nearest.NearestIndex`);
 * the truth for one :class:`~alte.metrics.maps.TruthOptions`: the surface samples, which
   of them the sensor saw (a KD-tree query of the whole cloud) and a KD-tree over them
   (3D maps); the x/y probe grid and the true top height under each probe (2D maps);
@@ -30,9 +30,9 @@ from typing import TYPE_CHECKING, Any, TypeVar
 import numpy as np
 from scipy.spatial import cKDTree
 
-from alte.metrics._gridnn import NearestIndex
 from alte.metrics.hausdorff import HausdorffResult, _as_set, summarise
 from alte.metrics.leaves import LeafTruth
+from alte.metrics.nearest import NearestIndex
 from alte.metrics.options import GroundTruth, TruthOptions
 from alte.metrics.truth import (
     cell_at_xy,

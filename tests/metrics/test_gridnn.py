@@ -11,16 +11,16 @@ from hypothesis.extra.numpy import arrays
 from pykdtree.kdtree import KDTree
 from scipy.spatial import cKDTree
 
-from alte.metrics import _gridnn
+from alte.metrics import nearest
 from alte.metrics._gridnn import (
     MAX_LOAD,
     RINGS,
     bounds,
     build_grid,
     first_side,
-    nearest_distances,
     query_grid,
 )
+from alte.metrics.nearest import nearest_distances
 
 
 def _reference(queries: np.ndarray, targets: np.ndarray) -> np.ndarray:
@@ -87,10 +87,10 @@ def test_crowded_targets_go_to_the_kdtree(monkeypatch):
             calls.append(len(q))
             return super().query(q, k=k)
 
-    monkeypatch.setattr(_gridnn, "KDTree", Counted)
+    monkeypatch.setattr(nearest, "KDTree", Counted)
     assert np.array_equal(nearest_distances(queries, targets), _reference(queries, targets))
     assert calls == [2000]
-    index = _gridnn.NearestIndex(targets)  # the tree is built once, then kept
+    index = nearest.NearestIndex(targets)  # the tree is built once, then kept
     index.distances(queries[:10])
     tree = index._tree
     assert np.array_equal(index.distances(queries), _reference(queries, targets))

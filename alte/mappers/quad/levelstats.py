@@ -20,12 +20,10 @@ when an insertion needs them.
 from __future__ import annotations
 
 import copy
-import mmap
 from collections.abc import Iterator
 from contextlib import contextmanager
 
 import numpy as np
-from numpy.typing import DTypeLike
 
 from alte.errors import MapperError
 from alte.mappers.quad.cellstats import (
@@ -35,6 +33,7 @@ from alte.mappers.quad.cellstats import (
     merge_cells,
     sort_keys,
 )
+from alte.mappers.quad.storage import PerLevel, lazy_zeros
 from alte.mappers.quad.treebuild import Sorted, sort_points, tree_cells
 
 __all__ = ["MAX_DEPTH", "LevelStats"]
@@ -49,41 +48,6 @@ _FIRST_CAPACITY = 1 << 22
 #: Levels of at most this many cells (``4**level``) index their rows densely (4 bytes a
 #: cell, paged in by the OS only where data lie); deeper levels hash.
 _DENSE_CELLS = 1 << 24
-
-
-def _lazy_zeros(shape: tuple[int, ...], dtype: DTypeLike) -> np.ndarray:
-    """A zeroed array in anonymous memory that the OS maps 4 KiB at a time on first touch.
-
-    numpy advises transparent huge pages for big arrays; then the first touch of every
-    2 MiB zeroes (and may compact memory for) a whole huge page, a stall of milliseconds
-    in whichever insertion meets it. Small pages spread that cost evenly."""
-    count = int(np.prod(shape))
-    buffer = mmap.mmap(-1, max(count * np.dtype(dtype).itemsize, 1))
-    return np.frombuffer(buffer, dtype, count).reshape(shape)
-
-
-class _PerLevel:
-    """``stats.keys``/``rows``/``split``: level ``l``'s sorted array (a view of its storage)."""
-
-    def __init__(self, stats: LevelStats, store: list[np.ndarray]) -> None:
-        self._stats, self._store = stats, store
-
-    def __len__(self) -> int:
-        return len(self._store)
-
-    def __iter__(self) -> Iterator[np.ndarray]:
-        return (self[level] for level in range(len(self)))
-
-    def __getitem__(self, level: int) -> np.ndarray:
-        self._stats.fold(level)
-        return self._store[level][:self._stats.size(level)]
-
-    def __setitem__(self, level: int, value: np.ndarray) -> None:
-        view = self[level]
-        if np.shape(value)[:1] != view.shape[:1]:
-            raise MapperError(f"level {level}: {np.shape(value)[:1]} values for "
-                              f"{len(view)} cells")
-        view[...] = value
 
 
 class LevelStats:
@@ -115,9 +79,9 @@ class LevelStats:
         self._shared = False  # cells shared with a branch: no more points (see branch)
         #: Cell statistics written so far, every level (the maps' machine-free cost).
         self.updates = 0
-        self.keys = _PerLevel(self, self._k)
-        self.rows = _PerLevel(self, self._r)
-        self.split = _PerLevel(self, self._s)
+        self.keys = PerLevel(self, self._k)
+        self.rows = PerLevel(self, self._r)
+        self.split = PerLevel(self, self._s)
 
     def size(self, level: int) -> int:
         """Number of cells at ``level``."""
@@ -193,8 +157,8 @@ class LevelStats:
         other = copy.copy(self)
         other._k, other._r, other._s = list(self._k), list(self._r), [s.copy() for s in self._s]
         other._n, other._sorted, other._index = list(self._n), list(self._sorted), list(self._index)
-        other.keys, other.rows = _PerLevel(other, other._k), _PerLevel(other, other._r)
-        other.split = _PerLevel(other, other._s)
+        other.keys, other.rows = PerLevel(other, other._k), PerLevel(other, other._r)
+        other.split = PerLevel(other, other._s)
         self._shared = other._shared = True
         return other
 
@@ -230,7 +194,7 @@ class LevelStats:
         if n + k > len(self._k[level]):
             cap = max(n + k, 2 * len(self._k[level]), min(4**level, _FIRST_CAPACITY))
             for store in (self._k, self._r, self._s):
-                grown = _lazy_zeros((cap, *store[level].shape[1:]), store[level].dtype)
+                grown = lazy_zeros((cap, *store[level].shape[1:]), store[level].dtype)
                 grown[:n] = store[level][:n]
                 store[level] = grown
             if not self._dense(level):
@@ -238,7 +202,7 @@ class LevelStats:
         index = self._index[level]
         if index is None:
             if self._dense(level):
-                index = _lazy_zeros((4**level,), np.int32)
+                index = lazy_zeros((4**level,), np.int32)
             else:
                 index = np.full(2 << int(2 * len(self._k[level])).bit_length(), -1, np.int64)
             fill_index(index, self._k[level], n, self._dense(level))
