@@ -33,15 +33,20 @@ from alte.errors import MapperError
 from alte.mappers._rows import unique_rows
 from alte.mappers.base import CellCounts, Cells, Cost, Feed, check_points, check_view
 from alte.mappers.domain import Domain, DomainUse, check_domain
+from alte.mappers.octree.celltable import (
+    KEY_MASK,
+    Z_OFFSET,
+    child_keys,
+    merge_counts,
+    pack_keys,
+    unpack_keys,
+)
 from alte.mappers.octree.tree import check_origin
 from alte.params import Record, param
 from alte.types import Box
 
 __all__ = ["Alte3D", "Alte3DParams"]
 
-_BITS = 21
-_MASK = (1 << _BITS) - 1
-_Z_OFFSET = 1 << (_BITS - 1)
 
 
 
@@ -58,15 +63,6 @@ class Alte3DParams(Record):
     variant: str = param("cube", lambda v: v in {"cube", "fixed_altitude"},
                          "cube|fixed_altitude", "cubes, or x/y cells in cell_height layers")
     cell_height: float = param(1.0, lambda v: v > 0, "> 0", "layer height (fixed_altitude)")
-
-
-def _pack(ix: np.ndarray, iy: np.ndarray, iz: np.ndarray) -> np.ndarray:
-    keys: np.ndarray = (ix << (2 * _BITS)) | (iy << _BITS) | iz
-    return keys
-
-
-def _unpack(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    return keys >> (2 * _BITS), (keys >> _BITS) & _MASK, keys & _MASK
 
 
 class Alte3D:
@@ -171,7 +167,7 @@ class Alte3D:
         for level in range(max_res + 1):
             keys, counts = np.unique(self._at_level(finest, max_res - level), return_counts=True)
             self._cost += keys.size
-            self._keys[level], self._counts[level] = _merge(
+            self._keys[level], self._counts[level] = merge_counts(
                 self._keys[level], self._counts[level], keys, counts
             )
 
@@ -183,20 +179,20 @@ class Alte3D:
         axes = 2 if self._params["variant"] == "fixed_altitude" else 3
         inside = dom.inside(pts, axes)
         if axes == 2:
-            layer = np.floor((pts[:, 2] - dom.zmin) / self._params["cell_height"]) + _Z_OFFSET
-            inside &= (layer >= 0) & (layer <= _MASK)
+            layer = np.floor((pts[:, 2] - dom.zmin) / self._params["cell_height"]) + Z_OFFSET
+            inside &= (layer >= 0) & (layer <= KEY_MASK)
         self.points_outside += int(inside.size - np.count_nonzero(inside))
         pts = pts[inside]
         idx = np.minimum(((pts - dom.lo) / dom.size * n).astype(np.int64), n - 1)
         if axes == 2:
             idx[:, 2] = layer[inside]
-        return _pack(idx[:, 0], idx[:, 1], idx[:, 2])
+        return pack_keys(idx[:, 0], idx[:, 1], idx[:, 2])
 
     def _at_level(self, finest: np.ndarray, shift: int) -> np.ndarray:
-        ix, iy, iz = _unpack(finest)
+        ix, iy, iz = unpack_keys(finest)
         if self._params["variant"] == "cube":
             iz = iz >> shift
-        return _pack(ix >> shift, iy >> shift, iz)
+        return pack_keys(ix >> shift, iy >> shift, iz)
 
     def _count(self, level: int, keys: np.ndarray) -> np.ndarray:
         """Point counts of ``keys`` at ``level`` (0 for cells never seen)."""
@@ -216,7 +212,7 @@ class Alte3D:
             split = (n > p["min_pts_split"]) & (level < p["max_res"])
             leaves.append(cells[~split])
             counts.append(n[~split])
-            cells = _children(cells[split], p["variant"])
+            cells = child_keys(cells[split], p["variant"])
         return leaves, counts
 
     def cell_counts(self) -> CellCounts:
@@ -248,11 +244,11 @@ class Alte3D:
         xmin, ymin, zmin, size = (self._domain.xmin, self._domain.ymin, self._domain.zmin,
                                   self._domain.size)
         edge = size / (1 << level)
-        ix, iy, iz = _unpack(keys)
+        ix, iy, iz = unpack_keys(keys)
         lo = np.c_[xmin + ix * edge, ymin + iy * edge, zmin + iz * edge]
         hi = lo + edge
         if self._params["variant"] == "fixed_altitude":
-            lo[:, 2] = zmin + (iz - _Z_OFFSET) * self._params["cell_height"]
+            lo[:, 2] = zmin + (iz - Z_OFFSET) * self._params["cell_height"]
             hi[:, 2] = lo[:, 2] + self._params["cell_height"]
         return lo, hi
 
@@ -277,28 +273,3 @@ class Alte3D:
         offsets = np.array([[i >> 2 & 1, i >> 1 & 1, i & 1] for i in range(8)], dtype=np.float64)
         corners = (lo[:, None, :] + offsets[None] * size[:, None, :]).reshape(-1, 3)
         return unique_rows(corners)
-
-
-def _children(keys: np.ndarray, variant: str) -> np.ndarray:
-    ix, iy, iz = _unpack(keys)
-    if variant == "fixed_altitude":
-        offsets = [(dx, dy, 0) for dx in (0, 1) for dy in (0, 1)]
-        kids = [_pack(2 * ix + dx, 2 * iy + dy, iz) for dx, dy, _ in offsets]
-    else:
-        kids = [_pack(2 * ix + (c & 1), 2 * iy + (c >> 1 & 1), 2 * iz + (c >> 2 & 1))
-                for c in range(8)]
-    return np.sort(np.concatenate(kids))
-
-
-def _merge(keys: np.ndarray, counts: np.ndarray, new_keys: np.ndarray,
-           new_counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Add ``new_counts`` at sorted unique ``new_keys`` into the sorted table."""
-    pos = np.searchsorted(keys, new_keys)
-    found = pos < keys.size
-    found[found] = keys[pos[found]] == new_keys[found]
-    counts[pos[found]] += new_counts[found]
-    fresh = ~found
-    if fresh.any():
-        keys = np.insert(keys, pos[fresh], new_keys[fresh])
-        counts = np.insert(counts, pos[fresh], new_counts[fresh])
-    return keys, counts
