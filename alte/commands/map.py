@@ -20,7 +20,7 @@ from alte.export import ExportOptions
 from alte.export import export_map as export_mcap
 from alte.fsutil import refuse_overwrite
 from alte.ground.surface import SurfaceRule
-from alte.mappers import MAPPERS, Domain, Feed, check_export, export_map, mapper_class
+from alte.mappers import MAPPERS, Domain, Feed, check_export, export_map
 from alte.pipeline import DomainPolicy, MapRun, MapSpec, open_input, run
 
 __all__ = ["add_map_options", "add_parser", "export_options", "map_spec", "mapped",
@@ -127,16 +127,15 @@ def print_summary(summary: dict[str, object], as_json: bool) -> None:
 
 def map_spec(args: argparse.Namespace) -> MapSpec:
     """The :class:`MapSpec` of the parsed flags, parameters checked before any read."""
-    spec = MapSpec(args.mapper, parse_sets(args.sets), parse_domain(args.domain),
+    return MapSpec(args.mapper, parse_sets(args.sets), parse_domain(args.domain),
                    Feed(args.feed) if args.feed else None)
-    mapper_class(args.mapper).Params.parse(spec.params)  # fail on a bad --set before the read
-    return spec
 
 
 def mapped(args: argparse.Namespace, mcap: Path | None, options: ExportOptions,
-           cloud: bool = False) -> tuple[MapRun, dict[str, int]]:
-    """Run the map (and write the MCAP when ``mcap`` is given); message counts per topic."""
-    spec, frames, source = map_spec(args), frame_spec(args), open_input(args.input)
+           cloud: bool = False, spec: MapSpec | None = None) -> tuple[MapRun, dict[str, int]]:
+    """Run the map as ``spec`` says (default: the flags'; and write the MCAP when ``mcap``
+    is given); message counts per topic."""
+    spec, frames, source = spec or map_spec(args), frame_spec(args), open_input(args.input)
     if mcap is None:
         return run(source, spec, frames, cache=args.cache, cloud=cloud,
                    progress=not args.json), {}
@@ -167,9 +166,10 @@ def export_options(args: argparse.Namespace, mcap: Path | None) -> ExportOptions
 def run_command(args: argparse.Namespace) -> int:
     """Build the map, print the summary, export when asked."""
     options = export_options(args, args.mcap)
+    spec = map_spec(args)
     if args.export is not None:
-        check_export(args.export, mapper_class(args.mapper), args.force)
-    result, topics = mapped(args, args.mcap, options, cloud=args.metrics)
+        check_export(args.export, spec.cls, args.force)
+    result, topics = mapped(args, args.mcap, options, cloud=args.metrics, spec=spec)
     summary = _summary(result, args.metrics)
     if topics:
         summary["mcap"] = {"file": str(args.mcap), "messages": topics}

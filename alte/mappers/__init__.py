@@ -43,8 +43,11 @@ def mapper_class(name: str) -> MapperClass:
 def make_mapper(name: str, params: Mapping[str, object] | Record | None = None, /, *,
                 domain: Domain | None = None, **given: object) -> Mapper:
     """Construct the mapper registered as ``name`` with validated ``params`` (a mapping or
-    record, and/or keywords) and, where the mapper uses one, its ``domain``."""
+    record, and/or keywords) and, where the mapper uses one, its ``domain``. A record of
+    the mapper's own ``Params`` with no keywords is used as it is, not parsed again."""
     cls = mapper_class(name)
+    if isinstance(params, cls.Params) and not given:
+        return cls(domain, record=params)
     merged = params.as_dict() if isinstance(params, Record) else dict(params or {})
     return cls(domain, **{**merged, **given})
 

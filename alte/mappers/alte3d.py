@@ -31,7 +31,15 @@ import numpy as np
 
 from alte.errors import MapperError
 from alte.mappers._rows import unique_rows
-from alte.mappers.base import CellCounts, Cells, Cost, Feed, check_points, check_view
+from alte.mappers.base import (
+    CellCounts,
+    Cells,
+    Cost,
+    Feed,
+    check_points,
+    check_view,
+    parsed,
+)
 from alte.mappers.domain import Domain, DomainUse, check_domain
 from alte.mappers.octree.celltable import (
     KEY_MASK,
@@ -89,9 +97,10 @@ class Alte3D:
     cost_unit: ClassVar[Cost] = Cost.CELL_UPDATES
     Params: ClassVar[type[Record]] = Alte3DParams
 
-    def __init__(self, domain: Domain | None = None, **given: object) -> None:
+    def __init__(self, domain: Domain | None = None, *, record: Record | None = None,
+                 **given: object) -> None:
         domain = check_domain("alte3d", domain)
-        self._record = Alte3DParams.parse(given)
+        self._record = parsed(Alte3DParams, record, given)
         self._params = self._record.as_dict()
         self._fixed = domain
         self._domain = domain

@@ -11,7 +11,7 @@ import enum
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import ClassVar, Protocol, runtime_checkable
+from typing import ClassVar, Protocol, TypeVar, runtime_checkable
 
 import numpy as np
 
@@ -20,7 +20,8 @@ from alte.mappers.domain import Domain, DomainUse
 from alte.params import Record
 from alte.types import as_points
 
-__all__ = ["CellCounts", "Cells", "Cost", "Feed", "Mapper", "check_points", "check_view"]
+__all__ = ["CellCounts", "Cells", "Cost", "Feed", "Mapper", "check_points", "check_view",
+           "parsed"]
 
 
 @dataclass(frozen=True)
@@ -194,3 +195,20 @@ def check_view(mapper: Mapper, changes: Mapping[str, object]) -> None:
         can = ", ".join(sorted(mapper.view_params)) or "none"
         raise MapperError(f"{mapper.name}: {', '.join(stored)} change(s) what the map stores; "
                           f"a map can be re-read with other {can} only")
+
+
+_R = TypeVar("_R", bound=Record)
+
+
+def parsed(params: type[_R], record: Record | None, given: Mapping[str, object]) -> _R:
+    """A mapper's parameters: ``record`` when one was resolved already (a
+    :class:`~alte.pipeline.MapSpec`'s), else ``given`` parsed; never both."""
+    if record is None:
+        return params.parse(given)
+    if not isinstance(record, params):
+        raise MapperError(f"{params.OWNER}: its parameters are a {params.__name__}, not a "
+                          f"{type(record).__name__}")
+    if given:
+        raise MapperError(f"{params.OWNER}: parameters come as a record or as names and "
+                          f"values, not both ({', '.join(sorted(given))} beside the record)")
+    return record

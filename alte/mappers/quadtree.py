@@ -116,8 +116,9 @@ class Quadtree(QuadMap):
     view_params: ClassVar[frozenset[str]] = frozenset({"occupancy", "height_threshold"})
     _NVALUES: ClassVar[int] = 2  # z, height above the plane
 
-    def __init__(self, domain: Domain | None = None, **given: object) -> None:
-        super().__init__(domain, **given)
+    def __init__(self, domain: Domain | None = None, *, record: Record | None = None,
+                 **given: object) -> None:
+        super().__init__(domain, record=record, **given)
         #: Ground plane (a, b, c, d); None until ``build`` fits it (``ground="fit"``).
         self.plane: np.ndarray | None = parse_ground(self._params["ground"])
 

@@ -19,7 +19,7 @@ from tqdm.auto import tqdm
 
 from alte.errors import ParameterError, RegistrationError
 from alte.io.pointfiles import local_origin
-from alte.mappers import Domain, DomainUse, Feed, Mapper, make_mapper, mapper_class
+from alte.mappers import Domain, DomainUse, Feed, Mapper
 from alte.pipeline.maprun import FrameLog, FrameObserver, MapRun, RunInfo, Snapshot
 from alte.pipeline.source import Source, StreamCounts
 from alte.pipeline.spec import DomainPolicy, FrameSpec, MapSpec
@@ -181,11 +181,11 @@ def _timed(frames: Iterator[RegisteredFrame]) -> Iterator[tuple[RegisteredFrame,
 def map_frames(frames: FrameInput, spec: MapSpec, *, cloud: bool = False,
                progress: bool = False, observer: FrameObserver | None = None) -> MapRun:
     """Map ``frames`` as ``spec`` says: the one map loop (module docstring)."""
-    cls = mapper_class(spec.mapper)
+    cls = spec.cls
     feed = spec.feed or cls.default_feed
     domain, policy = resolve_domain(cls, spec.domain, frames.spec.crop,
                                     lambda: frames.bounds(feed))
-    mapper = make_mapper(spec.mapper, spec.params, domain=domain)
+    mapper = cls(domain, record=spec.record)
     start = time.perf_counter()
     stream = frames.frames(cloud or feed is Feed.BATCH, progress)
     first = next(stream, None)

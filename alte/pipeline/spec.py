@@ -18,8 +18,10 @@ from pathlib import Path
 import numpy as np
 
 from alte.errors import ParameterError
+from alte.mappers import MapperClass, mapper_class
 from alte.mappers.base import Feed
 from alte.mappers.domain import Domain
+from alte.params import Record
 from alte.registration.grid import check_voxel
 from alte.registration.odometry import OdometryParams
 from alte.types import Box, Mount
@@ -131,17 +133,28 @@ class MapSpec:
     ``feed`` None uses the mapper's own protocol (``Mapper.default_feed``: the thesis
     built Quadtree once on the final cloud and fed the others frame by frame);
     ``snapshots`` keeps the cells that many times over the run (time-lapse figures)
-    and counts the basis functions after every frame.
+    and counts the basis functions after every frame. The mapper's class (``cls``) and
+    its parameter record (``record``) are resolved here, once: an unknown mapper or a
+    bad parameter fails before any input is read.
     """
 
     mapper: str
-    params: Mapping[str, object] = field(default_factory=dict)
+    params: Mapping[str, object] | Record = field(default_factory=dict)
     domain: Domain | DomainPolicy = DomainPolicy.AUTO
     feed: Feed | None = None
     snapshots: int = 0
+    cls: MapperClass = field(init=False, repr=False, compare=False)
+    record: Record = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         if isinstance(self.snapshots, bool) or not isinstance(self.snapshots, int) \
                 or self.snapshots < 0:
             raise ParameterError(f"snapshots={self.snapshots!r}: expected an integer >= 0")
-        object.__setattr__(self, "params", dict(self.params))
+        cls = mapper_class(self.mapper)
+        given = self.params
+        record = given if isinstance(given, cls.Params) else cls.Params.parse(
+            given.as_dict() if isinstance(given, Record) else given)
+        object.__setattr__(self, "cls", cls)
+        object.__setattr__(self, "record", record)
+        object.__setattr__(self, "params", given.as_dict() if isinstance(given, Record)
+                           else dict(given))

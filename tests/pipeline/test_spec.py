@@ -35,3 +35,31 @@ def test_map_spec_defaults_and_errors() -> None:
     assert spec.domain is DomainPolicy.AUTO and spec.feed is None and spec.snapshots == 0
     with pytest.raises(ParameterError, match=r"snapshots=-1: expected an integer >= 0"):
         MapSpec("alte2d", snapshots=-1)
+
+
+def test_map_spec_resolves_the_mapper_and_its_parameters_once() -> None:
+    """The class and the parameter record are resolved when the spec is made (an unknown
+    mapper or a bad parameter fails before any read), and the map loop builds the mapper
+    from that very record."""
+    from alte.errors import MapperError
+    from alte.mappers import Alte2D, make_mapper
+    from alte.mappers.alte2d import Alte2DParams
+
+    spec = MapSpec("alte2d", {"kappa": "0.5", "max_res": 5})
+    assert spec.cls is Alte2D and isinstance(spec.record, Alte2DParams)
+    assert spec.record.as_dict()["kappa"] == 0.5 and spec.params == {"kappa": "0.5",
+                                                                     "max_res": 5}
+    mapper = make_mapper("alte2d", spec.record)
+    assert mapper.params is spec.record  # used as it is, not parsed again
+    again = MapSpec("alte2d", spec.record)
+    assert again.record is spec.record and again.params == spec.record.as_dict()
+    with pytest.raises(MapperError, match="unknown mapper 'kriging'; valid: quadtree"):
+        MapSpec("kriging")
+    with pytest.raises(ParameterError, match="alte2d: unknown parameter"):
+        MapSpec("alte2d", {"max_points": 3})
+    with pytest.raises(MapperError, match=r"alte2d: parameters come as a record or as names "
+                                          r"and values, not both \(kappa beside the record\)"):
+        Alte2D(None, record=spec.record, kappa=1.0)
+    with pytest.raises(MapperError, match="alte3d: its parameters are a Alte3DParams, not a "
+                                          "Alte2DParams"):
+        make_mapper("alte3d", {}, record=spec.record)

@@ -8,7 +8,7 @@ from collections.abc import Iterable
 
 import numpy as np
 
-from alte.mappers.octomap.mapper import Octomap
+from alte.mappers.octomap.mapper import Octomap, OctomapParams
 
 __all__ = ["compare_backends"]
 
@@ -22,9 +22,9 @@ def compare_backends(
     the reference time) plus the final leaf count (native: pruning; reference: C++
     ``getNumLeafNodes``); numba compilation is excluded by a warm-up insert.
     """
-    native = Octomap(None, **{**params, "backend": "native"})
-    reference = Octomap(None, **{**params, "backend": "reference"})
-    warm = Octomap(None, **{**params, "backend": "native"})  # load the numba kernels untimed
+    native, reference, warm = (
+        Octomap(None, record=OctomapParams.parse({**params, "backend": backend}))
+        for backend in ("native", "reference", "native"))  # warm: the numba kernels, untimed
     warm.insert(np.ones((1, 3)), np.zeros(3))
     _ = warm.basis_functions
     times = {"native": 0.0, "reference": 0.0}

@@ -22,7 +22,15 @@ import numpy as np
 from alte.errors import MapperError, ParameterError
 from alte.fsutil import atomic_path
 from alte.mappers._rows import unique_rows
-from alte.mappers.base import CellCounts, Cells, Cost, Feed, check_points, check_view
+from alte.mappers.base import (
+    CellCounts,
+    Cells,
+    Cost,
+    Feed,
+    check_points,
+    check_view,
+    parsed,
+)
 from alte.mappers.domain import Domain, DomainUse
 from alte.mappers.octomap.backends import NativeTree, ReferenceTree, SensorModel
 from alte.mappers.octomap.cells import leaf_subset, leaves_to_cells, occupied_voxels
@@ -133,11 +141,12 @@ class Octomap:
     cost_unit: ClassVar[Cost] = Cost.RAY_STEPS
     Params: ClassVar[type[Record]] = OctomapParams
 
-    def __init__(self, domain: Domain | None = None, **given: object) -> None:
+    def __init__(self, domain: Domain | None = None, *, record: Record | None = None,
+                 **given: object) -> None:
         if domain is not None:
             raise MapperError("octomap: its domain is the fixed key space of 2^16 voxels per "
                               "axis around 0; it takes no domain")
-        self._record = OctomapParams.parse(given)
+        self._record = parsed(OctomapParams, record, given)
         self._tree = self._new_tree()
         self.points_outside = 0
         self._cells: tuple[Leaves, Cells] | None = None  # the cells of those leaves

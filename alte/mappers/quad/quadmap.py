@@ -25,7 +25,15 @@ import numpy as np
 
 from alte.errors import MapperError
 from alte.mappers._rows import unique_rows
-from alte.mappers.base import CellCounts, Cells, Cost, Feed, check_points, check_view
+from alte.mappers.base import (
+    CellCounts,
+    Cells,
+    Cost,
+    Feed,
+    check_points,
+    check_view,
+    parsed,
+)
 from alte.mappers.domain import Domain, DomainUse, check_domain
 from alte.mappers.quad.levelstats import LevelStats
 from alte.mappers.quad.quadgrid import Square
@@ -71,9 +79,10 @@ class QuadMap:
     view_params: ClassVar[frozenset[str]] = frozenset()
     _NVALUES: ClassVar[int] = 1
 
-    def __init__(self, domain: Domain | None = None, **given: object) -> None:
+    def __init__(self, domain: Domain | None = None, *, record: Record | None = None,
+                 **given: object) -> None:
         domain = check_domain(self.name, domain)
-        self._record = self.Params.parse(given)
+        self._record = parsed(self.Params, record, given)
         self._params = self._record.as_dict()
         self._zmin = 0.0 if domain is None else domain.zmin
         self._fixed = None if domain is None else Square(domain.xmin, domain.ymin, domain.size)
