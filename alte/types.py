@@ -16,10 +16,19 @@ from scipy.spatial.transform import Rotation
 
 from alte.errors import ParameterError, PoseError
 
-__all__ = ["Box", "Frame", "Mount", "RegisteredFrame", "Trajectory", "as_points", "finite_rows",
-           "rows_all", "thesis_mount"]
+__all__ = ["Box", "Counts", "Frame", "Mount", "RegisteredFrame", "Trajectory", "as_points",
+           "finite_rows", "rows_all", "thesis_mount"]
 
 _NS = 1_000_000_000
+
+
+class Counts:
+    """Base of the pipeline's counters (dataclasses of what a stage kept and dropped)."""
+
+    def as_dict(self) -> dict[str, object]:
+        """Counts by name (JSON-ready: lists and dicts copied)."""
+        return {k: (dict(v) if isinstance(v, dict) else list(v) if isinstance(v, list) else v)
+                for k, v in vars(self).items()}
 
 
 def as_points(points: object, name: str = "points", *, owner: str = "",

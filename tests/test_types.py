@@ -72,3 +72,22 @@ def test_rows_all_and_finite_rows_match_numpy() -> None:
     assert np.array_equal(finite_rows(pts), np.isfinite(pts).all(axis=1))
     mask = rng.random((200, 4)) > 0.2
     assert np.array_equal(rows_all(mask), mask.all(axis=1))
+
+
+def test_every_counter_gives_its_counts_by_name_as_copies() -> None:
+    """The four counters share ``Counts.as_dict``: every field by name, lists and dicts
+    copied so that a summary does not change when the run goes on counting."""
+    from alte.io.bag import ReadCounts
+    from alte.registration.deskew import DeskewCounts
+    from alte.registration.odometry import PoseCounts
+    from alte.registration.register import RegistrationCounts
+    from alte.types import Counts
+
+    poses = PoseCounts(frames=3, kept={"weak": 1})
+    out = poses.as_dict()
+    poses.kept["weak"] += 1
+    poses.scans.append({"scan": 0})
+    assert out["frames"] == 3 and out["kept"] == {"weak": 1} and out["scans"] == []
+    for counter in (ReadCounts(), DeskewCounts(), RegistrationCounts(), poses):
+        assert isinstance(counter, Counts)
+        assert set(counter.as_dict()) == set(vars(counter))

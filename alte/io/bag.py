@@ -24,7 +24,7 @@ from alte.io.pointcloud2 import decode_timed
 from alte.io.pose import PoseTrack, header_stamp
 from alte.io.reader import SCAN_TYPE, open_bag, read_messages
 from alte.io.topics import NO_POSE_NOTE, bag_sources
-from alte.types import Frame, Mount
+from alte.types import Counts, Frame, Mount
 
 __all__ = ["NO_POSE_NOTE", "FrameSet", "FrameStream", "ReadCounts", "ReadOptions",
            "StreamOptions",
@@ -34,7 +34,7 @@ _IDENTITY_Q = np.array([0.0, 0.0, 0.0, 1.0])
 
 
 @dataclass
-class ReadCounts:
+class ReadCounts(Counts):
     """What reading a bag's scans kept and dropped, updated as frames stream through."""
 
     scans_read: int = 0
@@ -47,10 +47,6 @@ class ReadCounts:
     pose_duplicates: int = 0
     pose_reordered: int = 0
     frames: int = 0
-
-    def as_dict(self) -> dict[str, int]:
-        """Counts by name (JSON-ready)."""
-        return dict(vars(self))
 
 
 @dataclass

@@ -25,7 +25,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from alte.io.pose import PoseTrack
-from alte.types import Frame, Mount
+from alte.types import Counts, Frame, Mount
 
 __all__ = ["DESKEW_STEP_S", "DeskewCounts", "deskew_constant_velocity", "deskew_frames",
            "deskew_points"]
@@ -35,17 +35,13 @@ DESKEW_STEP_S = 1e-4
 
 
 @dataclass
-class DeskewCounts:
+class DeskewCounts(Counts):
     """Scans deskewed, scans without per-point time, and points whose instant lies
     outside the pose track (moved with the nearest pose there: no extrapolation)."""
 
     deskewed: int = 0
     no_time: int = 0
     points_clamped: int = 0
-
-    def as_dict(self) -> dict[str, int]:
-        """Counts by name (JSON-ready)."""
-        return dict(vars(self))
 
 
 def _groups(times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

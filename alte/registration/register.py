@@ -25,7 +25,7 @@ from tqdm import tqdm
 from alte.errors import ParameterError, RegistrationError
 from alte.registration.grid import GridAccumulator, check_voxel, grid_average
 from alte.registration.transform import register_with_origin
-from alte.types import Frame, Mount, finite_rows, rows_all
+from alte.types import Counts, Frame, Mount, finite_rows, rows_all
 
 __all__ = [
     "ManoeuvreFilter",
@@ -98,7 +98,7 @@ class ManoeuvreFilter:
 
 
 @dataclass
-class RegistrationCounts:
+class RegistrationCounts(Counts):
     """Frames and points in, dropped by reason, and out; updated as frames stream through."""
 
     frames_in: int = 0
@@ -116,10 +116,6 @@ class RegistrationCounts:
         """Count a frame dropped for ``reason`` (rate, offset or empty)."""
         name = f"frames_dropped_{reason}"
         setattr(self, name, getattr(self, name) + 1)
-
-    def as_dict(self) -> dict[str, int]:
-        """Counts by name (JSON-ready)."""
-        return dict(vars(self))
 
 
 def _frame_points(

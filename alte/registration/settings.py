@@ -16,6 +16,7 @@ from scipy.spatial.transform import Rotation
 
 from alte.errors import ParameterError
 from alte.params import Record, param
+from alte.types import Counts
 
 __all__ = ["KEYS", "METHODS", "OdometryParams", "PoseCounts", "odometry_label",
            "odometry_params", "pose_matrix", "resolve_method"]
@@ -128,7 +129,7 @@ def odometry_label(params: OdometryParams) -> str:
 
 
 @dataclass
-class PoseCounts:
+class PoseCounts(Counts):
     """Where the poses came from, what odometry / refinement did and how long it took
     (``seconds``: the pose step alone, wall; ``cpu_seconds``: its thread's CPU time);
     ``scans``: refinement's decision per scan."""
@@ -146,11 +147,6 @@ class PoseCounts:
     seconds: float = 0.0
     cpu_seconds: float = 0.0
     scans: list[dict[str, object]] = field(default_factory=list)
-
-    def as_dict(self) -> dict[str, object]:
-        """Counts by name (JSON-ready)."""
-        return {k: (dict(v) if isinstance(v, dict) else list(v) if isinstance(v, list) else v)
-                for k, v in vars(self).items()}
 
 
 def pose_matrix(position: np.ndarray, quaternion: np.ndarray) -> np.ndarray:
