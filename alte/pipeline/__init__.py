@@ -18,9 +18,10 @@ from alte.pipeline.prepare import (
 )
 from alte.pipeline.run import run
 from alte.pipeline.source import InputKind, Source, StreamCounts, open_input, stream_frames
-from alte.pipeline.spec import DomainPolicy, FrameSpec, MapSpec, PoseSource
+from alte.pipeline.spec import DomainChoice, DomainPolicy, FrameSpec, MapSpec, PoseSource
 
 __all__ = [
+    "DomainChoice",
     "DomainPolicy",
     "FrameLog",
     "FrameObserver",

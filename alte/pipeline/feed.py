@@ -22,7 +22,7 @@ from alte.io.pointfiles import local_origin
 from alte.mappers import Domain, DomainUse, Feed, Mapper
 from alte.pipeline.maprun import FrameLog, FrameObserver, MapRun, RunInfo, Snapshot
 from alte.pipeline.source import Source, StreamCounts
-from alte.pipeline.spec import DomainPolicy, FrameSpec, MapSpec
+from alte.pipeline.spec import DomainChoice, DomainPolicy, FrameSpec, MapSpec
 from alte.registration.register import empty_reason
 from alte.types import Box, RegisteredFrame, Trajectory
 
@@ -77,12 +77,12 @@ class FrameInput(Protocol):
 
 
 def resolve_domain(cls: type[Mapper], choice: Domain | DomainPolicy, control: Box | None,
-                   data: Callable[[], Box]) -> tuple[Domain | None, str]:
+                   data: Callable[[], Box]) -> tuple[Domain | None, DomainChoice]:
     """The domain a mapper gets and the policy that chose it (one rule for every caller)."""
     if cls.domain_use is DomainUse.UNUSED:
-        return None, "none (fixed key space)"
+        return None, DomainChoice.NONE
     if isinstance(choice, Domain):
-        return choice, "explicit"
+        return choice, DomainChoice.EXPLICIT
     policy = choice
     if policy is DomainPolicy.AUTO:
         policy = DomainPolicy.CONTROL if control is not None else DomainPolicy.DATA
@@ -90,8 +90,8 @@ def resolve_domain(cls: type[Mapper], choice: Domain | DomainPolicy, control: Bo
         if control is None:
             raise ParameterError("domain policy 'control': the input has no control volume "
                                  "(terrain folders have one); use 'data' or explicit numbers")
-        return Domain.over(control), "control"
-    return Domain.over(data()), "data"
+        return Domain.over(control), DomainChoice.CONTROL
+    return Domain.over(data()), DomainChoice.DATA
 
 
 def local_shift(cls: type[Mapper], first: Callable[[], np.ndarray]) -> np.ndarray:

@@ -17,7 +17,7 @@ from alte import __version__
 from alte.mappers import Cells, Domain, Feed, Mapper
 from alte.params import Record
 from alte.pipeline.source import InputKind, StreamCounts
-from alte.pipeline.spec import FrameSpec
+from alte.pipeline.spec import DomainChoice, FrameSpec
 from alte.types import RegisteredFrame, Trajectory
 
 __all__ = ["FrameLog", "FrameObserver", "MapRun", "RunInfo", "Snapshot"]
@@ -69,7 +69,7 @@ class RunInfo:
     mapper: str
     params: Record
     domain: Domain | None
-    domain_policy: str
+    domain_policy: DomainChoice
     feed: Feed
     frames: FrameSpec
     local_origin: tuple[float, float, float]
@@ -108,7 +108,7 @@ class MapRun:
             "input": info.input, "input_kind": info.kind.value, "mapper": info.mapper,
             "params": info.params.as_dict(), "feed": info.feed.value,
             "domain": None if info.domain is None else info.domain.as_dict(),
-            "domain_policy": info.domain_policy, "voxel": info.frames.voxel,
+            "domain_policy": info.domain_policy.value, "voxel": info.frames.voxel,
             "pose_source": self.counts.poses.source,
             "odometry": {"method": self.counts.poses.method,
                          "settings": dict(self.counts.poses.settings)}

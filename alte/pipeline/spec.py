@@ -26,7 +26,7 @@ from alte.registration.grid import check_voxel
 from alte.registration.odometry import OdometryParams
 from alte.types import Box, Mount
 
-__all__ = ["DomainPolicy", "FrameSpec", "MapSpec", "PoseSource"]
+__all__ = ["DomainChoice", "DomainPolicy", "FrameSpec", "MapSpec", "PoseSource"]
 
 
 class DomainPolicy(enum.Enum):
@@ -39,6 +39,17 @@ class DomainPolicy(enum.Enum):
     """
 
     AUTO = "auto"
+    CONTROL = "control"
+    DATA = "data"
+
+
+class DomainChoice(enum.StrEnum):
+    """Where a run's root cell came from (the resolved :class:`DomainPolicy`, in the run's
+    summary): none for a mapper with a fixed key space, the caller's explicit domain, the
+    control volume or the data."""
+
+    NONE = "none (fixed key space)"
+    EXPLICIT = "explicit"
     CONTROL = "control"
     DATA = "data"
 

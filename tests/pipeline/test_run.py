@@ -13,6 +13,7 @@ from alte.io.pointfiles import write_points
 from alte.mappers import Feed
 from alte.mappers.domain import Domain
 from alte.pipeline import (
+    DomainChoice,
     DomainPolicy,
     FrameSpec,
     MapSpec,
@@ -63,7 +64,7 @@ def test_domain_policies(terrain: Path, bag: Path) -> None:
     crop = json.loads((terrain / "scenario.json").read_text())["crop_box"]
     assert crop == [-35.0, -35.0, -1.0, 35.0, 35.0, 12.0]
     on_terrain = run(terrain, MapSpec("alte2d"), FrameSpec(frames=2))
-    assert on_terrain.info.domain_policy == "control"
+    assert on_terrain.info.domain_policy is DomainChoice.CONTROL
     assert _as_list(on_terrain.info.domain) == pytest.approx([-35.0, -35.0, -1.0, 70.0],
                                                              rel=1e-8)
     on_bag = run(bag, MapSpec("alte2d"), FrameSpec(frames=2))
@@ -76,7 +77,8 @@ def test_domain_policies(terrain: Path, bag: Path) -> None:
     chosen = run(terrain, MapSpec("alte3d", domain=explicit), FrameSpec(frames=2))
     assert (chosen.info.domain, chosen.info.domain_policy) == (explicit, "explicit")
     octo = run(terrain, MapSpec("octomap", PARAMS["octomap"]), FrameSpec(frames=2))
-    assert octo.info.domain_policy == "none (fixed key space)"
+    assert octo.info.domain_policy is DomainChoice.NONE
+    assert octo.summary()["domain_policy"] == "none (fixed key space)"
     with pytest.raises(ParameterError, match="domain policy 'control': the input has no "
                                              "control volume"):
         run(bag, MapSpec("alte2d", domain=DomainPolicy.CONTROL), FrameSpec(frames=2))
