@@ -9,6 +9,7 @@ per-object values stay in :attr:`TruthMetrics.completeness_by_object`).
 from __future__ import annotations
 
 import dataclasses
+import enum
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
@@ -25,8 +26,17 @@ if TYPE_CHECKING:
     from alte.mappers.base import Cells, Mapper
     from alte.metrics.reference import Reference
 
-__all__ = ["SET_B", "GroundTruth", "MapMetrics", "TruthMetrics", "TruthOptions", "measure_map",
-           "set_b_points"]
+__all__ = [
+    "SET_B",
+    "GroundTruth",
+    "MapMetrics",
+    "SetB",
+    "TruthMetrics",
+    "TruthOptions",
+    "measure_map",
+    "set_b_points",
+    "set_b_rule",
+]
 
 _NAN = float("nan")
 #: Definitions of set B (the map's points in HD/MHD): ``corners`` of every basis function
@@ -34,7 +44,24 @@ _NAN = float("nan")
 #: of every cell with a height (2D: a height map's free cells are ground); ``occupied``:
 #: corners of the cells the mapper marks occupied (2D: Quadtree's height-above-ground
 #: rule; every known cell of 2D-ALTE; 3D: the same as ``corners``).
-SET_B = ("corners", "centers", "occupied")
+class SetB(enum.StrEnum):
+    """Which points of a map are set B of its HD/MHD (comment above)."""
+
+    CORNERS = "corners"
+    CENTERS = "centers"
+    OCCUPIED = "occupied"
+
+
+#: The names of :class:`SetB` (what a sweep spec or a notebook may give).
+SET_B = tuple(s.value for s in SetB)
+
+
+def set_b_rule(value: SetB | str) -> SetB:
+    """``value`` as a :class:`SetB`, or :class:`MetricsError` naming the valid ones."""
+    try:
+        return SetB(value)
+    except ValueError as err:
+        raise MetricsError(f"set B {value!r}: expected one of {', '.join(SET_B)}") from err
 
 
 @dataclass(frozen=True)
@@ -110,16 +137,15 @@ def _size_spread(cells: Cells) -> tuple[float, float, float]:
     return lo, hi, float(np.log2(hi / lo))
 
 
-def set_b_points(mapper: Mapper, cells: Cells, rule: str = "corners") -> np.ndarray:
-    """Set B of the thesis' HD/MHD by ``rule`` (see :data:`SET_B`), (M, 3)."""
-    if rule not in SET_B:
-        raise MetricsError(f"set B {rule!r}: expected one of {', '.join(SET_B)}")
-    if rule == "corners" or (rule == "occupied" and mapper.dims == 3):
+def set_b_points(mapper: Mapper, cells: Cells, rule: SetB = SetB.CORNERS) -> np.ndarray:
+    """Set B of the thesis' HD/MHD by ``rule`` (see :class:`SetB`), (M, 3)."""
+    rule = set_b_rule(rule)
+    if rule is SetB.CORNERS or (rule is SetB.OCCUPIED and mapper.dims == 3):
         return mapper.corners()
     keep = np.isfinite(cells.centers).all(axis=1)
-    if mapper.dims == 3 or rule == "occupied":
+    if mapper.dims == 3 or rule is SetB.OCCUPIED:
         keep &= cells.occupied.astype(bool)
-    if rule == "occupied":
+    if rule is SetB.OCCUPIED:
         return rectangle_corners(cells, keep)
     return np.asarray(cells.centers[keep], dtype=np.float64)
 
@@ -137,18 +163,17 @@ def _thesis(points: np.ndarray, cloud: np.ndarray,
 
 def measure_map(mapper: Mapper, cloud: np.ndarray, *, elapsed_s: float | Timing,
                 truth: GroundTruth | None = None, options: TruthOptions | None = None,
-                set_b: str = "corners", reference: Reference | None = None,
+                set_b: SetB = SetB.CORNERS, reference: Reference | None = None,
                 cells: Cells | None = None) -> MapMetrics:
     """Every metric of ``mapper`` against the registered ``cloud`` (and ``truth``);
     ``elapsed_s``: the mapping's time (one wall reading, or a :class:`Timing`);
-    ``set_b`` defines the map's points of HD/MHD (:data:`SET_B`). ``reference``: the
+    ``set_b`` defines the map's points of HD/MHD (:class:`SetB`). ``reference``: the
     same ``cloud``, ``truth`` and ``options`` prepared once for many maps
     (:class:`~alte.metrics.reference.Reference`): the same values, with the work the
     maps of one input share done once. ``cells``: the map's cells when the caller has
     listed them already (a large Octomap's leaves take seconds to list)."""
     timing = elapsed_s if isinstance(elapsed_s, Timing) else Timing(float(elapsed_s))
-    if set_b not in SET_B:
-        raise MetricsError(f"set B {set_b!r}: expected one of {', '.join(SET_B)}")
+    set_b = set_b_rule(set_b)
     if reference is not None and not reference.matches(cloud, truth, options):
         raise MetricsError("measure_map: the reference was prepared from another cloud, "
                            "truth or truth options")

@@ -14,7 +14,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-from alte.metrics.maps import TruthOptions
+from alte.metrics.maps import SetB, TruthOptions
 from alte.studies.sweep.spec import SweepSpec
 from alte.studies.sweep.variants import Variant
 
@@ -33,7 +33,7 @@ class SweepRun:
     voxel: float | None = None
     truth: TruthOptions = field(default_factory=TruthOptions)
     domain: str = "auto"
-    set_b: str = "corners"
+    set_b: SetB = SetB.CORNERS
     sensor: str = "thesis"
     deskew: bool = True
     obstacles: bool = False
@@ -48,8 +48,8 @@ class SweepRun:
                "voxel": self.voxel, "truth": dataclasses.asdict(self.truth)}
         if self.domain != "auto":
             key["domain"] = self.domain
-        if self.set_b != "corners":
-            key["set_b"] = self.set_b
+        if self.set_b != SetB.CORNERS:
+            key["set_b"] = str(self.set_b)
         if self.sensor != "thesis":
             key["sensor"] = self.sensor
         if not self.deskew:

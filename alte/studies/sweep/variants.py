@@ -22,7 +22,7 @@ from typing import Any
 
 from alte.errors import AlteError, ParameterError
 from alte.mappers import DomainUse, make_mapper, mapper_class
-from alte.metrics.maps import SET_B
+from alte.metrics.maps import SET_B, SetB
 from alte.pipeline import DomainPolicy
 from alte.sim.profile import PROFILES
 
@@ -44,7 +44,7 @@ class Variant:
     name: str = BASE
     text: str = "the grid as specified"
     domain: str = DomainPolicy.AUTO.value
-    set_b: str = "corners"
+    set_b: SetB = SetB.CORNERS
     params: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)
     terrains: tuple[str, ...] = ()
     sensor: str = "thesis"
@@ -56,9 +56,9 @@ class Variant:
         return (DomainPolicy.AUTO.value if mapper_class(mapper).domain_use is DomainUse.UNUSED
                 else self.domain)
 
-    def set_b_for(self, mapper: str) -> str:
+    def set_b_for(self, mapper: str) -> SetB:
         """The set B a run of ``mapper`` gets (``occupied`` is ``corners`` in 3D)."""
-        return ("corners" if self.set_b == "occupied" and mapper_class(mapper).dims == 3
+        return (SetB.CORNERS if self.set_b is SetB.OCCUPIED and mapper_class(mapper).dims == 3
                 else self.set_b)
 
     def params_for(self, mapper: str, row: Mapping[str, Any]) -> dict[str, Any]:
@@ -119,7 +119,7 @@ def _variant(source: str, name: str, body: Any, terrains: tuple[str, ...],
     variant = Variant(
         name, str(body.get("text", "")),
         _choice(source, f"{key}.domain", body.get("domain", "auto"), DOMAINS),
-        _choice(source, f"{key}.set_b", body.get("set_b", "corners"), SET_B),
+        SetB(_choice(source, f"{key}.set_b", body.get("set_b", "corners"), SET_B)),
         _params(source, f"{key}.params", body.get("params", {}), mappers),
         tuple(dict.fromkeys(own)),
         _choice(source, f"{key}.sensor", body.get("sensor", "thesis"), tuple(PROFILES)),

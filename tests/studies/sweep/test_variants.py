@@ -6,6 +6,7 @@ import pandas as pd
 import pytest
 
 from alte.errors import ParameterError
+from alte.metrics.maps import SetB
 from alte.studies.sweep import (
     BASE,
     Variant,
@@ -70,9 +71,9 @@ def test_variants_run_only_what_they_change():
 
 
 def test_variant_helpers():
-    v = Variant("v", domain="data", set_b="occupied", params={"alte2d": {"kappa": 2.0}})
+    v = Variant("v", domain="data", set_b=SetB.OCCUPIED, params={"alte2d": {"kappa": 2.0}})
     assert v.domain_for("octomap") == "auto" and v.domain_for("alte2d") == "data"
-    assert v.set_b_for("alte3d") == "corners" and v.set_b_for("quadtree") == "occupied"
+    assert v.set_b_for("alte3d") is SetB.CORNERS and v.set_b_for("quadtree") is SetB.OCCUPIED
     assert v.params_for("alte2d", {"kappa": 1.0, "max_res": 3}) == {"kappa": 2.0, "max_res": 3}
     assert v.params_for("quadtree", {"max_points": 9}) == {"max_points": 9}
 
@@ -158,3 +159,10 @@ def test_an_odometry_variant_poses_the_whole_mission_then_keeps_the_sweeps_scans
     assert "poses" not in base[0].key() and base[0].poses == "recorded"
     assert run.input_key() == ("sim_nav_1", 4, 0, None, "uav", True, "odometry")
     assert base[0].input_key() == ("sim_nav_1", 4, 0, None, "thesis", True, "recorded")
+
+
+def test_a_variants_set_b_is_a_typed_choice():
+    spec = parse_spec(_raw(variants={"c": {"set_b": "centers"}}))
+    assert spec.variants[0].set_b is SetB.CENTERS
+    runs = [r for n, r in plan_variants(spec) if n == "c"]
+    assert runs and all(r.set_b is SetB.CENTERS and r.key()["set_b"] == "centers" for r in runs)
