@@ -9,17 +9,26 @@ Stamps are integer nanoseconds, as in ROS.
 
 from __future__ import annotations
 
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from typing import TypeAlias
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
 from alte.errors import ParameterError, PoseError
 
-__all__ = ["Box", "Counts", "Frame", "Mount", "RegisteredFrame", "Trajectory", "as_points",
-           "finite_rows", "rows_all", "thesis_mount"]
+__all__ = ["JSON", "Box", "Counts", "Frame", "JSONDict", "JSONMap", "Mount", "RegisteredFrame",
+           "Trajectory", "as_points", "finite_rows", "rows_all", "thesis_mount"]
 
 _NS = 1_000_000_000
+
+#: A value that JSON can hold (what results.json, run records and summaries carry).
+JSON: TypeAlias = "str | int | float | bool | Sequence[JSON] | Mapping[str, JSON] | None"
+#: A JSON object alte builds (mutable).
+JSONDict: TypeAlias = "dict[str, JSON]"
+#: A JSON object alte reads (read-only, so a ``dict[str, float]`` fits).
+JSONMap: TypeAlias = "Mapping[str, JSON]"
 
 
 class Counts:
