@@ -23,14 +23,17 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from alte.errors import ParameterError
-from alte.export.rosmsg import blank, header, pose, typestore
+from alte.export.rosmsg import blank, header, pose, time_msg, typestore
 from alte.ground.surface import SurfaceRule, classify_surface
 from alte.mappers import Cells
+
+if TYPE_CHECKING:  # rosbags declares its message classes' type for checkers only
+    from rosbags.typesys.store import MsgType
 
 __all__ = ["GRID_FIELDS", "Raster", "foxglove_grid", "grid_cells", "grid_map",
            "height_colours", "occupancy_grid", "raster"]
@@ -133,18 +136,18 @@ def raster(cells: Cells, shift: np.ndarray, max_cells: int = 4_000_000, dims: in
     return Raster(np.array([lo[0], lo[1]]), res, height, occupancy)
 
 
-def occupancy_grid(grid: Raster, stamp: int, frame: str) -> Any:
+def occupancy_grid(grid: Raster, stamp: int, frame: str) -> MsgType:
     """``nav_msgs/msg/OccupancyGrid`` of the raster (row-major from the origin cell)."""
     types = typestore().types
     rows, cols = grid.shape
     info = types["nav_msgs/msg/MapMetaData"](
-        header(stamp, frame).stamp, float(grid.resolution), cols, rows,
+        time_msg(stamp), float(grid.resolution), cols, rows,
         pose(np.array([grid.origin[0], grid.origin[1], grid.floor]), _IDENTITY))
     return types["nav_msgs/msg/OccupancyGrid"](header(stamp, frame), info,
                                                grid.occupancy.reshape(-1).astype(np.int8))
 
 
-def _layer(values: np.ndarray) -> Any:
+def _layer(values: np.ndarray) -> MsgType:
     """A grid_map layer: column-major over grid_map's indices (row = -x, column = -y)."""
     types = typestore().types
     gm = values[::-1, ::-1].T  # [x index from max x, y index from max y]
@@ -156,7 +159,7 @@ def _layer(values: np.ndarray) -> Any:
         layout, np.asarray(gm, dtype=np.float32).reshape(-1, order="F"))
 
 
-def grid_map(grid: Raster, stamp: int, frame: str) -> Any:
+def grid_map(grid: Raster, stamp: int, frame: str) -> MsgType:
     """``grid_map_msgs/msg/GridMap`` with layers ``elevation`` (m) and ``occupancy`` (0-100)."""
     rows, cols = grid.shape
     length = np.array([cols, rows], dtype=np.float64) * grid.resolution
@@ -182,7 +185,7 @@ def grid_cells(grid: Raster) -> np.ndarray:
     return cells
 
 
-def foxglove_grid(grid: Raster, stamp: int, frame: str) -> Any:
+def foxglove_grid(grid: Raster, stamp: int, frame: str) -> MsgType:
     """``foxglove_msgs/msg/Grid`` of the raster (row-major from the origin cell)."""
     types = typestore().types
     cols = grid.shape[1]
@@ -191,6 +194,6 @@ def foxglove_grid(grid: Raster, stamp: int, frame: str) -> Any:
     data = np.frombuffer(grid_cells(grid).tobytes(), dtype=np.uint8)
     corner = np.array([grid.origin[0], grid.origin[1], grid.floor - grid.resolution / 2])
     return types["foxglove_msgs/msg/Grid"](
-        header(stamp, frame).stamp, frame, pose(corner, _IDENTITY), cols,
+        time_msg(stamp), frame, pose(corner, _IDENTITY), cols,
         types["foxglove_msgs/msg/Vector2"](float(grid.resolution), float(grid.resolution)),
         cols * _CELL.itemsize, _CELL.itemsize, fields, data)

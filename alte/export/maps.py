@@ -12,13 +12,16 @@ from __future__ import annotations
 
 import tempfile
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from alte.export.grids import height_colours
 from alte.export.rosmsg import blank, header, pose, typestore
 from alte.mappers import Cells, Octomap
+
+if TYPE_CHECKING:  # rosbags declares its message classes' type for checkers only
+    from rosbags.typesys.store import MsgType
 
 __all__ = ["CUBE_LIST", "DELETEALL", "cell_markers", "octomap_msg", "shown_cells"]
 
@@ -38,8 +41,8 @@ def shown_cells(cells: Cells, dims: int, everything: bool = False) -> np.ndarray
     return shown
 
 
-def _cube_list(head: Any, ident: int, size: np.ndarray, centers: np.ndarray,
-               colours: np.ndarray) -> Any:
+def _cube_list(head: MsgType, ident: int, size: np.ndarray, centers: np.ndarray,
+               colours: np.ndarray) -> MsgType:
     types = typestore().types
     point, rgba = types["geometry_msgs/msg/Point"], types["std_msgs/msg/ColorRGBA"]
     return blank("visualization_msgs/msg/Marker", header=head, ns="cells",
@@ -52,7 +55,7 @@ def _cube_list(head: Any, ident: int, size: np.ndarray, centers: np.ndarray,
 
 
 def cell_markers(cells: Cells, mask: np.ndarray, stamp: int, frame: str,
-                 shift: np.ndarray) -> Any:
+                 shift: np.ndarray) -> MsgType:
     """MarkerArray of the masked cells (centres moved back by the local ``shift``)."""
     centers = cells.centers[mask] + shift
     sizes = cells.sizes[mask].copy()
@@ -68,7 +71,7 @@ def cell_markers(cells: Cells, mask: np.ndarray, stamp: int, frame: str,
     return typestore().types["visualization_msgs/msg/MarkerArray"](markers)
 
 
-def octomap_msg(mapper: Octomap, stamp: int, frame: str) -> Any:
+def octomap_msg(mapper: Octomap, stamp: int, frame: str) -> MsgType:
     """The binary tree of ``mapper`` (its ``.bt`` payload) as ``octomap_msgs/msg/Octomap``."""
     with tempfile.TemporaryDirectory() as tmp:
         path = mapper.write_bt(Path(tmp) / "map.bt")

@@ -35,7 +35,6 @@ import tempfile
 from importlib.metadata import version
 from pathlib import Path
 from types import TracebackType
-from typing import Any
 
 import yaml
 from mcap.reader import make_reader
@@ -43,6 +42,7 @@ from mcap.writer import CompressionType, Writer
 from rosbags.interfaces import Qos, QosDurability, QosHistory, QosLiveliness, QosReliability
 from rosbags.interfaces import QosTime as Time
 from rosbags.rosbag2.metadata import dump_qos_v9
+from rosbags.typesys.store import Typestore
 
 from alte.fsutil import atomic_path
 
@@ -83,7 +83,7 @@ def _qos(topic: str) -> str:
 class _Channels:
     """Schemas and channels of one MCAP writer, registered on first use per topic."""
 
-    def __init__(self, writer: Writer, store: Any) -> None:
+    def __init__(self, writer: Writer, store: Typestore) -> None:
         self.writer, self.store = writer, store
         self.schemas: dict[str, int] = {}
         self.ids: dict[str, int] = {}
@@ -129,7 +129,7 @@ class McapFile:
         self._channels = _Channels(self._writer, self._store)
         return self
 
-    def put(self, topic: str, stamp: int, message: Any, opening: bool = False) -> None:
+    def put(self, topic: str, stamp: int, message: object, opening: bool = False) -> None:
         """Serialise ``message`` and log it on ``topic`` at ``stamp`` (ns)."""
         if self._writer is None:
             raise RuntimeError("McapFile.put outside its with block")

@@ -12,16 +12,21 @@ as the store's own classes (typed fields).
 from __future__ import annotations
 
 from functools import cache
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
+from rosbags.interfaces import Nodetype
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 from rosbags.typesys.store import Typestore
 
-from alte.io.pointcloud2 import encode_pointcloud2, make_header
+from alte.io.pointcloud2 import encode_pointcloud2, make_header, make_time
+
+if TYPE_CHECKING:  # rosbags declares its message classes' types for checkers only
+    from rosbags.interfaces.typing import FieldDesc, Typesdict
+    from rosbags.typesys.store import Msgarg, MsgType
 
 __all__ = ["EXTRA_MSGDEFS", "blank", "cloud_msg", "header", "path_msg", "pose", "pose_stamped",
-           "tf_msg", "typestore"]
+           "tf_msg", "time_msg", "typestore"]
 
 #: Message definitions registered on top of ROS 2 Humble (ROS 2 versions of the packages).
 EXTRA_MSGDEFS: dict[str, str] = {
@@ -83,34 +88,35 @@ _NUMPY = {"bool": np.bool_, "int8": np.int8, "uint8": np.uint8, "byte": np.uint8
 def typestore() -> Typestore:
     """ROS 2 Humble types plus :data:`EXTRA_MSGDEFS` (one store per process)."""
     store = get_typestore(Stores.ROS2_HUMBLE)
-    types: dict[str, Any] = {}
+    types: Typesdict = {}
     for name, text in EXTRA_MSGDEFS.items():
         types.update(get_types_from_msg(text, name))
     store.register(types)
     return store
 
 
-def _blank_field(kind: Any, spec: Any) -> Any:
+def _blank_field(desc: FieldDesc) -> Msgarg:
     """Default value of one field definition (rosbags' ``(node type, details)`` pair)."""
-    name = kind.name
-    if name == "NAME":
-        return blank(spec)
-    if name == "BASE":
-        base = spec[0]
+    if desc[0] == Nodetype.NAME:
+        return blank(desc[1])
+    if desc[0] == Nodetype.BASE:
+        base = desc[1][0]
         return "" if base in {"string", "wstring"} else _NUMPY[base](0).item()
-    inner_kind, inner = spec[0]
-    if inner_kind.name == "BASE" and inner[0] in _NUMPY:
-        return np.zeros(spec[1] if name == "ARRAY" else 0, dtype=_NUMPY[inner[0]])
-    if name == "ARRAY":
-        return [_blank_field(inner_kind, inner) for _ in range(spec[1])]
+    inner, size = desc[1]
+    if inner[0] == Nodetype.BASE and inner[1][0] in _NUMPY:
+        return np.zeros(size if desc[0] == Nodetype.ARRAY else 0, dtype=_NUMPY[inner[1][0]])
+    if desc[0] == Nodetype.ARRAY:
+        if inner[0] == Nodetype.NAME:
+            return [blank(inner[1]) for _ in range(size)]
+        return [str(_blank_field(inner)) for _ in range(size)]
     return []
 
 
-def blank(msgtype: str, **values: Any) -> Any:
+def blank(msgtype: str, **values: Msgarg) -> MsgType:
     """A ``msgtype`` message with every field at its ROS default except ``values``."""
     store = typestore()
     fields = store.fielddefs[msgtype][1]
-    given = {name: values[name] if name in values else _blank_field(*definition)
+    given = {name: values[name] if name in values else _blank_field(definition)
              for name, definition in fields}
     unknown = set(values) - {name for name, _ in fields}
     if unknown:
@@ -118,12 +124,17 @@ def blank(msgtype: str, **values: Any) -> Any:
     return store.types[msgtype](**given)
 
 
-def header(stamp_ns: int, frame_id: str) -> Any:
+def time_msg(stamp_ns: int) -> MsgType:
+    """``builtin_interfaces/msg/Time``."""
+    return make_time(stamp_ns, typestore())
+
+
+def header(stamp_ns: int, frame_id: str) -> MsgType:
     """``std_msgs/msg/Header``."""
     return make_header(stamp_ns, frame_id, typestore())
 
 
-def pose(position: np.ndarray, quaternion: np.ndarray) -> Any:
+def pose(position: np.ndarray, quaternion: np.ndarray) -> MsgType:
     """``geometry_msgs/msg/Pose`` from a position and an (x, y, z, w) quaternion."""
     types = typestore().types
     return types["geometry_msgs/msg/Pose"](
@@ -132,14 +143,14 @@ def pose(position: np.ndarray, quaternion: np.ndarray) -> Any:
 
 
 def pose_stamped(stamp_ns: int, frame_id: str, position: np.ndarray,
-                 quaternion: np.ndarray) -> Any:
+                 quaternion: np.ndarray) -> MsgType:
     """``geometry_msgs/msg/PoseStamped``."""
     return typestore().types["geometry_msgs/msg/PoseStamped"](
         header(stamp_ns, frame_id), pose(position, quaternion))
 
 
 def path_msg(stamp_ns: int, frame_id: str, stamps: np.ndarray, positions: np.ndarray,
-             quaternions: np.ndarray) -> Any:
+             quaternions: np.ndarray) -> MsgType:
     """``nav_msgs/msg/Path`` through the given poses (each stamped with its own time)."""
     poses = [pose_stamped(int(s), frame_id, p, q)
              for s, p, q in zip(stamps, positions, quaternions, strict=True)]
@@ -147,7 +158,7 @@ def path_msg(stamp_ns: int, frame_id: str, stamps: np.ndarray, positions: np.nda
 
 
 def tf_msg(stamp_ns: int, parent: str, child: str, translation: np.ndarray,
-           quaternion: np.ndarray) -> Any:
+           quaternion: np.ndarray) -> MsgType:
     """``tf2_msgs/msg/TFMessage`` holding one ``parent -> child`` transform."""
     types = typestore().types
     transform = types["geometry_msgs/msg/Transform"](
@@ -158,6 +169,6 @@ def tf_msg(stamp_ns: int, parent: str, child: str, translation: np.ndarray,
     return types["tf2_msgs/msg/TFMessage"]([stamped])
 
 
-def cloud_msg(points: np.ndarray, stamp_ns: int, frame_id: str) -> Any:
+def cloud_msg(points: np.ndarray, stamp_ns: int, frame_id: str) -> MsgType:
     """``sensor_msgs/msg/PointCloud2`` of (N, 3) points (float32 x, y, z)."""
     return encode_pointcloud2(points, stamp_ns, frame_id, typestore())

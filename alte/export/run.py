@@ -14,7 +14,6 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
@@ -108,7 +107,7 @@ class MapExporter:
         if not opening:
             self.last_map = index
 
-    def _put(self, stamp: int, opening: bool) -> Callable[[str, Any], None]:
+    def _put(self, stamp: int, opening: bool) -> Callable[[str, object], None]:
         """``put(topic, message)`` at ``stamp``, streamed or kept for the opening."""
         return lambda topic, message: self.out.put(topic, stamp, message, opening)
 

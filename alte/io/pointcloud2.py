@@ -27,6 +27,7 @@ __all__ = [
     "decode_timed",
     "encode_pointcloud2",
     "make_header",
+    "make_time",
 ]
 
 #: ``sensor_msgs/PointField`` datatype code -> numpy scalar type.
@@ -229,8 +230,13 @@ def encode_pointcloud2(
     )
 
 
+def make_time(stamp_ns: int, typestore: Typestore) -> MsgType:
+    """A ``builtin_interfaces/msg/Time`` for ``stamp_ns``."""
+    sec, nanosec = divmod(int(stamp_ns), 1_000_000_000)
+    return typestore.types["builtin_interfaces/msg/Time"](sec=sec, nanosec=nanosec)
+
+
 def make_header(stamp_ns: int, frame_id: str, typestore: Typestore) -> MsgType:
     """A ``std_msgs/msg/Header`` for ``stamp_ns``."""
-    sec, nanosec = divmod(int(stamp_ns), 1_000_000_000)
-    stamp = typestore.types["builtin_interfaces/msg/Time"](sec=sec, nanosec=nanosec)
-    return typestore.types["std_msgs/msg/Header"](stamp=stamp, frame_id=frame_id)
+    return typestore.types["std_msgs/msg/Header"](stamp=make_time(stamp_ns, typestore),
+                                                  frame_id=frame_id)
