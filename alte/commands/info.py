@@ -10,10 +10,9 @@ from __future__ import annotations
 import argparse
 import json
 from pathlib import Path
-from typing import Any
 
 from alte.io.baginfo import BagInfo, inspect_bag
-from alte.io.pointfiles import describe_points
+from alte.io.pointfiles import PointSummary, describe_points
 from alte.pipeline import InputKind, Source, open_input
 
 __all__ = ["add_parser", "format_info", "format_points", "imu_topics", "odometry_choice",
@@ -99,7 +98,7 @@ def format_terrain(terrain: dict[str, object]) -> list[str]:
             f"voxel:     {terrain['voxel']} m (registration grid)"]
 
 
-def format_points(about: dict[str, Any]) -> list[str]:
+def format_points(about: PointSummary) -> list[str]:
     """Human-readable lines describing a point file (:func:`describe_points`)."""
     fields = ", ".join(f"{f['name']} {f['type']}" + (f" x{f['count']}" if f["count"] > 1 else "")
                        for f in about["fields"])

@@ -51,7 +51,7 @@ class HeaderMsg(Protocol):
 
 
 class StampedMsg(Protocol):
-    """Any message with a header (clouds, scans, stamped poses)."""
+    """A message with a header (clouds, scans, stamped poses)."""
 
     @property
     def header(self) -> HeaderMsg: ...

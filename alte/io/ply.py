@@ -9,16 +9,38 @@ through open3d's tensor reader. A body shorter than the header announces is refu
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import NotRequired, TypedDict
 
 import numpy as np
 
 from alte.errors import PointFileError
 from alte.io.pcd import read_table
 
-__all__ = ["Fields", "ply_layout", "read_ply", "write_ply"]
+__all__ = ["FieldInfo", "Fields", "FileAbout", "ply_layout", "read_ply", "write_ply"]
 
 Fields = dict[str, np.ndarray]
+
+
+class FieldInfo(TypedDict):
+    """One field a point file declares: its name, type (as the file spells it) and values
+    per point."""
+
+    name: str
+    type: str
+    count: int
+
+
+class FileAbout(TypedDict):
+    """What a point file says of itself (a JSON object of ``alte info --json``): format,
+    encoding and declared fields; a PCD also its layout and viewpoint."""
+
+    format: str
+    encoding: str
+    fields: list[FieldInfo]
+    width: NotRequired[int]
+    height: NotRequired[int]
+    viewpoint: NotRequired[list[float]]
+
 _PLY_SIZES = {"char": 1, "int8": 1, "uchar": 1, "uint8": 1, "short": 2, "int16": 2,
               "ushort": 2, "uint16": 2, "int": 4, "int32": 4, "uint": 4, "uint32": 4,
               "float": 4, "float32": 4, "double": 8, "float64": 8}
@@ -83,11 +105,11 @@ def _vertex_dtype(fmt: str, lines: list[list[str]]) -> np.dtype | None:
     return np.dtype([(w[2], order[fmt] + _PLY_NUMPY[w[1]]) for w in props])
 
 
-def read_ply(path: Path) -> tuple[np.ndarray, Fields, dict[str, Any]]:
+def read_ply(path: Path) -> tuple[np.ndarray, Fields, FileAbout]:
     """A point-cloud PLY (one vertex element) read with numpy, every property kept (red,
     green, blue as ``colors``); other PLYs through open3d's tensor reader."""
     fmt, start, lines = _check_ply_complete(path)
-    about = {"format": "PLY", "encoding": fmt, "fields": [
+    about: FileAbout = {"format": "PLY", "encoding": fmt, "fields": [
         {"name": w[-1], "type": " ".join(w[1:-1]), "count": 1}
         for w in lines if w[0] == "property"]}
     dtype = _vertex_dtype(fmt, lines)

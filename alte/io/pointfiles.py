@@ -19,7 +19,6 @@ import os
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
@@ -28,6 +27,7 @@ from alte.fsutil import atomic_path
 from alte.io.pcd import read_pcd_table, write_pcd
 from alte.io.pointformats import (
     Fields,
+    FileAbout,
     local_origin,
     read_las,
     read_npz,
@@ -44,6 +44,7 @@ __all__ = [
     "READ_SUFFIXES",
     "WRITE_SUFFIXES",
     "PointFileInfo",
+    "PointSummary",
     "PointTable",
     "describe_points",
     "local_origin",
@@ -67,7 +68,7 @@ class PointTable:
 
     points: np.ndarray
     fields: Fields
-    about: dict[str, Any]
+    about: FileAbout
 
 
 @dataclass(frozen=True)
@@ -81,6 +82,21 @@ class PointFileInfo:
     fields: Fields = field(default_factory=dict)
 
 
+class PointSummary(FileAbout):
+    """What a point file holds (``alte info FILE``; its ``--json`` object): the file's own
+    description, its rows, finite points and non-finite rows (those with NaN apart), the
+    finite points' bounds ``[[xmin, ymin, zmin], [xmax, ymax, zmax]]`` (None without any)
+    and each numeric field's ``[min, max]``."""
+
+    file: str
+    rows: int
+    points: int
+    nonfinite: int
+    nan: int
+    bounds: list[list[float]] | None
+    field_ranges: dict[str, list[float]]
+
+
 def _suffix(path: Path) -> str:
     suffixes = [s.lower() for s in path.suffixes[-2:]]
     if len(suffixes) == 2 and suffixes[1] == ".bz2":
@@ -88,15 +104,15 @@ def _suffix(path: Path) -> str:
     return suffixes[-1] if suffixes else ""
 
 
-def _read_pcd(path: Path) -> tuple[np.ndarray, Fields, dict[str, Any]]:
+def _read_pcd(path: Path) -> tuple[np.ndarray, Fields, FileAbout]:
     head, points, fields = read_pcd_table(path)
-    about = {"format": f"PCD {head.version}", "encoding": head.encoding,
+    about: FileAbout = {"format": f"PCD {head.version}", "encoding": head.encoding,
              "fields": [{"name": n, "type": f"{t}{s}", "count": c} for n, s, t, c in head.fields],
              "width": head.width, "height": head.height, "viewpoint": list(head.viewpoint)}
     return points, fields, about
 
 
-_READERS: dict[str, Callable[[Path], tuple[np.ndarray, Fields, dict[str, Any]]]] = {
+_READERS: dict[str, Callable[[Path], tuple[np.ndarray, Fields, FileAbout]]] = {
     ".pcd": _read_pcd, ".ply": read_ply, ".las": read_las, ".laz": read_las, ".npz": read_npz}
 _READERS |= {s: read_text for s in READ_SUFFIXES if s.startswith(_TEXT)}
 
@@ -137,7 +153,7 @@ def read_points_info(path: str | os.PathLike[str]) -> PointFileInfo:
     return PointFileInfo(kept, len(points), int(len(points) - len(kept)), fields)
 
 
-def describe_points(path: str | os.PathLike[str]) -> dict[str, Any]:
+def describe_points(path: str | os.PathLike[str]) -> PointSummary:
     """What a point file holds (``alte info FILE``): format, encoding, fields, rows,
     finite points, non-finite rows, the finite points' bounds, and per field its range."""
     table = read_point_table(path)

@@ -19,17 +19,17 @@ from __future__ import annotations
 
 import datetime
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 import pandas as pd
 
 from alte.errors import ParameterError, PointFileError
 from alte.io.pcd import read_table
-from alte.io.ply import Fields, read_ply, write_ply
+from alte.io.ply import FieldInfo, Fields, FileAbout, read_ply, write_ply
 
-__all__ = ["Fields", "local_origin", "read_las", "read_npz", "read_ply", "read_text",
-           "storable", "write_las", "write_npz", "write_ply", "write_text"]
+__all__ = ["FieldInfo", "Fields", "FileAbout", "local_origin", "read_las", "read_npz",
+           "read_ply", "read_text", "storable", "write_las", "write_npz", "write_ply",
+           "write_text"]
 
 _LAS_SCALE = 1e-4
 #: The header's creation day: fixed, as numpy fixes the dates inside ``.npz`` files, so the
@@ -43,7 +43,7 @@ _LAS_RESERVED = frozenset({"x", "y", "z", "intensity", "return_number", "number_
                            "user_data", "scan_angle", "point_source_id", "gps_time", "red",
                            "green", "blue", "nir"})
 
-def _describe(fields: Fields) -> list[dict[str, Any]]:
+def _describe(fields: Fields) -> list[FieldInfo]:
     return [{"name": k, "type": str(v.dtype), "count": int(np.prod(v.shape[1:], dtype=int))}
             for k, v in fields.items()]
 
@@ -51,7 +51,7 @@ def _describe(fields: Fields) -> list[dict[str, Any]]:
 # ------------------------------------------------------------------------------ LAS
 
 
-def read_las(path: Path) -> tuple[np.ndarray, Fields, dict[str, Any]]:
+def read_las(path: Path) -> tuple[np.ndarray, Fields, FileAbout]:
     import laspy
 
     las = laspy.read(path)
@@ -65,11 +65,13 @@ def read_las(path: Path) -> tuple[np.ndarray, Fields, dict[str, Any]]:
             fields["colors"] = (rgb >> 8 if rgb.max() > 255 else rgb).astype(np.uint8)
     for name in las.point_format.extra_dimension_names:
         fields[name] = np.asarray(las[name])
-    about = {"format": f"LAS {las.header.version} point format {las.header.point_format.id}",
-             "encoding": "laz" if path.suffix.lower() == ".laz" else "las",
-             "fields": [{"name": d.name, "type": str(d.dtype) if d.dtype is not None
-                         else f"{d.num_bits} bit", "count": 1}
-                        for d in las.point_format.dimensions]}
+    head = las.header
+    about: FileAbout = {
+        "format": f"LAS {head.version} point format {head.point_format.id}",
+        "encoding": "laz" if path.suffix.lower() == ".laz" else "las",
+        "fields": [{"name": d.name, "type": str(d.dtype) if d.dtype is not None
+                    else f"{d.num_bits} bit", "count": 1}
+                   for d in las.point_format.dimensions]}
     return points, fields, about
 
 
@@ -109,32 +111,34 @@ def write_las(tmp: Path, points: np.ndarray, fields: Fields, compress: bool) -> 
 # ------------------------------------------------------------------------------ npz, text
 
 
-def read_npz(path: Path) -> tuple[np.ndarray, Fields, dict[str, Any]]:
+def read_npz(path: Path) -> tuple[np.ndarray, Fields, FileAbout]:
     with np.load(path, allow_pickle=False) as archive:
         if "points" not in archive.files:
             raise PointFileError(f"{path}: no 'points' array (has {archive.files})")
         points = np.asarray(archive["points"], dtype=np.float64)
         fields = {k: archive[k] for k in archive.files if k != "points"
                   and archive[k].ndim >= 1 and len(archive[k]) == len(points)}
-    about = {"format": "npz", "encoding": "zip", "fields": [
+    about: FileAbout = {"format": "npz", "encoding": "zip", "fields": [
         {"name": "points", "type": "float64", "count": 3}, *_describe(fields)]}
     return points, fields, about
 
 
 def write_npz(tmp: Path, points: np.ndarray, fields: Fields) -> None:
     with open(tmp, "wb") as fh:  # a handle stops numpy appending ".npz"
-        arrays: dict[str, Any] = {"points": points, **fields}
-        np.savez_compressed(fh, **arrays)
+        arrays: Fields = {"points": points, **fields}
+        np.savez_compressed(fh, allow_pickle=True, **arrays)
 
 
-def read_text(path: Path) -> tuple[np.ndarray, Fields, dict[str, Any]]:
+def read_text(path: Path) -> tuple[np.ndarray, Fields, FileAbout]:
     table = read_table(path)
     if table.shape[1] < 3:
         raise PointFileError(f"{path}: {table.shape[1]} column(s); expected x y z per line")
-    about = {"format": "text", "encoding": "bzip2" if path.suffix.lower() == ".bz2" else "ascii",
-             "fields": [{"name": c, "type": "text", "count": 1} for c in "xyz"]
-             + [{"name": f"column {k + 1} (ignored)", "type": "text", "count": 1}
-                for k in range(3, table.shape[1])]}
+    described: list[FieldInfo] = [{"name": c, "type": "text", "count": 1} for c in "xyz"]
+    described += [{"name": f"column {k + 1} (ignored)", "type": "text", "count": 1}
+                  for k in range(3, table.shape[1])]
+    about: FileAbout = {"format": "text",
+                        "encoding": "bzip2" if path.suffix.lower() == ".bz2" else "ascii",
+                        "fields": described}
     return table.iloc[:, :3].to_numpy(np.float64), {}, about
 
 
