@@ -8,15 +8,20 @@ it is. A run's page is built as data first (:mod:`alte.report.page`), then rende
 from __future__ import annotations
 
 import os
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING
 
 from alte.errors import ReportError
 from alte.fsutil import atomic_path
 from alte.report.page import run_page
+from alte.report.runs import record_runs
+from alte.types import JSONMap
+
+if TYPE_CHECKING:
+    import jinja2
 
 __all__ = ["notebook_to_html", "run_index_html", "top_index_html", "write_html"]
 
@@ -44,7 +49,7 @@ def notebook_to_html(ipynb: str | os.PathLike[str], out: str | os.PathLike[str])
 
 
 @cache
-def _environment() -> Any:
+def _environment() -> jinja2.Environment:
     import jinja2
 
     return jinja2.Environment(loader=jinja2.PackageLoader("alte.report", "templates"),
@@ -52,7 +57,7 @@ def _environment() -> Any:
                               trim_blocks=True, lstrip_blocks=True, keep_trailing_newline=True)
 
 
-def _render(template: str, **context: Any) -> str:
+def _render(template: str, **context: object) -> str:
     import jinja2
 
     try:
@@ -61,7 +66,7 @@ def _render(template: str, **context: Any) -> str:
         raise ReportError(f"report template {template}: {err}") from err
 
 
-def run_index_html(record: Mapping[str, Any], run_dir: str | os.PathLike[str],
+def run_index_html(record: JSONMap, run_dir: str | os.PathLike[str],
                    tables: Sequence[Path]) -> str:
     """A run's front page: claims and verdicts, trade-offs, key tables, then each
     chapter's results and captioned figures, failures flagged at the top."""
@@ -79,17 +84,17 @@ class _Listed:
     state: str
 
 
-def _listed(rel: str, record: Mapping[str, Any] | None) -> _Listed:
+def _listed(rel: str, record: JSONMap | None) -> _Listed:
     name, href = Path(rel).name, f"{rel}/index.html"
     if record is None:
         return _Listed(name, href, "", None, None, "interrupted (unfinished)")
-    runs = record["runs"]
+    runs = record_runs(record)
     bad = sum(r["status"] != "ok" for r in runs)
     state = f"{record['mode']}, {len(runs)} runs, {bad} failed"
     return _Listed(name, href, str(record["mode"]), len(runs), bad, state)
 
 
-def top_index_html(runs: Sequence[tuple[str, Mapping[str, Any] | None]],
+def top_index_html(runs: Sequence[tuple[str, JSONMap | None]],
                    latest: str | None) -> str:
     """``reports/index.html``: a link to the latest run and every run, newest first."""
     return _render("top.html.j2", title="alte reports", latest=latest,

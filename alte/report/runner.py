@@ -11,12 +11,12 @@ from __future__ import annotations
 
 import os
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from concurrent.futures import ThreadPoolExecutor, as_completed
 from dataclasses import asdict, dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Protocol
 
 from tqdm.auto import tqdm
 
@@ -25,11 +25,19 @@ from alte.paths import REPO_ROOT
 from alte.report.html import notebook_to_html, run_index_html, top_index_html, write_html
 from alte.report.plan import Run
 from alte.report.runs import list_runs, new_run_dir, point_latest, publish_tables, write_record
+from alte.types import JSONDict
+
+if TYPE_CHECKING:
+    from traitlets.config import Config
 
 __all__ = ["Report", "RunResult", "ensure_terrains", "execute_run", "run_report"]
 
-#: ``ensure(name, out_dir=..., seed=..., frames=...)`` makes a terrain's data exist.
-EnsureTerrain = Callable[..., Any]
+class EnsureTerrain(Protocol):
+    """``ensure(name, out_dir=..., seed=..., frames=...)`` makes a terrain's data exist
+    (:func:`alte.sim.ensure_terrain`; frames None: the whole mission)."""
+
+    def __call__(self, name: str, *, out_dir: Path, seed: int, frames: int | None) -> object:
+        ...
 
 
 @dataclass
@@ -42,7 +50,7 @@ class RunResult:
     notebook: str | None = None
     html: str | None = None
     error: str | None = None
-    parameters: dict[str, Any] = field(default_factory=dict)
+    parameters: JSONDict = field(default_factory=dict)
 
 
 @dataclass
@@ -101,13 +109,13 @@ def ensure_terrains(runs: Sequence[Run], data_dir: Path, ensure: EnsureTerrain |
     return errors
 
 
-def _injected(run: Run, run_dir: Path, data_dir: Path) -> dict[str, Any]:
+def _injected(run: Run, run_dir: Path, data_dir: Path) -> dict[str, str]:
     given = {"OUT_DIR": run_dir / run.name, "TABLES_DIR": run_dir / "tables",
              "DATA_DIR": data_dir}
     return {k: str(v) for k, v in given.items() if k in run.defaults}
 
 
-def _kernel_config() -> Any:
+def _kernel_config() -> Config:
     """Kernels encrypt their local TCP traffic (CurveZMQ, which the python3 kernelspec
     declares) when pyzmq can, instead of ipykernel warning about plain text per run."""
     import zmq
@@ -122,7 +130,7 @@ def execute_run(run: Run, run_dir: Path, data_dir: Path, cwd: Path = REPO_ROOT,
     """Execute one notebook into ``run_dir``; failures are returned, never raised."""
     import papermill
 
-    params = {**run.parameters, **_injected(run, run_dir, data_dir)}
+    params: JSONDict = {**run.parameters, **_injected(run, run_dir, data_dir)}
     tmp = run_dir / f".{run.name}.part.ipynb"
     start = time.perf_counter()
     status, error = "ok", None
@@ -192,7 +200,7 @@ def run_report(runs: Sequence[Run], reports: str | os.PathLike[str],
                            cwd=Path(cwd))
     tables = sorted((run_dir / "tables").glob("*.csv"))
     seconds = time.perf_counter() - t0
-    record = {"mode": "quick" if quick else "full",
+    record: JSONDict = {"mode": "quick" if quick else "full",
               "started": started.isoformat(timespec="seconds"), "seconds": seconds,
               "runs": [asdict(r) for r in results],
               "problems": sorted(skip.values()), "tables": [t.name for t in tables]}

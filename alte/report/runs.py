@@ -11,13 +11,14 @@ from __future__ import annotations
 import json
 import os
 import shutil
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from datetime import UTC, datetime
 from pathlib import Path
-from typing import Any
 
 from alte.errors import ReportError
 from alte.fsutil import atomic_path
+from alte.types import JSONDict, JSONMap
 
 __all__ = [
     "RUN_RECORD",
@@ -27,6 +28,7 @@ __all__ = [
     "point_latest",
     "publish_tables",
     "read_record",
+    "record_runs",
     "write_record",
 ]
 
@@ -39,7 +41,7 @@ class RunInfo:
     """A run folder and its record (``None`` when the run never finished)."""
 
     path: Path
-    record: dict[str, Any] | None
+    record: JSONDict | None
 
     @property
     def finished(self) -> bool:
@@ -75,7 +77,7 @@ def point_latest(reports: str | os.PathLike[str], run_dir: str | os.PathLike[str
     return link
 
 
-def write_record(run_dir: str | os.PathLike[str], record: dict[str, Any]) -> Path:
+def write_record(run_dir: str | os.PathLike[str], record: JSONMap) -> Path:
     """Write ``run.json`` (atomically, once): the run is finished from then on."""
     path = Path(run_dir) / RUN_RECORD
     with atomic_path(path) as tmp:
@@ -84,16 +86,24 @@ def write_record(run_dir: str | os.PathLike[str], record: dict[str, Any]) -> Pat
     return path
 
 
-def read_record(run_dir: str | os.PathLike[str]) -> dict[str, Any] | None:
+def read_record(run_dir: str | os.PathLike[str]) -> JSONDict | None:
     """The run's record, or ``None`` for a run that did not finish."""
     path = Path(run_dir) / RUN_RECORD
     try:
-        record: dict[str, Any] = json.loads(path.read_text())
+        record: JSONDict = json.loads(path.read_text())
         return record
     except FileNotFoundError:
         return None
     except ValueError as err:
         raise ReportError(f"{path}: corrupt run record ({err})") from err
+
+
+def record_runs(record: JSONMap) -> list[JSONMap]:
+    """The notebook runs of a run record (its ``runs``: one object per notebook)."""
+    runs = record.get("runs", [])
+    if isinstance(runs, str) or not isinstance(runs, Sequence):
+        return []
+    return [r for r in runs if isinstance(r, Mapping)]
 
 
 def list_runs(reports: str | os.PathLike[str]) -> list[RunInfo]:

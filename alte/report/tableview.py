@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
 
 import pandas as pd
 
@@ -55,7 +54,7 @@ def header(column: str) -> str:
     return column.replace("_", " ")
 
 
-def cell_text(value: Any, column: str = "") -> str:
+def cell_text(value: object, column: str = "") -> str:
     """One value as text: mapper names spelled out, numbers to 4 significant digits."""
     if value is None or (isinstance(value, float) and math.isnan(value)):
         return "\u2013"  # an en dash
