@@ -17,7 +17,7 @@ import os
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, NotRequired, TypedDict
 
 import numpy as np
 
@@ -29,15 +29,16 @@ from alte.sim.profile import PROFILES, SensorProfile
 from alte.sim.scene import Scene
 from alte.sim.sensor import VLP16
 from alte.sim.terrains import TERRAINS, Terrain
-from alte.types import Mount
+from alte.types import JSONDict, Mount
 
 if TYPE_CHECKING:
     from alte.io.imu import ImuSamples
     from alte.io.writer import Cloud
 
-__all__ = ["BAG_DIR", "IMU_TOPIC", "SCENARIO_FILE", "SIM_VERSION", "Scenario", "ensure_terrain",
-           "get_terrain", "is_current", "load_metadata", "load_scenario", "profile_label",
-           "spec_hash", "terrain_folder", "update_terrain", "write_scenario"]
+__all__ = ["BAG_DIR", "IMU_TOPIC", "SCENARIO_FILE", "SIM_VERSION", "MountMeta", "Scenario",
+           "ScenarioMeta", "ensure_terrain", "get_terrain", "is_current", "load_metadata",
+           "load_scenario", "profile_label", "spec_hash", "terrain_folder", "update_terrain",
+           "write_scenario"]
 
 #: Bump when the simulator's output changes for the same spec (invalidates caches).
 SIM_VERSION = 1
@@ -92,12 +93,34 @@ def _file_table(root: Path) -> dict[str, dict[str, int | str]]:
     return table
 
 
-def _mount_dict(mount: Mount) -> dict[str, Any]:
+class MountMeta(TypedDict):
+    """A sensor mount in ``scenario.json``: offset (m), quaternion (x, y, z, w) and the
+    ``--mount`` string ``x,y,z,roll,pitch,yaw``."""
+
+    translation: list[float]
+    quaternion: list[float]
+    xyz_rpy_deg: str
+
+
+class ScenarioMeta(TypedDict):
+    """What the pipeline reads of ``scenario.json`` (:func:`load_metadata` checks these keys
+    are there; the file holds more: the spec, sensor, counts, files, ...)."""
+
+    name: str
+    case: str
+    bag: str
+    crop_box: list[float]
+    registration_voxel: float
+    mount: MountMeta
+    title: NotRequired[str]
+
+
+def _mount_dict(mount: Mount) -> MountMeta:
     return {"translation": mount.translation.tolist(), "quaternion": mount.quaternion.tolist(),
             "xyz_rpy_deg": mount.to_string()}
 
 
-def _metadata(terrain: Terrain, sim: Simulation, run: dict[str, Any]) -> dict[str, Any]:
+def _metadata(terrain: Terrain, sim: Simulation, run: JSONDict) -> JSONDict:
     spec = terrain.spec
     control = list(spec.crop_box) if spec.kind == "exp" else None
     return {
@@ -132,7 +155,7 @@ def write_scenario(target: str | os.PathLike[str], terrain: Terrain, sim: Simula
                   sim.mount, cloud_topic=CLOUD_TOPIC, pose_topic=POSE_TOPIC, storage=storage,
                   progress=progress, imu=_imu_samples(sim))
         write_ground_truth(tmp / GROUND_TRUTH_FILE, terrain.scene)
-        run = {"seed": int(seed), "frames_requested": frames, "spec_hash": key,
+        run: JSONDict = {"seed": int(seed), "frames_requested": frames, "spec_hash": key,
                "storage": storage}
         meta = _metadata(terrain, sim, run)
         meta["files"] = _file_table(tmp)
@@ -166,7 +189,7 @@ def _imu_samples(sim: Simulation) -> ImuSamples | None:
 def is_current(folder: Path, key: str, seed: int) -> bool:
     """True when ``folder`` holds a finished simulation with this spec hash and seed."""
     try:
-        meta = json.loads((folder / SCENARIO_FILE).read_text())
+        meta: JSONDict = json.loads((folder / SCENARIO_FILE).read_text())
     except (OSError, ValueError):
         return False
     if meta.get("spec_hash") != key or meta.get("seed") != seed or not meta.get("files"):
@@ -222,7 +245,7 @@ class Scenario:
 
     path: Path
     bag: Path
-    metadata: dict[str, Any]
+    metadata: ScenarioMeta
     ground_truth: Scene
 
     @property
@@ -252,11 +275,11 @@ class Scenario:
         return Mount(np.asarray(mount["translation"]), np.asarray(mount["quaternion"]))
 
 
-def load_metadata(directory: str | os.PathLike[str]) -> dict[str, Any]:
+def load_metadata(directory: str | os.PathLike[str]) -> ScenarioMeta:
     """``DIR/NAME/scenario.json``, checked for the keys the pipeline reads."""
     folder = Path(directory)
     try:
-        meta = json.loads((folder / SCENARIO_FILE).read_text())
+        meta: ScenarioMeta = json.loads((folder / SCENARIO_FILE).read_text())
     except OSError as err:
         raise SimulationError(f"{folder}: no {SCENARIO_FILE}; run `alte simulate`") from err
     except ValueError as err:
@@ -265,7 +288,7 @@ def load_metadata(directory: str | os.PathLike[str]) -> dict[str, Any]:
                if k not in meta]
     if missing:
         raise SimulationError(f"{folder / SCENARIO_FILE}: missing keys {missing}")
-    return dict(meta)
+    return meta
 
 
 def load_scenario(directory: str | os.PathLike[str]) -> Scenario:
