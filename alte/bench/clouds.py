@@ -11,7 +11,7 @@ are built once, outside the timed calls: the peer is timed on its own data layou
 from __future__ import annotations
 
 from functools import partial
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -19,6 +19,13 @@ from alte.bench.core import LIMITS, Context, Result
 from alte.bench.maps import NAV, mapper_setup, octomap_passes
 from alte.bench.timing import measure
 from alte.studies.thesis import mapper_params
+from alte.types import JSONDict
+
+if TYPE_CHECKING:
+    import open3d as o3d
+
+    from alte.bench.timing import Sample
+    from alte.mappers import Mapper
 
 __all__ = ["CLUSTER_TOLERANCE", "OBSTACLE_HEIGHT", "PLANE_THRESHOLD", "cloud_stages",
            "corner_sets", "hausdorff_speed", "open3d_hausdorff"]
@@ -31,13 +38,14 @@ OBSTACLE_HEIGHT = 0.3
 CLUSTER_TOLERANCE = 0.5
 
 
-def _pcd(points: np.ndarray) -> Any:
+def _pcd(points: np.ndarray) -> o3d.geometry.PointCloud:
     import open3d as o3d
 
     return o3d.geometry.PointCloud(o3d.utility.Vector3dVector(np.asarray(points, np.float64)))
 
 
-def open3d_hausdorff(pa: Any, pb: Any) -> tuple[float, float]:
+def open3d_hausdorff(pa: o3d.geometry.PointCloud, pb: o3d.geometry.PointCloud
+                     ) -> tuple[float, float]:
     """HD and MHD from Open3D's nearest distances in both directions."""
     d_ab = np.asarray(pa.compute_point_cloud_distance(pb))
     d_ba = np.asarray(pb.compute_point_cloud_distance(pa))
@@ -48,10 +56,10 @@ def corner_sets(ctx: Context) -> dict[str, np.ndarray]:
     """Corners of the occupied cells of Octomap (native) and 3D-ALTE maps of sim_nav_1."""
     from alte.mappers import make_mapper
 
-    def octomap() -> Any:
+    def octomap() -> Mapper:
         if ctx.has("octomap-passes"):
             return octomap_passes(ctx).maps["native"]
-        mapper = make_mapper("octomap", **mapper_setup(ctx, "octomap"))
+        mapper = mapper_setup(ctx, "octomap").make()
         for points, origin in ctx.scans(NAV):
             mapper.insert(points, origin)
         return mapper
@@ -75,9 +83,9 @@ def hausdorff_speed(ctx: Context) -> list[Result]:
                         ctx.config.repeats, ctx.config.warmup)
         ours = hausdorff(cloud, corners)
         hd, mhd = open3d_hausdorff(pa, pb)
-        detail = {"points_a": len(cloud), "points_b": len(corners), "hd_m": ours.hd,
-                  "mhd_m": ours.mhd, "hd_open3d_m": hd, "mhd_open3d_m": mhd,
-                  **{k: s.as_dict() for k, s in times.items()}}
+        detail: JSONDict = {"points_a": len(cloud), "points_b": len(corners), "hd_m": ours.hd,
+                            "mhd_m": ours.mhd, "hd_open3d_m": hd, "mhd_open3d_m": mhd,
+                            **{k: s.as_dict() for k, s in times.items()}}
         ratio = times["ours"].median / times["peer"].median
         out.append(Result(4, f"HD+MHD both ways, cloud vs {name} corners",
                           times["ours"].median, times["peer"].median, "s",
@@ -85,7 +93,7 @@ def hausdorff_speed(ctx: Context) -> list[Result]:
     return out
 
 
-def _stage(case: str, times: dict[str, Any], detail: dict[str, Any]) -> Result:
+def _stage(case: str, times: dict[str, Sample], detail: JSONDict) -> Result:
     ours, peer = times["ours"].median, times["peer"].median
     summary = {k: s.as_dict() for k, s in times.items()}
     return Result(6, case, ours, peer, "s", "ratio <= 2 (else reason in note)",
@@ -104,7 +112,7 @@ def cloud_stages(ctx: Context) -> list[Result]:
     raw, _ = work.stacked()
     p_raw, p_cloud = _pcd(raw), _pcd(work.cloud)
 
-    def ransac() -> Any:
+    def ransac() -> tuple[np.ndarray, list[int]]:
         o3d.utility.random.seed(0)
         return p_cloud.segment_plane(PLANE_THRESHOLD, 3, 1000)
 

@@ -11,12 +11,13 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, TypeVar
+from typing import TypeVar, cast
 
 import numpy as np
 
 from alte.bench.workload import Workload, load_workload
 from alte.params import Record, param
+from alte.types import JSONDict
 
 __all__ = ["LIMITS", "BenchConfig", "Context", "Result"]
 
@@ -66,14 +67,14 @@ class Result:
     unit: str
     target: str
     met: bool | None
-    detail: dict[str, Any] = field(default_factory=dict)
+    detail: JSONDict = field(default_factory=dict)
 
     @property
     def ratio(self) -> float:
         """ours / peer (NaN when the peer is 0)."""
         return self.ours / self.peer if self.peer else float("nan")
 
-    def as_dict(self) -> dict[str, Any]:
+    def as_dict(self) -> JSONDict:
         """JSON-ready row."""
         return {"row": self.row, "case": self.case, "ours": self.ours, "peer": self.peer,
                 "unit": self.unit, "ratio": self.ratio, "target": self.target,
@@ -85,14 +86,14 @@ class Context:
 
     def __init__(self, config: BenchConfig) -> None:
         self.config = config
-        self._memo: dict[str, Any] = {}
+        self._memo: dict[str, object] = {}
 
     def memo(self, key: str, make: Callable[[], T]) -> T:
-        """``make()`` once per process and key."""
+        """``make()`` once per process and key (a key always names the same kind of value,
+        so the cached one is what ``make`` returns)."""
         if key not in self._memo:
             self._memo[key] = make()
-        value: T = self._memo[key]
-        return value
+        return cast("T", self._memo[key])
 
     def has(self, key: str) -> bool:
         """True when ``key`` is already memoised."""

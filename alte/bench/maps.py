@@ -14,7 +14,7 @@ import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from functools import partial
-from typing import Any
+from typing import TYPE_CHECKING, Generic, Protocol, TypeVar
 
 import numpy as np
 from tqdm.auto import tqdm
@@ -22,10 +22,17 @@ from tqdm.auto import tqdm
 from alte.bench.core import LIMITS, Context, Result
 from alte.bench.timing import interleave, measure
 from alte.studies.thesis import mapper_params
+from alte.types import JSONDict
+
+if TYPE_CHECKING:
+    from alte.mappers import Mapper, Octomap
+    from alte.mappers.domain import Domain
 
 __all__ = [
     "JACCARD_MIN",
     "ROTATION_S",
+    "Inserts",
+    "MapperSetup",
     "Passes",
     "batch_builds",
     "insert_latencies",
@@ -48,13 +55,23 @@ NAV, LAN = "sim_nav_1", "sim_lan_2"
 TERRAIN_OF = {"octomap": NAV, "alte3d": NAV, "quadtree": LAN, "alte2d": LAN}
 
 
+class Inserts(Protocol):
+    """What a contender of :func:`interleaved_passes` does: insert one scan from its origin."""
+
+    def insert(self, points: np.ndarray, origin: np.ndarray, /) -> None: ...
+
+
+_M_co = TypeVar("_M_co", bound=Inserts, covariant=True)
+_T = TypeVar("_T", bound=Inserts)
+
+
 @dataclass(frozen=True, eq=False)
-class Passes:
+class Passes(Generic[_M_co]):
     """Per-frame insert seconds (wall, and CPU of the process) of every timed pass, and the
     last map, per contender."""
 
     latencies: dict[str, list[np.ndarray]]
-    maps: dict[str, Any]
+    maps: Mapping[str, _M_co]
     cpu: dict[str, list[np.ndarray]]
 
     def totals(self, name: str) -> list[float]:
@@ -62,7 +79,7 @@ class Passes:
         return [float(t.sum()) for t in self.latencies[name]]
 
 
-def insert_latencies(mapper: Any, scans: Sequence[tuple[np.ndarray, np.ndarray]],
+def insert_latencies(mapper: Inserts, scans: Sequence[tuple[np.ndarray, np.ndarray]],
                      ) -> tuple[np.ndarray, np.ndarray]:
     """Insert every scan in order; wall and process CPU seconds of each ``insert`` call (the
     CPU time tells a loaded machine's waiting apart from the work)."""
@@ -74,13 +91,14 @@ def insert_latencies(mapper: Any, scans: Sequence[tuple[np.ndarray, np.ndarray]]
     return wall, cpu
 
 
-def interleaved_passes(makers: Mapping[str, Callable[[], Any]],
+def interleaved_passes(makers: Mapping[str, Callable[[], _T]],
                        scans: Sequence[tuple[np.ndarray, np.ndarray]], *, repeats: int,
-                       warmup: int, progress: bool = False, desc: str = "passes") -> Passes:
+                       warmup: int, progress: bool = False, desc: str = "passes"
+                       ) -> Passes[_T]:
     """Fresh map per pass; contenders alternate pass by pass; warm-up passes discarded."""
     latencies: dict[str, list[np.ndarray]] = {name: [] for name in makers}
     cpu: dict[str, list[np.ndarray]] = {name: [] for name in makers}
-    maps: dict[str, Any] = {}
+    maps: dict[str, _T] = {}
     rounds = list(interleave(list(makers), warmup + repeats))
     for r, name in tqdm(rounds, desc=desc, unit="pass", disable=not progress, leave=False):
         mapper = makers[name]()
@@ -92,28 +110,47 @@ def interleaved_passes(makers: Mapping[str, Callable[[], Any]],
     return Passes(latencies, maps, cpu)
 
 
-def mapper_setup(ctx: Context, name: str) -> dict[str, Any]:
-    """Chapter 4 parameters of ``name`` on its terrain and, for mappers with a domain, the
-    control volume's cube (as the pipeline gives it), as keywords of ``make_mapper``."""
+@dataclass(frozen=True)
+class MapperSetup:
+    """A mapper as the bench makes it: ``name``, its chapter 4 ``params`` on its terrain and,
+    for mappers with a domain, the control volume's cube (as the pipeline gives it)."""
+
+    name: str
+    params: dict[str, float]
+    domain: Domain | None = None
+
+    def make(self, **given: object) -> Mapper:
+        """A fresh mapper (``given``: further keywords, e.g. Octomap's ``backend``)."""
+        from alte.mappers import make_mapper
+
+        return make_mapper(self.name, self.params, domain=self.domain, **given)
+
+
+def mapper_setup(ctx: Context, name: str) -> MapperSetup:
+    """How the bench makes ``name`` (:class:`MapperSetup`)."""
     from alte.mappers import DomainUse, mapper_class
     from alte.mappers.domain import Domain
     from alte.types import Box
 
     terrain = TERRAIN_OF[name]
-    params: dict[str, Any] = mapper_params(terrain)[name]
-    if mapper_class(name).domain_use is not DomainUse.UNUSED:
-        params["domain"] = Domain.over(Box.of(ctx.workload(terrain).bounds))
-    return params
+    params = mapper_params(terrain)[name]
+    if mapper_class(name).domain_use is DomainUse.UNUSED:
+        return MapperSetup(name, params)
+    return MapperSetup(name, params, Domain.over(Box.of(ctx.workload(terrain).bounds)))
 
 
-def octomap_passes(ctx: Context) -> Passes:
+def octomap_passes(ctx: Context) -> Passes[Octomap]:
     """Native and reference Octomap over the same scans (memoised: rows 1, 2, 4, 5 share it)."""
-    from alte.mappers import make_mapper
+    from alte.mappers import Octomap
 
-    def run() -> Passes:
-        params = mapper_setup(ctx, "octomap")
-        makers = {b: (lambda b=b: make_mapper("octomap", **params, backend=b))
-                  for b in ("native", "reference")}
+    def octomap(setup: MapperSetup, backend: str) -> Octomap:
+        mapper = setup.make(backend=backend)
+        assert isinstance(mapper, Octomap), "the registry's octomap is Octomap"
+        return mapper
+
+    def run() -> Passes[Octomap]:
+        setup = mapper_setup(ctx, "octomap")
+        makers = {b: partial(octomap, setup, b) for b in ("native", "reference")}
         cfg = ctx.config
         return interleaved_passes(makers, ctx.scans(NAV), repeats=cfg.repeats,
                                   warmup=cfg.warmup, progress=cfg.progress, desc="octomap")
@@ -135,10 +172,11 @@ def octomap_speed(ctx: Context) -> list[Result]:
     ours, peer = np.median(passes.totals("native")), np.median(passes.totals("reference"))
     scans = ctx.scans(NAV)
     leaves = (native.basis_functions, reference.basis_functions)
-    detail = {"jaccard": jac, "frames": len(scans), "points": int(sum(len(p) for p, _ in scans)),
-              "params": native.params, "native_s": passes.totals("native"),
-              "reference_s": passes.totals("reference"), "leaves_native": leaves[0],
-              "leaves_reference": leaves[1]}
+    detail: JSONDict = {
+        "jaccard": jac, "frames": len(scans), "points": int(sum(len(p) for p, _ in scans)),
+        "params": str(native.params), "native_s": passes.totals("native"),
+        "reference_s": passes.totals("reference"), "leaves_native": leaves[0],
+        "leaves_reference": leaves[1]}
     met = bool(ours / peer <= LIMITS[1] and jac >= JACCARD_MIN and leaves[0] == leaves[1])
     target = f"ratio <= {LIMITS[1]:.3f}, Jaccard >= {JACCARD_MIN}, equal leaf counts"
     return [Result(1, f"Octomap native vs pyoctomap, {NAV} ({len(scans)} frames)", float(ours),
@@ -150,8 +188,8 @@ def octomap_memory(ctx: Context) -> list[Result]:
     passes = octomap_passes(ctx)
     native, reference = passes.maps["native"], passes.maps["reference"]
     ours, peer = native.memory_bytes, reference.memory_bytes
-    detail = {"leaves_native": native.basis_functions,
-              "leaves_reference": reference.basis_functions}
+    detail: JSONDict = {"leaves_native": native.basis_functions,
+                        "leaves_reference": reference.basis_functions}
     return [Result(2, f"Octomap native memory, {NAV}", float(ours), float(peer), "B",
                    "ratio <= 1", bool(ours <= LIMITS[2] * peer), detail)]
 
@@ -185,25 +223,24 @@ def batch_builds(ctx: Context) -> list[Result]:
 
 
 def _latency_result(name: str, terrain: str, lat: list[np.ndarray], cpu: list[np.ndarray],
-                    extra: dict[str, Any]) -> Result:
+                    extra: JSONDict) -> Result:
     p99 = [float(np.percentile(t, 99)) for t in lat]
     ours = float(np.median(p99)) * 1e3
     bound = LIMITS[5] * ROTATION_S * 1e3
-    detail = {"p99_ms_per_pass": [v * 1e3 for v in p99], "frames": len(lat[0]),
-              "median_ms": float(np.median(np.concatenate(lat))) * 1e3,
-              "max_ms": float(np.max(np.concatenate(lat))) * 1e3,
-              "cpu_p99_ms": float(np.median([np.percentile(c, 99) for c in cpu])) * 1e3,
-              "cpu_median_ms": float(np.median(np.concatenate(cpu))) * 1e3, **extra}
+    detail: JSONDict = {"p99_ms_per_pass": [v * 1e3 for v in p99], "frames": len(lat[0]),
+                        "median_ms": float(np.median(np.concatenate(lat))) * 1e3,
+                        "max_ms": float(np.max(np.concatenate(lat))) * 1e3,
+                        "cpu_p99_ms": float(np.median([np.percentile(c, 99) for c in cpu])) * 1e3,
+                        "cpu_median_ms": float(np.median(np.concatenate(cpu))) * 1e3, **extra}
     return Result(5, f"{name} insert p99, {terrain}", ours, ROTATION_S * 1e3, "ms",
-                  f"p99 < {bound:g} ms", bool(ours < bound) and extra.get("same", True), detail)
+                  f"p99 < {bound:g} ms", bool(ours < bound) and extra.get("same", True) is True,
+                  detail)
 
 
-def _same_as_batch(mapper: Any, frames: Sequence[tuple[np.ndarray, np.ndarray]],
-                   params: dict[str, Any]) -> dict[str, Any]:
+def _same_as_batch(mapper: Mapper, frames: Sequence[tuple[np.ndarray, np.ndarray]],
+                   setup: MapperSetup) -> JSONDict:
     """Whether an incremental 2D map equals the batch build of its frames (same cells)."""
-    from alte.mappers import make_mapper
-
-    batch = make_mapper(mapper.name, **params)
+    batch = setup.make()
     batch.build(np.vstack([p for p, _ in frames]))
     a, b = mapper.cells(), batch.cells()
     same = bool(len(a) == len(b) and np.array_equal(a.centers[:, :2], b.centers[:, :2])
@@ -215,7 +252,7 @@ def _same_as_batch(mapper: Any, frames: Sequence[tuple[np.ndarray, np.ndarray]],
 def insert_latency(ctx: Context) -> list[Result]:
     """Row 5: p99 per-frame insert latency of each incremental mapper over EVERY frame
     (``--frames`` does not apply: later frames meet a bigger map), median over passes."""
-    from alte.mappers import MAPPERS, make_mapper
+    from alte.mappers import MAPPERS
 
     cfg = ctx.config
     out = []
@@ -224,12 +261,12 @@ def insert_latency(ctx: Context) -> list[Result]:
             continue
         terrain = TERRAIN_OF[name]
         frames = ctx.workload(terrain).frames
+        passes: Passes[Mapper]
         if name == "octomap" and cfg.frames is None and ctx.has("octomap-passes"):
             passes, key = octomap_passes(ctx), "native"  # row 1 already inserted every frame
         else:
-            params = mapper_setup(ctx, name)
             passes, key = interleaved_passes(
-                {name: partial(make_mapper, name, **params)}, frames,
+                {name: mapper_setup(ctx, name).make}, frames,
                 repeats=cfg.repeats, warmup=cfg.warmup, progress=cfg.progress, desc=name), name
         extra = (_same_as_batch(passes.maps[key], frames, mapper_setup(ctx, name))
                  if cls.dims == 2 else {})

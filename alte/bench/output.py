@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import json
 import math
+from collections.abc import Mapping
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
@@ -14,6 +14,7 @@ from alte.bench.core import LIMITS, Result
 from alte.bench.runner import ROWS, Bench
 from alte.bench.timing import nlogn_exponent
 from alte.fsutil import atomic_path
+from alte.types import JSONDict, JSONMap
 
 __all__ = ["format_value", "miss_note", "plot_scaling", "render_markdown", "write_outputs"]
 
@@ -31,6 +32,20 @@ def format_value(value: float, unit: str) -> str:
     return f"{value:.3g}"
 
 
+def _numbers(detail: JSONMap, key: str) -> list[float]:
+    """The numbers listed under ``key`` in a row's detail (none when absent)."""
+    values = detail.get(key)
+    return [v for v in values if isinstance(v, int | float)] if isinstance(values, list) else []
+
+
+def _named_numbers(detail: JSONMap, key: str) -> dict[str, float]:
+    """The numbers by name under ``key`` in a row's detail (none when absent)."""
+    values = detail.get(key)
+    if not isinstance(values, Mapping):
+        return {}
+    return {k: v for k, v in values.items() if isinstance(v, int | float)}
+
+
 def miss_note(result: Result) -> str:
     """One sentence on a missed target: by how much."""
     if result.met is not False:
@@ -42,7 +57,8 @@ def miss_note(result: Result) -> str:
         return (f"row {result.row} {result.case}: the grid's estimated wall time "
                 f"{result.detail['grid_wall_h']:.2f} h on {result.detail['workers']} cores, "
                 f"{result.target}")
-    bound = float(result.detail.get("limit", LIMITS[result.row]))
+    limit = result.detail.get("limit", LIMITS[result.row])
+    bound = float(limit) if isinstance(limit, int | float) else LIMITS[result.row]
     return (f"row {result.row} {result.case}: ratio {result.ratio:.3g}, target <= {bound:.3g} "
             f"(missed by {result.ratio / bound:.2f}x)")
 
@@ -75,17 +91,17 @@ def _row8(results: list[Result]) -> list[str]:
     for r in (r for r in results if r.row == 8 and r.detail.get("shares")):
         out += ["", "Row 8 stage shares of the report's wall time:", "",
                 "| stage | share |", "|---|---|"]
-        out += [f"| {k} | {v:.1%} |" for k, v in r.detail["shares"].items()]
+        out += [f"| {k} | {v:.1%} |" for k, v in _named_numbers(r.detail, "shares").items()]
     return out
 
 
 def _row7(results: list[Result]) -> list[str]:
     out = []
     for r in (r for r in results if r.row == 7):
-        sizes = ", ".join(f"{n:.0e}: {s:.3g} s" for n, s in zip(r.detail["sizes"],
-                                                                 r.detail["seconds"], strict=True))
+        sizes = ", ".join(f"{n:.0e}: {s:.3g} s" for n, s in zip(
+            _numbers(r.detail, "sizes"), _numbers(r.detail, "seconds"), strict=True))
         skipped = ", ".join(f"{int(n):.0e} (predicted {s:.0f} s)"
-                            for n, s in r.detail["skipped_predicted_s"].items())
+                            for n, s in _named_numbers(r.detail, "skipped_predicted_s").items())
         out.append(f"- {r.case}: {sizes}" + (f"; skipped {skipped}" if skipped else ""))
     return (["", "Row 7 timings (plot: bench_scaling.png):", "", *out]) if out else []
 
@@ -121,7 +137,7 @@ def render_markdown(bench: Bench) -> str:
 
 def plot_scaling(results: list[Result], path: Path) -> Path | None:
     """Log-log seconds vs points of every row 7 case, exponents in the legend."""
-    cases = [r for r in results if r.row == 7 and len(r.detail["sizes"]) >= 2]
+    cases = [r for r in results if r.row == 7 and len(_numbers(r.detail, "sizes")) >= 2]
     if not cases:
         return None
     import matplotlib
@@ -131,10 +147,11 @@ def plot_scaling(results: list[Result], path: Path) -> Path | None:
 
     fig, ax = plt.subplots(figsize=(7, 5))
     for r in cases:
-        ax.loglog(r.detail["sizes"], r.detail["seconds"], "o-",
+        ax.loglog(_numbers(r.detail, "sizes"), _numbers(r.detail, "seconds"), "o-",
                   label=f"{r.case.split()[0]} (exponent {r.ours:.2f})")
-    n = np.asarray(sorted({s for r in cases for s in r.detail["sizes"]}), float)
-    ref = n * np.log(n) / (n[0] * np.log(n[0])) * min(r.detail["seconds"][0] for r in cases)
+    n = np.asarray(sorted({s for r in cases for s in _numbers(r.detail, "sizes")}), float)
+    ref = n * np.log(n) / (n[0] * np.log(n[0])) * min(_numbers(r.detail, "seconds")[0]
+                                                      for r in cases)
     ax.loglog(n, ref, "k--", label=f"n log n (exponent {nlogn_exponent(n):.2f})")
     ax.set(xlabel="points", ylabel="seconds (median)", title="Row 7: scaling")
     ax.legend(fontsize=8)
@@ -150,7 +167,7 @@ def write_outputs(bench: Bench, reports_dir: str | Path) -> dict[str, Path]:
     out = Path(reports_dir)
     out.mkdir(parents=True, exist_ok=True)
     paths: dict[str, Path] = {"json": out / "bench.json", "md": out / "bench.md"}
-    record: dict[str, Any] = bench.as_dict()
+    record: JSONDict = bench.as_dict()
     with atomic_path(paths["json"], overwrite=True) as tmp:
         tmp.write_text(json.dumps(_finite(record), indent=2, default=_jsonable) + "\n")
     with atomic_path(paths["md"], overwrite=True) as tmp:
@@ -161,7 +178,7 @@ def write_outputs(bench: Bench, reports_dir: str | Path) -> dict[str, Path]:
     return paths
 
 
-def _jsonable(value: Any) -> Any:
+def _jsonable(value: object) -> object:
     if isinstance(value, np.generic):
         return value.item()
     if isinstance(value, np.ndarray):
@@ -169,7 +186,7 @@ def _jsonable(value: Any) -> Any:
     return str(value)
 
 
-def _finite(value: Any) -> Any:
+def _finite(value: object) -> object:
     """NaN and inf become null, so bench.json is strict JSON."""
     if isinstance(value, dict):
         return {str(k): _finite(v) for k, v in value.items()}

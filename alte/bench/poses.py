@@ -20,7 +20,7 @@ import numpy as np
 from alte.bench.core import LIMITS, Context, Result
 from alte.bench.timing import one_core
 from alte.paths import realdata_dir
-from alte.types import Frame
+from alte.types import Frame, JSONDict
 
 __all__ = ["pose_speed"]
 
@@ -99,11 +99,11 @@ def pose_speed(ctx: Context) -> list[Result]:
             _ours(frames, False, clocks["odometry"])
             _ours(frames, True, clocks["refine"])
     med = {k: float(np.median(c.cpu)) for k, c in clocks.items()}
-    detail = {"scans": len(frames), "points_per_scan": int(np.median([len(f.points)
-                                                                      for f in frames])),
-              "cpu_ms_median": med,
-              "wall_ms_median": {k: float(np.median(c.wall)) for k, c in clocks.items()},
-              "cpu_ms_p90": {k: float(np.percentile(c.cpu, 90)) for k, c in clocks.items()}}
+    detail: JSONDict = {
+        "scans": len(frames), "points_per_scan": int(np.median([len(f.points) for f in frames])),
+        "cpu_ms_median": med,
+        "wall_ms_median": {k: float(np.median(c.wall)) for k, c in clocks.items()},
+        "cpu_ms_p90": {k: float(np.percentile(c.cpu, 90)) for k, c in clocks.items()}}
     peer = med["kiss-icp"]
     return [
         Result(12, f"odometry per real scan vs kiss-icp pipeline, balm_seq ({len(frames)} scans)",

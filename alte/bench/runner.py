@@ -13,7 +13,6 @@ import traceback
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
-from typing import Any
 
 from tqdm.auto import tqdm
 
@@ -28,6 +27,7 @@ from alte.bench.sweep import sweep_throughput
 from alte.bench.timing import machine_info, peak_rss_bytes
 from alte.bench.wall import report_wall_time
 from alte.errors import ParameterError
+from alte.types import JSONDict
 
 __all__ = ["ROWS", "Bench", "run_bench", "select_rows"]
 
@@ -59,19 +59,20 @@ class Bench:
     config: BenchConfig
     results: list[Result]
     errors: dict[int, str]
-    machine: dict[str, Any]
+    machine: JSONDict
     started: str
     seconds: float = 0.0
     row_seconds: dict[int, float] = field(default_factory=dict)
 
-    def as_dict(self) -> dict[str, Any]:
-        """JSON-ready record."""
+    def as_dict(self) -> JSONDict:
+        """JSON-ready record (row numbers as keys are strings, as JSON has them)."""
         cfg = self.config
         return {"started": self.started, "seconds": self.seconds, "machine": self.machine,
                 "config": {"quick": cfg.quick, "repeats": cfg.repeats, "warmup": cfg.warmup,
                            "frames": cfg.frames, "sizes": list(cfg.scaling_sizes),
                            "budget_s": cfg.budget_s},
-                "row_seconds": self.row_seconds, "errors": self.errors,
+                "row_seconds": {str(k): v for k, v in self.row_seconds.items()},
+                "errors": {str(k): v for k, v in self.errors.items()},
                 "results": [r.as_dict() for r in self.results]}
 
 

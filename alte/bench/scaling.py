@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from typing import Any
 
 import numpy as np
 from tqdm.auto import tqdm
@@ -24,6 +23,7 @@ from alte.bench.maps import NAV, TERRAIN_OF
 from alte.bench.timing import fit_exponent, measure, nlogn_exponent, peak_rss_bytes
 from alte.bench.workload import tile_points
 from alte.studies.thesis import mapper_params
+from alte.types import JSONDict
 
 __all__ = ["EXPONENT_SLACK", "predicted_seconds", "scaling", "scaling_cases", "whole_scans"]
 
@@ -106,8 +106,9 @@ def _one_case(ctx: Context, name: str, make: Case) -> Result:
         rss[n] = peak_rss_bytes()
     exponent = fit_exponent(sizes, seconds) if len(sizes) >= 2 else float("nan")
     bar = nlogn_exponent(sizes) if len(sizes) >= 2 else float("nan")
-    detail: dict[str, Any] = {"sizes": sizes, "seconds": seconds, "peak_rss_bytes": rss,
-                              "skipped_predicted_s": skipped}
+    detail: JSONDict = {"sizes": sizes, "seconds": seconds,
+                                  "peak_rss_bytes": {str(n): b for n, b in rss.items()},
+                                  "skipped_predicted_s": {str(n): s for n, s in skipped.items()}}
     met = bool(exponent <= bar + EXPONENT_SLACK) if len(sizes) >= 2 else None
     span = f"{sizes[0]:.0e}..{sizes[-1]:.0e}" if sizes else "none"
     return Result(7, f"{name} scaling, n = {span}", exponent, bar, "exponent",

@@ -27,7 +27,7 @@ import os
 import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 from tqdm.auto import tqdm
@@ -36,6 +36,10 @@ from alte.bench.core import LIMITS, Context, Result
 from alte.bench.maps import LAN, NAV, ROTATION_S, interleaved_passes
 from alte.bench.timing import interleave, one_core
 from alte.bench.workload import QUICK_FRAMES, workload_dir
+from alte.types import JSONDict
+
+if TYPE_CHECKING:
+    from alte.pipeline import MapRun, MapSpec
 
 __all__ = ["STREAM_MAPPERS", "UfoPeer", "mission_seconds", "scan_peer", "streaming_chain"]
 
@@ -62,7 +66,7 @@ def _bag(ctx: Context, terrain: str) -> Path:
     return source.bag
 
 
-def _one_run(bag: Path, spec: Any) -> tuple[float, float, Any]:
+def _one_run(bag: Path, spec: MapSpec) -> tuple[float, float, MapRun]:
     """Wall and process CPU seconds of one ``run`` of ``spec`` on ``bag``, and the run."""
     from alte.pipeline import run
 
@@ -78,17 +82,18 @@ def _quantiles_ms(seconds: list[np.ndarray]) -> dict[str, float]:
 
 
 def _chain_result(terrain: str, name: str, times: tuple[list[float], list[float]],
-                  runs: list[Any], cpu: int | None) -> Result:
+                  runs: list[MapRun], cpu: int | None) -> Result:
     log, walls = runs[-1].log, times[0]
     mission = mission_seconds(log.stamps)
     wall = float(np.median(walls))
-    detail = {"rtf": mission / wall, "wall_s": walls, "cpu_s": times[1], "pinned_cpu": cpu,
-              "mission_s": mission,
-              "frames": len(log.stamps), "points_per_frame": float(np.mean(log.points)),
-              "latency_ms": _quantiles_ms([r.log.latency_s for r in runs]),
-              "insert_ms": _quantiles_ms([r.log.insert_s for r in runs]),
-              "sensor_period_ms": ROTATION_S * 1e3, "domain_policy": runs[-1].info.domain_policy,
-              "params": runs[-1].info.params.as_dict(), "feed": runs[-1].info.feed.value}
+    detail: JSONDict = {
+        "rtf": mission / wall, "wall_s": walls, "cpu_s": times[1], "pinned_cpu": cpu,
+        "mission_s": mission,
+        "frames": len(log.stamps), "points_per_frame": float(np.mean(log.points)),
+        "latency_ms": _quantiles_ms([r.log.latency_s for r in runs]),
+        "insert_ms": _quantiles_ms([r.log.insert_s for r in runs]),
+        "sensor_period_ms": ROTATION_S * 1e3, "domain_policy": runs[-1].info.domain_policy,
+        "params": runs[-1].info.params.as_dict(), "feed": runs[-1].info.feed.value}
     return Result(10, f"alte map BAG, {name}, {terrain}", wall, mission, "s",
                   f"wall <= {LIMITS[10]:g} x mission (>= {1 / LIMITS[10]:g}x real time)",
                   bool(wall <= LIMITS[10] * mission), detail)
@@ -108,7 +113,7 @@ def streaming_chain(ctx: Context) -> list[Result]:
         specs = {name: MapSpec(name, dict(params.get(name, {})), DomainPolicy.AUTO,
                                Feed.FRAMES) for name in STREAM_MAPPERS}
         times: dict[str, tuple[list[float], list[float]]] = {name: ([], []) for name in specs}
-        runs: dict[str, list[Any]] = {name: [] for name in specs}
+        runs: dict[str, list[MapRun]] = {name: [] for name in specs}
         rounds = list(interleave(list(specs), cfg.warmup + cfg.repeats))
         with one_core() as cpu:
             for r, name in tqdm(rounds, desc=f"alte map {terrain}", unit="run",
@@ -141,14 +146,13 @@ class UfoPeer:
 
 def scan_peer(ctx: Context) -> list[Result]:
     """Row 11: native Octomap vs DUFOMap (UFOMap) integrating the same scans at 0.2 m."""
-    from alte.bench.maps import mapper_setup
-    from alte.mappers import make_mapper
+    from alte.bench.maps import Inserts, mapper_setup
 
-    params = mapper_setup(ctx, "octomap")
-    voxel = 1.0 / float(params.get("resolution", 5.0))
+    setup = mapper_setup(ctx, "octomap")
+    voxel = 1.0 / float(setup.params.get("resolution", 5.0))
     threads = 1  # the native Octomap walks a scan's rays on one thread
-    makers: dict[str, Callable[[], Any]] = {
-        "native": lambda: make_mapper("octomap", **params),
+    makers: dict[str, Callable[[], Inserts]] = {
+        "native": setup.make,
         "dufomap": lambda: UfoPeer(voxel, threads)}
     scans: Sequence[tuple[np.ndarray, np.ndarray]] = ctx.scans(NAV)
     cfg = ctx.config
@@ -157,10 +161,11 @@ def scan_peer(ctx: Context) -> list[Result]:
     ours, peer = np.median(passes.totals("native")), np.median(passes.totals("dufomap"))
     p99 = {k: float(np.median([np.percentile(t, 99) for t in v])) * 1e3
            for k, v in passes.latencies.items()}
-    detail = {"frames": len(scans), "voxel_m": voxel, "threads": threads,
-              "native_s": passes.totals("native"), "dufomap_s": passes.totals("dufomap"),
-              "p99_ms": p99, "dufomap_options": {"d_s": 0.0, "d_p": 0, "hit_extension": False,
-                                                 "ray_passthrough_hits": False}}
+    detail: JSONDict = {
+        "frames": len(scans), "voxel_m": voxel, "threads": threads,
+        "native_s": passes.totals("native"), "dufomap_s": passes.totals("dufomap"),
+        "p99_ms": p99, "dufomap_options": {"d_s": 0.0, "d_p": 0, "hit_extension": False,
+                                           "ray_passthrough_hits": False}}
     return [Result(11, f"Octomap native vs DUFOMap scan integration, {NAV} ({len(scans)} frames)",
                    float(ours), float(peer), "s", f"ratio <= {LIMITS[11]:g}",
                    bool(ours <= LIMITS[11] * peer), detail)]

@@ -25,12 +25,18 @@ import time
 from collections import Counter
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, TypeVar
 
 from tqdm.auto import tqdm
 
 from alte.bench.core import Context, Result
 from alte.bench.workload import QUICK_FRAMES, workload_dir
+from alte.types import JSONDict
+
+if TYPE_CHECKING:
+    from alte.studies.sweep import SweepSpec
+    from alte.studies.sweep.runs import SweepRun
+    from alte.studies.sweep.work import MapGroup
 
 __all__ = ["GRID_HOURS", "SIZE_PARAM", "WORKERS", "Sample", "grid_estimate", "stratified_groups",
            "sweep_throughput"]
@@ -46,6 +52,7 @@ GRID_HOURS = 2.0
 RUN_CORE_S = 0.3
 #: Strata sampled in quick mode (evenly spaced among the spec's).
 QUICK_STRATA = 12
+_T = TypeVar("_T")
 _SPECS = (("20 scans", "notebooks/sweeps/tradeoff.yaml"),
           ("whole missions", "notebooks/sweeps/tradeoff-full.yaml"))
 
@@ -60,7 +67,7 @@ class Sample:
     prepare_s: float
     grid_runs: int
     grid_cpu_s: float
-    per_stratum: list[dict[str, Any]]
+    per_stratum: list[JSONDict]
 
     @property
     def runs_per_core_s(self) -> float:
@@ -68,11 +75,11 @@ class Sample:
         return self.runs / self.cpu_s if self.cpu_s else float("nan")
 
 
-def _stratum(run: Any) -> tuple[str, float, str]:
+def _stratum(run: SweepRun) -> tuple[str, float, str]:
     return run.mapper, float(run.params.get(SIZE_PARAM[run.mapper], 0)), run.domain
 
 
-def stratified_groups(spec: Any, seed: int = 0) -> list[tuple[Any, int]]:
+def stratified_groups(spec: SweepSpec, seed: int = 0) -> list[tuple[MapGroup, int]]:
     """One map group per stratum of ``spec`` (its first seed, terrain drawn with
     ``seed``) and the stratum's number of runs in the whole grid (every seed)."""
     from alte.studies.sweep import override, plan_runs
@@ -82,21 +89,21 @@ def stratified_groups(spec: Any, seed: int = 0) -> list[tuple[Any, int]]:
     for g in group_runs(plan_runs(spec)):
         everything[_stratum(g.runs[0])] += len(g)
     first = group_runs(plan_runs(override(spec, seeds=[spec.seeds[0]])))
-    by: dict[tuple[str, float, str], list[Any]] = {}
+    by: dict[tuple[str, float, str], list[MapGroup]] = {}
     for group in first:
         by.setdefault(_stratum(group.runs[0]), []).append(group)
     rng = random.Random(seed)
     return [(rng.choice(by[key]), everything[key]) for key in sorted(by, key=str)]
 
 
-def _thinned(items: list[Any], most: int | None) -> list[Any]:
+def _thinned(items: list[_T], most: int | None) -> list[_T]:
     if most is None or len(items) <= most:
         return items
     step = len(items) / most
     return [items[int(i * step)] for i in range(most)]
 
 
-def _prepare_input(run: Any, data_dir: str) -> float:
+def _prepare_input(run: SweepRun, data_dir: str) -> float:
     """CPU seconds to simulate/register (if needed) and prepare one run's input."""
     from alte.studies.sweep.runner import _ensure
     from alte.studies.sweep.work import _inputs
@@ -111,7 +118,7 @@ def _prepare_input(run: Any, data_dir: str) -> float:
     return time.process_time() - start
 
 
-def measure_sample(spec: Any, data_dir: str, *, seed: int = 0, strata: int | None = None,
+def measure_sample(spec: SweepSpec, data_dir: str, *, seed: int = 0, strata: int | None = None,
                    progress: bool = False) -> Sample:
     """Run :func:`stratified_groups` of ``spec`` (``strata``: at most that many, evenly
     spaced) as a sweep does; see :class:`Sample`."""
@@ -119,8 +126,9 @@ def measure_sample(spec: Any, data_dir: str, *, seed: int = 0, strata: int | Non
 
     every = stratified_groups(spec, seed)
     chosen = _thinned(every, strata)
-    prepared: dict[tuple[Any, ...], float] = {}
-    rows, runs, cpu, estimate = [], 0, 0.0, 0.0
+    prepared: dict[tuple[object, ...], float] = {}
+    rows: list[JSONDict] = []
+    runs, cpu, estimate, sampled_in_grid = 0, 0.0, 0.0, 0
     for group, in_grid in tqdm(chosen, desc="sweep sample", unit="map", disable=not progress):
         first = group.runs[0]
         key = first.input_key()
@@ -134,12 +142,13 @@ def measure_sample(spec: Any, data_dir: str, *, seed: int = 0, strata: int | Non
             raise failed[0]
         # the stratum's runs in the grid cost what these cost per run
         runs, cpu, estimate = runs + len(group), cpu + used, estimate + used / len(group) * in_grid
+        sampled_in_grid += in_grid
         rows.append({"mapper": first.mapper, "size": first.params.get(SIZE_PARAM[first.mapper]),
                      "domain": first.domain, "terrain": first.terrain, "runs": len(group),
                      "cpu_s": round(used, 3), "runs_in_grid": in_grid})
     grid_runs = sum(n for _, n in every)  # strata left out cost what the sampled ones do
     return Sample(runs, len(chosen), cpu, sum(prepared.values()) / len(prepared), grid_runs,
-                  estimate * grid_runs / sum(r["runs_in_grid"] for r in rows), rows)
+                  estimate * grid_runs / sampled_in_grid, rows)
 
 
 def grid_estimate(sample: Sample, inputs: int, workers: int = WORKERS) -> dict[str, float]:
@@ -150,7 +159,8 @@ def grid_estimate(sample: Sample, inputs: int, workers: int = WORKERS) -> dict[s
             "runs_per_core_s": sample.grid_runs / cpu if cpu else float("nan")}
 
 
-def _peer(sample_spec: Any, data_dir: str, seed: int, strata: int | None) -> tuple[int, float]:
+def _peer(sample_spec: SweepSpec, data_dir: str, seed: int, strata: int | None
+          ) -> tuple[int, float]:
     """Runs and CPU seconds of today's path (one fresh map per run, metrics from scratch)
     on the first run of each sampled group."""
     from alte.pipeline import DomainPolicy, MapSpec
@@ -168,7 +178,7 @@ def _peer(sample_spec: Any, data_dir: str, seed: int, strata: int | None) -> tup
     return runs, cpu
 
 
-def _spec(path: str, ctx: Context, data_dir: str) -> Any:
+def _spec(path: str, ctx: Context, data_dir: str) -> SweepSpec:
     from alte.studies.sweep import load_spec, override
 
     spec = override(load_spec(path), data_dir=data_dir)

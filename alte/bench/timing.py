@@ -16,11 +16,11 @@ from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
 from importlib import metadata
-from typing import Any
 
 import numpy as np
 
 from alte.errors import ParameterError
+from alte.types import JSONDict
 
 __all__ = ["Sample", "fit_exponent", "interleave", "machine_info", "measure", "nlogn_exponent",
            "one_core", "peak_rss_bytes"]
@@ -43,7 +43,7 @@ class Sample:
         q1, q3 = np.percentile(self.times, [25, 75])
         return float(q3 - q1)
 
-    def as_dict(self) -> dict[str, Any]:
+    def as_dict(self) -> JSONDict:
         """JSON-ready summary."""
         return {"median_s": self.median, "iqr_s": self.spread, "repeats": len(self.times),
                 "times_s": list(self.times)}
@@ -150,7 +150,7 @@ def _version(package: str) -> str:
         return "absent"
 
 
-def machine_info() -> dict[str, Any]:
+def machine_info() -> JSONDict:
     """CPU model, core counts, load, memory and the versions that matter for the figures."""
     try:
         pages = os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")

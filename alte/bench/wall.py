@@ -9,10 +9,10 @@ machine, and the thesis times the mappers alone).
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
 
 from alte.bench.core import Context, Result
 from alte.studies.thesis import COMPARISONS, SWEEPS
+from alte.types import JSON, JSONDict, JSONMap
 
 __all__ = ["report_wall_time", "stage_shares", "thesis_total_s"]
 
@@ -25,10 +25,17 @@ def thesis_total_s() -> float:
     return float(sweeps + repeated)
 
 
-def stage_shares(record: dict[str, Any]) -> dict[str, float]:
+def _seconds(value: JSON) -> float:
+    """A record's seconds (0 when missing)."""
+    return float(value) if isinstance(value, int | float) else 0.0
+
+
+def stage_shares(record: JSONMap) -> dict[str, float]:
     """Each notebook run's share of the report's wall time; the rest is simulation/publishing."""
-    total = float(record.get("seconds") or 0.0)
-    runs = {r["name"]: float(r.get("seconds") or 0.0) for r in record.get("runs", [])}
+    from alte.report.runs import record_runs
+
+    total = _seconds(record.get("seconds"))
+    runs = {str(r["name"]): _seconds(r.get("seconds")) for r in record_runs(record)}
     if total <= 0:
         return {}
     shares = {name: sec / total for name, sec in runs.items()}
@@ -38,7 +45,7 @@ def stage_shares(record: dict[str, Any]) -> dict[str, float]:
 
 def report_wall_time(ctx: Context) -> list[Result]:
     """Row 8 from the latest finished report run, or 'not run' when there is none."""
-    from alte.report.runs import read_record
+    from alte.report.runs import read_record, record_runs
 
     latest = Path(ctx.config.reports_dir) / "latest"
     record = read_record(latest) if latest.is_dir() else None
@@ -46,9 +53,10 @@ def report_wall_time(ctx: Context) -> list[Result]:
     if record is None:
         return [Result(8, "make report (not run: no reports/latest/run.json)", float("nan"),
                        peer, "s", "informative", None, {"status": "not run"})]
-    detail = {"status": "read", "run": str(latest.resolve()), "mode": record.get("mode"),
-              "started": record.get("started"), "shares": stage_shares(record),
-              "run_status": {r["name"]: r.get("status") for r in record.get("runs", [])}}
+    detail: JSONDict = {
+        "status": "read", "run": str(latest.resolve()), "mode": record.get("mode"),
+        "started": record.get("started"), "shares": stage_shares(record),
+        "run_status": {str(r["name"]): r.get("status") for r in record_runs(record)}}
+    seconds = _seconds(record.get("seconds"))
     return [Result(8, f"make report ({record.get('mode')} mode, {record.get('started')})",
-                   float(record.get("seconds") or float("nan")), peer, "s", "informative",
-                   None, detail)]
+                   seconds or float("nan"), peer, "s", "informative", None, detail)]
