@@ -18,7 +18,7 @@ if TYPE_CHECKING:
 
 __all__ = ["to_array", "to_tensor"]
 
-_T = TypeVar("_T", bound=np.generic)
+_T = TypeVar("_T", np.float32, np.float64, np.int64)
 
 
 def to_tensor(values: ArrayLike, dtype: type[np.float32 | np.uint32] = np.float32,

@@ -14,10 +14,12 @@ from functools import partial
 from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import NDArray
 
 from alte.bench.core import LIMITS, Context, Result
 from alte.bench.maps import NAV, mapper_setup, octomap_passes
 from alte.bench.timing import measure
+from alte.bench.workload import Points
 from alte.studies.thesis import mapper_params
 from alte.types import JSONDict
 
@@ -38,7 +40,7 @@ OBSTACLE_HEIGHT = 0.3
 CLUSTER_TOLERANCE = 0.5
 
 
-def _pcd(points: np.ndarray) -> o3d.geometry.PointCloud:
+def _pcd(points: Points) -> o3d.geometry.PointCloud:
     import open3d as o3d
 
     return o3d.geometry.PointCloud(o3d.utility.Vector3dVector(np.asarray(points, np.float64)))
@@ -52,7 +54,7 @@ def open3d_hausdorff(pa: o3d.geometry.PointCloud, pb: o3d.geometry.PointCloud
     return max(d_ab.max(), d_ba.max()), max(d_ab.mean(), d_ba.mean())
 
 
-def corner_sets(ctx: Context) -> dict[str, np.ndarray]:
+def corner_sets(ctx: Context) -> dict[str, Points]:
     """Corners of the occupied cells of Octomap (native) and 3D-ALTE maps of sim_nav_1."""
     from alte.mappers import make_mapper
 
@@ -112,7 +114,7 @@ def cloud_stages(ctx: Context) -> list[Result]:
     raw, _ = work.stacked()
     p_raw, p_cloud = _pcd(raw), _pcd(work.cloud)
 
-    def ransac() -> tuple[np.ndarray, list[int]]:
+    def ransac() -> tuple[NDArray[np.float64], list[int]]:
         o3d.utility.random.seed(0)
         return p_cloud.segment_plane(PLANE_THRESHOLD, 3, 1000)
 

@@ -15,7 +15,7 @@ from typing import TypeVar, cast
 
 import numpy as np
 
-from alte.bench.workload import Workload, load_workload
+from alte.bench.workload import Scan, Workload, load_workload
 from alte.params import Record, param
 from alte.types import JSONDict
 
@@ -105,7 +105,7 @@ class Context:
         return self.memo(f"workload:{terrain}", lambda: load_workload(
             terrain, cfg.data_dir, quick=cfg.quick, progress=cfg.progress))
 
-    def scans(self, terrain: str) -> list[tuple[np.ndarray, np.ndarray]]:
+    def scans(self, terrain: str) -> list[Scan]:
         """The frames rows 1, 2 and 4 insert: all, or ``config.frames`` evenly spaced."""
         frames = self.workload(terrain).frames
         limit = self.config.frames

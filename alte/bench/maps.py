@@ -17,10 +17,12 @@ from functools import partial
 from typing import TYPE_CHECKING, Generic, Protocol, TypeVar
 
 import numpy as np
+from numpy.typing import NDArray
 from tqdm.auto import tqdm
 
 from alte.bench.core import LIMITS, Context, Result
 from alte.bench.timing import interleave, measure
+from alte.bench.workload import Points, Scan
 from alte.studies.thesis import mapper_params
 from alte.types import JSONDict
 
@@ -58,7 +60,7 @@ TERRAIN_OF = {"octomap": NAV, "alte3d": NAV, "quadtree": LAN, "alte2d": LAN}
 class Inserts(Protocol):
     """What a contender of :func:`interleaved_passes` does: insert one scan from its origin."""
 
-    def insert(self, points: np.ndarray, origin: np.ndarray, /) -> None: ...
+    def insert(self, points: Points, origin: Points, /) -> None: ...
 
 
 _M_co = TypeVar("_M_co", bound=Inserts, covariant=True)
@@ -70,17 +72,17 @@ class Passes(Generic[_M_co]):
     """Per-frame insert seconds (wall, and CPU of the process) of every timed pass, and the
     last map, per contender."""
 
-    latencies: dict[str, list[np.ndarray]]
+    latencies: dict[str, list[NDArray[np.float64]]]
     maps: Mapping[str, _M_co]
-    cpu: dict[str, list[np.ndarray]]
+    cpu: dict[str, list[NDArray[np.float64]]]
 
     def totals(self, name: str) -> list[float]:
         """Seconds of each timed pass of ``name`` (sum of its frame latencies)."""
         return [float(t.sum()) for t in self.latencies[name]]
 
 
-def insert_latencies(mapper: Inserts, scans: Sequence[tuple[np.ndarray, np.ndarray]],
-                     ) -> tuple[np.ndarray, np.ndarray]:
+def insert_latencies(mapper: Inserts, scans: Sequence[Scan],
+                     ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Insert every scan in order; wall and process CPU seconds of each ``insert`` call (the
     CPU time tells a loaded machine's waiting apart from the work)."""
     wall, cpu = np.empty(len(scans)), np.empty(len(scans))
@@ -92,12 +94,12 @@ def insert_latencies(mapper: Inserts, scans: Sequence[tuple[np.ndarray, np.ndarr
 
 
 def interleaved_passes(makers: Mapping[str, Callable[[], _T]],
-                       scans: Sequence[tuple[np.ndarray, np.ndarray]], *, repeats: int,
+                       scans: Sequence[Scan], *, repeats: int,
                        warmup: int, progress: bool = False, desc: str = "passes"
                        ) -> Passes[_T]:
     """Fresh map per pass; contenders alternate pass by pass; warm-up passes discarded."""
-    latencies: dict[str, list[np.ndarray]] = {name: [] for name in makers}
-    cpu: dict[str, list[np.ndarray]] = {name: [] for name in makers}
+    latencies: dict[str, list[NDArray[np.float64]]] = {name: [] for name in makers}
+    cpu: dict[str, list[NDArray[np.float64]]] = {name: [] for name in makers}
     maps: dict[str, _T] = {}
     rounds = list(interleave(list(makers), warmup + repeats))
     for r, name in tqdm(rounds, desc=desc, unit="pass", disable=not progress, leave=False):
@@ -158,7 +160,7 @@ def octomap_passes(ctx: Context) -> Passes[Octomap]:
     return ctx.memo("octomap-passes", run)
 
 
-def _jaccard(a: np.ndarray, b: np.ndarray) -> float:
+def _jaccard(a: NDArray[np.uint64], b: NDArray[np.uint64]) -> float:
     union = np.union1d(a, b).size
     return np.intersect1d(a, b, assume_unique=True).size / union if union else 1.0
 
@@ -194,7 +196,7 @@ def octomap_memory(ctx: Context) -> list[Result]:
                    "ratio <= 1", bool(ours <= LIMITS[2] * peer), detail)]
 
 
-def _build(name: str, params: Mapping[str, object], cloud: np.ndarray) -> None:
+def _build(name: str, params: Mapping[str, object], cloud: Points) -> None:
     """A fresh ``name`` map built from ``cloud`` (the timed call of row 3)."""
     from alte.mappers import make_mapper
 
@@ -222,7 +224,8 @@ def batch_builds(ctx: Context) -> list[Result]:
     return out
 
 
-def _latency_result(name: str, terrain: str, lat: list[np.ndarray], cpu: list[np.ndarray],
+def _latency_result(name: str, terrain: str, lat: list[NDArray[np.float64]],
+                    cpu: list[NDArray[np.float64]],
                     extra: JSONDict) -> Result:
     p99 = [float(np.percentile(t, 99)) for t in lat]
     ours = float(np.median(p99)) * 1e3
@@ -237,7 +240,7 @@ def _latency_result(name: str, terrain: str, lat: list[np.ndarray], cpu: list[np
                   detail)
 
 
-def _same_as_batch(mapper: Mapper, frames: Sequence[tuple[np.ndarray, np.ndarray]],
+def _same_as_batch(mapper: Mapper, frames: Sequence[Scan],
                    setup: MapperSetup) -> JSONDict:
     """Whether an incremental 2D map equals the batch build of its frames (same cells)."""
     batch = setup.make()

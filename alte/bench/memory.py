@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from alte.bench.core import LIMITS, Context, Result
-from alte.bench.workload import workload_dir
+from alte.bench.workload import Points, workload_dir
 
 __all__ = ["LAPS", "MAPPER_SETS", "RSS_CEILING_MB", "RSS_SPREAD", "long_mission",
            "map_memory", "peak_rss_mb"]
@@ -36,7 +36,7 @@ MAPPER_SETS: dict[str, tuple[str, ...]] = {"alte3d": (), "octomap": ("--set", "r
 TERRAIN = "sim_nav_1"
 
 
-def _laps(bag: Path, laps: int, gap_ns: int) -> Iterator[tuple[int, np.ndarray]]:
+def _laps(bag: Path, laps: int, gap_ns: int) -> Iterator[tuple[int, Points]]:
     """The bag's scans (sensor frame) ``laps`` times, each lap shifted by ``gap_ns``."""
     from alte.io.bag import FrameStream
 

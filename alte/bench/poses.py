@@ -12,15 +12,19 @@ of the peer, and under 100 ms per scan (a 10 Hz sensor) for odometry and refinem
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Iterable
+from collections.abc import Iterable, Iterator
 from dataclasses import replace
+from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
 
 from alte.bench.core import LIMITS, Context, Result
 from alte.bench.timing import one_core
 from alte.paths import realdata_dir
-from alte.types import Frame, JSONDict
+from alte.types import Frame, JSONDict, Mount
+
+if TYPE_CHECKING:
+    from alte.registration.odometry import OdometryParams, PoseCounts
 
 __all__ = ["pose_speed"]
 
@@ -72,6 +76,13 @@ def _peer(frames: list[Frame], clock: _Clock) -> None:
         clock.wall.append(1e3 * (time.perf_counter() - wall))
 
 
+class _Poser(Protocol):
+    """``odometry_frames`` or ``refine_frames`` as the row calls them."""
+
+    def __call__(self, frames: Iterable[Frame], mount: Mount, *, counts: PoseCounts,
+                 params: OdometryParams) -> Iterator[Frame]: ...
+
+
 def _ours(frames: list[Frame], refine: bool, clock: _Clock) -> None:
     from alte.registration.odometry import (
         OdometryParams,
@@ -79,9 +90,7 @@ def _ours(frames: list[Frame], refine: bool, clock: _Clock) -> None:
         odometry_frames,
         refine_frames,
     )
-    from alte.types import Mount
-
-    stream: Callable[..., Iterable[Frame]] = refine_frames if refine else odometry_frames
+    stream: _Poser = refine_frames if refine else odometry_frames
     bare = [replace(f, times=None) for f in frames]
     for _ in clock.timed(stream(bare, Mount(), counts=PoseCounts(), params=OdometryParams())):
         pass

@@ -21,7 +21,7 @@ from tqdm.auto import tqdm
 from alte.bench.core import Context, Result
 from alte.bench.maps import NAV, TERRAIN_OF
 from alte.bench.timing import fit_exponent, measure, nlogn_exponent, peak_rss_bytes
-from alte.bench.workload import tile_points
+from alte.bench.workload import Points, Scan, tile_points
 from alte.studies.thesis import mapper_params
 from alte.types import JSONDict
 
@@ -33,8 +33,7 @@ EXPONENT_SLACK = 0.1
 Case = Callable[[int], tuple[int, Callable[[], object]]]
 
 
-def whole_scans(frames: Sequence[tuple[np.ndarray, np.ndarray]],
-                n: int) -> tuple[np.ndarray, np.ndarray]:
+def whole_scans(frames: Sequence[Scan], n: int) -> tuple[Points, Points]:
     """About ``n`` points as whole scans with per-point origins: evenly spaced scans of the
     mission below its size, the whole mission tiled side by side above it."""
     sizes = np.array([len(p) for p, _ in frames])

@@ -30,12 +30,13 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import NDArray
 from tqdm.auto import tqdm
 
 from alte.bench.core import LIMITS, Context, Result
 from alte.bench.maps import LAN, NAV, ROTATION_S, interleaved_passes
 from alte.bench.timing import interleave, one_core
-from alte.bench.workload import QUICK_FRAMES, workload_dir
+from alte.bench.workload import QUICK_FRAMES, Points, Scan, workload_dir
 from alte.types import JSONDict
 
 if TYPE_CHECKING:
@@ -47,7 +48,7 @@ __all__ = ["STREAM_MAPPERS", "UfoPeer", "mission_seconds", "scan_peer", "streami
 STREAM_MAPPERS = ("octomap", "alte3d", "quadtree", "alte2d")
 
 
-def mission_seconds(stamps_ns: np.ndarray) -> float:
+def mission_seconds(stamps_ns: NDArray[np.int64]) -> float:
     """Sensor time a run covers: its scans times their (median) period."""
     if len(stamps_ns) < 2:
         return ROTATION_S * len(stamps_ns)
@@ -75,7 +76,7 @@ def _one_run(bag: Path, spec: MapSpec) -> tuple[float, float, MapRun]:
     return time.perf_counter() - start, time.process_time() - used, result
 
 
-def _quantiles_ms(seconds: list[np.ndarray]) -> dict[str, float]:
+def _quantiles_ms(seconds: list[NDArray[np.float64]]) -> dict[str, float]:
     """p50, p99 and max (ms) of per-frame seconds, each the median over the runs."""
     return {name: float(np.median([np.percentile(s, q) for s in seconds])) * 1e3
             for name, q in (("p50", 50), ("p99", 99), ("max", 100))}
@@ -137,7 +138,7 @@ class UfoPeer:
         self._map = dufomap.dufomap(voxel, 0.0, 0, num_threads=threads, hit_extension=False,
                                     ray_passthrough_hits=False)
 
-    def insert(self, points: np.ndarray, origin: np.ndarray) -> None:
+    def insert(self, points: Points, origin: Points) -> None:
         """Cast the scan's rays from ``origin`` (points already in the map frame)."""
         pose = np.eye(4)
         pose[:3, 3] = origin
@@ -154,7 +155,7 @@ def scan_peer(ctx: Context) -> list[Result]:
     makers: dict[str, Callable[[], Inserts]] = {
         "native": setup.make,
         "dufomap": lambda: UfoPeer(voxel, threads)}
-    scans: Sequence[tuple[np.ndarray, np.ndarray]] = ctx.scans(NAV)
+    scans: Sequence[Scan] = ctx.scans(NAV)
     cfg = ctx.config
     passes = interleaved_passes(makers, scans, repeats=cfg.repeats, warmup=cfg.warmup,
                                 progress=cfg.progress, desc="dufomap")

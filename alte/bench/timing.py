@@ -18,6 +18,7 @@ from dataclasses import dataclass
 from importlib import metadata
 
 import numpy as np
+from numpy.typing import NDArray
 
 from alte.errors import ParameterError
 from alte.types import JSONDict
@@ -78,8 +79,8 @@ def measure(funcs: Mapping[str, Callable[[], object]], repeats: int = 5,
     return {name: Sample(tuple(t)) for name, t in times.items()}
 
 
-def fit_exponent(sizes: Sequence[float] | np.ndarray,
-                 seconds: Sequence[float] | np.ndarray) -> float:
+def fit_exponent(sizes: Sequence[float] | NDArray[np.float64],
+                 seconds: Sequence[float] | NDArray[np.float64]) -> float:
     """Slope of log(seconds) against log(size): the empirical complexity exponent."""
     x, y = np.log(np.asarray(sizes, float)), np.log(np.asarray(seconds, float))
     if np.unique(x).size < 2 or not np.isfinite(y).all():
@@ -88,7 +89,7 @@ def fit_exponent(sizes: Sequence[float] | np.ndarray,
     return float(np.polyfit(x, y, 1)[0])
 
 
-def nlogn_exponent(sizes: Sequence[float] | np.ndarray) -> float:
+def nlogn_exponent(sizes: Sequence[float] | NDArray[np.float64]) -> float:
     """The slope :func:`fit_exponent` gives for exact n log n over ``sizes`` (about 1.1)."""
     n = np.asarray(sizes, float)
     return fit_exponent(n, n * np.log(n))

@@ -14,10 +14,17 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import NDArray
 
 from alte.errors import ParameterError
 
-__all__ = ["QUICK_FRAMES", "Workload", "load_workload", "tile_points", "workload_dir"]
+__all__ = ["QUICK_FRAMES", "Points", "Scan", "Workload", "load_workload", "tile_points",
+           "workload_dir"]
+
+#: float64 points (N, 3), or a sensor origin (3,).
+Points = NDArray[np.float64]
+#: One frame as the mappers insert it: registered points (N, 3) and the sensor origin (3,).
+Scan = tuple[Points, Points]
 
 #: Scans simulated per terrain in quick mode.
 QUICK_FRAMES = 6
@@ -28,9 +35,9 @@ class Workload:
     """One terrain ready for mapping: frames ``(points, origin)``, merged cloud, control box."""
 
     name: str
-    frames: list[tuple[np.ndarray, np.ndarray]]
-    cloud: np.ndarray
-    bounds: np.ndarray
+    frames: list[Scan]
+    cloud: Points
+    bounds: NDArray[np.float64]
     voxel: float
 
     @property
@@ -38,7 +45,7 @@ class Workload:
         """Points over all frames (what incremental mappers insert)."""
         return int(sum(len(p) for p, _ in self.frames))
 
-    def stacked(self) -> tuple[np.ndarray, np.ndarray]:
+    def stacked(self) -> tuple[Points, Points]:
         """All frame points (P, 3) and each point's sensor origin (P, 3), frame order kept."""
         pts = np.vstack([p for p, _ in self.frames])
         origins = np.repeat(np.array([o for _, o in self.frames]),
@@ -67,7 +74,7 @@ def load_workload(terrain: str, data_dir: str | Path, *, quick: bool = False,
                     float(data.spec.voxel))
 
 
-def tile_points(points: np.ndarray, count: int, *extra: np.ndarray) -> list[np.ndarray]:
+def tile_points(points: Points, count: int, *extra: Points) -> list[Points]:
     """``count`` rows of ``points`` (N, 3): evenly subsampled, or tiled side by side in x/y.
 
     Copies are shifted by whole multiples of the cloud's x/y extent (plus 1 m), so

@@ -16,6 +16,7 @@ from alte.errors import ParameterError, PointFileError
 from alte.export import export_registered
 from alte.fsutil import refuse_overwrite
 from alte.io.pointfiles import WRITE_SUFFIXES, storable, write_points
+from alte.io.pointformats import Fields
 from alte.pipeline import InputKind, StreamCounts, merge_frames, open_input, prepare
 from alte.registration import RegistrationCounts
 
@@ -90,7 +91,7 @@ def format_file_counts(path: Path, counts: StreamCounts) -> list[str]:
             f"{c.points_dropped_crop} (outside crop box); {out}{c.points_out} points out"]
 
 
-def _fields_line(out: Path, fields: dict[str, np.ndarray]) -> tuple[dict[str, np.ndarray], str]:
+def _fields_line(out: Path, fields: Fields) -> tuple[Fields, str]:
     """The fields ``out`` can hold, and a line naming what is kept and what is not (why)."""
     kept, dropped = storable(out.suffix.lower(), fields)
     parts = [f"kept {', '.join(kept)}"] if kept else []
@@ -104,7 +105,7 @@ def run(args: argparse.Namespace) -> int:
         raise PointFileError(f"--out {args.out}: unknown point file type; use {WRITE_SUFFIXES}")
     refuse_overwrite(args.out, args.force)  # fail before the long read
     spec, source = frame_spec(args), open_input(args.input)
-    fields: dict[str, np.ndarray] = {}
+    fields: Fields = {}
     if args.mcap is not None:
         _check_mcap(args.mcap, args.force)
         reg = prepare(source, spec, progress=True)

@@ -26,6 +26,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import NDArray
 
 from alte.errors import ParameterError
 from alte.export.rosmsg import blank, header, pose, time_msg, typestore
@@ -48,7 +49,7 @@ _CELL = np.dtype({"names": [n for n, _, _ in GRID_FIELDS],
 _IDENTITY = np.array([0.0, 0.0, 0.0, 1.0])
 
 
-def height_colours(z: np.ndarray) -> np.ndarray:
+def height_colours(z: NDArray[np.float64]) -> NDArray[np.float64]:
     """(N, 4) RGBA in 0..1, viridis over the heights' range (one colour when flat)."""
     from matplotlib import colormaps
 
@@ -65,10 +66,10 @@ class Raster:
     lower-left corner at ``origin``; NaN height where no surface is known, occupancy
     0 free / 100 occupied / -1 unknown."""
 
-    origin: np.ndarray
+    origin: NDArray[np.float64]
     resolution: float
-    height: np.ndarray
-    occupancy: np.ndarray
+    height: NDArray[np.float64]
+    occupancy: NDArray[np.int8]
 
     @property
     def shape(self) -> tuple[int, int]:
@@ -82,8 +83,8 @@ class Raster:
         return float(known.min()) - self.resolution if known.size else 0.0
 
 
-def _footprints(centers: np.ndarray, edge: np.ndarray, max_cells: int
-                ) -> tuple[np.ndarray, float, int, int]:
+def _footprints(centers: NDArray[np.float64], edge: NDArray[np.float64], max_cells: int
+                ) -> tuple[NDArray[np.float64], float, int, int]:
     """Lower-left corner, pixel size, rows and columns of the grid covering the leaves."""
     lo = (centers[:, :2] - edge[:, None] / 2).min(axis=0)
     hi = (centers[:, :2] + edge[:, None] / 2).max(axis=0)
@@ -94,8 +95,9 @@ def _footprints(centers: np.ndarray, edge: np.ndarray, max_cells: int
     return lo, res, rows, cols
 
 
-def _pixels(centers: np.ndarray, edge: np.ndarray, lo: np.ndarray, res: float,
-            shape: tuple[int, int]) -> Iterator[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+def _pixels(centers: NDArray[np.float64], edge: NDArray[np.float64], lo: NDArray[np.float64],
+            res: float, shape: tuple[int, int]
+            ) -> Iterator[tuple[NDArray[np.bool_], NDArray[np.int64], NDArray[np.int64]]]:
     """(leaf mask, rows, columns) of the pixels under the leaves, one leaf size at a time."""
     rows, cols = shape
     first = np.floor((centers[:, :2] - edge[:, None] / 2 - lo) / res + 1e-9).astype(np.int64)
@@ -108,7 +110,7 @@ def _pixels(centers: np.ndarray, edge: np.ndarray, lo: np.ndarray, res: float,
         yield sel, r, c
 
 
-def raster(cells: Cells, shift: np.ndarray, max_cells: int = 4_000_000, dims: int = 2,
+def raster(cells: Cells, shift: NDArray[np.float64], max_cells: int = 4_000_000, dims: int = 2,
            rule: SurfaceRule | None = None) -> Raster:
     """Paint the map's leaves onto a grid and classify it (module docstring)."""
     if max_cells < 1:
@@ -147,7 +149,7 @@ def occupancy_grid(grid: Raster, stamp: int, frame: str) -> MsgType:
                                                grid.occupancy.reshape(-1).astype(np.int8))
 
 
-def _layer(values: np.ndarray) -> MsgType:
+def _layer(values: NDArray[np.float64]) -> MsgType:
     """A grid_map layer: column-major over grid_map's indices (row = -x, column = -y)."""
     types = typestore().types
     gm = values[::-1, ::-1].T  # [x index from max x, y index from max y]
@@ -173,7 +175,7 @@ def grid_map(grid: Raster, stamp: int, frame: str) -> MsgType:
                  data=[_layer(grid.height), _layer(occupancy)])
 
 
-def grid_cells(grid: Raster) -> np.ndarray:
+def grid_cells(grid: Raster) -> NDArray[np.void]:
     """The raster as ``foxglove_msgs/msg/Grid`` cells (rows, cols) of :data:`GRID_FIELDS`."""
     cells = np.zeros(grid.shape, dtype=_CELL)
     cells["elevation"] = grid.height

@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import NDArray
 
 from alte.export.grids import height_colours
 from alte.export.rosmsg import blank, header, pose, typestore
@@ -31,18 +32,18 @@ TILE = 0.05
 _BT_DATA = b"\ndata\n"
 
 
-def shown_cells(cells: Cells, dims: int, everything: bool = False) -> np.ndarray:
+def shown_cells(cells: Cells, dims: int, everything: bool = False) -> NDArray[np.bool_]:
     """Mask of the cells drawn: occupied (3D maps) or known (2D height maps: a free leaf is
     ground at its height); ``everything`` adds the free cells of a 3D map."""
-    known: np.ndarray = np.isfinite(cells.centers).all(axis=1)
+    known: NDArray[np.bool_] = np.isfinite(cells.centers).all(axis=1)
     if dims == 2 or everything:
         return known
-    shown: np.ndarray = known & np.asarray(cells.occupied, dtype=bool)
+    shown: NDArray[np.bool_] = known & np.asarray(cells.occupied, dtype=bool)
     return shown
 
 
-def _cube_list(head: MsgType, ident: int, size: np.ndarray, centers: np.ndarray,
-               colours: np.ndarray) -> MsgType:
+def _cube_list(head: MsgType, ident: int, size: NDArray[np.float64], centers: NDArray[np.float64],
+               colours: NDArray[np.float64]) -> MsgType:
     types = typestore().types
     point, rgba = types["geometry_msgs/msg/Point"], types["std_msgs/msg/ColorRGBA"]
     return blank("visualization_msgs/msg/Marker", header=head, ns="cells",
@@ -54,8 +55,8 @@ def _cube_list(head: MsgType, ident: int, size: np.ndarray, centers: np.ndarray,
                  colors=[rgba(*map(float, c)) for c in colours])
 
 
-def cell_markers(cells: Cells, mask: np.ndarray, stamp: int, frame: str,
-                 shift: np.ndarray) -> MsgType:
+def cell_markers(cells: Cells, mask: NDArray[np.bool_], stamp: int, frame: str,
+                 shift: NDArray[np.float64]) -> MsgType:
     """MarkerArray of the masked cells (centres moved back by the local ``shift``)."""
     centers = cells.centers[mask] + shift
     sizes = cells.sizes[mask].copy()

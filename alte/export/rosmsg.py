@@ -15,6 +15,7 @@ from functools import cache
 from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import NDArray
 from rosbags.interfaces import Nodetype
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 from rosbags.typesys.store import Typestore
@@ -134,7 +135,7 @@ def header(stamp_ns: int, frame_id: str) -> MsgType:
     return make_header(stamp_ns, frame_id, typestore())
 
 
-def pose(position: np.ndarray, quaternion: np.ndarray) -> MsgType:
+def pose(position: NDArray[np.float64], quaternion: NDArray[np.float64]) -> MsgType:
     """``geometry_msgs/msg/Pose`` from a position and an (x, y, z, w) quaternion."""
     types = typestore().types
     return types["geometry_msgs/msg/Pose"](
@@ -142,23 +143,23 @@ def pose(position: np.ndarray, quaternion: np.ndarray) -> MsgType:
         types["geometry_msgs/msg/Quaternion"](*map(float, quaternion)))
 
 
-def pose_stamped(stamp_ns: int, frame_id: str, position: np.ndarray,
-                 quaternion: np.ndarray) -> MsgType:
+def pose_stamped(stamp_ns: int, frame_id: str, position: NDArray[np.float64],
+                 quaternion: NDArray[np.float64]) -> MsgType:
     """``geometry_msgs/msg/PoseStamped``."""
     return typestore().types["geometry_msgs/msg/PoseStamped"](
         header(stamp_ns, frame_id), pose(position, quaternion))
 
 
-def path_msg(stamp_ns: int, frame_id: str, stamps: np.ndarray, positions: np.ndarray,
-             quaternions: np.ndarray) -> MsgType:
+def path_msg(stamp_ns: int, frame_id: str, stamps: NDArray[np.int64],
+             positions: NDArray[np.float64], quaternions: NDArray[np.float64]) -> MsgType:
     """``nav_msgs/msg/Path`` through the given poses (each stamped with its own time)."""
     poses = [pose_stamped(int(s), frame_id, p, q)
              for s, p, q in zip(stamps, positions, quaternions, strict=True)]
     return typestore().types["nav_msgs/msg/Path"](header(stamp_ns, frame_id), poses)
 
 
-def tf_msg(stamp_ns: int, parent: str, child: str, translation: np.ndarray,
-           quaternion: np.ndarray) -> MsgType:
+def tf_msg(stamp_ns: int, parent: str, child: str, translation: NDArray[np.float64],
+           quaternion: NDArray[np.float64]) -> MsgType:
     """``tf2_msgs/msg/TFMessage`` holding one ``parent -> child`` transform."""
     types = typestore().types
     transform = types["geometry_msgs/msg/Transform"](
@@ -169,6 +170,6 @@ def tf_msg(stamp_ns: int, parent: str, child: str, translation: np.ndarray,
     return types["tf2_msgs/msg/TFMessage"]([stamped])
 
 
-def cloud_msg(points: np.ndarray, stamp_ns: int, frame_id: str) -> MsgType:
+def cloud_msg(points: NDArray[np.float64], stamp_ns: int, frame_id: str) -> MsgType:
     """``sensor_msgs/msg/PointCloud2`` of (N, 3) points (float32 x, y, z)."""
     return encode_pointcloud2(points, stamp_ns, frame_id, typestore())

@@ -16,6 +16,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import NDArray
 
 from alte.errors import ParameterError
 from alte.export import grids, maps
@@ -72,7 +73,7 @@ class MapExporter:
                                           frame.position, frame.quaternion))
 
     def __call__(self, index: int, frame: RegisteredFrame, mapper: Mapper,
-                 shift: np.ndarray) -> None:
+                 shift: NDArray[np.float64]) -> None:
         self.frame(frame)
         every = self.options.timeline
         if every is not None and (index + 1) % every == 0:
@@ -85,7 +86,7 @@ class MapExporter:
             stamp, WORLD, np.array([f.stamp for f in p]), np.array([f.position for f in p]),
             np.array([f.quaternion for f in p])), opening)
 
-    def map(self, index: int, mapper: Mapper, shift: np.ndarray, stamp: int | None = None,
+    def map(self, index: int, mapper: Mapper, shift: NDArray[np.float64], stamp: int | None = None,
             opening: bool = False) -> None:
         """The map after mapped scan ``index``, stamped with that scan's time (or ``stamp``,
         with ``opening``: kept for the start of the file)."""
@@ -111,7 +112,8 @@ class MapExporter:
         """``put(topic, message)`` at ``stamp``, streamed or kept for the opening."""
         return lambda topic, message: self.out.put(topic, stamp, message, opening)
 
-    def finish(self, mapper: Mapper | None, shift: np.ndarray, cloud: np.ndarray | None) -> None:
+    def finish(self, mapper: Mapper | None, shift: NDArray[np.float64],
+               cloud: NDArray[np.float64] | None) -> None:
         """The final map (unless the timeline just wrote it), merged cloud and trajectory,
         at the last scan and again at the first (the opening)."""
         if not self.poses:

@@ -9,16 +9,18 @@ through open3d's tensor reader. A body shorter than the header announces is refu
 from __future__ import annotations
 
 from pathlib import Path
-from typing import NotRequired, TypedDict
+from typing import NotRequired, TypeAlias, TypedDict
 
 import numpy as np
+from numpy.typing import NDArray
 
 from alte.errors import PointFileError
 from alte.io.pcd import read_table
 
 __all__ = ["FieldInfo", "Fields", "FileAbout", "ply_layout", "read_ply", "write_ply"]
 
-Fields = dict[str, np.ndarray]
+#: Per-point values by name (N rows each), each array of its own dtype.
+Fields: TypeAlias = "dict[str, NDArray[np.generic[object]]]"
 
 
 class FieldInfo(TypedDict):
