@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import TypedDict, Unpack, cast
 
 import numpy as np
+from numpy.typing import NDArray
 from rosbags.highlevel import AnyReader
 from tqdm.auto import tqdm
 
@@ -69,7 +70,7 @@ class FrameSet:
 
 
 def _decode(msg: object, msgtype: str, topic: str, return_mode: str,
-            stamp: int) -> tuple[np.ndarray, np.ndarray | None, int]:
+            stamp: int) -> tuple[NDArray[np.float64], NDArray[np.float64] | None, int]:
     """Points, per-point times (s from ``stamp``, None without) and dropped points of one
     cloud-topic message; ``msgtype`` names the class rosbags built."""
     if msgtype == SCAN_TYPE:
@@ -176,8 +177,8 @@ class _StampRange:
         self.high = stamp if self.high is None else max(self.high, stamp)
 
 
-def _pose_at(track: PoseTrack | None, stamp: int, max_gap_s: float,
-             counts: ReadCounts) -> tuple[np.ndarray, np.ndarray, float, float] | None:
+def _pose_at(track: PoseTrack | None, stamp: int, max_gap_s: float, counts: ReadCounts
+             ) -> tuple[NDArray[np.float64], NDArray[np.float64], float, float] | None:
     """The body pose at ``stamp`` (identity without a track); None, counted, when none."""
     if track is None:
         return np.zeros(3), _IDENTITY_Q.copy(), 0.0, 0.0

@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import Protocol, cast
 
 import numpy as np
+from numpy.typing import NDArray
 
 from alte.errors import BagError, TopicError
 from alte.io.messages import StampedMsg, XYZMsg
@@ -42,9 +43,9 @@ class ImuSamples:
     pose on the body is ``mount`` (identity when the bag does not say); ``gyro_sigma`` /
     ``accel_sigma`` the per-sample white noise written into the covariances (0: unknown)."""
 
-    stamps: np.ndarray
-    angular_velocity: np.ndarray
-    linear_acceleration: np.ndarray
+    stamps: NDArray[np.int64]
+    angular_velocity: NDArray[np.float64]
+    linear_acceleration: NDArray[np.float64]
     frame_id: str = "imu_link"
     mount: Mount | None = None
     gyro_sigma: float = 0.0
@@ -67,7 +68,7 @@ def imu_topic(path: str | Path, override: str | None = None) -> str | None:
         return select_topic(topic_table(reader), override, (IMU_TYPE,), "IMU", Path(path))
 
 
-def _vectors(items: Sequence[XYZMsg]) -> np.ndarray:
+def _vectors(items: Sequence[XYZMsg]) -> NDArray[np.float64]:
     return np.array([[v.x, v.y, v.z] for v in items], dtype=np.float64).reshape(-1, 3)
 
 

@@ -4,12 +4,14 @@ from __future__ import annotations
 
 import numba
 import numpy as np
+from numpy.typing import NDArray
 
 __all__ = ["lzf_decompress"]
 
 
 @numba.njit(cache=True)
-def lzf_decompress(src: np.ndarray, size: int) -> np.ndarray:  # pragma: no cover - compiled
+def lzf_decompress(src: NDArray[np.uint8],  # pragma: no cover - compiled
+                   size: int) -> NDArray[np.uint8]:
     """liblzf decompression (PCD binary_compressed); empty result on corrupt input."""
     out = np.empty(size, np.uint8)
     ip, op = 0, 0

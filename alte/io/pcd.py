@@ -14,15 +14,20 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TypeAlias
 
 import numpy as np
 import pandas as pd
+from numpy.typing import NDArray
 
 from alte.errors import PointFileError
 from alte.io.lzf import lzf_decompress
 
-__all__ = ["PcdHeader", "pack_rgb", "pcd_header", "read_pcd", "read_pcd_table", "read_table",
-           "unpack_rgb", "write_pcd"]
+__all__ = ["Fields", "PcdHeader", "pack_rgb", "pcd_header", "read_pcd", "read_pcd_table",
+           "read_table", "unpack_rgb", "write_pcd"]
+
+#: A point file's per-point values by name (N rows each), each array of its own dtype.
+Fields: TypeAlias = "dict[str, NDArray[np.generic[object]]]"
 
 _PCD_TYPES = {"F": "f", "U": "u", "I": "i"}
 _TYPE_LETTER = {"f": "F", "u": "U", "i": "I", "b": "U"}
@@ -44,7 +49,7 @@ class PcdHeader:
     offset: int
 
     @property
-    def dtype(self) -> np.dtype:
+    def dtype(self) -> np.dtype[np.void]:
         """One row of the body (fields suffixed with their index: names may repeat)."""
         return np.dtype([(f"{name}_{i}", f"<{_PCD_TYPES[t]}{size}", (count,))
                          for i, (name, size, t, count) in enumerate(self.fields)])
@@ -136,7 +141,7 @@ def _last_row_width(raw: bytes, offset: int) -> int:
     return len(body[body.rfind(b"\n") + 1:].split()) if body else 0
 
 
-def _ascii(raw: bytes, head: PcdHeader, path: Path) -> np.ndarray:
+def _ascii(raw: bytes, head: PcdHeader, path: Path) -> NDArray[np.void]:
     dtype = head.dtype
     width = sum(count for *_, count in head.fields)
     try:
@@ -164,7 +169,7 @@ def _ascii(raw: bytes, head: PcdHeader, path: Path) -> np.ndarray:
     return out
 
 
-def _binary(raw: bytes, head: PcdHeader, path: Path) -> np.ndarray:
+def _binary(raw: bytes, head: PcdHeader, path: Path) -> NDArray[np.void]:
     need, have = head.points * head.dtype.itemsize, len(raw) - head.offset
     if have < need:
         raise PointFileError(f"{path}: truncated binary PCD: {have} of the {need} bytes "
@@ -173,7 +178,7 @@ def _binary(raw: bytes, head: PcdHeader, path: Path) -> np.ndarray:
     return np.frombuffer(raw, head.dtype, count=head.points, offset=head.offset)
 
 
-def _compressed(raw: bytes, head: PcdHeader, path: Path) -> np.ndarray:
+def _compressed(raw: bytes, head: PcdHeader, path: Path) -> NDArray[np.void]:
     """Decompress a binary_compressed body (field-major) into a structured array."""
     blob, dtype, count = raw[head.offset:], head.dtype, head.points
     if len(blob) < 8:
@@ -199,20 +204,20 @@ def _compressed(raw: bytes, head: PcdHeader, path: Path) -> np.ndarray:
     return out
 
 
-def unpack_rgb(values: np.ndarray) -> np.ndarray:
+def unpack_rgb(values: NDArray[np.generic[object]]) -> NDArray[np.uint8]:
     """PCL's packed colour (float32 or uint32 bits 0xAARRGGBB) -> (N, 3) uint8 RGB."""
     bits = np.ascontiguousarray(values).view(np.uint32) if values.dtype.itemsize == 4 \
         else np.asarray(values, dtype=np.uint32)
     return np.column_stack([(bits >> 16) & 255, (bits >> 8) & 255, bits & 255]).astype(np.uint8)
 
 
-def pack_rgb(colors: np.ndarray) -> np.ndarray:
+def pack_rgb(colors: NDArray[np.generic[object]]) -> NDArray[np.float32]:
     """(N, 3) uint8 RGB -> PCL's float32-packed ``rgb``."""
     c = np.asarray(colors, dtype=np.uint32)
     return ((c[:, 0] << 16) | (c[:, 1] << 8) | c[:, 2]).astype(np.uint32).view(np.float32)
 
 
-def read_pcd_table(path: Path) -> tuple[PcdHeader, np.ndarray, dict[str, np.ndarray]]:
+def read_pcd_table(path: Path) -> tuple[PcdHeader, NDArray[np.float64], Fields]:
     """Header, (N, 3) float64 x y z and every other field ((N,) or (N, count); packed
     colours as ``colors`` (N, 3) uint8) of a PCD file, every row kept (NaN included)."""
     raw = path.read_bytes()
@@ -225,7 +230,7 @@ def read_pcd_table(path: Path) -> tuple[PcdHeader, np.ndarray, dict[str, np.ndar
     bare = [name.rsplit("_", 1)[0] for name in names]
     points = np.column_stack([data[names[bare.index(c)]][:, 0] for c in "xyz"]
                              ).astype(np.float64) if len(data) else np.empty((0, 3))
-    fields: dict[str, np.ndarray] = {}
+    fields: Fields = {}
     for name, field in zip(bare, names, strict=True):
         if name in {"x", "y", "z", "_"} or name in fields:
             continue  # padding ("_") and repeated names carry nothing a user named
@@ -238,17 +243,16 @@ def read_pcd_table(path: Path) -> tuple[PcdHeader, np.ndarray, dict[str, np.ndar
     return head, points, fields
 
 
-def read_pcd(path: Path) -> np.ndarray:
+def read_pcd(path: Path) -> NDArray[np.float64]:
     """(N, 3) float64 x y z of a PCD file (ascii, binary or binary_compressed)."""
     return read_pcd_table(path)[1]
 
 
-def write_pcd(tmp: Path, points: np.ndarray, fields: dict[str, np.ndarray] | None = None
-              ) -> None:
+def write_pcd(tmp: Path, points: NDArray[np.float64], fields: Fields | None = None) -> None:
     """Binary PCD: float64 x y z, then each field with its own type (``colors`` packed
     into a float32 ``rgb``)."""
-    columns: list[tuple[str, np.ndarray]] = [("x", points[:, 0]), ("y", points[:, 1]),
-                                             ("z", points[:, 2])]
+    columns: list[tuple[str, NDArray[np.generic[object]]]] = [
+        ("x", points[:, 0]), ("y", points[:, 1]), ("z", points[:, 2])]
     for name, values in (fields or {}).items():
         columns.append(("rgb", pack_rgb(values)) if name == "colors"
                        else (name, np.asarray(values)))

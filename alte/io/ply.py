@@ -9,18 +9,15 @@ through open3d's tensor reader. A body shorter than the header announces is refu
 from __future__ import annotations
 
 from pathlib import Path
-from typing import NotRequired, TypeAlias, TypedDict
+from typing import NotRequired, TypedDict
 
 import numpy as np
 from numpy.typing import NDArray
 
 from alte.errors import PointFileError
-from alte.io.pcd import read_table
+from alte.io.pcd import Fields, read_table
 
 __all__ = ["FieldInfo", "Fields", "FileAbout", "ply_layout", "read_ply", "write_ply"]
-
-#: Per-point values by name (N rows each), each array of its own dtype.
-Fields: TypeAlias = "dict[str, NDArray[np.generic[object]]]"
 
 
 class FieldInfo(TypedDict):
@@ -95,7 +92,7 @@ def _check_ply_complete(path: Path) -> tuple[str, int, list[list[str]]]:
     return fmt, start, lines
 
 
-def _vertex_dtype(fmt: str, lines: list[list[str]]) -> np.dtype | None:
+def _vertex_dtype(fmt: str, lines: list[list[str]]) -> np.dtype[np.void] | None:
     """The body's row type when it is one ``vertex`` element of scalar properties (a
     point cloud), else None (meshes, lists: left to open3d)."""
     elements = [w for w in lines if w[0] == "element"]
@@ -107,7 +104,7 @@ def _vertex_dtype(fmt: str, lines: list[list[str]]) -> np.dtype | None:
     return np.dtype([(w[2], order[fmt] + _PLY_NUMPY[w[1]]) for w in props])
 
 
-def read_ply(path: Path) -> tuple[np.ndarray, Fields, FileAbout]:
+def read_ply(path: Path) -> tuple[NDArray[np.float64], Fields, FileAbout]:
     """A point-cloud PLY (one vertex element) read with numpy, every property kept (red,
     green, blue as ``colors``); other PLYs through open3d's tensor reader."""
     fmt, start, lines = _check_ply_complete(path)
@@ -136,7 +133,7 @@ def read_ply(path: Path) -> tuple[np.ndarray, Fields, FileAbout]:
     return points, fields, about
 
 
-def _read_ply_open3d(path: Path) -> tuple[np.ndarray, Fields]:
+def _read_ply_open3d(path: Path) -> tuple[NDArray[np.float64], Fields]:
     import open3d as o3d
 
     with o3d.utility.VerbosityContextManager(o3d.utility.VerbosityLevel.Error):
@@ -148,10 +145,11 @@ def _read_ply_open3d(path: Path) -> tuple[np.ndarray, Fields]:
     return points, fields
 
 
-def write_ply(tmp: Path, points: np.ndarray, fields: Fields) -> None:
+def write_ply(tmp: Path, points: NDArray[np.float64], fields: Fields) -> None:
     """Binary little-endian PLY: double x y z, then each field as properties (colors as
     uchar red green blue)."""
-    columns = [("x", points[:, 0]), ("y", points[:, 1]), ("z", points[:, 2])]
+    columns: list[tuple[str, NDArray[np.generic[object]]]] = [
+        ("x", points[:, 0]), ("y", points[:, 1]), ("z", points[:, 2])]
     for name, values in fields.items():
         if name == "colors":
             columns += [(c, values[:, k]) for k, c in enumerate(("red", "green", "blue"))]
@@ -172,7 +170,7 @@ def write_ply(tmp: Path, points: np.ndarray, fields: Fields) -> None:
                     + body.tobytes())
 
 
-def _ply_code(values: np.ndarray) -> str:
+def _ply_code(values: NDArray[np.generic[object]]) -> str:
     """PLY-representable dtype code (64-bit integers go as float64, bools as uchar)."""
     kind, size = values.dtype.kind, values.dtype.itemsize
     if kind == "b":

@@ -8,9 +8,11 @@ padding (``row_step > width * point_step``) are cut to their payload first.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from typing import TYPE_CHECKING, Literal
 
 import numpy as np
+from numpy.typing import NDArray
 
 from alte.errors import BagError
 from alte.io.messages import PointCloud2Msg
@@ -31,7 +33,7 @@ __all__ = [
 ]
 
 #: ``sensor_msgs/PointField`` datatype code -> numpy scalar type.
-POINTFIELD_DTYPES: dict[int, np.dtype] = {
+POINTFIELD_DTYPES: dict[int, np.dtype[np.generic[object]]] = {
     1: np.dtype(np.int8),
     2: np.dtype(np.uint8),
     3: np.dtype(np.int16),
@@ -52,7 +54,7 @@ TIME_FIELDS = ("t", "time", "timestamp", "offset_time")
 _MAX_SPAN_S = 2.0
 
 
-def _xyz_dtype(msg: PointCloud2Msg, topic: str, timed: bool = False) -> np.dtype:
+def _xyz_dtype(msg: PointCloud2Msg, topic: str, timed: bool = False) -> np.dtype[np.void]:
     """Structured dtype holding x, y, z (and the first per-point time field when ``timed``)
     at their offsets, ``itemsize == point_step``."""
     order: Literal[">", "<"] = ">" if msg.is_bigendian else "<"
@@ -87,7 +89,7 @@ def _xyz_dtype(msg: PointCloud2Msg, topic: str, timed: bool = False) -> np.dtype
     )
 
 
-def _payload(msg: PointCloud2Msg, topic: str) -> np.ndarray:
+def _payload(msg: PointCloud2Msg, topic: str) -> NDArray[np.uint8]:
     """The point bytes without row padding, checked against width/height/steps."""
     width, height = int(msg.width), int(msg.height)
     point_step, row_step = int(msg.point_step), int(msg.row_step)
@@ -110,7 +112,8 @@ def _payload(msg: PointCloud2Msg, topic: str) -> np.ndarray:
     return np.ascontiguousarray(data.reshape(height, row_step)[:, :row_bytes]).reshape(-1)
 
 
-def decode_pointcloud2(msg: PointCloud2Msg, topic: str = "PointCloud2") -> tuple[np.ndarray, int]:
+def decode_pointcloud2(msg: PointCloud2Msg, topic: str = "PointCloud2"
+                       ) -> tuple[NDArray[np.float64], int]:
     """Return the finite (N, 3) float64 x, y, z of ``msg`` and how many points were dropped.
 
     Points with a NaN or infinite coordinate (``is_dense = false`` clouds mark
@@ -121,8 +124,8 @@ def decode_pointcloud2(msg: PointCloud2Msg, topic: str = "PointCloud2") -> tuple
     return points, dropped
 
 
-def decode_timed(msg: PointCloud2Msg, stamp_ns: int,
-                 topic: str = "PointCloud2") -> tuple[np.ndarray, np.ndarray | None, int]:
+def decode_timed(msg: PointCloud2Msg, stamp_ns: int, topic: str = "PointCloud2"
+                 ) -> tuple[NDArray[np.float64], NDArray[np.float64] | None, int]:
     """As :func:`decode_pointcloud2`, plus each point's time in seconds from ``stamp_ns``
     (None when the cloud has no :data:`TIME_FIELDS` field).
 
@@ -134,13 +137,13 @@ def decode_timed(msg: PointCloud2Msg, stamp_ns: int,
     return _decode(msg, topic, stamp_ns)
 
 
-def _seconds(raw: np.ndarray, stamp_ns: int, name: str, topic: str) -> np.ndarray:
+def _seconds(raw: np.ndarray, stamp_ns: int, name: str, topic: str) -> NDArray[np.float64]:
     """Per-point times as float64 seconds relative to the scan stamp (see decode_timed)."""
     if raw.dtype.kind in "iu":
         ns = raw.astype(np.int64)
         if ns.size and int(np.median(ns)) > 10**15:
             ns = ns - stamp_ns
-        times = ns * 1e-9
+        times = ns * np.float64(1e-9)
     elif raw.size and float(np.median(raw)) > 1e15:  # nanoseconds in a float (Livox)
         times = (raw.astype(np.float64) - stamp_ns) * 1e-9
     else:
@@ -156,7 +159,7 @@ def _seconds(raw: np.ndarray, stamp_ns: int, name: str, topic: str) -> np.ndarra
 
 
 def _decode(msg: PointCloud2Msg, topic: str,
-            stamp_ns: int | None) -> tuple[np.ndarray, np.ndarray | None, int]:
+            stamp_ns: int | None) -> tuple[NDArray[np.float64], NDArray[np.float64] | None, int]:
     dtype = _xyz_dtype(msg, topic, timed=stamp_ns is not None)
     payload = _payload(msg, topic)
     count = int(msg.width) * int(msg.height)
@@ -177,13 +180,13 @@ def _decode(msg: PointCloud2Msg, topic: str,
 
 
 def encode_pointcloud2(
-    points: np.ndarray,
+    points: NDArray[np.float64],
     stamp_ns: int,
     frame_id: str,
     typestore: Typestore,
     *,
     dtype: CoordType = np.float32,
-    extra_fields: dict[str, np.ndarray] | None = None,
+    extra_fields: Mapping[str, np.ndarray] | None = None,
 ) -> MsgType:
     """Build an unorganized little-endian PointCloud2 message (x, y, z, then ``extra_fields``).
 

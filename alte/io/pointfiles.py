@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import NDArray
 
 from alte.errors import PointFileError
 from alte.fsutil import atomic_path
@@ -66,7 +67,7 @@ class PointTable:
     per-point ``fields`` and ``about``: what the file says of itself (format, encoding,
     its fields and their types, ...)."""
 
-    points: np.ndarray
+    points: NDArray[np.float64]
     fields: Fields
     about: FileAbout
 
@@ -76,7 +77,7 @@ class PointFileInfo:
     """Points read from a file (finite rows), how many rows it had and how many were dropped
     as non-finite, and the kept rows' other fields."""
 
-    points: np.ndarray
+    points: NDArray[np.float64]
     rows: int
     nonfinite: int
     fields: Fields = field(default_factory=dict)
@@ -104,7 +105,7 @@ def _suffix(path: Path) -> str:
     return suffixes[-1] if suffixes else ""
 
 
-def _read_pcd(path: Path) -> tuple[np.ndarray, Fields, FileAbout]:
+def _read_pcd(path: Path) -> tuple[NDArray[np.float64], Fields, FileAbout]:
     head, points, fields = read_pcd_table(path)
     about: FileAbout = {"format": f"PCD {head.version}", "encoding": head.encoding,
              "fields": [{"name": n, "type": f"{t}{s}", "count": c} for n, s, t, c in head.fields],
@@ -112,7 +113,7 @@ def _read_pcd(path: Path) -> tuple[np.ndarray, Fields, FileAbout]:
     return points, fields, about
 
 
-_READERS: dict[str, Callable[[Path], tuple[np.ndarray, Fields, FileAbout]]] = {
+_READERS: dict[str, Callable[[Path], tuple[NDArray[np.float64], Fields, FileAbout]]] = {
     ".pcd": _read_pcd, ".ply": read_ply, ".las": read_las, ".laz": read_las, ".npz": read_npz}
 _READERS |= {s: read_text for s in READ_SUFFIXES if s.startswith(_TEXT)}
 
@@ -168,14 +169,14 @@ def describe_points(path: str | os.PathLike[str]) -> PointSummary:
             "field_ranges": ranges}
 
 
-def read_points(path: str | os.PathLike[str]) -> np.ndarray:
+def read_points(path: str | os.PathLike[str]) -> NDArray[np.float64]:
     """(N, 3) float64 points of a PCD, PLY, LAS/LAZ, npz or xyz file; non-finite rows dropped."""
     return read_points_info(path).points
 
 
 # ------------------------------------------------------------------------------ writers
 
-_WRITERS: dict[str, Callable[[Path, np.ndarray, Fields], None]] = {
+_WRITERS: dict[str, Callable[[Path, NDArray[np.float64], Fields], None]] = {
     ".pcd": write_pcd, ".ply": write_ply, ".npz": write_npz}
 _WRITERS |= {s: write_text for s in _TEXT}
 _WRITERS |= {
@@ -184,7 +185,7 @@ _WRITERS |= {
 }
 
 
-def write_points(path: str | os.PathLike[str], points: np.ndarray, overwrite: bool = False,
+def write_points(path: str | os.PathLike[str], points: NDArray[np.float64], overwrite: bool = False,
                  fields: Fields | None = None) -> Path:
     """Write (N, 3) points atomically as PCD (binary, float64), PLY, npz, xyz text or LAS/LAZ,
     with the ``fields`` (N rows each) the format can hold (:func:`storable`)."""

@@ -22,6 +22,7 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+from numpy.typing import NDArray
 
 from alte.errors import ParameterError, PointFileError
 from alte.io.pcd import read_table
@@ -51,7 +52,7 @@ def _describe(fields: Fields) -> list[FieldInfo]:
 # ------------------------------------------------------------------------------ LAS
 
 
-def read_las(path: Path) -> tuple[np.ndarray, Fields, FileAbout]:
+def read_las(path: Path) -> tuple[NDArray[np.float64], Fields, FileAbout]:
     import laspy
 
     las = laspy.read(path)
@@ -75,12 +76,12 @@ def read_las(path: Path) -> tuple[np.ndarray, Fields, FileAbout]:
     return points, fields, about
 
 
-def _fits(values: np.ndarray, top: int) -> bool:
+def _fits(values: np.ndarray, top: int) -> bool:  # numeric, any dtype
     return bool(values.ndim == 1 and np.all(np.isfinite(values)) and np.all(values >= 0)
                 and np.all(values <= top) and np.all(np.mod(values, 1) == 0))
 
 
-def write_las(tmp: Path, points: np.ndarray, fields: Fields, compress: bool) -> None:
+def write_las(tmp: Path, points: NDArray[np.float64], fields: Fields, compress: bool) -> None:
     import laspy
 
     fields = dict(fields)
@@ -111,7 +112,7 @@ def write_las(tmp: Path, points: np.ndarray, fields: Fields, compress: bool) -> 
 # ------------------------------------------------------------------------------ npz, text
 
 
-def read_npz(path: Path) -> tuple[np.ndarray, Fields, FileAbout]:
+def read_npz(path: Path) -> tuple[NDArray[np.float64], Fields, FileAbout]:
     with np.load(path, allow_pickle=False) as archive:
         if "points" not in archive.files:
             raise PointFileError(f"{path}: no 'points' array (has {archive.files})")
@@ -123,13 +124,13 @@ def read_npz(path: Path) -> tuple[np.ndarray, Fields, FileAbout]:
     return points, fields, about
 
 
-def write_npz(tmp: Path, points: np.ndarray, fields: Fields) -> None:
+def write_npz(tmp: Path, points: NDArray[np.float64], fields: Fields) -> None:
     with open(tmp, "wb") as fh:  # a handle stops numpy appending ".npz"
         arrays: Fields = {"points": points, **fields}
         np.savez_compressed(fh, allow_pickle=True, **arrays)
 
 
-def read_text(path: Path) -> tuple[np.ndarray, Fields, FileAbout]:
+def read_text(path: Path) -> tuple[NDArray[np.float64], Fields, FileAbout]:
     table = read_table(path)
     if table.shape[1] < 3:
         raise PointFileError(f"{path}: {table.shape[1]} column(s); expected x y z per line")
@@ -142,13 +143,13 @@ def read_text(path: Path) -> tuple[np.ndarray, Fields, FileAbout]:
     return table.iloc[:, :3].to_numpy(np.float64), {}, about
 
 
-def write_text(tmp: Path, points: np.ndarray, fields: Fields) -> None:
+def write_text(tmp: Path, points: NDArray[np.float64], fields: Fields) -> None:
     del fields  # plain text holds x y z only (:func:`storable`)
     # pandas prints the shortest repr that round-trips each float64 exactly
     pd.DataFrame(points).to_csv(tmp, sep=" ", header=False, index=False)
 
 
-def _las_refusal(name: str, values: np.ndarray) -> str | None:
+def _las_refusal(name: str, values: NDArray[np.generic[object]]) -> str | None:
     """Why a LAS 1.4 file (point format 6/7) cannot hold a field, or None."""
     limits = {"intensity": 65535, "classification": 255}
     if name in limits and not _fits(values, limits[name]):
@@ -180,7 +181,7 @@ def storable(suffix: str, fields: Fields) -> tuple[Fields, dict[str, str]]:
     return kept, dropped
 
 
-def local_origin(points: np.ndarray, quantum: float = 1000.0) -> np.ndarray:
+def local_origin(points: NDArray[np.float64], quantum: float = 1000.0) -> NDArray[np.float64]:
     """Bounding-box centre rounded to ``quantum`` metres: subtract it from georeferenced
     clouds so that local coordinates (and centimetre cells) stay exact in float64.
     Clouds already near the origin get a zero origin."""
@@ -192,5 +193,5 @@ def local_origin(points: np.ndarray, quantum: float = 1000.0) -> np.ndarray:
     if not np.isfinite(arr).all():
         raise ParameterError("points hold non-finite coordinates; cannot choose an origin")
     centre = 0.5 * (arr.min(axis=0) + arr.max(axis=0))
-    origin: np.ndarray = np.round(centre / quantum) * quantum + 0.0  # + 0.0: -0.0 -> 0.0
+    origin: NDArray[np.float64] = np.round(centre / quantum) * quantum + 0.0  # + 0.0: -0.0 -> 0.0
     return origin

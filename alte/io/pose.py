@@ -15,7 +15,7 @@ from functools import cached_property
 from typing import NamedTuple, cast
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation, Slerp
 
 from alte.errors import PoseError
@@ -64,22 +64,22 @@ _UNIT_FACTORS = {1e6: "milliseconds vs nanoseconds", 1e9: "seconds vs nanosecond
 class PoseSamples:
     """Poses at K query stamps; rows where ``valid`` is False hold NaN."""
 
-    positions: np.ndarray
-    quaternions: np.ndarray
-    offset_s: np.ndarray
-    angular_rate: np.ndarray
-    valid: np.ndarray
-    outside: np.ndarray
-    in_gap: np.ndarray
+    positions: NDArray[np.float64]
+    quaternions: NDArray[np.float64]
+    offset_s: NDArray[np.float64]
+    angular_rate: NDArray[np.float64]
+    valid: NDArray[np.bool_]
+    outside: NDArray[np.bool_]
+    in_gap: NDArray[np.bool_]
 
 
 @dataclass(frozen=True)
 class PoseTrack:
     """Time-sorted body poses: int64 ns ``stamps``, ``positions`` (M, 3), ``quaternions`` (M, 4)."""
 
-    stamps: np.ndarray
-    positions: np.ndarray
-    quaternions: np.ndarray
+    stamps: NDArray[np.int64]
+    positions: NDArray[np.float64]
+    quaternions: NDArray[np.float64]
     source: str = "poses"
     duplicates: int = 0
     reordered: int = 0
@@ -171,12 +171,13 @@ class PoseTrack:
         return PoseSamples(pos, quat, nearest / _NS, rate, valid, outside, in_gap)
 
     @cached_property
-    def _rates(self) -> np.ndarray:
+    def _rates(self) -> NDArray[np.float64]:
         """Rotation rate (rad/s) between each sample and the next (once per track: a
         stream asks for one scan's pose at a time)."""
         q = self.quaternions
         rel = Rotation.from_quat(q[:-1]).inv() * Rotation.from_quat(q[1:])
-        rates: np.ndarray = np.linalg.norm(rel.as_rotvec(), axis=1) / (np.diff(self.stamps) / _NS)
+        rates: NDArray[np.float64] = np.linalg.norm(rel.as_rotvec(), axis=1) / (
+            np.diff(self.stamps) / _NS)
         return rates
 
     @cached_property
@@ -187,8 +188,9 @@ class PoseTrack:
         )
 
     def _at(
-        self, s: np.ndarray, valid: np.ndarray, hit: np.ndarray, right: np.ndarray
-    ) -> tuple[np.ndarray, np.ndarray]:
+        self, s: NDArray[np.int64], valid: NDArray[np.bool_], hit: NDArray[np.bool_],
+        right: NDArray[np.intp]
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Positions and quaternions at valid stamps (exact samples on hits), NaN elsewhere."""
         pos = np.full((s.size, 3), np.nan)
         quat = np.full((s.size, 4), np.nan)
@@ -211,7 +213,7 @@ class PoseTrack:
 
 def _as_arrays(
     stamps: ArrayLike, positions: ArrayLike, quats: ArrayLike, source: str
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+) -> tuple[NDArray[np.int64], NDArray[np.float64], NDArray[np.float64]]:
     """Copies of the inputs as int64 (M,), float64 (M, 3) and (M, 4), shape-checked."""
     t = np.array(stamps, dtype=np.int64).reshape(-1)
     p = np.array(positions, dtype=np.float64)

@@ -16,6 +16,7 @@ from typing import cast
 
 import apsw
 import numpy as np
+from numpy.typing import NDArray
 from rosbags.highlevel import AnyReader, AnyReaderError
 from rosbags.rosbag1 import ReaderError as Reader1Error
 from rosbags.rosbag2 import ReaderError as Reader2Error
@@ -240,7 +241,7 @@ def static_mount(reader: AnyReader, sensor: str | None, path: Path) -> tuple[Mou
     return Mount(matrix[:3, 3].copy(), quaternion), frame
 
 
-def _matrix(values: tuple[float, ...]) -> np.ndarray:
+def _matrix(values: tuple[float, ...]) -> NDArray[np.float64]:
     """4x4 transform of ``(x, y, z, qx, qy, qz, qw)``."""
     out = np.eye(4)
     out[:3, :3] = Rotation.from_quat(np.asarray(values[3:])).as_matrix()

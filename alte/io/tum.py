@@ -12,6 +12,7 @@ from decimal import Decimal, InvalidOperation
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import NDArray
 
 from alte.errors import PoseError
 from alte.fsutil import atomic_path
@@ -50,9 +51,9 @@ def read_tum(path: str | os.PathLike[str]) -> PoseTrack:
                                   str(where))
 
 
-def write_tum(path: str | os.PathLike[str], stamps: np.ndarray, positions: np.ndarray,
-              quaternions: np.ndarray, *, overwrite: bool = False,
-              header: str = "timestamp x y z qx qy qz qw") -> Path:
+def write_tum(path: str | os.PathLike[str], stamps: NDArray[np.int64],
+              positions: NDArray[np.float64], quaternions: NDArray[np.float64], *,
+              overwrite: bool = False, header: str = "timestamp x y z qx qy qz qw") -> Path:
     """Write poses as a TUM file (stamps in ns, exact); refuses to replace a file unless
     ``overwrite``."""
     stamps = np.asarray(stamps, dtype=np.int64).reshape(-1)

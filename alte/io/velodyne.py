@@ -23,6 +23,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import NDArray
 
 from alte.errors import BagError, ParameterError
 from alte.io.messages import VelodyneScanMsg
@@ -81,7 +82,7 @@ def register_velodyne_types(typestore: Typestore) -> None:
         raise BagError(f"cannot register velodyne_msgs types: {err}") from err
 
 
-def _parse(data: np.ndarray) -> np.ndarray:
+def _parse(data: NDArray[np.uint8]) -> NDArray[np.void]:
     """View a (P, 1206) uint8 array as structured packets after checking shape and flags."""
     arr = np.asarray(data)
     if arr.dtype != np.uint8 or arr.ndim != 2 or arr.shape[1] != PACKET_SIZE:
@@ -105,7 +106,7 @@ def _parse(data: np.ndarray) -> np.ndarray:
     return packets
 
 
-def _packet_mode(packets: np.ndarray) -> str:
+def _packet_mode(packets: NDArray[np.void]) -> str:
     """The return mode the packets were recorded in (all packets must agree)."""
     modes = np.unique(packets["mode"])
     if modes.size != 1 or int(modes[0]) not in _MODE_BYTES:
@@ -117,8 +118,8 @@ def _packet_mode(packets: np.ndarray) -> str:
 
 
 def _block_steps(
-    azimuth: np.ndarray, dual: bool, interpolation: str
-) -> tuple[np.ndarray, np.ndarray]:
+    azimuth: NDArray[np.uint16], dual: bool, interpolation: str
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Start azimuth and step to the next firing block (both 0.01 deg, shape (P, 12))."""
     az = azimuth.astype(np.float64)
     stride = 2 if dual else 1
@@ -136,7 +137,8 @@ def _block_steps(
     return start, step
 
 
-def _point_azimuth(azimuth: np.ndarray, dual: bool, interpolation: str) -> np.ndarray:
+def _point_azimuth(azimuth: NDArray[np.uint16], dual: bool, interpolation: str
+                   ) -> NDArray[np.float64]:
     """Per-point azimuth (radians), shape (P, 12, 2, 16), from block azimuths (P, 12)."""
     laser = np.arange(16) * _FIRING_US
     offset = (laser[None, :] + np.arange(2)[:, None] * _SEQUENCE_US) / _BLOCK_US  # (2, 16)
@@ -148,8 +150,8 @@ def _point_azimuth(azimuth: np.ndarray, dual: bool, interpolation: str) -> np.nd
 
 
 def _select_returns(
-    packets: np.ndarray, recorded: str, return_mode: str, interpolation: str
-) -> tuple[np.ndarray, np.ndarray]:
+    packets: NDArray[np.void], recorded: str, return_mode: str, interpolation: str
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Distances (m) and azimuths (rad), shape (..., 2, 16), of the requested returns."""
     blocks = packets["blocks"]
     dist = blocks["rec"]["dist"].astype(np.float64) * _DISTANCE_UNIT_M
@@ -172,7 +174,8 @@ def _select_returns(
     return np.stack([last, second], axis=2), np.stack([azimuth[:, 0::2], azimuth[:, 1::2]], 2)
 
 
-def _to_xyz(dist: np.ndarray, azimuth: np.ndarray, frame: str, min_range: float) -> np.ndarray:
+def _to_xyz(dist: NDArray[np.float64], azimuth: NDArray[np.float64], frame: str, min_range: float
+            ) -> NDArray[np.float64]:
     """Polar (distance, azimuth, laser elevation) -> Cartesian, dropping ranges <= min_range."""
     elev = np.broadcast_to(np.deg2rad(VLP16_ELEVATIONS_DEG), dist.shape)
     keep = dist > min_range
@@ -184,12 +187,12 @@ def _to_xyz(dist: np.ndarray, azimuth: np.ndarray, frame: str, min_range: float)
 
 
 def decode_velodyne_packets(
-    data: np.ndarray,
+    data: NDArray[np.uint8],
     return_mode: str = "strongest",
     frame: str = "manual",
     min_range: float = 0.0,
     interpolation: str = "manual",
-) -> np.ndarray:
+) -> NDArray[np.float64]:
     """Decode raw VLP-16 packets (P, 1206) uint8 into (N, 3) float64 points in metres.
 
     ``return_mode`` picks from dual-return packets: ``"strongest"``, ``"last"`` or
@@ -224,7 +227,7 @@ def decode_velodyne_scan(
     frame: str = "manual",
     min_range: float = 0.0,
     interpolation: str = "manual",
-) -> np.ndarray:
+) -> NDArray[np.float64]:
     """Decode one ``velodyne_msgs/msg/VelodyneScan`` message (all its packets) into (N, 3).
 
     Anything without packets (an untyped caller's wrong message) is a :class:`BagError`.

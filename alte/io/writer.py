@@ -11,13 +11,13 @@ clock or random data; only its version string enters the mcap header).
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, TypedDict, Unpack
+from typing import TYPE_CHECKING, TypeAlias, TypedDict, Unpack
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 from rosbags.rosbag2 import StoragePlugin, Writer
 from rosbags.typesys import Stores, get_typestore
 from tqdm.auto import tqdm
@@ -39,14 +39,15 @@ _PC2 = "sensor_msgs/msg/PointCloud2"
 _TF = "tf2_msgs/msg/TFMessage"
 _TYPESTORE = get_typestore(Stores.ROS2_HUMBLE)
 #: Poses to interleave with the clouds: stamps, positions, quaternions, write order.
-_Poses = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+_Poses = tuple[NDArray[np.int64], NDArray[np.float64], NDArray[np.float64], NDArray[np.intp]]
 #: A scan: stamp and points, optionally extra per-point fields (name -> (N,) array).
-Cloud = tuple[int, np.ndarray] | tuple[int, np.ndarray, dict[str, np.ndarray]]
+Cloud: TypeAlias = ("tuple[int, NDArray[np.float64]] | tuple[int, NDArray[np.float64], "
+                    "Mapping[str, NDArray[np.generic[object]]]]")
 
 
 def _pose_arrays(
     pose_stamps: ArrayLike, positions: ArrayLike, quaternions: ArrayLike
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+) -> tuple[NDArray[np.int64], NDArray[np.float64], NDArray[np.float64]]:
     stamps = np.asarray(pose_stamps, dtype=np.int64).reshape(-1)
     pos = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
     quat = np.asarray(quaternions, dtype=np.float64).reshape(-1, 4)
@@ -60,7 +61,7 @@ def _pose_arrays(
     return stamps, pos, quat
 
 
-def _pose_msg(header: MsgType, position: np.ndarray, quat: np.ndarray) -> MsgType:
+def _pose_msg(header: MsgType, position: NDArray[np.float64], quat: NDArray[np.float64]) -> MsgType:
     types = _TYPESTORE.types
     point = types["geometry_msgs/msg/Point"](*map(float, position))
     orientation = types["geometry_msgs/msg/Quaternion"](*map(float, quat))
@@ -165,9 +166,9 @@ _IMU_TOPIC = "/imu"
 def write_bag(  # noqa: PLR0917 - positional arrays as specified for the simulator
     path: str | Path,
     clouds: Iterable[Cloud],
-    pose_stamps: Sequence[int] | np.ndarray,
-    positions: np.ndarray,
-    quaternions: np.ndarray,
+    pose_stamps: Sequence[int] | NDArray[np.int64],
+    positions: NDArray[np.float64],
+    quaternions: NDArray[np.float64],
     mount: Mount | None = None,
     *,
     cloud_topic: str = "/velodyne_points",
