@@ -43,6 +43,9 @@ POINTFIELD_DTYPES: dict[int, np.dtype[np.generic[object]]] = {
     7: np.dtype(np.float32),
     8: np.dtype(np.float64),
 }
+#: The scalar types a ``PointField`` can hold (its datatypes 1-8).
+_Numeric = (np.int8 | np.uint8 | np.int16 | np.uint16 | np.int32 | np.uint32 | np.float32
+            | np.float64)
 #: Storage type of x, y, z when encoding (float32 like real drivers, float64 lossless).
 CoordType = type[np.float32] | type[np.float64]
 _CODES = {dt: code for code, dt in POINTFIELD_DTYPES.items()}
@@ -137,7 +140,8 @@ def decode_timed(msg: PointCloud2Msg, stamp_ns: int, topic: str = "PointCloud2"
     return _decode(msg, topic, stamp_ns)
 
 
-def _seconds(raw: np.ndarray, stamp_ns: int, name: str, topic: str) -> NDArray[np.float64]:
+def _seconds(raw: NDArray[_Numeric], stamp_ns: int, name: str, topic: str
+             ) -> NDArray[np.float64]:
     """Per-point times as float64 seconds relative to the scan stamp (see decode_timed)."""
     if raw.dtype.kind in "iu":
         ns = raw.astype(np.int64)
@@ -186,7 +190,7 @@ def encode_pointcloud2(
     typestore: Typestore,
     *,
     dtype: CoordType = np.float32,
-    extra_fields: Mapping[str, np.ndarray] | None = None,
+    extra_fields: Mapping[str, NDArray[np.generic[object]]] | None = None,
 ) -> MsgType:
     """Build an unorganized little-endian PointCloud2 message (x, y, z, then ``extra_fields``).
 
@@ -196,7 +200,8 @@ def encode_pointcloud2(
     pts = np.asarray(points, dtype=np.float64)
     if pts.ndim != 2 or pts.shape[1] != 3:
         raise BagError(f"cloud for frame {frame_id!r} must have shape (N, 3), got {pts.shape}")
-    columns = {name: pts[:, axis] for axis, name in enumerate(_XYZ)}
+    columns: dict[str, NDArray[np.generic[object]]] = {
+        name: pts[:, axis] for axis, name in enumerate(_XYZ)}
     formats = {name: np.dtype(dtype).newbyteorder("<") for name in _XYZ}
     for name, values in (extra_fields or {}).items():
         arr = np.asarray(values).reshape(-1)

@@ -76,9 +76,10 @@ def read_las(path: Path) -> tuple[NDArray[np.float64], Fields, FileAbout]:
     return points, fields, about
 
 
-def _fits(values: np.ndarray, top: int) -> bool:  # numeric, any dtype
-    return bool(values.ndim == 1 and np.all(np.isfinite(values)) and np.all(values >= 0)
-                and np.all(values <= top) and np.all(np.mod(values, 1) == 0))
+def _fits(values: NDArray[np.generic[object]], top: int) -> bool:
+    return bool(values.ndim == 1 and np.all(np.isfinite(values))
+                and np.all(np.greater_equal(values, 0)) and np.all(np.less_equal(values, top))
+                and np.all(np.equal(np.mod(values, 1), 0)))
 
 
 def write_las(tmp: Path, points: NDArray[np.float64], fields: Fields, compress: bool) -> None:

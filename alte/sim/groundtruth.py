@@ -12,6 +12,7 @@ import os
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import NDArray
 
 from alte.errors import PointFileError
 from alte.fsutil import atomic_path
@@ -94,7 +95,7 @@ def load_ground_truth(directory: str | os.PathLike[str]) -> Scene:
     return read_ground_truth(Path(directory) / GROUND_TRUTH_FILE)
 
 
-def mesh_distance(points: np.ndarray, scene: Scene) -> np.ndarray:
+def mesh_distance(points: NDArray[np.float64], scene: Scene) -> NDArray[np.float64]:
     """Unsigned distance (N,) from each point to the nearest triangle of ``scene``."""
     pts = np.asarray(points).reshape(-1, 3)
     return to_array(scene.raycaster().compute_distance(to_tensor(pts)), np.float64)

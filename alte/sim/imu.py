@@ -15,6 +15,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import NDArray
 
 from alte.sim.platform import Trajectory
 from alte.sim.profile import SensorProfile
@@ -32,11 +33,11 @@ class ImuStream:
     """IMU samples: stamps (N,) int64 ns, gyro (N, 3) rad/s, accel (N, 3) m/s^2 in the
     IMU frame; the biases (N, 3) each sample carries (the truth, for tests)."""
 
-    stamps: np.ndarray
-    angular_velocity: np.ndarray
-    linear_acceleration: np.ndarray
-    gyro_bias: np.ndarray
-    accel_bias: np.ndarray
+    stamps: NDArray[np.int64]
+    angular_velocity: NDArray[np.float64]
+    linear_acceleration: NDArray[np.float64]
+    gyro_bias: NDArray[np.float64]
+    accel_bias: NDArray[np.float64]
     mount: Mount
     gyro_sigma: float
     accel_sigma: float
@@ -45,8 +46,8 @@ class ImuStream:
         return int(self.stamps.shape[0])
 
 
-def true_imu(trajectory: Trajectory, times: np.ndarray, rate_hz: float,
-             mount: Mount = IMU_MOUNT) -> tuple[np.ndarray, np.ndarray]:
+def true_imu(trajectory: Trajectory, times: NDArray[np.float64], rate_hz: float,
+             mount: Mount = IMU_MOUNT) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Noise-free gyro (N, 3) and accelerometer (N, 3) readings at ``times`` (s)."""
     t = np.asarray(times, dtype=np.float64)
     dt = 1.0 / rate_hz
@@ -69,7 +70,7 @@ def true_imu(trajectory: Trajectory, times: np.ndarray, rate_hz: float,
 
 
 def _noise(n: int, rate: float, figures: tuple[float, float, float],
-           rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+           rng: np.random.Generator) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """White noise (N, 3) and bias (N, 3) of one sensor triad: ``figures`` are the white
     noise density, the bias random walk and the turn-on bias sigma."""
     white, walk, turn_on = figures

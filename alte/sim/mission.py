@@ -20,6 +20,7 @@ import zlib
 from dataclasses import dataclass, field
 
 import numpy as np
+from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 from tqdm.auto import tqdm
 
@@ -49,21 +50,21 @@ class Simulation:
     ``imu`` the IMU samples when the profile has an IMU.
     """
 
-    stamps: np.ndarray
-    scans: list[np.ndarray]
-    scan_index: np.ndarray
-    pose_stamps: np.ndarray
-    positions: np.ndarray
-    quaternions: np.ndarray
+    stamps: NDArray[np.int64]
+    scans: list[NDArray[np.float64]]
+    scan_index: NDArray[np.int64]
+    pose_stamps: NDArray[np.int64]
+    positions: NDArray[np.float64]
+    quaternions: NDArray[np.float64]
     mount: Mount
     counts: dict[str, int]
     duration_s: float
-    times: list[np.ndarray] | None = None
+    times: list[NDArray[np.float64]] | None = None
     imu: ImuStream | None = None
     profile: SensorProfile = field(default_factory=SensorProfile)
 
 
-def scan_indices(total: int, frames: int | None) -> np.ndarray:
+def scan_indices(total: int, frames: int | None) -> NDArray[np.int64]:
     """Indices of the simulated scans among the mission's ``total`` (evenly spaced)."""
     if frames is None:
         return np.arange(total)
@@ -82,20 +83,21 @@ def _rng(seed: int, name: str, *stream: int) -> np.random.Generator:
     return np.random.default_rng(np.random.SeedSequence(int(seed), spawn_key=(key, *stream)))
 
 
-def _acquisition_times(terrain: Terrain, seed: int, stamps_s: np.ndarray,
-                       index: np.ndarray) -> np.ndarray:
+def _acquisition_times(terrain: Terrain, seed: int, stamps_s: NDArray[np.float64],
+                       index: NDArray[np.int64]) -> NDArray[np.float64]:
     """True scan times: the stamps, late by the pose/scan offset and jitter (cart only)."""
     platform = terrain.spec.platform
     if not isinstance(platform, Cart):
         return stamps_s
     rng = _rng(seed, terrain.spec.name, 1)
     jitter = rng.normal(0.0, platform.jitter_s, terrain.spec.frames)[index]
-    late: np.ndarray = stamps_s + platform.time_offset_s + jitter
+    late: NDArray[np.float64] = stamps_s + platform.time_offset_s + jitter
     return late
 
 
-def _pose_stream(terrain: Terrain, traj: Trajectory, seed: int, stamps: np.ndarray,
-                 pose_hz: float = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _pose_stream(terrain: Terrain, traj: Trajectory, seed: int, stamps: NDArray[np.int64],
+                 pose_hz: float = 0.0
+                 ) -> tuple[NDArray[np.int64], NDArray[np.float64], NDArray[np.float64]]:
     """Gazebo's true state at the scan stamps (or at ``pose_hz``), or 100 Hz motion
     capture (cart)."""
     platform = terrain.spec.platform
@@ -121,13 +123,13 @@ class TruePoses:
     a pose estimate (odometry, refinement) is scored against.
     """
 
-    stamps: np.ndarray
-    positions: np.ndarray
-    quaternions: np.ndarray
+    stamps: NDArray[np.int64]
+    positions: NDArray[np.float64]
+    quaternions: NDArray[np.float64]
 
 
 def _mission(terrain: Terrain, seed: int, frames: int | None, sensor: VLP16
-             ) -> tuple[np.ndarray, np.ndarray, Trajectory, np.ndarray]:
+             ) -> tuple[NDArray[np.int64], NDArray[np.int64], Trajectory, NDArray[np.float64]]:
     """Scan indices, stamps, trajectory and true acquisition times (s from start)."""
     _rng(seed, terrain.spec.name)  # validates the seed
     index = scan_indices(terrain.spec.frames, frames)
@@ -154,8 +156,8 @@ def simulate(terrain: Terrain, seed: int = 0, frames: int | None = None,
     spec = terrain.spec
     index, stamps, traj, acq = _mission(terrain, seed, frames, sensor)
     caster = _Caster(terrain, traj, sensor, profile)
-    scans: list[np.ndarray] = []
-    times: list[np.ndarray] = []
+    scans: list[NDArray[np.float64]] = []
+    times: list[NDArray[np.float64]] = []
     counts: dict[str, int] = {}
     for lo in tqdm(range(0, len(index), _BATCH), desc=spec.name, unit="batch",
                    disable=not progress):
@@ -197,7 +199,7 @@ class _Caster:
         self.class_ids = terrain.scene.class_ids
         self.group_times, self.ray_times = sensor.firing_times()
 
-    def hits(self, acq: np.ndarray) -> Hits:
+    def hits(self, acq: NDArray[np.float64]) -> Hits:
         """Hits (K, M) of the scans taken at ``acq`` (s from the mission start)."""
         t = (acq[:, None] + self.group_times[None, :]).reshape(-1) if self.profile.sweep \
             else acq
@@ -212,13 +214,14 @@ class _Caster:
         left, right = (self._shoot(pos, rot, d) for d in self.sub_rays)
         return mixed_distance(centre, left, right, self.profile)
 
-    def _shoot(self, pos: np.ndarray, rot: Rotation, directions: np.ndarray) -> Hits:
+    def _shoot(self, pos: NDArray[np.float64], rot: Rotation[tuple[int, ...]],
+               directions: NDArray[np.float64]) -> Hits:
         if self.profile.sweep:
             return cast_sweep(self.raycaster, pos, rot, directions)
         return cast(self.raycaster, pos, rot, directions)
 
 
-def _class_counts(class_ids: np.ndarray) -> dict[str, int]:
+def _class_counts(class_ids: NDArray[np.uint8]) -> dict[str, int]:
     """Returns per object class, keyed ``returns_<class>``."""
     per = np.bincount(class_ids, minlength=len(CLASSES))
     return {f"returns_{c}": int(n) for c, n in zip(CLASSES, per, strict=True) if n}

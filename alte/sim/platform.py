@@ -16,7 +16,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 from scipy.interpolate import CubicSpline
 from scipy.spatial.transform import Rotation
 
@@ -92,38 +92,39 @@ class Trajectory:
         """Cruise speed (m/s)."""
         return self._speed
 
-    def _distance(self, t: np.ndarray) -> np.ndarray:
+    def _distance(self, t: NDArray[np.float64]) -> NDArray[np.float64]:
         """Travelled distance: constant speed with smooth (cosine) ramps at both ends."""
         r, v, d = self._ramp, self._speed, self.duration
         tc = np.clip(t, 0.0, d)
 
-        def ramp_dist(x: ArrayLike) -> np.ndarray:  # integral of v (1 - cos(pi x / r)) / 2
+        def ramp_dist(x: ArrayLike) -> NDArray[np.float64]:  # integral of v (1 - cos(pi x / r)) / 2
             xc = np.clip(x, 0.0, r)
-            dist: np.ndarray = 0.5 * v * (xc - r / np.pi * np.sin(np.pi * xc / r))
+            dist: NDArray[np.float64] = 0.5 * v * (xc - r / np.pi * np.sin(np.pi * xc / r))
             return dist
 
-        travelled: np.ndarray = ramp_dist(tc) + v * np.clip(tc - r, 0.0, d - 2 * r) + (
+        travelled: NDArray[np.float64] = ramp_dist(tc) + v * np.clip(tc - r, 0.0, d - 2 * r) + (
             ramp_dist(r) - ramp_dist(d - tc)) * (tc > d - r)
         return travelled
 
-    def xy(self, t: np.ndarray) -> np.ndarray:
+    def xy(self, t: NDArray[np.float64]) -> NDArray[np.float64]:
         """Horizontal position (K, 2) at times ``t``."""
         return self._spline(np.interp(self._distance(np.asarray(t, float)), self._s, self._u))
 
-    def heading(self, t: np.ndarray) -> np.ndarray:
+    def heading(self, t: NDArray[np.float64]) -> NDArray[np.float64]:
         """Path tangent direction (rad), defined even when stopped."""
         u = np.interp(self._distance(np.asarray(t, float)), self._s, self._u)
         du = self._spline(u, 1)
         return np.unwrap(np.arctan2(du[:, 1], du[:, 0]))
 
-    def pose(self, t: np.ndarray) -> tuple[np.ndarray, Rotation]:
+    def pose(self, t: NDArray[np.float64]) -> tuple[NDArray[np.float64], Rotation[tuple[int, ...]]]:
         """Body position (K, 3) and body-to-inertial rotation at times ``t``."""
         t = np.atleast_1d(np.asarray(t, dtype=np.float64))
         if isinstance(self.platform, Quadrotor):
             return self._quadrotor_pose(t, self.platform)
         return self._cart_pose(t, self.platform)
 
-    def _quadrotor_pose(self, t: np.ndarray, quad: Quadrotor) -> tuple[np.ndarray, Rotation]:
+    def _quadrotor_pose(self, t: NDArray[np.float64], quad: Quadrotor
+                        ) -> tuple[NDArray[np.float64], Rotation[tuple[int, ...]]]:
         h = 0.02
         acc = (self.xy(t + h) - 2 * self.xy(t) + self.xy(t - h)) / h**2
         yaw = self.heading(t)
@@ -133,7 +134,8 @@ class Trajectory:
         pos = np.column_stack([self.xy(t), np.full(len(t), quad.altitude)])
         return pos, Rotation.from_euler("ZYX", np.column_stack([yaw, pitch, roll]))
 
-    def _cart_pose(self, t: np.ndarray, cart: Cart) -> tuple[np.ndarray, Rotation]:
+    def _cart_pose(self, t: NDArray[np.float64], cart: Cart
+                   ) -> tuple[NDArray[np.float64], Rotation[tuple[int, ...]]]:
         ph = cart.phases
         w = np.radians(cart.wobble_deg)
         roll = w * (0.6 * np.sin(2.1 * t + ph[0]) + 0.4 * np.sin(5.3 * t + ph[1]))
@@ -153,8 +155,8 @@ class Trajectory:
         return pos, Rotation.from_euler("ZYX", np.column_stack([yaw, pitch, roll]))
 
 
-def mocap_stream(trajectory: Trajectory, stamps_s: np.ndarray, cart: Cart,
-                 rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+def mocap_stream(trajectory: Trajectory, stamps_s: NDArray[np.float64], cart: Cart,
+                 rng: np.random.Generator) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Motion-capture samples at ``stamps_s``: noisy positions and quaternions (w >= 0)."""
     pos, rot = trajectory.pose(stamps_s)
     pos = pos + rng.normal(0.0, cart.position_sigma, pos.shape)

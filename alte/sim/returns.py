@@ -7,6 +7,7 @@ stated); both work on whole batches of scans (K scans x M rays) at once.
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import NDArray
 
 from alte.sim.profile import REFLECTIVITY, SensorProfile
 from alte.sim.scene import CLASSES
@@ -21,8 +22,8 @@ _REFERENCE = 0.1  # reflectivity of the target that defines ``dropout_range``
 _STEEPNESS = 4.0
 
 
-def lost_returns(hits: Hits, class_ids: np.ndarray, profile: SensorProfile,
-                 rngs: list[np.random.Generator]) -> np.ndarray:
+def lost_returns(hits: Hits, class_ids: NDArray[np.uint8], profile: SensorProfile,
+                 rngs: list[np.random.Generator]) -> NDArray[np.bool_]:
     """Mask (K, M) of hits whose echo is too weak to be detected (one draw per ray).
 
     ``class_ids`` holds the object class of every triangle; each scan draws from its
@@ -36,7 +37,7 @@ def lost_returns(hits: Hits, class_ids: np.ndarray, profile: SensorProfile,
     power = refl * np.maximum(hits.cos_incidence, 1e-9) / np.maximum(dist, 1e-3) ** 2
     half = _REFERENCE / profile.dropout_range**2
     detect = 1.0 / (1.0 + (half / power) ** _STEEPNESS)
-    lost: np.ndarray = hit & (draws > detect)
+    lost: NDArray[np.bool_] = hit & (draws > detect)
     return lost
 
 

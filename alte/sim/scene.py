@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import NDArray
 
 from alte.tensors import to_tensor
 
@@ -44,16 +45,16 @@ class SceneObject:
 class Scene:
     """A triangle mesh with the object each triangle belongs to."""
 
-    vertices: np.ndarray
-    triangles: np.ndarray
-    object_ids: np.ndarray
+    vertices: NDArray[np.float64]
+    triangles: NDArray[np.int32]
+    object_ids: NDArray[np.int32]
     objects: tuple[SceneObject, ...]
 
     @property
-    def class_ids(self) -> np.ndarray:
+    def class_ids(self) -> NDArray[np.uint8]:
         """Class index per triangle."""
         lut = np.array([o.class_id for o in self.objects], dtype=np.uint8)
-        ids: np.ndarray = lut[self.object_ids]
+        ids: NDArray[np.uint8] = lut[self.object_ids]
         return ids
 
     @property
@@ -74,12 +75,13 @@ class Scene:
         rc.add_triangles(to_tensor(self.vertices), to_tensor(self.triangles, np.uint32))
         return rc
 
-    def bounds(self) -> np.ndarray:
+    def bounds(self) -> NDArray[np.float64]:
         """``(xmin, ymin, zmin, xmax, ymax, zmax)`` of the mesh."""
         return np.concatenate([self.vertices.min(axis=0), self.vertices.max(axis=0)])
 
 
-def _orient_outward(vertices: np.ndarray, triangles: np.ndarray) -> np.ndarray:
+def _orient_outward(vertices: NDArray[np.float64], triangles: NDArray[np.int64]
+                    ) -> NDArray[np.int64]:
     """Flip triangles of a convex part so their normals point away from its centre."""
     tri = vertices[triangles]
     normals = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
@@ -89,7 +91,7 @@ def _orient_outward(vertices: np.ndarray, triangles: np.ndarray) -> np.ndarray:
     return fixed
 
 
-def _ring(radius: float, segments: int) -> np.ndarray:
+def _ring(radius: float, segments: int) -> NDArray[np.float64]:
     ang = np.arange(segments) * (2 * np.pi / segments)
     return np.column_stack([radius * np.cos(ang), radius * np.sin(ang)])
 
@@ -104,13 +106,13 @@ _BOX_TRIS = np.array([
 class SceneBuilder:
     """Collects convex parts; :meth:`build` returns the :class:`Scene`."""
 
-    _verts: list[np.ndarray] = field(default_factory=list)
-    _tris: list[np.ndarray] = field(default_factory=list)
-    _ids: list[np.ndarray] = field(default_factory=list)
+    _verts: list[NDArray[np.float64]] = field(default_factory=list)
+    _tris: list[NDArray[np.int64]] = field(default_factory=list)
+    _ids: list[NDArray[np.int32]] = field(default_factory=list)
     _objects: list[SceneObject] = field(default_factory=list)
     _count: int = 0
 
-    def add(self, name: str, cls: str, vertices: np.ndarray, triangles: np.ndarray,
+    def add(self, name: str, cls: str, vertices: NDArray[np.float64], triangles: NDArray[np.int64],
             convex: bool = True) -> int:
         """Add a part as its own object; returns the object id."""
         if cls not in CLASSES:
@@ -190,8 +192,8 @@ class SceneBuilder:
                      np.concatenate(self._ids), tuple(self._objects))
 
 
-def _yawed(local: np.ndarray, yaw_deg: float) -> np.ndarray:
+def _yawed(local: NDArray[np.float64], yaw_deg: float) -> NDArray[np.float64]:
     c, s = np.cos(np.radians(yaw_deg)), np.sin(np.radians(yaw_deg))
     rot = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-    yawed: np.ndarray = local @ rot.T
+    yawed: NDArray[np.float64] = local @ rot.T
     return yawed

@@ -19,6 +19,7 @@ from dataclasses import asdict, dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
 from alte.tensors import to_array, to_tensor
@@ -53,26 +54,26 @@ class VLP16:
         """Rotations (scans) per second."""
         return self.rpm / 60.0
 
-    def azimuths_deg(self) -> np.ndarray:
+    def azimuths_deg(self) -> NDArray[np.float64]:
         """Firing azimuths inside the field of view, ``-fov <= a < fov``."""
         n = round(2 * self.fov_half_deg / self.azimuth_step_deg)
-        return -self.fov_half_deg + self.azimuth_step_deg * np.arange(n)
+        return -self.fov_half_deg + self.azimuth_step_deg * np.arange(n, dtype=np.float64)
 
-    def beams(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def beams(self) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.intp]]:
         """Azimuth (deg), elevation (deg) and laser id of every ray, in firing order."""
         az = self.azimuths_deg()
         n_lasers = len(FIRING_ORDER_DEG)
         laser = np.tile(np.arange(n_lasers), len(az))
         return np.repeat(az, n_lasers), FIRING_ORDER_DEG[laser], laser
 
-    def directions(self, azimuth_offset_deg: float = 0.0) -> np.ndarray:
+    def directions(self, azimuth_offset_deg: float = 0.0) -> NDArray[np.float64]:
         """Unit ray directions (M, 3) in the sensor frame, in firing order (azimuths
         shifted by ``azimuth_offset_deg``: the sub-rays of a beam's footprint)."""
         az, el, _ = self.beams()
         a, w = np.radians(az + azimuth_offset_deg), np.radians(el)
         return np.column_stack([np.cos(w) * np.sin(a), np.cos(w) * np.cos(a), np.sin(w)])
 
-    def firing_times(self) -> tuple[np.ndarray, np.ndarray]:
+    def firing_times(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """When each firing sequence starts (G,) and each ray fires (M,), seconds after
         the start of the rotation at azimuth -180 deg (the scan stamp of a swept scan).
 
@@ -92,13 +93,13 @@ class VLP16:
 class Hits:
     """First-surface hits of K scans x M rays: distance (inf = miss), |cos| incidence, triangle."""
 
-    distance: np.ndarray
-    cos_incidence: np.ndarray
-    triangle: np.ndarray
+    distance: NDArray[np.float64]
+    cos_incidence: NDArray[np.float64]
+    triangle: NDArray[np.int64]
 
 
-def cast(raycaster: o3d.t.geometry.RaycastingScene, positions: np.ndarray, rotations: Rotation,
-         directions: np.ndarray) -> Hits:
+def cast(raycaster: o3d.t.geometry.RaycastingScene, positions: NDArray[np.float64],
+         rotations: Rotation[tuple[int, ...]], directions: NDArray[np.float64]) -> Hits:
     """Cast the sensor's rays from K poses in one ``RaycastingScene.cast_rays`` call.
 
     ``positions`` (K, 3) and ``rotations`` (K) are the sensor poses in the scene
@@ -108,8 +109,8 @@ def cast(raycaster: o3d.t.geometry.RaycastingScene, positions: np.ndarray, rotat
     return _cast(raycaster, np.asarray(positions, dtype=np.float64), world)
 
 
-def cast_sweep(raycaster: o3d.t.geometry.RaycastingScene, positions: np.ndarray,
-               rotations: Rotation, directions: np.ndarray) -> Hits:
+def cast_sweep(raycaster: o3d.t.geometry.RaycastingScene, positions: NDArray[np.float64],
+               rotations: Rotation[tuple[int, ...]], directions: NDArray[np.float64]) -> Hits:
     """Cast K swept scans: each of the G firing sequences from its own sensor pose.
 
     ``positions`` (K, G, 3) and ``rotations`` (K * G, row-major) are the sensor poses
@@ -124,8 +125,8 @@ def cast_sweep(raycaster: o3d.t.geometry.RaycastingScene, positions: np.ndarray,
     return _cast(raycaster, origins, world)
 
 
-def _cast(raycaster: o3d.t.geometry.RaycastingScene, origins: np.ndarray,
-          world: np.ndarray) -> Hits:
+def _cast(raycaster: o3d.t.geometry.RaycastingScene, origins: NDArray[np.float64],
+          world: NDArray[np.float64]) -> Hits:
     """First hits of rays from ``origins`` ((K, 3) or (K, M, 3)) along ``world`` (K, M, 3)."""
     k, m = world.shape[:2]
     if origins.ndim == 2:
@@ -141,7 +142,7 @@ def _cast(raycaster: o3d.t.geometry.RaycastingScene, origins: np.ndarray,
 
 
 def measure(hits: Hits, sensor: VLP16, rngs: list[np.random.Generator]) -> tuple[
-        np.ndarray, dict[str, int]]:
+        NDArray[np.float64], dict[str, int]]:
     """Measured ranges (K, M), NaN where the sensor reports no return, and drop counts.
 
     No return for a miss, beyond ``max_range`` / below ``min_range``, or at grazing
