@@ -22,7 +22,6 @@ true ground: negative where a coarse cell averages it away.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -131,7 +130,7 @@ class ObstacleScores:
     min_height: float = float("nan")
     hidden: tuple[str, ...] = ()
 
-    def flat(self) -> dict[str, Any]:
+    def flat(self) -> dict[str, float]:
         """The scalar scores as columns of a table row (:data:`SCORE_COLUMNS`)."""
         values = (self.true, self.found, self.map_obstacles, self.map_there, self.recall,
                   self.precision, self.area_precision, self.height_error_m,
