@@ -48,6 +48,7 @@ from alte.studies.claims.types import (
     Optimum,
     Summary,
     Trend,
+    renamed,
 )
 from alte.studies.comparisons import measure_compare
 from alte.studies.sweep.variants import BASE
@@ -257,20 +258,14 @@ def _mappers(check: Check) -> tuple[str, ...]:
     return ()
 
 
-def _on(check: Check, column: str) -> Check:
-    """``check`` with every field naming the elapsed time naming ``column`` instead."""
-    return replace(check, **{f.name: column for f in fields(check)  # type: ignore[arg-type]
-                             if getattr(check, f.name) == ELAPSED})
-
-
 def _by_cost(check: Check, table: pd.DataFrame) -> CheckValues:
     """A within-mapper check on the time: judged on the cost where every map of its
     mappers has one, with the CPU time as cross-check (else on the CPU time alone)."""
-    timed = _on(check, TIME_COLUMN)
+    timed = renamed(check, ELAPSED, TIME_COLUMN)
     mine = table[table["mapper"].isin(_mappers(check))]
     if "cost" not in mine or mine.empty or mine["cost"].isna().any():
         return replace(_measure(timed, table), time="cpu")
-    found = _measure(_on(check, "cost"), table)
+    found = _measure(renamed(check, ELAPSED, "cost"), table)
     units = ", ".join(dict.fromkeys(mapper_class(m).cost_unit.value for m in _mappers(check)))
     return replace(found, what=f"{found.what}; cost in {units}", time="cost",
                    crosscheck=_measure(timed, table))

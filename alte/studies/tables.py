@@ -23,8 +23,8 @@ from __future__ import annotations
 
 import os
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -166,7 +166,7 @@ def rule_pick(table: pd.DataFrame, criteria: Sequence[str] | None = None) -> int
     return int(picks[np.argmin(comparison_scores(table, by_cost)[picks])])
 
 
-def _params_text(params: Mapping[str, Any]) -> str:
+def _params_text(params: Mapping[str, object]) -> str:
     return ", ".join(f"{k}={v}" for k, v in params.items())
 
 
@@ -220,7 +220,21 @@ def _rho(x: pd.Series, y: pd.Series) -> float:
     return float(spearmanr(x, y).statistic)
 
 
-def _sweep_trends(number: int, ours: pd.DataFrame) -> list[dict[str, Any]]:
+@dataclass(frozen=True)
+class _TrendRow:
+    """One row of :func:`trend_table`."""
+
+    table: str
+    trend: str
+    thesis_rho: float
+    ours_rho: float
+    holds_in_thesis: bool
+    holds_on_ours: bool
+    ours_on: str
+    ours_time_rho: float
+
+
+def _sweep_trends(number: int, ours: pd.DataFrame) -> list[_TrendRow]:
     """A time trend is read on our maps' machine-independent cost where they have one
     (``ours_rho``), with the rank correlation of their CPU time beside it."""
     theirs = thesis_metrics(number)
@@ -231,10 +245,8 @@ def _sweep_trends(number: int, ours: pd.DataFrame) -> list[dict[str, Any]]:
         r_o = _rho(ours[param], ours["cost" if timed else metric])
         r_time = _rho(ours[param], ours[TIME_COLUMN]) if timed and TIME_COLUMN in ours \
             else np.nan
-        out.append({"table": f"5.{number}", "trend": text, "thesis_rho": r_t, "ours_rho": r_o,
-                    "holds_in_thesis": bool(r_t * sign >= 0.5), "holds_on_ours":
-                    bool(r_o * sign >= 0.5), "ours_on": "cost" if timed else metric,
-                    "ours_time_rho": r_time})
+        out.append(_TrendRow(f"5.{number}", text, r_t, r_o, bool(r_t * sign >= 0.5),
+                             bool(r_o * sign >= 0.5), "cost" if timed else metric, r_time))
     return out
 
 
@@ -251,16 +263,13 @@ def _lower(table: pd.DataFrame, column: str, low: str, high: str) -> bool:
     return bool(top[mine].max() < bottom[other].min())
 
 
-def _comparison_trends(number: int, table: pd.DataFrame) -> list[dict[str, Any]]:
+def _comparison_trends(number: int, table: pd.DataFrame) -> list[_TrendRow]:
     out = []
     for text, low, high, metric in COMPARISON_TRENDS[number]:
         tcol = "thesis_hd_minus_mhd_m" if metric == "hd_minus_mhd_m" else _THESIS_COLS[metric]
         ours = TIME_COLUMN if metric == "elapsed_s" and TIME_COLUMN in table else metric
-        out.append({"table": f"5.{number}", "trend": text,
-                    "thesis_rho": np.nan, "ours_rho": np.nan,
-                    "holds_in_thesis": _lower(table, tcol, low, high),
-                    "holds_on_ours": _lower(table, ours, low, high), "ours_on": ours,
-                    "ours_time_rho": np.nan})
+        out.append(_TrendRow(f"5.{number}", text, np.nan, np.nan, _lower(table, tcol, low, high),
+                             _lower(table, ours, low, high), ours, np.nan))
     return out
 
 

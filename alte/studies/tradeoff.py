@@ -17,8 +17,7 @@ front of the compared mappers covers on that terrain.
 from __future__ import annotations
 
 import json
-from collections.abc import Sequence
-from typing import Any
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 import pandas as pd
@@ -66,7 +65,7 @@ def label(metric: str, unit: bool = True) -> str:
     return f"{name} [{units}]" if unit and units else name
 
 
-def parse_params(text: Any) -> dict[str, Any]:
+def parse_params(text: object) -> dict[str, object]:
     """A parameter setting from JSON (``{"kappa": 0.1}``) or ``"kappa=0.1, max_res=5"``."""
     if isinstance(text, dict):
         return dict(text)
@@ -76,7 +75,7 @@ def parse_params(text: Any) -> dict[str, Any]:
             return dict(json.loads(raw))
         except ValueError as err:
             raise ParameterError(f"trade-off table: params {raw!r} is not JSON") from err
-    out: dict[str, Any] = {}
+    out: dict[str, object] = {}
     for item in filter(None, (p.strip() for p in raw.split(","))):
         key, sep, value = item.partition("=")
         if not sep:
@@ -116,7 +115,7 @@ def prepare(table: pd.DataFrame) -> pd.DataFrame:
     return out
 
 
-def thesis_setting(mapper: str) -> dict[str, Any] | None:
+def thesis_setting(mapper: str) -> dict[str, float] | None:
     """The parameters of ``mapper``'s map the thesis chose (tables 5.10-5.11), if any."""
     for chosen in COMPARISONS.values():
         if mapper in chosen:
@@ -125,7 +124,7 @@ def thesis_setting(mapper: str) -> dict[str, Any] | None:
     return None
 
 
-def matching(rows: pd.DataFrame, setting: dict[str, Any]) -> pd.Series:
+def matching(rows: pd.DataFrame, setting: Mapping[str, float]) -> pd.Series:
     """Which ``rows`` (with ``p_*`` columns) have every parameter of ``setting``."""
     match = pd.Series(True, index=rows.index)
     for key, value in setting.items():
@@ -214,9 +213,9 @@ def _levels(lo: float, hi: float, log: bool) -> list[float]:
 Curve = tuple[np.ndarray, np.ndarray, float]
 
 
-def _curves(part: pd.DataFrame, x: str, y: str, sign: float) -> dict[tuple[str, Any], Curve]:
+def _curves(part: pd.DataFrame, x: str, y: str, sign: float) -> dict[tuple[str, object], Curve]:
     """Each (mapper, seed)'s front on one terrain (y times ``sign``) and its largest x."""
-    curves = {}
+    curves: dict[tuple[str, object], Curve] = {}
     for (mapper, seed), group in part.groupby(["mapper", "seed"], sort=True):
         xv = group[x].to_numpy(dtype=np.float64)
         yv = sign * group[y].to_numpy(dtype=np.float64)

@@ -20,8 +20,6 @@ area whose disk the map knows (unmapped ground does not count against it).
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
 import open3d as o3d
 from scipy.spatial import ConvexHull, QhullError
@@ -122,7 +120,7 @@ def _share(num: int, den: int) -> float:
 
 
 def score_detection(detection: Detection, truth: Centres, params: LandingParams,
-                    ) -> dict[str, Any]:
+                    ) -> dict[str, float]:
     """Precision of the chosen sites, area precision and recall (module docstring)."""
     true = truth.feasible
     if true.shape != detection.grid.shape:

@@ -26,7 +26,6 @@ import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -50,7 +49,7 @@ __all__ = ["FRONT_COLUMNS", "FRONT_GRID", "SEQUENCE", "RealSequence", "front_tab
 SEQUENCE = "balm_seq"
 #: Settings per mapper for the real fronts: each spans its mapper's range of sizes on a
 #: 190 m scene (the cube over the data), from about 100 to 100,000 basis functions.
-FRONT_GRID: dict[str, list[dict[str, Any]]] = {
+FRONT_GRID: dict[str, list[dict[str, float]]] = {
     "quadtree": [{"max_points": v} for v in (10, 25, 50, 100, 200, 500, 1000)],
     "alte2d": [{"kappa": k, "max_res": r, "min_pts": 10} for k in (0.01, 0.1)
                for r in (5, 6, 7, 8)],
@@ -133,7 +132,7 @@ def reference_metrics(cells: Cells, dims: int, reference: np.ndarray, *,
 
 
 def front_table(sequence: RealSequence | None,
-                grid: Mapping[str, Sequence[Mapping[str, Any]]] | None = None, *,
+                grid: Mapping[str, Sequence[Mapping[str, object]]] | None = None, *,
                 tolerance: float = 0.2, progress: bool = True) -> pd.DataFrame:
     """One row per mapper and setting of ``grid`` (default :data:`FRONT_GRID`) on the
     sequence (:data:`FRONT_COLUMNS`); empty when ``sequence`` is None."""
