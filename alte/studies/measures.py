@@ -26,6 +26,7 @@ from dataclasses import fields, replace
 
 import numpy as np
 import pandas as pd
+from numpy.typing import ArrayLike
 from scipy.stats import spearmanr
 
 from alte.errors import ParameterError
@@ -58,7 +59,8 @@ from alte.studies.tradeoff import label
 __all__ = ["STAT_COLUMNS", "CheckValues", "NoDataError", "measure_check"]
 
 
-def _rho(x: np.ndarray, y: np.ndarray) -> float:
+def _rho(xs: ArrayLike, ys: ArrayLike) -> float:
+    x, y = np.asarray(xs, dtype=np.float64), np.asarray(ys, dtype=np.float64)
     keep = np.isfinite(x) & np.isfinite(y)
     x, y = x[keep], y[keep]
     if x.size < 3 or np.unique(x).size < 2 or np.unique(y).size < 2:
@@ -80,7 +82,7 @@ def _xcol(rows: pd.DataFrame, x: str) -> str:
     raise NoDataError(f"the table has no parameter or column {x!r}")
 
 
-def _level_means(group: pd.DataFrame, x: str, metric: str) -> pd.Series:
+def _level_means(group: pd.DataFrame, x: str, metric: str) -> pd.Series[float]:
     return group.groupby(x)[metric].mean().dropna().sort_index()
 
 
@@ -168,7 +170,7 @@ def _agreement(c: Agreement, table: pd.DataFrame) -> CheckValues:
     return CheckValues(_per_seed(rows, stat), what + "settings")
 
 
-def _aggregate(values: pd.Series, agg: str) -> float:
+def _aggregate(values: pd.Series[float], agg: str) -> float:
     data = values.to_numpy(float)
     data = data[np.isfinite(data)]
     if data.size == 0:

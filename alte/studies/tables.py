@@ -28,6 +28,7 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+from numpy.typing import NDArray
 from scipy.stats import spearmanr
 
 from alte.errors import ParameterError
@@ -91,7 +92,7 @@ def thesis_metrics(number: int) -> pd.DataFrame:
 
 
 def comparison_scores(table: pd.DataFrame,
-                      criteria: Sequence[str] = THESIS_CRITERIA) -> np.ndarray:
+                      criteria: Sequence[str] = THESIS_CRITERIA) -> NDArray[np.float64]:
     """Equal-weight score per row: the sum of min-max normalised criteria (lower is better)."""
     missing = [c for c in criteria if c not in table.columns]
     if missing:
@@ -122,7 +123,8 @@ def rule_criteria(table: pd.DataFrame) -> tuple[str, ...]:
     return THESIS_CRITERIA
 
 
-def _surely_beaten(fixed: np.ndarray, times: np.ndarray, spreads: np.ndarray) -> np.ndarray:
+def _surely_beaten(fixed: NDArray[np.float64], times: NDArray[np.float64],
+                   spreads: NDArray[np.float64]) -> NDArray[np.bool_]:
     """``out[i, j]``: row i's score is below row j's whatever the times within their
     spreads (``fixed``: the score without the time term). The time term of a row is
     (t - min t) / (max t - min t) over perturbed times; its largest difference i - j
@@ -138,7 +140,8 @@ def _surely_beaten(fixed: np.ndarray, times: np.ndarray, spreads: np.ndarray) ->
     return np.asarray(fixed[:, None] - fixed[None, :] + worst < -1e-12)
 
 
-def rule_picks(table: pd.DataFrame, criteria: Sequence[str] | None = None) -> np.ndarray:
+def rule_picks(table: pd.DataFrame, criteria: Sequence[str] | None = None,
+               ) -> NDArray[np.intp]:
     """Positions (ascending) of the rows the rule cannot tell from the best one: every
     row with all criteria that no other row beats whatever the times within their
     spreads (:func:`~alte.studies.uncertainty.time_spreads`). One position, or a tie."""
@@ -214,7 +217,7 @@ def point_cloud_table(number: int, name: str, frames: int, points: int) -> pd.Da
                           "thesis_points": ref["points"]}])
 
 
-def _rho(x: pd.Series, y: pd.Series) -> float:
+def _rho(x: pd.Series[float], y: pd.Series[float]) -> float:
     if len(x) < 3 or x.nunique() < 2 or y.nunique() < 2:
         return float("nan")
     return float(spearmanr(x, y).statistic)

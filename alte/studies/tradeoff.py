@@ -21,6 +21,7 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 import pandas as pd
+from numpy.typing import NDArray
 
 from alte.errors import ParameterError
 from alte.studies.thesis import COMPARISONS, SWEEPS
@@ -31,7 +32,7 @@ __all__ = ["MAPPER_NAMES", "METRICS", "OPTIONAL_COLUMNS", "REQUIRED_COLUMNS", "e
            "parse_params", "prepare", "read_at_size", "size_for_fidelity", "thesis_setting"]
 
 #: Sizes or fidelities to read fronts at.
-Levels = Sequence[float] | np.ndarray
+Levels = Sequence[float] | NDArray[np.float64]
 #: Columns every trade-off table must have.
 REQUIRED_COLUMNS = ("terrain", "mapper", "params", "seed", "basis_functions", "occupied_cells",
                     "memory_bytes", "elapsed_s", "mhd_m", "hd_m", "accuracy_mean_m",
@@ -124,7 +125,7 @@ def thesis_setting(mapper: str) -> dict[str, float] | None:
     return None
 
 
-def matching(rows: pd.DataFrame, setting: Mapping[str, float]) -> pd.Series:
+def matching(rows: pd.DataFrame, setting: Mapping[str, float]) -> pd.Series[bool]:
     """Which ``rows`` (with ``p_*`` columns) have every parameter of ``setting``."""
     match = pd.Series(True, index=rows.index)
     for key, value in setting.items():
@@ -135,7 +136,7 @@ def matching(rows: pd.DataFrame, setting: Mapping[str, float]) -> pd.Series:
     return match
 
 
-def pareto_front(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+def pareto_front(x: NDArray[np.float64], y: NDArray[np.float64]) -> NDArray[np.intp]:
     """Indices of the lower-left Pareto front of points (x, y), sorted by x.
 
     A point is on the front when no other point has both x and y no larger (one
@@ -152,8 +153,8 @@ def pareto_front(x: np.ndarray, y: np.ndarray) -> np.ndarray:
     return order[keep]
 
 
-def read_at_size(xs: np.ndarray, ys: np.ndarray, levels: Levels,
-                 x_max: float | None = None) -> np.ndarray:
+def read_at_size(xs: NDArray[np.float64], ys: NDArray[np.float64], levels: Levels,
+                 x_max: float | None = None) -> NDArray[np.float64]:
     """The front's error at each size in ``levels``: linear in log10 size between front
     points, flat from the last front point up to ``x_max`` (the largest map made: a
     larger map did no better), NaN outside."""
@@ -165,7 +166,8 @@ def read_at_size(xs: np.ndarray, ys: np.ndarray, levels: Levels,
                                 ys, left=np.nan, right=np.nan), dtype=np.float64)
 
 
-def size_for_fidelity(xs: np.ndarray, ys: np.ndarray, levels: Levels) -> np.ndarray:
+def size_for_fidelity(xs: NDArray[np.float64], ys: NDArray[np.float64],
+                      levels: Levels) -> NDArray[np.float64]:
     """The size the front needs to reach each error in ``levels`` (linear in log10 size
     between front points); NaN outside the front's error range (a level its smallest map
     already beats is censored: a smaller map might too)."""
@@ -210,7 +212,7 @@ def _levels(lo: float, hi: float, log: bool) -> list[float]:
     return sorted({r if lo <= r <= hi else v for r, v in zip(rounded, values, strict=True)})
 
 
-Curve = tuple[np.ndarray, np.ndarray, float]
+Curve = tuple[NDArray[np.float64], NDArray[np.float64], float]
 
 
 def _curves(part: pd.DataFrame, x: str, y: str, sign: float) -> dict[tuple[str, object], Curve]:

@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+from numpy.typing import NDArray
 from tqdm.auto import tqdm
 
 from alte.errors import ParameterError
@@ -44,7 +45,7 @@ class PlanningCase:
     step: float
 
     @property
-    def box(self) -> np.ndarray:
+    def box(self) -> NDArray[np.float64]:
         return np.asarray(self.bounds, dtype=np.float64).reshape(2, 3)
 
 
@@ -86,7 +87,8 @@ class TerrainPlans:
     terrain: str
     case: PlanningCase
     surface: TrueSurface | None
-    occupied: dict[str, tuple[np.ndarray, np.ndarray]] = field(default_factory=dict)
+    occupied: dict[str, tuple[NDArray[np.float64], NDArray[np.float64]]] = field(
+        default_factory=dict)
     results: dict[tuple[str, str], PlanResult] = field(default_factory=dict)
     scores: dict[tuple[str, str], PathScore] = field(default_factory=dict)
 

@@ -20,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+from numpy.typing import NDArray
 from tqdm.auto import tqdm
 
 from alte.errors import ParameterError
@@ -118,9 +119,9 @@ class IsprsSample:
     """An ISPRS sample in local coordinates (``origin`` subtracted) and its labels."""
 
     name: str
-    points: np.ndarray
-    reference: np.ndarray
-    origin: np.ndarray
+    points: NDArray[np.float64]
+    reference: NDArray[np.bool_]
+    origin: NDArray[np.float64]
 
 
 def isprs_samples(data: RealData) -> tuple[str, ...]:
@@ -149,9 +150,9 @@ class GroundRun:
     sample: str
     mapper_name: str
     params: dict[str, object]
-    points: np.ndarray
-    ground: np.ndarray
-    reference: np.ndarray
+    points: NDArray[np.float64]
+    ground: NDArray[np.bool_]
+    reference: NDArray[np.bool_]
     metrics: dict[str, float] = field(default_factory=dict)
 
 

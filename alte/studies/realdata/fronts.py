@@ -29,6 +29,7 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 from tqdm.auto import tqdm
 
@@ -71,7 +72,7 @@ class RealSequence:
 
     name: str
     data: Registered
-    reference: np.ndarray
+    reference: NDArray[np.float64]
 
 
 def sequence_data(data: RealData, *, frames: int = 20, voxel: float = 0.2,
@@ -90,7 +91,7 @@ def sequence_data(data: RealData, *, frames: int = 20, voxel: float = 0.2,
     return RealSequence(name, some, np.asarray(every.cloud, dtype=np.float64))
 
 
-def _top_raster(points: np.ndarray, grid: Grid) -> np.ndarray:
+def _top_raster(points: NDArray[np.float64], grid: Grid) -> NDArray[np.float64]:
     """Highest point per pixel (NaN where none)."""
     ny, nx = grid.shape
     rc = grid.index(points[:, :2])
@@ -100,7 +101,7 @@ def _top_raster(points: np.ndarray, grid: Grid) -> np.ndarray:
     return np.where(np.isfinite(top), top, np.nan).reshape(grid.shape)
 
 
-def reference_metrics(cells: Cells, dims: int, reference: np.ndarray, *,
+def reference_metrics(cells: Cells, dims: int, reference: NDArray[np.float64], *,
                       tolerance: float = 0.2, step: float = 0.5,
                       samples: int = 50_000, seed: int = 0) -> dict[str, float]:
     """The map's distance to the reference cloud (module docstring); ``samples``
