@@ -174,10 +174,10 @@ def _plain(owner: str, name: str, kind: object, value: object) -> object:
     return value
 
 
-_HINTS: dict[type, dict[str, Any]] = {}
+_HINTS: dict[type, dict[str, object]] = {}
 
 
-def _hints(cls: type) -> dict[str, Any]:
+def _hints(cls: type) -> dict[str, object]:
     """A record class's resolved field types, once per class (resolving them costs about
     0.7 ms, and every mapper and map run makes records)."""
     if cls not in _HINTS:
