@@ -28,7 +28,6 @@ from alte.studies.sweep.runs import SweepRun, plan_runs, plan_variants
 from alte.studies.sweep.spec import SweepSettings, SweepSpec
 from alte.studies.sweep.store import finished_ids, load_results, write_row
 from alte.studies.sweep.work import MapGroup, group_runs, input_data, run_group, run_one
-from alte.types import JSONDict
 
 __all__ = ["SERIAL", "SweepResult", "override", "run_one", "run_sweep", "variant_table"]
 
@@ -64,7 +63,7 @@ class SweepResult:
     skipped: int
     failed: list[tuple[SweepRun, str]] = field(default_factory=list)
 
-    def summary(self) -> JSONDict:
+    def summary(self) -> dict[str, object]:
         """Counts and failures, JSON-ready (for ``save_results``)."""
         return {"output": str(self.output), "rows": len(self.table), "ran": self.ran,
                 "skipped": self.skipped,

@@ -10,12 +10,12 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import json
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 from alte.metrics.maps import SetB, TruthOptions
 from alte.studies.sweep.spec import SweepSpec
 from alte.studies.sweep.variants import Variant
-from alte.types import JSONDict, JSONMap
 
 __all__ = ["SweepRun", "plan_runs", "plan_variants"]
 
@@ -28,7 +28,7 @@ class SweepRun:
     frames: int | None
     seed: int
     mapper: str
-    params: JSONMap
+    params: Mapping[str, object]
     voxel: float | None = None
     truth: TruthOptions = field(default_factory=TruthOptions)
     domain: str = "auto"
@@ -38,11 +38,11 @@ class SweepRun:
     obstacles: bool = False
     poses: str = "recorded"
 
-    def key(self) -> JSONDict:
+    def key(self) -> dict[str, object]:
         """Everything that determines the run's result, JSON-ready (``domain``, ``set_b``,
         ``sensor``, ``deskew``, ``obstacles`` and ``poses`` only when not the default, so
         earlier runs keep their ids)."""
-        key: JSONDict = {"terrain": self.terrain, "frames": self.frames, "seed": self.seed,
+        key: dict[str, object] = {"terrain": self.terrain, "frames": self.frames, "seed": self.seed,
                "mapper": self.mapper, "params": dict(sorted(self.params.items())),
                "voxel": self.voxel, "truth": dataclasses.asdict(self.truth)}
         if self.domain != "auto":

@@ -22,7 +22,6 @@ import json
 import time
 from collections.abc import Iterable
 from dataclasses import dataclass
-from typing import TypeAlias
 
 from alte.mappers import mapper_class
 from alte.metrics.maps import TruthOptions, measure_map
@@ -38,7 +37,7 @@ from alte.types import JSONDict
 __all__ = ["MapGroup", "RunOutcome", "group_runs", "input_data", "run_group", "run_one"]
 
 #: One run's result: (run id, its row or None, the exception or None).
-RunOutcome: TypeAlias = "tuple[str, JSONDict | None, Exception | None]"
+RunOutcome = tuple[str, dict[str, object] | None, Exception | None]
 
 
 @dataclass(frozen=True)
@@ -51,7 +50,7 @@ class MapGroup:
         return len(self.runs)
 
 
-def _resolved(run: SweepRun) -> JSONDict:
+def _resolved(run: SweepRun) -> dict[str, object]:
     """The run's mapper parameters, defaults filled in."""
     return mapper_class(run.mapper).Params.parse(run.params).as_dict()
 
@@ -109,7 +108,7 @@ def _inputs(run: SweepRun, data_dir: str) -> tuple[Registered, Reference]:
 
 
 def _row(run: SweepRun, data: Registered, measured: tuple[dict[str, float], JSONDict],
-         cost: tuple[float, float]) -> JSONDict:
+         cost: tuple[float, float]) -> dict[str, object]:
     metrics, obstacles = measured
     return {
         "run_id": run.run_id, "terrain": run.terrain, "frames_requested": run.frames or 0,
@@ -166,7 +165,7 @@ def run_group(group: MapGroup, data_dir: str) -> list[RunOutcome]:
     return out
 
 
-def run_one(run: SweepRun, data_dir: str) -> JSONDict:
+def run_one(run: SweepRun, data_dir: str) -> dict[str, object]:
     """Map one run's terrain and return its flat row (keys, ``p_*`` params, metrics, and
     its cost: ``wall_s`` and ``cpu_s``, the CPU seconds of every thread of the process,
     which other load on the machine does not inflate). Raises what the run raised."""
