@@ -29,13 +29,20 @@ the readings, so they name no terrain or size.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, fields, replace
-from typing import Any
+from dataclasses import dataclass, fields
 
 import numpy as np
 import pandas as pd
 
-from alte.studies.claims.types import AllOf, Check, Claim, Contrast, NotMeasurable, Property
+from alte.studies.claims.types import (
+    AllOf,
+    Check,
+    Claim,
+    Contrast,
+    NotMeasurable,
+    Property,
+    renamed,
+)
 from alte.studies.measures import CheckValues, NoDataError, measure_check
 from alte.studies.tradeoff import MAPPER_NAMES, METRICS, prepare
 from alte.studies.uncertainty import (
@@ -252,7 +259,7 @@ def _one(check: Check, table: pd.DataFrame, options: EvidenceOptions,
     return verdict, depends, text, shown, _time_check(m)
 
 
-def _part_dims(good: Sequence[Any], bad: Sequence[Any]) -> list[str]:
+def _part_dims(good: Sequence[Check], bad: Sequence[Check]) -> list[str]:
     """What tells holding parts from failing ones: per pair the first of metric, view,
     mapper, case, parameter that differs."""
     dims = set()
@@ -264,7 +271,7 @@ def _part_dims(good: Sequence[Any], bad: Sequence[Any]) -> list[str]:
     return sorted(dims, key=_PRIORITY.index)
 
 
-def _combine(parts: Sequence[Any], results: Sequence[Result]) -> tuple[str, str]:
+def _combine(parts: Sequence[Check], results: Sequence[Result]) -> tuple[str, str]:
     verdicts = [r[0] for r in results]
     tested = [v for v in verdicts if v in (_HOLDS, _FAILS, _DEPENDS)]
     if not tested:
@@ -286,18 +293,12 @@ def _resized(check: Check | AllOf, size: str | None) -> Check | AllOf:
     if size is None:
         return check
     if isinstance(check, AllOf):
-        return AllOf(tuple(_resized_check(p, size) for p in check.parts))
-    return _resized_check(check, size)
-
-
-def _resized_check(check: Check, size: str) -> Check:
-    changes: dict[str, Any] = {f.name: size for f in fields(check)
-                               if getattr(check, f.name) == "basis_functions"}
-    return replace(check, **changes)
+        return AllOf(tuple(renamed(p, "basis_functions", size) for p in check.parts))
+    return renamed(check, "basis_functions", size)
 
 
 def _evaluate(claim: Claim, table: pd.DataFrame, options: EvidenceOptions,
-              cache: dict[Any, Result] | None = None,
+              cache: dict[Check, Result] | None = None,
               variants: pd.DataFrame | None = None) -> Finding:
     check = _resized(claim.check, options.size)
     parts = check.parts if isinstance(check, AllOf) else (check,)
@@ -340,7 +341,7 @@ def evaluate_all(claims: Sequence[Claim], table: pd.DataFrame,
     """:func:`evaluate` for every claim (the tables are checked and prepared once)."""
     prepared = prepare(table)
     ready = prepare(variants) if variants is not None else None
-    cache: dict[Any, Result] = {}
+    cache: dict[Check, Result] = {}
     return [_evaluate(c, prepared, options or EvidenceOptions(), cache, ready) for c in claims]
 
 

@@ -18,7 +18,6 @@ import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 import pandas as pd
 
@@ -170,7 +169,7 @@ def ablation_verdicts(claims: Sequence[Claim],
     claim, in the order of ``claims``)."""
     rows = []
     for i, claim in enumerate(claims):
-        row: dict[str, Any] = {"id": claim.id, "section": claim.section, "claim": claim.quote}
+        row: dict[str, str] = {"id": claim.id, "section": claim.section, "claim": claim.quote}
         for name, found in verdicts.items():
             f = found[i]
             row[name] = f.verdict + (f" ({f.depends_on})" if f.depends_on else "")

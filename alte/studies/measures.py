@@ -23,10 +23,10 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import fields, replace
-from typing import Any
 
 import numpy as np
 import pandas as pd
+from numpy.typing import ArrayLike
 from scipy.stats import spearmanr
 
 from alte.errors import ParameterError
@@ -49,6 +49,7 @@ from alte.studies.claims.types import (
     Optimum,
     Summary,
     Trend,
+    renamed,
 )
 from alte.studies.comparisons import measure_compare
 from alte.studies.sweep.variants import BASE
@@ -58,7 +59,8 @@ from alte.studies.tradeoff import label
 __all__ = ["STAT_COLUMNS", "CheckValues", "NoDataError", "measure_check"]
 
 
-def _rho(x: np.ndarray, y: np.ndarray) -> float:
+def _rho(xs: ArrayLike, ys: ArrayLike) -> float:
+    x, y = np.asarray(xs, dtype=np.float64), np.asarray(ys, dtype=np.float64)
     keep = np.isfinite(x) & np.isfinite(y)
     x, y = x[keep], y[keep]
     if x.size < 3 or np.unique(x).size < 2 or np.unique(y).size < 2:
@@ -80,7 +82,7 @@ def _xcol(rows: pd.DataFrame, x: str) -> str:
     raise NoDataError(f"the table has no parameter or column {x!r}")
 
 
-def _level_means(group: pd.DataFrame, x: str, metric: str) -> pd.Series:
+def _level_means(group: pd.DataFrame, x: str, metric: str) -> pd.Series[float]:
     return group.groupby(x)[metric].mean().dropna().sort_index()
 
 
@@ -168,7 +170,7 @@ def _agreement(c: Agreement, table: pd.DataFrame) -> CheckValues:
     return CheckValues(_per_seed(rows, stat), what + "settings")
 
 
-def _aggregate(values: pd.Series, agg: str) -> float:
+def _aggregate(values: pd.Series[float], agg: str) -> float:
     data = values.to_numpy(float)
     data = data[np.isfinite(data)]
     if data.size == 0:
@@ -224,9 +226,30 @@ def _contrast(c: Contrast, table: pd.DataFrame) -> CheckValues:
     return CheckValues(_per_seed(rows, stat), what, unit(c.column) if c.agg == "median" else "")
 
 
-_MEASURES: dict[type, Callable[[Any, pd.DataFrame], CheckValues]] = {
-    Compare: measure_compare, Trend: _trend, Optimum: _optimum, Effect: _effect,
-    Agreement: _agreement, Summary: _summary, Contrast: _contrast}
+#: The checks measured on a table (exact types; the others raise).
+_MEASURED = (Compare, Trend, Optimum, Effect, Agreement, Summary, Contrast)
+
+
+def _measure(check: Check, table: pd.DataFrame) -> CheckValues:
+    """The measure of ``check``'s kind on ``table``."""
+    match check:
+        case Compare():
+            values = measure_compare(check, table)
+        case Trend():
+            values = _trend(check, table)
+        case Optimum():
+            values = _optimum(check, table)
+        case Effect():
+            values = _effect(check, table)
+        case Agreement():
+            values = _agreement(check, table)
+        case Summary():
+            values = _summary(check, table)
+        case Contrast():
+            values = _contrast(check, table)
+        case _:
+            raise ParameterError(f"{type(check).__name__} checks are not measured on a table")
+    return values
 
 
 def _mappers(check: Check) -> tuple[str, ...]:
@@ -237,34 +260,25 @@ def _mappers(check: Check) -> tuple[str, ...]:
     return ()
 
 
-def _on(check: Check, column: str) -> Check:
-    """``check`` with every field naming the elapsed time naming ``column`` instead."""
-    return replace(check, **{f.name: column for f in fields(check)  # type: ignore[arg-type]
-                             if getattr(check, f.name) == ELAPSED})
-
-
-def _by_cost(check: Check, table: pd.DataFrame,
-             fn: Callable[[Any, pd.DataFrame], CheckValues]) -> CheckValues:
+def _by_cost(check: Check, table: pd.DataFrame) -> CheckValues:
     """A within-mapper check on the time: judged on the cost where every map of its
     mappers has one, with the CPU time as cross-check (else on the CPU time alone)."""
-    timed = _on(check, TIME_COLUMN)
+    timed = renamed(check, ELAPSED, TIME_COLUMN)
     mine = table[table["mapper"].isin(_mappers(check))]
     if "cost" not in mine or mine.empty or mine["cost"].isna().any():
-        return replace(fn(timed, table), time="cpu")
-    found = fn(_on(check, "cost"), table)
+        return replace(_measure(timed, table), time="cpu")
+    found = _measure(renamed(check, ELAPSED, "cost"), table)
     units = ", ".join(dict.fromkeys(mapper_class(m).cost_unit.value for m in _mappers(check)))
     return replace(found, what=f"{found.what}; cost in {units}", time="cost",
-                   crosscheck=fn(timed, table))
+                   crosscheck=_measure(timed, table))
 
 
 def measure_check(check: Check, table: pd.DataFrame) -> CheckValues:
     """Per-seed statistics of ``check`` on ``table`` (prepared by
     :func:`alte.studies.tradeoff.prepare`); :class:`NoDataError` when it cannot be measured."""
-    try:
-        fn = _MEASURES[type(check)]
-    except KeyError as err:
-        raise ParameterError(f"{type(check).__name__} checks are not measured on a table") from err
+    if type(check) not in _MEASURED:
+        raise ParameterError(f"{type(check).__name__} checks are not measured on a table")
     if not isinstance(check, Compare) and any(getattr(check, f.name) == ELAPSED
                                               for f in fields(check)):
-        return _by_cost(check, table, fn)
-    return fn(check, table)
+        return _by_cost(check, table)
+    return _measure(check, table)

@@ -26,10 +26,8 @@ from __future__ import annotations
 import json
 import os
 import subprocess
-from collections.abc import Mapping
 from dataclasses import asdict, dataclass
 from pathlib import Path
-from typing import Any
 
 import pandas as pd
 
@@ -38,6 +36,7 @@ from alte.errors import ReportError
 from alte.studies.evidence_tables import EQUAL_SIZE, write_evidence
 from alte.studies.tables import write_csv
 from alte.studies.tradeoff import fronts, prepare
+from alte.types import JSONDict
 
 __all__ = ["CELLS", "EVIDENCE_TABLES", "PROVENANCE", "WHOLE_MISSIONS", "MissionEvidence",
            "Provenance", "compare_verdicts", "front_points", "git_commit", "load_mission_evidence",
@@ -75,7 +74,7 @@ class Provenance:
     wall_s: float
     started: str
     finished: str
-    machine: dict[str, Any]
+    machine: JSONDict
     version: str = __version__
 
 
@@ -156,7 +155,7 @@ def load_mission_evidence(folder: str | os.PathLike[str]) -> MissionEvidence:
         raise ReportError(f"whole-mission evidence {root}: missing {', '.join(missing)} (made "
                           "by alte sweep SPEC --evidence FOLDER)")
     try:
-        raw: Mapping[str, Any] = json.loads((root / PROVENANCE).read_text(encoding="utf-8"))
+        raw = json.loads((root / PROVENANCE).read_text(encoding="utf-8"))
         provenance = Provenance(**raw)
     except (OSError, ValueError, TypeError) as err:
         raise ReportError(f"whole-mission evidence {root / PROVENANCE}: unreadable "

@@ -32,6 +32,7 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+from numpy.typing import NDArray
 from tqdm.auto import tqdm
 
 from alte.errors import ParameterError
@@ -116,8 +117,9 @@ def _reference_spec(item: BenchInput) -> FrameSpec:
                      pose_file=item.reference)
 
 
-def _anchored(reg: Registered, reference: Registered, mine: np.ndarray,
-              theirs: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _anchored(reg: Registered, reference: Registered, mine: NDArray[np.intp],
+              theirs: NDArray[np.intp],
+              ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """Odometry's positions, quaternions and cloud moved so that its first matched pose is
     the reference's (module docstring)."""
     from scipy.spatial.transform import Rotation
@@ -133,7 +135,8 @@ def _anchored(reg: Registered, reference: Registered, mine: np.ndarray,
             np.asarray(reg.cloud) @ turn.T + shift)
 
 
-def _matched(reg: Registered, reference: Registered) -> tuple[np.ndarray, np.ndarray]:
+def _matched(reg: Registered, reference: Registered,
+             ) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
     """Indices of the scans both registrations kept, in each."""
     common, mine, theirs = np.intersect1d(reg.trajectory.stamps, reference.trajectory.stamps,
                                           return_indices=True)
@@ -182,7 +185,7 @@ def _settings(key: str, odometry: OdometryParams) -> str:
     return " ".join(f"{k}={v}" for k, v in changed.items()) or "defaults"
 
 
-def _mesh_mean(item: BenchInput, points: np.ndarray) -> float:
+def _mesh_mean(item: BenchInput, points: NDArray[np.float64]) -> float:
     if item.source.ground_truth() is None:
         return float("nan")
     from alte.sim import load_ground_truth, mesh_distance

@@ -26,10 +26,11 @@ alone: 3D-ALTE's unoccupied leaves are "not occupied", not observed-free; the me
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
-from typing import Any
+from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
+from numpy.typing import ArrayLike
 
 from alte.metrics.maps import TruthOptions
 from alte.pipeline import Registered
@@ -37,9 +38,19 @@ from alte.studies.experiments import Measured, measure
 from alte.studies.tables import rule_pick
 from alte.studies.thesis import QUALITATIVE
 
-__all__ = ["MEASURES", "class_completeness", "qualitative_inputs", "qualitative_table"]
+__all__ = ["MEASURES", "Inputs", "class_completeness", "qualitative_inputs", "qualitative_table"]
 
-Inputs = Mapping[str, Any]
+
+@dataclass(frozen=True)
+class Inputs:
+    """What the measured criteria read of one mapper: the metrics of its ``best`` (chosen)
+    map, the MHD of every row of its sweep, whether it inserts incrementally and its
+    completeness on the overhang objects of sim_nav_2 (NaN: not measured)."""
+
+    best: Mapping[str, float]
+    sweep_mhd: ArrayLike
+    incremental: bool
+    overhang_completeness: float = float("nan")
 
 
 def _grade(value: float, high: float, mid: float, reverse: bool = False) -> str:
@@ -51,40 +62,40 @@ def _grade(value: float, high: float, mid: float, reverse: bool = False) -> str:
 
 
 def _recursive(m: Inputs, _pair: Mapping[str, Inputs]) -> tuple[str, float]:
-    return ("Yes" if m["incremental"] else "No"), float(m["incremental"])
+    return ("Yes" if m.incremental else "No"), float(m.incremental)
 
 
 def _adaptability(m: Inputs, _pair: Mapping[str, Inputs]) -> tuple[str, float]:
-    v = float(m["best"].get("size_octaves", np.nan))
+    v = float(m.best.get("size_octaves", np.nan))
     return _grade(v, 3.0, 1.0), v
 
 
 def _robustness(m: Inputs, _pair: Mapping[str, Inputs]) -> tuple[str, float]:
-    mhd = np.asarray(m["sweep_mhd"], dtype=np.float64)
+    mhd = np.asarray(m.sweep_mhd, dtype=np.float64)
     v = float(mhd.std() / mhd.mean()) if mhd.size > 1 and mhd.mean() > 0 else np.nan
     return _grade(v, 0.1, 0.25, reverse=True), v
 
 
 def _outliers(m: Inputs, pair: Mapping[str, Inputs]) -> tuple[str, float]:
-    v = float(m["best"]["hd_minus_mhd_m"])
-    best = min(float(p["best"]["hd_minus_mhd_m"]) for p in pair.values())
+    v = float(m.best["hd_minus_mhd_m"])
+    best = min(float(p.best["hd_minus_mhd_m"]) for p in pair.values())
     ratio = v / best if best > 0 else (1.0 if v == 0 else np.inf)
     return _grade(ratio, 1.25, 2.0, reverse=True), v
 
 
 def _quality(m: Inputs, _pair: Mapping[str, Inputs]) -> tuple[str, float]:
-    v = float(m["best"].get("completeness", np.nan))
+    v = float(m.best.get("completeness", np.nan))
     return _grade(v, 0.8, 0.5), v
 
 
 def _size(m: Inputs, pair: Mapping[str, Inputs]) -> tuple[str, float]:
-    v = float(m["best"]["basis_functions"])
-    return _grade(v / max(float(p["best"]["basis_functions"]) for p in pair.values()), 0.5,
+    v = float(m.best["basis_functions"])
+    return _grade(v / max(float(p.best["basis_functions"]) for p in pair.values()), 0.5,
                   0.1), v
 
 
 def _overhang(m: Inputs, _pair: Mapping[str, Inputs]) -> tuple[str, float]:
-    v = float(m.get("overhang_completeness", np.nan))
+    v = float(m.overhang_completeness)
     return ("n/a" if not np.isfinite(v) else "Yes" if v >= 0.5 else "No"), v
 
 
@@ -107,7 +118,7 @@ def qualitative_table(number: int, inputs: Mapping[str, Inputs]) -> pd.DataFrame
     measurement is missing) fall back to the thesis' label."""
     rows = []
     for mapper, criteria in QUALITATIVE[number].items():
-        row: dict[str, Any] = {"mapper": mapper}
+        row: dict[str, str | float] = {"mapper": mapper}
         for crit, thesis_label in criteria.items():
             label, value, source = thesis_label, np.nan, "thesis"
             if crit in MEASURES and mapper in inputs:
@@ -123,7 +134,7 @@ def qualitative_table(number: int, inputs: Mapping[str, Inputs]) -> pd.DataFrame
 
 
 def qualitative_inputs(sweeps: Mapping[str, tuple[pd.DataFrame, Sequence[Measured]]],
-                       overhang: Mapping[str, float] | None = None) -> dict[str, dict[str, Any]]:
+                       overhang: Mapping[str, float] | None = None) -> dict[str, Inputs]:
     """Inputs of :func:`qualitative_table` from :func:`alte.studies.experiments.sweep` results.
 
     The chosen map of each sweep is the row the comparison rule picks (of a tie, by the
@@ -133,9 +144,9 @@ def qualitative_inputs(sweeps: Mapping[str, tuple[pd.DataFrame, Sequence[Measure
     out = {}
     for mapper, (table, runs) in sweeps.items():
         run = runs[rule_pick(table)]
-        out[mapper] = {"best": run.metrics.flat(), "sweep_mhd": table["mhd_m"].to_numpy(),
-                       "incremental": bool(type(run.mapper).incremental),
-                       "overhang_completeness": (overhang or {}).get(mapper, np.nan)}
+        out[mapper] = Inputs(run.metrics.flat(), table["mhd_m"].to_numpy(),
+                             bool(type(run.mapper).incremental),
+                             (overhang or {}).get(mapper, np.nan))
     return out
 
 

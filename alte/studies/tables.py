@@ -23,11 +23,12 @@ from __future__ import annotations
 
 import os
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 import pandas as pd
+from numpy.typing import NDArray
 from scipy.stats import spearmanr
 
 from alte.errors import ParameterError
@@ -91,7 +92,7 @@ def thesis_metrics(number: int) -> pd.DataFrame:
 
 
 def comparison_scores(table: pd.DataFrame,
-                      criteria: Sequence[str] = THESIS_CRITERIA) -> np.ndarray:
+                      criteria: Sequence[str] = THESIS_CRITERIA) -> NDArray[np.float64]:
     """Equal-weight score per row: the sum of min-max normalised criteria (lower is better)."""
     missing = [c for c in criteria if c not in table.columns]
     if missing:
@@ -122,7 +123,8 @@ def rule_criteria(table: pd.DataFrame) -> tuple[str, ...]:
     return THESIS_CRITERIA
 
 
-def _surely_beaten(fixed: np.ndarray, times: np.ndarray, spreads: np.ndarray) -> np.ndarray:
+def _surely_beaten(fixed: NDArray[np.float64], times: NDArray[np.float64],
+                   spreads: NDArray[np.float64]) -> NDArray[np.bool_]:
     """``out[i, j]``: row i's score is below row j's whatever the times within their
     spreads (``fixed``: the score without the time term). The time term of a row is
     (t - min t) / (max t - min t) over perturbed times; its largest difference i - j
@@ -138,7 +140,8 @@ def _surely_beaten(fixed: np.ndarray, times: np.ndarray, spreads: np.ndarray) ->
     return np.asarray(fixed[:, None] - fixed[None, :] + worst < -1e-12)
 
 
-def rule_picks(table: pd.DataFrame, criteria: Sequence[str] | None = None) -> np.ndarray:
+def rule_picks(table: pd.DataFrame, criteria: Sequence[str] | None = None,
+               ) -> NDArray[np.intp]:
     """Positions (ascending) of the rows the rule cannot tell from the best one: every
     row with all criteria that no other row beats whatever the times within their
     spreads (:func:`~alte.studies.uncertainty.time_spreads`). One position, or a tie."""
@@ -166,7 +169,7 @@ def rule_pick(table: pd.DataFrame, criteria: Sequence[str] | None = None) -> int
     return int(picks[np.argmin(comparison_scores(table, by_cost)[picks])])
 
 
-def _params_text(params: Mapping[str, Any]) -> str:
+def _params_text(params: Mapping[str, object]) -> str:
     return ", ".join(f"{k}={v}" for k, v in params.items())
 
 
@@ -214,13 +217,27 @@ def point_cloud_table(number: int, name: str, frames: int, points: int) -> pd.Da
                           "thesis_points": ref["points"]}])
 
 
-def _rho(x: pd.Series, y: pd.Series) -> float:
+def _rho(x: pd.Series[float], y: pd.Series[float]) -> float:
     if len(x) < 3 or x.nunique() < 2 or y.nunique() < 2:
         return float("nan")
     return float(spearmanr(x, y).statistic)
 
 
-def _sweep_trends(number: int, ours: pd.DataFrame) -> list[dict[str, Any]]:
+@dataclass(frozen=True)
+class _TrendRow:
+    """One row of :func:`trend_table`."""
+
+    table: str
+    trend: str
+    thesis_rho: float
+    ours_rho: float
+    holds_in_thesis: bool
+    holds_on_ours: bool
+    ours_on: str
+    ours_time_rho: float
+
+
+def _sweep_trends(number: int, ours: pd.DataFrame) -> list[_TrendRow]:
     """A time trend is read on our maps' machine-independent cost where they have one
     (``ours_rho``), with the rank correlation of their CPU time beside it."""
     theirs = thesis_metrics(number)
@@ -231,10 +248,8 @@ def _sweep_trends(number: int, ours: pd.DataFrame) -> list[dict[str, Any]]:
         r_o = _rho(ours[param], ours["cost" if timed else metric])
         r_time = _rho(ours[param], ours[TIME_COLUMN]) if timed and TIME_COLUMN in ours \
             else np.nan
-        out.append({"table": f"5.{number}", "trend": text, "thesis_rho": r_t, "ours_rho": r_o,
-                    "holds_in_thesis": bool(r_t * sign >= 0.5), "holds_on_ours":
-                    bool(r_o * sign >= 0.5), "ours_on": "cost" if timed else metric,
-                    "ours_time_rho": r_time})
+        out.append(_TrendRow(f"5.{number}", text, r_t, r_o, bool(r_t * sign >= 0.5),
+                             bool(r_o * sign >= 0.5), "cost" if timed else metric, r_time))
     return out
 
 
@@ -251,16 +266,13 @@ def _lower(table: pd.DataFrame, column: str, low: str, high: str) -> bool:
     return bool(top[mine].max() < bottom[other].min())
 
 
-def _comparison_trends(number: int, table: pd.DataFrame) -> list[dict[str, Any]]:
+def _comparison_trends(number: int, table: pd.DataFrame) -> list[_TrendRow]:
     out = []
     for text, low, high, metric in COMPARISON_TRENDS[number]:
         tcol = "thesis_hd_minus_mhd_m" if metric == "hd_minus_mhd_m" else _THESIS_COLS[metric]
         ours = TIME_COLUMN if metric == "elapsed_s" and TIME_COLUMN in table else metric
-        out.append({"table": f"5.{number}", "trend": text,
-                    "thesis_rho": np.nan, "ours_rho": np.nan,
-                    "holds_in_thesis": _lower(table, tcol, low, high),
-                    "holds_on_ours": _lower(table, ours, low, high), "ours_on": ours,
-                    "ours_time_rho": np.nan})
+        out.append(_TrendRow(f"5.{number}", text, np.nan, np.nan, _lower(table, tcol, low, high),
+                             _lower(table, ours, low, high), ours, np.nan))
     return out
 
 

@@ -17,6 +17,7 @@ from collections.abc import Sequence
 
 import numpy as np
 import pandas as pd
+from numpy.typing import NDArray
 
 from alte.studies.tradeoff import equal_fidelity
 from alte.studies.uncertainty import run_time_spreads
@@ -27,8 +28,8 @@ __all__ = ["READ_COLUMNS", "time_at_fidelity"]
 READ_COLUMNS = ["terrain", "seed", "level", "mapper", "value", "low", "high"]
 
 
-def _least(maps: pd.DataFrame, time: str, fidelity: str, levels: np.ndarray,
-           sign: float) -> np.ndarray:
+def _least(maps: pd.DataFrame, time: str, fidelity: str, levels: NDArray[np.float64],
+           sign: float) -> NDArray[np.float64]:
     """(levels, 3): the least time, lower and upper bound of the maps reaching each level
     (signed fidelity at most the level); NaN where none does."""
     x = maps[time].to_numpy(dtype=np.float64)

@@ -17,11 +17,11 @@ front of the compared mappers covers on that terrain.
 from __future__ import annotations
 
 import json
-from collections.abc import Sequence
-from typing import Any
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 import pandas as pd
+from numpy.typing import NDArray
 
 from alte.errors import ParameterError
 from alte.studies.thesis import COMPARISONS, SWEEPS
@@ -32,7 +32,7 @@ __all__ = ["MAPPER_NAMES", "METRICS", "OPTIONAL_COLUMNS", "REQUIRED_COLUMNS", "e
            "parse_params", "prepare", "read_at_size", "size_for_fidelity", "thesis_setting"]
 
 #: Sizes or fidelities to read fronts at.
-Levels = Sequence[float] | np.ndarray
+Levels = Sequence[float] | NDArray[np.float64]
 #: Columns every trade-off table must have.
 REQUIRED_COLUMNS = ("terrain", "mapper", "params", "seed", "basis_functions", "occupied_cells",
                     "memory_bytes", "elapsed_s", "mhd_m", "hd_m", "accuracy_mean_m",
@@ -66,7 +66,7 @@ def label(metric: str, unit: bool = True) -> str:
     return f"{name} [{units}]" if unit and units else name
 
 
-def parse_params(text: Any) -> dict[str, Any]:
+def parse_params(text: object) -> dict[str, object]:
     """A parameter setting from JSON (``{"kappa": 0.1}``) or ``"kappa=0.1, max_res=5"``."""
     if isinstance(text, dict):
         return dict(text)
@@ -76,7 +76,7 @@ def parse_params(text: Any) -> dict[str, Any]:
             return dict(json.loads(raw))
         except ValueError as err:
             raise ParameterError(f"trade-off table: params {raw!r} is not JSON") from err
-    out: dict[str, Any] = {}
+    out: dict[str, object] = {}
     for item in filter(None, (p.strip() for p in raw.split(","))):
         key, sep, value = item.partition("=")
         if not sep:
@@ -116,7 +116,7 @@ def prepare(table: pd.DataFrame) -> pd.DataFrame:
     return out
 
 
-def thesis_setting(mapper: str) -> dict[str, Any] | None:
+def thesis_setting(mapper: str) -> dict[str, float] | None:
     """The parameters of ``mapper``'s map the thesis chose (tables 5.10-5.11), if any."""
     for chosen in COMPARISONS.values():
         if mapper in chosen:
@@ -125,7 +125,7 @@ def thesis_setting(mapper: str) -> dict[str, Any] | None:
     return None
 
 
-def matching(rows: pd.DataFrame, setting: dict[str, Any]) -> pd.Series:
+def matching(rows: pd.DataFrame, setting: Mapping[str, float]) -> pd.Series[bool]:
     """Which ``rows`` (with ``p_*`` columns) have every parameter of ``setting``."""
     match = pd.Series(True, index=rows.index)
     for key, value in setting.items():
@@ -136,7 +136,7 @@ def matching(rows: pd.DataFrame, setting: dict[str, Any]) -> pd.Series:
     return match
 
 
-def pareto_front(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+def pareto_front(x: NDArray[np.float64], y: NDArray[np.float64]) -> NDArray[np.intp]:
     """Indices of the lower-left Pareto front of points (x, y), sorted by x.
 
     A point is on the front when no other point has both x and y no larger (one
@@ -153,8 +153,8 @@ def pareto_front(x: np.ndarray, y: np.ndarray) -> np.ndarray:
     return order[keep]
 
 
-def read_at_size(xs: np.ndarray, ys: np.ndarray, levels: Levels,
-                 x_max: float | None = None) -> np.ndarray:
+def read_at_size(xs: NDArray[np.float64], ys: NDArray[np.float64], levels: Levels,
+                 x_max: float | None = None) -> NDArray[np.float64]:
     """The front's error at each size in ``levels``: linear in log10 size between front
     points, flat from the last front point up to ``x_max`` (the largest map made: a
     larger map did no better), NaN outside."""
@@ -166,7 +166,8 @@ def read_at_size(xs: np.ndarray, ys: np.ndarray, levels: Levels,
                                 ys, left=np.nan, right=np.nan), dtype=np.float64)
 
 
-def size_for_fidelity(xs: np.ndarray, ys: np.ndarray, levels: Levels) -> np.ndarray:
+def size_for_fidelity(xs: NDArray[np.float64], ys: NDArray[np.float64],
+                      levels: Levels) -> NDArray[np.float64]:
     """The size the front needs to reach each error in ``levels`` (linear in log10 size
     between front points); NaN outside the front's error range (a level its smallest map
     already beats is censored: a smaller map might too)."""
@@ -211,12 +212,12 @@ def _levels(lo: float, hi: float, log: bool) -> list[float]:
     return sorted({r if lo <= r <= hi else v for r, v in zip(rounded, values, strict=True)})
 
 
-Curve = tuple[np.ndarray, np.ndarray, float]
+Curve = tuple[NDArray[np.float64], NDArray[np.float64], float]
 
 
-def _curves(part: pd.DataFrame, x: str, y: str, sign: float) -> dict[tuple[str, Any], Curve]:
+def _curves(part: pd.DataFrame, x: str, y: str, sign: float) -> dict[tuple[str, object], Curve]:
     """Each (mapper, seed)'s front on one terrain (y times ``sign``) and its largest x."""
-    curves = {}
+    curves: dict[tuple[str, object], Curve] = {}
     for (mapper, seed), group in part.groupby(["mapper", "seed"], sort=True):
         xv = group[x].to_numpy(dtype=np.float64)
         yv = sign * group[y].to_numpy(dtype=np.float64)

@@ -23,6 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
+from numpy.typing import NDArray
 from scipy.stats import bootstrap
 
 __all__ = ["CONFIDENCE", "RUN_TIME_SPREAD", "TIME_SPREAD_FLOOR", "Interval", "bootstrap_bounds",
@@ -52,7 +53,7 @@ class Interval:
     level: float = CONFIDENCE
 
 
-def bootstrap_ci(values: np.ndarray | list[float], level: float = CONFIDENCE,
+def bootstrap_ci(values: NDArray[np.float64] | list[float], level: float = CONFIDENCE,
                  n_resamples: int = 2000, seed: int = 0) -> Interval:
     """Mean of the finite ``values`` with its percentile bootstrap interval at ``level``.
 
@@ -72,8 +73,9 @@ def bootstrap_ci(values: np.ndarray | list[float], level: float = CONFIDENCE,
     return Interval(mean, float(ci.low), float(ci.high), int(data.size), level)
 
 
-def bootstrap_columns(values: np.ndarray, level: float = CONFIDENCE, n_resamples: int = 2000,
-                      seed: int = 0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def bootstrap_columns(values: NDArray[np.float64], level: float = CONFIDENCE,
+                      n_resamples: int = 2000, seed: int = 0,
+                      ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """Mean and percentile-bootstrap interval of every column of ``values`` (seeds x
     quantities, all finite) in one resampling: the seeds are resampled together, as for
     a curve read at many sizes."""
@@ -88,8 +90,9 @@ def bootstrap_columns(values: np.ndarray, level: float = CONFIDENCE, n_resamples
     return mean, np.where(flat, mean, ci.low), np.where(flat, mean, ci.high)
 
 
-def bootstrap_bounds(values: np.ndarray | list[float], low: np.ndarray | list[float],
-                     high: np.ndarray | list[float], *, level: float = CONFIDENCE,
+def bootstrap_bounds(values: NDArray[np.float64] | list[float],
+                     low: NDArray[np.float64] | list[float],
+                     high: NDArray[np.float64] | list[float], *, level: float = CONFIDENCE,
                      n_resamples: int = 2000, seed: int = 0) -> Interval:
     """Mean of the finite ``values`` (over the seeds with both bounds), with an interval
     from the bootstrap interval of the mean of ``low`` (its low end) and of ``high`` (its
@@ -109,7 +112,7 @@ def bootstrap_bounds(values: np.ndarray | list[float], low: np.ndarray | list[fl
     return Interval(float(data[:, 0].mean()), float(ends[0]), float(ends[1]), len(data), level)
 
 
-def time_spreads(table: pd.DataFrame, spread: str = "map_cpu_spread") -> np.ndarray:
+def time_spreads(table: pd.DataFrame, spread: str = "map_cpu_spread") -> NDArray[np.float64]:
     """Each row's time spread, at least :data:`TIME_SPREAD_FLOOR` (the floor alone where
     the table has no ``spread`` column or a row no value: a time read once)."""
     if spread not in table:
@@ -118,7 +121,7 @@ def time_spreads(table: pd.DataFrame, spread: str = "map_cpu_spread") -> np.ndar
     return np.asarray(np.fmax(np.nan_to_num(values, nan=0.0), TIME_SPREAD_FLOOR))
 
 
-def run_time_spreads(table: pd.DataFrame) -> np.ndarray:
+def run_time_spreads(table: pd.DataFrame) -> NDArray[np.float64]:
     """:data:`RUN_TIME_SPREAD` for every row: the band within which two mappers' times are
     compared, whatever the maps' own repeats read."""
     return np.full(len(table), RUN_TIME_SPREAD)

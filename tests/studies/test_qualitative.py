@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from alte.studies.qualitative import qualitative_table
+from alte.studies.qualitative import Inputs, qualitative_table
 
 
 def test_qualitative_table_marks_sources():
@@ -10,8 +10,8 @@ def test_qualitative_table_marks_sources():
                         "free_truly_free_share": 0.97},
             "alte3d": {"size_octaves": 4.0, "hd_minus_mhd_m": 1.0, "basis_functions": 100,
                        "free_truly_free_share": float("nan")}}
-    inputs = {m: {"best": b, "sweep_mhd": [0.4, 0.41, 0.39] if m == "octomap" else [0.2, 0.6],
-                  "incremental": True} for m, b in best.items()}
+    inputs = {m: Inputs(b, [0.4, 0.41, 0.39] if m == "octomap" else [0.2, 0.6], True)
+              for m, b in best.items()}
     t2 = qualitative_table(2, inputs).set_index("mapper")
     assert t2.loc["octomap", "adaptability"] == "Low" and t2.loc["alte3d", "adaptability"] == "High"
     assert t2.loc["octomap", "robustness"] == "High" and t2.loc["alte3d", "robustness"] == "Low"

@@ -115,7 +115,7 @@ class Choice:
     by_mhd: Pick | None
 
 
-def ms_per_scan(table: pd.DataFrame) -> pd.Series:
+def ms_per_scan(table: pd.DataFrame) -> pd.Series[float]:
     """Milliseconds of mapping per scan: the mapper's CPU time (wall time for tables
     without it) over the scans mapped (NaN where the table does not say how many)."""
     seconds = table["map_cpu_s"] if "map_cpu_s" in table else table["elapsed_s"]
@@ -176,18 +176,21 @@ def budgets(pool: pd.DataFrame, use: Use) -> list[Budget]:
     return list(dict.fromkeys(out))
 
 
-def _pick(row: pd.Series, use: Use) -> Pick:
+def _pick(chosen: pd.DataFrame, use: Use) -> Pick:
+    """The :class:`Pick` of a one-row frame of candidates."""
+    row = chosen.iloc[0]
     return Pick(str(row["mapper"]), setting_text(row["params"]), float(row["size"]),
                 float(row["ms"]), bootstrap_ci(row[use.truth]), bootstrap_ci(row[use.second]),
                 bootstrap_ci(row["mhd_m"]))
 
 
-def _best(pool: pd.DataFrame, column: str, higher: bool) -> pd.Series | None:
+def _best(pool: pd.DataFrame, column: str, higher: bool) -> pd.DataFrame | None:
+    """The best candidate by ``column`` (the smaller of a tie) as a one-row frame."""
     ranked = pool.dropna(subset=[f"{column}_mean"])
     if ranked.empty:
         return None
     order = ranked.sort_values([f"{column}_mean", "size"], ascending=[not higher, True])
-    return order.iloc[0]
+    return order.iloc[:1]
 
 
 def _feasible(pool: pd.DataFrame, budget: Budget, use: Use) -> pd.DataFrame:
@@ -199,8 +202,9 @@ def _feasible(pool: pd.DataFrame, budget: Budget, use: Use) -> pd.DataFrame:
     return pool[met]
 
 
-def _decided(best: pd.Series, rival: pd.Series, use: Use) -> bool:
-    diff = np.asarray(best[use.truth], float) - np.asarray(rival[use.truth], float)
+def _decided(best: pd.DataFrame, rival: pd.DataFrame, use: Use) -> bool:
+    diff = (np.asarray(best[use.truth].iloc[0], float)
+            - np.asarray(rival[use.truth].iloc[0], float))
     ci = bootstrap_ci(diff)
     return bool(ci.seeds > 1 and (ci.low > 0 or ci.high < 0))
 
@@ -212,14 +216,14 @@ def choose(pool: pd.DataFrame, use: Use, group: str, terrains: Sequence[str],
     if budget.kind == "need":
         ranked = fit.sort_values(["size", f"{use.truth}_mean"],
                                  ascending=[True, not use.truth_higher])
-        best = ranked.iloc[0] if len(ranked) else None
+        best = ranked.iloc[:1] if len(ranked) else None
     else:
         best = _best(fit, use.truth, use.truth_higher) if len(fit) else None
     rival = by_mhd = None
     if best is not None:
-        others = fit[fit["mapper"] != best["mapper"]]
+        others = fit[fit["mapper"] != best["mapper"].iloc[0]]
         if budget.kind == "need":
-            rival = others.sort_values("size").iloc[0] if len(others) else None
+            rival = others.sort_values("size").iloc[:1] if len(others) else None
         else:
             rival = _best(others, use.truth, use.truth_higher) if len(others) else None
             by_mhd = _best(fit, "mhd_m", False)

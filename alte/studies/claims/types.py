@@ -30,12 +30,12 @@ Kinds of check:
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields, replace
 from typing import Literal
 
 __all__ = ["CASES", "SIZE_COLUMNS", "Agreement", "AllOf", "Check", "Claim", "Compare",
            "Contrast", "Effect", "NotMeasurable", "Optimum", "Property", "Relation", "Summary",
-           "Trend", "Where"]
+           "Trend", "Where", "renamed"]
 
 #: Terrain cases: landing (2D maps) and urban navigation (3D maps).
 CASES = ("lan", "nav")
@@ -187,6 +187,14 @@ class NotMeasurable:
 
 Check = (Compare | Trend | Optimum | Effect | Agreement | Summary | Contrast | Property
          | NotMeasurable)
+
+
+def renamed(check: Check, column: str, to: str) -> Check:
+    """``check`` with every field naming ``column`` naming ``to`` instead."""
+    changes = {f.name: to for f in fields(check) if getattr(check, f.name) == column}
+    # Only fields that held a column name (text) change; mypy checks the keywords of
+    # ``replace`` against every field of every kind of check at once.
+    return replace(check, **changes)  # type: ignore[arg-type]
 
 
 @dataclass(frozen=True)

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
+from numpy.typing import NDArray
 from scipy import ndimage
 
 from alte.errors import ParameterError
@@ -37,12 +38,12 @@ class Centres:
     """Per pixel: ``feasible`` site centre, distances (m) to the nearest unknown and
     obstacle pixel, the window plane's ``slope_deg``/``roughness`` and the masks used."""
 
-    feasible: np.ndarray
-    known_dist: np.ndarray
-    obstacle_dist: np.ndarray
-    slope_deg: np.ndarray
-    roughness: np.ndarray
-    obstacle: np.ndarray
+    feasible: NDArray[np.bool_]
+    known_dist: NDArray[np.float64]
+    obstacle_dist: NDArray[np.float64]
+    slope_deg: NDArray[np.float64]
+    roughness: NDArray[np.float64]
+    obstacle: NDArray[np.bool_]
 
 
 @dataclass(frozen=True)
@@ -50,7 +51,7 @@ class Detection:
     """Detected landing sites on one raster: the per-pixel tests and the ranked sites."""
 
     grid: Grid
-    height: np.ndarray
+    height: NDArray[np.float64]
     centres: Centres
     sites: pd.DataFrame
 
@@ -60,7 +61,7 @@ class Detection:
         return self.sites[self.sites["chosen"]]
 
 
-def _distance_to(mask: np.ndarray, step: float, pad_true: bool) -> np.ndarray:
+def _distance_to(mask: NDArray[np.bool_], step: float, pad_true: bool) -> NDArray[np.float64]:
     """Distance (m) from every pixel centre to the nearest ``mask`` pixel (inf if none).
 
     ``pad_true`` counts the outside of the raster as ``mask`` (unknown space)."""
@@ -72,8 +73,8 @@ def _distance_to(mask: np.ndarray, step: float, pad_true: bool) -> np.ndarray:
     return dist[1:-1, 1:-1] if pad_true else dist
 
 
-def map_obstacles(height: np.ndarray, grid: Grid, params: LandingParams,
-                  ground: float | None = None, seed: int = 0) -> np.ndarray:
+def map_obstacles(height: NDArray[np.float64], grid: Grid, params: LandingParams,
+                  ground: float | None = None, seed: int = 0) -> NDArray[np.bool_]:
     """Known pixels more than ``obstacle_height`` above or below the ground.
 
     ``ground`` is a height (m); None fits the ground plane with MSAC (thesis 2.1.4)
@@ -82,7 +83,7 @@ def map_obstacles(height: np.ndarray, grid: Grid, params: LandingParams,
     return ground_obstacles(height, grid.centers(), params.obstacle_height, ground, seed)
 
 
-def feasible_centres(height: np.ndarray, obstacle: np.ndarray, step: float,
+def feasible_centres(height: NDArray[np.float64], obstacle: NDArray[np.bool_], step: float,
                      params: LandingParams) -> Centres:
     """Test every pixel as a site centre (module docstring); NaN heights are unknown."""
     height = np.asarray(height, dtype=np.float64)
@@ -100,7 +101,8 @@ def feasible_centres(height: np.ndarray, obstacle: np.ndarray, step: float,
                    obstacle & known)
 
 
-def _pixel_terms(centres: Centres, params: LandingParams) -> tuple[np.ndarray, np.ndarray]:
+def _pixel_terms(centres: Centres, params: LandingParams,
+                 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Room (gap from the footprint to the nearest obstacle or unknown pixel, over twice
     ``keep_out``; not capped) and flatness in [0, 1] per pixel."""
     room = np.minimum(centres.obstacle_dist, centres.known_dist) - params.radius
@@ -109,7 +111,7 @@ def _pixel_terms(centres: Centres, params: LandingParams) -> tuple[np.ndarray, n
     return room / (2.0 * params.keep_out), np.clip(np.nan_to_num(flat, nan=0.0), 0.0, 1.0)
 
 
-def rank_sites(centres: Centres, height: np.ndarray, grid: Grid,
+def rank_sites(centres: Centres, height: NDArray[np.float64], grid: Grid,
                params: LandingParams) -> pd.DataFrame:
     """Sites = 8-connected components of feasible centres, best first (:data:`SITE_COLUMNS`).
 
@@ -142,7 +144,7 @@ def rank_sites(centres: Centres, height: np.ndarray, grid: Grid,
     return table.reset_index(drop=True)[list(SITE_COLUMNS)]
 
 
-def detect_sites(height: np.ndarray, grid: Grid, params: LandingParams,
+def detect_sites(height: NDArray[np.float64], grid: Grid, params: LandingParams,
                  ground: float | None = None, seed: int = 0) -> Detection:
     """Landing sites on a height raster (NaN = unknown); ``ground`` as in :func:`map_obstacles`."""
     height = np.asarray(height, dtype=np.float64)

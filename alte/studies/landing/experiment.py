@@ -15,7 +15,6 @@ import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 import pandas as pd
 from tqdm.auto import tqdm
@@ -29,6 +28,7 @@ from alte.studies.landing.raster import Grid, rasterise
 from alte.studies.landing.truth import score_detection, truth_centres
 from alte.studies.tables import write_csv
 from alte.studies.thesis import SWEEPS, mapper_params
+from alte.types import JSONDict
 
 __all__ = ["LANDING_MAPPERS", "SWEEP_ROWS", "LandingRun", "evaluate_landing", "landing_grid",
            "landing_param_sets", "landing_summary", "landing_table", "landing_truth",
@@ -52,7 +52,7 @@ class LandingRun:
     map_run: MapRun
     detection: Detection
     truth: Centres | None
-    scores: dict[str, Any]
+    scores: dict[str, float]
 
 
 def landing_grid(data: Registered, params: LandingParams) -> Grid:
@@ -71,7 +71,7 @@ def landing_truth(data: Registered, params: LandingParams) -> Centres:
                          z_start=float(truth.bounds.hi[2]))
 
 
-def evaluate_landing(data: Registered, mapper: str, params: Mapping[str, Any] | None,
+def evaluate_landing(data: Registered, mapper: str, params: Mapping[str, object] | None,
                      landing: LandingParams, *, truth: Centres | None = None,
                      label: str = "") -> LandingRun:
     """Map ``data`` with ``mapper``/``params``, detect sites and score them when truth exists.
@@ -95,13 +95,13 @@ def evaluate_landing(data: Registered, mapper: str, params: Mapping[str, Any] | 
                       detection, truth, scores)
 
 
-def score_landing(dataset: Registered, mapper: str, params: Mapping[str, Any] | None,
-                  landing_params: LandingParams) -> dict[str, Any]:
+def score_landing(dataset: Registered, mapper: str, params: Mapping[str, object] | None,
+                  landing_params: LandingParams) -> dict[str, float]:
     """Scores of :func:`evaluate_landing` (precision, recall, ...) as a flat dict."""
     return evaluate_landing(dataset, mapper, params, landing_params).scores
 
 
-def landing_param_sets(terrain: str) -> list[tuple[str, str, dict[str, Any]]]:
+def landing_param_sets(terrain: str) -> list[tuple[str, str, dict[str, float]]]:
     """(label, mapper, params) to run on ``terrain``: chapter 4, then the sweep rows."""
     out = [(f"ch4 {name}", name, p) for name, p in mapper_params(terrain).items()]
     for name, (table, rows) in SWEEP_ROWS.items():
@@ -109,8 +109,8 @@ def landing_param_sets(terrain: str) -> list[tuple[str, str, dict[str, Any]]]:
     return out
 
 
-def _row(run: LandingRun, mapper: str, params: Mapping[str, Any],
-         landing: LandingParams) -> dict[str, Any]:
+def _row(run: LandingRun, mapper: str, params: Mapping[str, float],
+         landing: LandingParams) -> JSONDict:
     best = run.detection.sites.head(1)
     return {"terrain": run.terrain, "mapper": mapper, "param_set": run.label,
             "params": ", ".join(f"{k}={v}" for k, v in params.items()),

@@ -20,7 +20,6 @@ between the debris, so :func:`landing_params` scales everything down for them
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
 
 from alte.errors import ParameterError
 from alte.ground.surface import SurfaceRule
@@ -83,7 +82,7 @@ LAB = LandingParams(radius=0.25, margin=0.1, clearance=0.15, max_slope_deg=10.0,
                     max_roughness=0.03, obstacle_height=0.06, step=0.05)
 
 
-def landing_params(terrain: str, **overrides: Any) -> LandingParams:
+def landing_params(terrain: str, **overrides: object) -> LandingParams:
     """The preset for ``terrain`` (``exp_*``: :data:`LAB`, else :data:`QUADROTOR`), overridden."""
     base = LAB if terrain.startswith("exp_") else QUADROTOR
     return base.replace(**overrides)

@@ -13,6 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import NDArray
 
 from alte.errors import ParameterError
 from alte.ground.surface import PlaneFeatures, pixel_centres, plane_features
@@ -31,7 +32,7 @@ class Grid:
     shape: tuple[int, int]
 
     @classmethod
-    def from_bounds(cls, bounds: np.ndarray, step: float) -> Grid:
+    def from_bounds(cls, bounds: NDArray[np.float64], step: float) -> Grid:
         """The grid of ``step`` pixels covering ``bounds`` ((2, 2) or (2, 3): min/max corner)."""
         box = np.asarray(bounds, dtype=np.float64)
         if box.ndim != 2 or box.shape[0] != 2 or box.shape[1] < 2:
@@ -45,17 +46,17 @@ class Grid:
         nx, ny = np.floor(size / step + 1e-9).astype(int)
         return cls((float(box[0, 0]), float(box[0, 1])), float(step), (int(ny), int(nx)))
 
-    def axes(self) -> tuple[np.ndarray, np.ndarray]:
+    def axes(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Pixel-centre x (nx,) and y (ny,) coordinates."""
         ny, nx = self.shape
-        return (self.origin[0] + (np.arange(nx) + 0.5) * self.step,
-                self.origin[1] + (np.arange(ny) + 0.5) * self.step)
+        return (self.origin[0] + (np.arange(nx, dtype=np.float64) + 0.5) * self.step,
+                self.origin[1] + (np.arange(ny, dtype=np.float64) + 0.5) * self.step)
 
-    def centers(self) -> np.ndarray:
+    def centers(self) -> NDArray[np.float64]:
         """Pixel centres (ny * nx, 2), row-major (y slow, x fast)."""
         return pixel_centres(self.origin, self.step, self.shape)
 
-    def index(self, xy: np.ndarray) -> np.ndarray:
+    def index(self, xy: NDArray[np.float64]) -> NDArray[np.int64]:
         """(row, col) of the pixels holding points ``xy`` (N, 2) (not clipped)."""
         rc = np.floor((np.asarray(xy, dtype=np.float64) - self.origin) / self.step)
         return rc[:, ::-1].astype(np.int64)
@@ -68,7 +69,7 @@ class Grid:
         return (x0, x0 + nx * self.step, y0, y0 + ny * self.step)
 
 
-def rasterise(cells: Cells, grid: Grid) -> np.ndarray:
+def rasterise(cells: Cells, grid: Grid) -> NDArray[np.float64]:
     """Height (ny, nx) of the cell holding each pixel centre; NaN where unknown."""
     known = np.isfinite(cells.centers[:, 2])
     centers, sizes = cells.centers[known], cells.sizes[known]

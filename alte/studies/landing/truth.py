@@ -20,10 +20,9 @@ area whose disk the map knows (unmapped ground does not count against it).
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
 import open3d as o3d
+from numpy.typing import NDArray
 from scipy.spatial import ConvexHull, QhullError
 
 from alte.errors import MetricsError
@@ -40,7 +39,7 @@ __all__ = ["GROUND_CLASSES", "object_footprints", "score_detection", "top_surfac
 GROUND_CLASSES = frozenset({"ground"})
 
 
-def _hull(xy: np.ndarray) -> np.ndarray:
+def _hull(xy: NDArray[np.float64]) -> NDArray[np.float64]:
     """Counter-clockwise convex hull of ``xy`` (a segment or point when degenerate)."""
     try:
         return xy[ConvexHull(xy).vertices]
@@ -49,8 +48,8 @@ def _hull(xy: np.ndarray) -> np.ndarray:
         return xy[[far[0], far[-1]]]
 
 
-def _square_overlaps(grid: Grid, rows: np.ndarray, cols: np.ndarray,
-                     hull: np.ndarray) -> np.ndarray:
+def _square_overlaps(grid: Grid, rows: NDArray[np.intp], cols: NDArray[np.intp],
+                     hull: NDArray[np.float64]) -> NDArray[np.bool_]:
     """Separating-axis test of the pixel squares (rows, cols) against a convex polygon."""
     xs, ys = grid.axes()
     centers = np.column_stack([xs[cols], ys[rows]])
@@ -63,11 +62,12 @@ def _square_overlaps(grid: Grid, rows: np.ndarray, cols: np.ndarray,
     reach = 0.5 * grid.step * np.abs(normals).sum(axis=1)
     proj = centers @ normals.T  # (pixels, axes)
     apart = (proj + reach < proj_hull.min(0)) | (proj - reach > proj_hull.max(0))
-    overlaps: np.ndarray = ~apart.any(axis=1)
+    overlaps: NDArray[np.bool_] = ~apart.any(axis=1)
     return overlaps
 
 
-def object_footprints(surface: TrueSurface, grid: Grid, ids: np.ndarray) -> np.ndarray:
+def object_footprints(surface: TrueSurface, grid: Grid, ids: NDArray[np.int64],
+                      ) -> NDArray[np.bool_]:
     """Pixels (ny, nx) whose square overlaps the x/y convex hull of any object in ``ids``."""
     out = np.zeros(grid.shape, dtype=bool)
     for oid in ids:  # one vectorized test per object (tens of them), never per pixel
@@ -86,8 +86,8 @@ def object_footprints(surface: TrueSurface, grid: Grid, ids: np.ndarray) -> np.n
     return out
 
 
-def top_surface(surface: TrueSurface, xy: np.ndarray, z_start: float,
-                ) -> tuple[np.ndarray, np.ndarray]:
+def top_surface(surface: TrueSurface, xy: NDArray[np.float64], z_start: float,
+                ) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
     """Height and object id of the highest surface below ``z_start`` at each (x, y).
 
     NaN height and id -1 where the ray hits nothing.
@@ -122,7 +122,7 @@ def _share(num: int, den: int) -> float:
 
 
 def score_detection(detection: Detection, truth: Centres, params: LandingParams,
-                    ) -> dict[str, Any]:
+                    ) -> dict[str, float]:
     """Precision of the chosen sites, area precision and recall (module docstring)."""
     true = truth.feasible
     if true.shape != detection.grid.shape:

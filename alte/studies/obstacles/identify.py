@@ -22,10 +22,10 @@ true ground: negative where a coarse cell averages it away.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 import pandas as pd
+from numpy.typing import NDArray
 from scipy import ndimage
 
 from alte.mappers.base import Cells
@@ -54,8 +54,8 @@ OBJECT_COLUMNS = ("object_id", "object", "cls", "true_height_m", "found", "map_h
 _EIGHT = np.ones((3, 3), dtype=bool)
 
 
-def _spans(lo: np.ndarray, hi: np.ndarray, origin: float, step: float, count: int, *,
-           centres: bool) -> tuple[np.ndarray, np.ndarray]:
+def _spans(lo: NDArray[np.float64], hi: NDArray[np.float64], origin: float, step: float,
+           count: int, *, centres: bool) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
     """First and last pixel of each interval [lo, hi): those whose centre it holds
     (``centres``), else those it overlaps; clipped to the raster, empty when last < first."""
     a, b = (lo - origin) / step, (hi - origin) / step
@@ -67,8 +67,8 @@ def _spans(lo: np.ndarray, hi: np.ndarray, origin: float, step: float, count: in
             np.clip(last, -1, count - 1).astype(np.int64))
 
 
-def _paint(centers: np.ndarray, half: np.ndarray, values: np.ndarray, grid: Grid,
-           centres: bool) -> np.ndarray:
+def _paint(centers: NDArray[np.float64], half: NDArray[np.float64],
+           values: NDArray[np.float64], grid: Grid, centres: bool) -> NDArray[np.float64]:
     """Per pixel, the largest of ``values`` over the cells covering it (NaN: none)."""
     ny, nx = grid.shape
     out = np.full(ny * nx, -np.inf)
@@ -93,8 +93,8 @@ class MapRaster:
     height only to within their edge, the highest occupied cell centre minus the larger
     of ``min_height`` and that cell's edge."""
 
-    height: np.ndarray
-    floor: np.ndarray
+    height: NDArray[np.float64]
+    floor: NDArray[np.float64]
 
 
 def map_raster(cells: Cells, dims: int, grid: Grid, min_height: float) -> MapRaster:
@@ -131,7 +131,7 @@ class ObstacleScores:
     min_height: float = float("nan")
     hidden: tuple[str, ...] = ()
 
-    def flat(self) -> dict[str, Any]:
+    def flat(self) -> dict[str, float]:
         """The scalar scores as columns of a table row (:data:`SCORE_COLUMNS`)."""
         values = (self.true, self.found, self.map_obstacles, self.map_there, self.recall,
                   self.precision, self.area_precision, self.height_error_m,
@@ -143,7 +143,7 @@ def _share(num: int, den: int) -> float:
     return float(num / den) if den else float("nan")
 
 
-def _object_rows(truth: TrueObstacles, height: np.ndarray, obstacle: np.ndarray,
+def _object_rows(truth: TrueObstacles, height: NDArray[np.float64], obstacle: NDArray[np.bool_],
                  ground: float) -> pd.DataFrame:
     flat_h = height.ravel()
     rows = []

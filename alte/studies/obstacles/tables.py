@@ -14,13 +14,13 @@ from __future__ import annotations
 import json
 import os
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 import pandas as pd
 
 from alte.studies.obstacles.identify import OBJECT_COLUMNS, SCORE_COLUMNS, ObstacleScores
 from alte.studies.tables import write_csv
+from alte.types import JSONDict
 
 __all__ = ["OBJECTS_COLUMN", "OBSTACLE_COLUMNS", "object_table", "obstacle_columns",
            "obstacles_table", "setting_text", "write_obstacle_tables"]
@@ -35,7 +35,7 @@ OBSTACLE_COLUMNS = ("terrain", "case", "mapper", "setting", "seed", "basis_funct
 _KEYS = ("terrain", "case", "mapper", "setting", "seed")
 
 
-def obstacle_columns(scores: ObstacleScores | None) -> dict[str, Any]:
+def obstacle_columns(scores: ObstacleScores | None) -> JSONDict:
     """A sweep row's obstacle columns (none without scores)."""
     if scores is None:
         return {}
@@ -45,7 +45,7 @@ def obstacle_columns(scores: ObstacleScores | None) -> dict[str, Any]:
             OBJECTS_COLUMN: json.dumps(objects, sort_keys=True)}
 
 
-def setting_text(params: Any) -> str:
+def setting_text(params: object) -> str:
     """A parameter setting (JSON text or mapping) as ``k=v, k=v``."""
     values = json.loads(params) if isinstance(params, str) and params.startswith("{") else params
     if not isinstance(values, dict):

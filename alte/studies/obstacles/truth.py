@@ -27,6 +27,7 @@ from dataclasses import dataclass
 from typing import ClassVar
 
 import numpy as np
+from numpy.typing import NDArray
 from scipy import ndimage
 
 from alte.errors import MetricsError
@@ -77,34 +78,36 @@ class TrueObstacles:
     grid: Grid
     options: ObstacleOptions
     ground: float
-    ids: np.ndarray
+    ids: NDArray[np.int64]
     names: tuple[str, ...]
     classes: tuple[str, ...]
-    heights: np.ndarray
-    footprints: tuple[np.ndarray, ...]
-    near: tuple[np.ndarray, ...]
-    objects: np.ndarray
+    heights: NDArray[np.float64]
+    footprints: tuple[NDArray[np.intp], ...]
+    near: tuple[NDArray[np.intp], ...]
+    objects: NDArray[np.bool_]
     hidden: tuple[str, ...]
 
     def __len__(self) -> int:
         return len(self.ids)
 
 
-def _grow(mask: np.ndarray, pixels: int) -> np.ndarray:
+def _grow(mask: NDArray[np.bool_], pixels: int) -> NDArray[np.bool_]:
     if pixels <= 0 or not mask.any():
         return mask
-    grown: np.ndarray = ndimage.binary_dilation(mask, np.ones((3, 3), bool), iterations=pixels)
+    grown: NDArray[np.bool_] = ndimage.binary_dilation(mask, np.ones((3, 3), bool),
+                                                       iterations=pixels)
     return grown
 
 
-def _ground_level(height: np.ndarray, top_ids: np.ndarray, ground_ids: np.ndarray) -> float:
+def _ground_level(height: NDArray[np.float64], top_ids: NDArray[np.int64],
+                  ground_ids: NDArray[np.int64]) -> float:
     on_ground = np.isin(top_ids, ground_ids) & np.isfinite(height)
     if not on_ground.any():
         raise MetricsError("obstacle truth: no pixel sees the ground, so heights have no datum")
     return float(np.median(height[on_ground]))
 
 
-def _object_tops(surface: TrueSurface, ids: np.ndarray) -> np.ndarray:
+def _object_tops(surface: TrueSurface, ids: NDArray[np.int64]) -> NDArray[np.float64]:
     return np.array([surface.vertices[surface.triangles[surface.object_ids == i].ravel(), 2].max()
                      for i in ids], dtype=np.float64)
 
@@ -127,7 +130,7 @@ def true_obstacles(surface: TrueSurface, bounds: Box, options: ObstacleOptions) 
     for hull, top in zip(hulls, tops, strict=True):
         cover[hull] = np.maximum(cover[hull], top)
     on_ground = np.isin(top_ids, ground_ids)
-    kept: list[tuple[int, np.ndarray, np.ndarray, float]] = []
+    kept: list[tuple[int, NDArray[np.intp], NDArray[np.intp], float]] = []
     hidden = []
     for oid, hull, top in zip(others, hulls, tops, strict=True):
         if top < options.min_height or not hull.any():

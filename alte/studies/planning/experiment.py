@@ -13,13 +13,14 @@ import os
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 import pandas as pd
+from numpy.typing import NDArray
 from tqdm.auto import tqdm
 
 from alte.errors import ParameterError
+from alte.metrics import TrueSurface
 from alte.pipeline import MapSpec, Registered, run
 from alte.studies.experiments import ground_truth, terrain
 from alte.studies.planning.lattice import POLICIES, PlanningMap, planning_map
@@ -27,6 +28,7 @@ from alte.studies.planning.score import PathScore, score_path
 from alte.studies.planning.search import PlanResult, plan_path
 from alte.studies.tables import write_csv
 from alte.studies.thesis import mapper_params
+from alte.types import JSONDict
 
 __all__ = ["PLANNING_CASES", "PlanningCase", "TerrainPlans", "plan_maps", "planning_case",
            "planning_experiment", "planning_rows", "write_planning_table"]
@@ -43,7 +45,7 @@ class PlanningCase:
     step: float
 
     @property
-    def box(self) -> np.ndarray:
+    def box(self) -> NDArray[np.float64]:
         return np.asarray(self.bounds, dtype=np.float64).reshape(2, 3)
 
 
@@ -84,14 +86,16 @@ class TerrainPlans:
 
     terrain: str
     case: PlanningCase
-    surface: Any
-    occupied: dict[str, tuple[np.ndarray, np.ndarray]] = field(default_factory=dict)
+    surface: TrueSurface | None
+    occupied: dict[str, tuple[NDArray[np.float64], NDArray[np.float64]]] = field(
+        default_factory=dict)
     results: dict[tuple[str, str], PlanResult] = field(default_factory=dict)
     scores: dict[tuple[str, str], PathScore] = field(default_factory=dict)
 
 
 def plan_maps(terrain: str, maps: Mapping[str, PlanningMap], case: PlanningCase,
-              surface: Any = None, policies: Sequence[str] = POLICIES) -> TerrainPlans:
+              surface: TrueSurface | None = None,
+              policies: Sequence[str] = POLICIES) -> TerrainPlans:
     """Plan on every map with every policy; score found paths when ``surface`` is given."""
     out = TerrainPlans(terrain, case, surface)
     for name, pmap in maps.items():
@@ -106,9 +110,9 @@ def plan_maps(terrain: str, maps: Mapping[str, PlanningMap], case: PlanningCase,
     return out
 
 
-def planning_rows(plans: TerrainPlans) -> list[dict[str, Any]]:
+def planning_rows(plans: TerrainPlans) -> list[JSONDict]:
     """One table row per (mapper, policy) of ``plans``."""
-    rows = []
+    rows: list[JSONDict] = []
     for (name, policy), res in plans.results.items():
         score = plans.scores.get((name, policy))
         rows.append({
@@ -125,15 +129,15 @@ def planning_rows(plans: TerrainPlans) -> list[dict[str, Any]]:
 
 
 def _terrain_maps(data: Registered, name: str, mappers: Iterable[str],
-                  params: Mapping[str, Mapping[str, Any]] | None) -> dict[str, PlanningMap]:
-    chosen = mapper_params(name) | {k: dict(v) for k, v in (params or {}).items()}
+                  params: Mapping[str, Mapping[str, object]] | None) -> dict[str, PlanningMap]:
+    chosen: dict[str, Mapping[str, object]] = {**mapper_params(name), **(params or {})}
     return {m: planning_map(run(data, MapSpec(m, chosen.get(m, {}))).mapper) for m in mappers}
 
 
 def planning_experiment(terrains: Sequence[str], data_dir: str | os.PathLike[str] = "data",
                         frames: int | None = None, seed: int = 0, *,
                         mappers: Sequence[str] = ("octomap", "alte3d"),
-                        params: Mapping[str, Mapping[str, Any]] | None = None,
+                        params: Mapping[str, Mapping[str, object]] | None = None,
                         policies: Sequence[str] = POLICIES,
                         progress: bool = True) -> tuple[pd.DataFrame, list[TerrainPlans]]:
     """Simulate (if needed), map and plan every terrain; the table and per-terrain plans.

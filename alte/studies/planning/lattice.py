@@ -20,6 +20,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import NDArray
 from scipy.ndimage import distance_transform_edt
 from scipy.spatial import cKDTree
 
@@ -42,7 +43,7 @@ MAX_NODES = 3_000_000
 class Lattice:
     """Nodes ``origin + step * (i, j, k)`` for ``(i, j, k) < shape`` (C order)."""
 
-    origin: np.ndarray
+    origin: NDArray[np.float64]
     step: float
     shape: tuple[int, int, int]
 
@@ -68,20 +69,20 @@ class Lattice:
         return int(np.prod(self.shape))
 
     @property
-    def upper(self) -> np.ndarray:
+    def upper(self) -> NDArray[np.float64]:
         """The last node (max corner of the lattice)."""
         return self.origin + self.step * (np.array(self.shape) - 1)
 
-    def points(self) -> np.ndarray:
+    def points(self) -> NDArray[np.float64]:
         """Coordinates of every node (N, 3), in node-index order."""
         axes = [self.origin[a] + self.step * np.arange(n) for a, n in enumerate(self.shape)]
         grid = np.meshgrid(*axes, indexing="ij")
         return np.stack([g.reshape(-1) for g in grid], axis=1)
 
-    def node_points(self, indices: np.ndarray) -> np.ndarray:
+    def node_points(self, indices: NDArray[np.intp]) -> NDArray[np.float64]:
         """Coordinates of the nodes with flat ``indices`` (M, 3)."""
         ijk = np.stack(np.unravel_index(np.asarray(indices, dtype=np.int64), self.shape), axis=1)
-        points: np.ndarray = self.origin + self.step * ijk
+        points: NDArray[np.float64] = self.origin + self.step * ijk
         return points
 
     def nearest(self, point: object, name: str = "point") -> int:
@@ -103,7 +104,7 @@ class PlanningMap:
 
     name: str
     cells: Cells
-    free: np.ndarray
+    free: NDArray[np.bool_]
 
     @classmethod
     def from_cells(cls, cells: Cells, observes_free: bool, name: str = "map") -> PlanningMap:
@@ -119,7 +120,7 @@ class PlanningMap:
         return cls(name, cells, free)
 
     @property
-    def occupied(self) -> np.ndarray:
+    def occupied(self) -> NDArray[np.bool_]:
         return np.asarray(self.cells.occupied, dtype=bool)
 
 
@@ -131,7 +132,7 @@ def planning_map(mapper: Mapper) -> PlanningMap:
     return PlanningMap.from_cells(mapper.cells(), mapper.free_space, mapper.name)
 
 
-def _level_groups(cells: Cells, name: str) -> list[tuple[np.ndarray, np.ndarray]]:
+def _level_groups(cells: Cells, name: str) -> list[tuple[NDArray[np.intp], NDArray[np.float64]]]:
     """Cell indices and their common size, per tree level (one size per level)."""
     groups = []
     for level in np.unique(cells.level):
@@ -143,7 +144,7 @@ def _level_groups(cells: Cells, name: str) -> list[tuple[np.ndarray, np.ndarray]
     return groups
 
 
-def locate(cells: Cells, points: np.ndarray, name: str = "map") -> np.ndarray:
+def locate(cells: Cells, points: NDArray[np.float64], name: str = "map") -> NDArray[np.int64]:
     """Index of the cell containing each point (-1 where none), one hash lookup per level."""
     out = np.full(len(points), -1, dtype=np.int64)
     for members, size in _level_groups(cells, name):
@@ -163,7 +164,7 @@ def locate(cells: Cells, points: np.ndarray, name: str = "map") -> np.ndarray:
     return out
 
 
-def classify(lattice_points: np.ndarray, pmap: PlanningMap) -> np.ndarray:
+def classify(lattice_points: NDArray[np.float64], pmap: PlanningMap) -> NDArray[np.uint8]:
     """State of every point: :data:`OCCUPIED`, :data:`FREE` or :data:`UNKNOWN` (uint8)."""
     idx = locate(pmap.cells, lattice_points, pmap.name)
     states = np.full(len(lattice_points), UNKNOWN, dtype=np.uint8)
@@ -173,8 +174,9 @@ def classify(lattice_points: np.ndarray, pmap: PlanningMap) -> np.ndarray:
     return states
 
 
-def near_boxes(points: np.ndarray, centers: np.ndarray, sizes: np.ndarray,
-               level: np.ndarray, radius: float) -> np.ndarray:
+def near_boxes(points: NDArray[np.float64], centers: NDArray[np.float64],
+               sizes: NDArray[np.float64], level: NDArray[np.int64],
+               radius: float) -> NDArray[np.bool_]:
     """True where a point lies within ``radius`` of an axis-aligned box (exact distance).
 
     Per box size, a KD-tree on box centres settles most points (centre distance is an
@@ -202,7 +204,7 @@ def near_boxes(points: np.ndarray, centers: np.ndarray, sizes: np.ndarray,
 
 
 def blocked_nodes(lattice: Lattice, pmap: PlanningMap, clearance: float,
-                  unknown: str = "free") -> tuple[np.ndarray, np.ndarray]:
+                  unknown: str = "free") -> tuple[NDArray[np.bool_], NDArray[np.uint8]]:
     """(blocked mask, node states) of the lattice for a clearance radius and unknown policy."""
     if not (np.isfinite(clearance) and clearance >= 0):
         raise ParameterError(f"planning clearance={clearance!r} must be >= 0 (m)")

@@ -13,6 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import NDArray
 
 from alte.errors import MetricsError
 from alte.metrics import TrueSurface
@@ -37,7 +38,8 @@ class PathScore:
                 "min_clearance_m": self.min_clearance_m}
 
 
-def densify(path: np.ndarray, spacing: float) -> tuple[np.ndarray, np.ndarray]:
+def densify(path: NDArray[np.float64], spacing: float,
+            ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Samples at most ``spacing`` apart along a polyline, and the length each stands for."""
     if not (np.isfinite(spacing) and spacing > 0):
         raise MetricsError(f"path sampling spacing={spacing!r} must be > 0 (m)")
@@ -55,7 +57,7 @@ def densify(path: np.ndarray, spacing: float) -> tuple[np.ndarray, np.ndarray]:
     return samples, weights
 
 
-def score_path(path: np.ndarray, surface: TrueSurface, clearance: float,
+def score_path(path: NDArray[np.float64], surface: TrueSurface, clearance: float,
                spacing: float | None = None) -> PathScore:
     """Collisions of ``path`` with the true mesh; ``spacing`` defaults to clearance / 4.
 

@@ -14,6 +14,7 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import NDArray
 from scipy.sparse import coo_matrix, csr_matrix
 from scipy.sparse.csgraph import dijkstra
 
@@ -39,7 +40,7 @@ class PlanResult:
     """
 
     status: str
-    path: np.ndarray
+    path: NDArray[np.float64]
     length_m: float
     straight_m: float
     build_s: float
@@ -54,11 +55,11 @@ class PlanResult:
         return self.status == "found"
 
 
-def _slices(off: int, n: int) -> tuple[slice, slice]:
+def _slices(off: int, n: int) -> tuple[slice[int, int, None], slice[int, int, None]]:
     return (slice(0, n - off), slice(off, n)) if off >= 0 else (slice(-off, n), slice(0, n + off))
 
 
-def lattice_graph(free: np.ndarray, step: float) -> csr_matrix:
+def lattice_graph(free: NDArray[np.bool_], step: float) -> csr_matrix[np.float64]:
     """Upper-triangular sparse graph of 26-neighbour edges between ``free`` (3D bool) nodes."""
     ids = np.arange(free.size, dtype=np.int64).reshape(free.shape)
     rows, cols, weights = [], [], []
@@ -74,7 +75,7 @@ def lattice_graph(free: np.ndarray, step: float) -> csr_matrix:
     return coo_matrix((w, (lo, hi)), shape=(free.size, free.size)).tocsr()
 
 
-def _walk(predecessors: np.ndarray, start: int, goal: int) -> np.ndarray:
+def _walk(predecessors: NDArray[np.int32], start: int, goal: int) -> NDArray[np.int64]:
     """Node indices from start to goal, read back from Dijkstra's predecessor array."""
     chain = [goal]
     while chain[-1] != start:  # one step per path node (a few hundred), not per point
@@ -82,7 +83,7 @@ def _walk(predecessors: np.ndarray, start: int, goal: int) -> np.ndarray:
     return np.array(chain[::-1], dtype=np.int64)
 
 
-def _polyline_length(path: np.ndarray) -> float:
+def _polyline_length(path: NDArray[np.float64]) -> float:
     return float(np.linalg.norm(np.diff(path, axis=0), axis=1).sum())
 
 

@@ -17,10 +17,10 @@ import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 import pandas as pd
+from numpy.typing import NDArray
 from tqdm.auto import tqdm
 
 from alte.errors import ParameterError
@@ -119,9 +119,9 @@ class IsprsSample:
     """An ISPRS sample in local coordinates (``origin`` subtracted) and its labels."""
 
     name: str
-    points: np.ndarray
-    reference: np.ndarray
-    origin: np.ndarray
+    points: NDArray[np.float64]
+    reference: NDArray[np.bool_]
+    origin: NDArray[np.float64]
 
 
 def isprs_samples(data: RealData) -> tuple[str, ...]:
@@ -149,20 +149,20 @@ class GroundRun:
 
     sample: str
     mapper_name: str
-    params: dict[str, Any]
-    points: np.ndarray
-    ground: np.ndarray
-    reference: np.ndarray
-    metrics: dict[str, Any] = field(default_factory=dict)
+    params: dict[str, object]
+    points: NDArray[np.float64]
+    ground: NDArray[np.bool_]
+    reference: NDArray[np.bool_]
+    metrics: dict[str, float] = field(default_factory=dict)
 
 
-def _ground_run(sample: IsprsSample, name: str, params: Mapping[str, Any],
+def _ground_run(sample: IsprsSample, name: str, params: Mapping[str, object],
                 options: Mapping[str, float]) -> GroundRun:
     pts, extra = sample.points, {"basis_functions": 0, "map_s": 0.0}
     if name == BASELINE:
         heights = pts[:, 2]
     else:
-        mapper = make_mapper(name, **params)
+        mapper = make_mapper(name, params)
         start = time.perf_counter()
         mapper.build(pts)
         extra = {"basis_functions": int(mapper.basis_functions),
@@ -175,7 +175,7 @@ def _ground_run(sample: IsprsSample, name: str, params: Mapping[str, Any],
 
 
 def ground_runs(data: RealData, samples: Sequence[str] | None,
-                mappers: Mapping[str, Mapping[str, Any]], *, step: float = 1.0,
+                mappers: Mapping[str, Mapping[str, object]], *, step: float = 1.0,
                 window: float = 20.0, tolerance: float = 1.0, baseline: bool = True,
                 progress: bool = True) -> list[GroundRun]:
     """Filter the named samples (None: every sample present, :func:`isprs_samples`) with
@@ -222,7 +222,7 @@ def vlp16_dataset(data: RealData, voxel: float | None = None,
     return prepare(open_input(data.file("vlp16_packets", "bag")), spec)
 
 
-def map_runs(dataset: Registered | None, mappers: Mapping[str, Mapping[str, Any]],
+def map_runs(dataset: Registered | None, mappers: Mapping[str, Mapping[str, object]],
              progress: bool = True) -> list[Measured]:
     """Map ``dataset`` with each mapper over the cube of its points (timed, measured);
     [] when None."""
@@ -241,7 +241,7 @@ def map_table(runs: Sequence[Measured]) -> pd.DataFrame:
                           **{k: getattr(r.metrics, k) for k in keys}} for r in runs])
 
 
-def dataset_summary(dataset: Registered) -> dict[str, Any]:
+def dataset_summary(dataset: Registered) -> dict[str, str | int]:
     """Name, frames, registered points and raw points read of a real-data input."""
     return {"name": dataset.source.name, "frames": len(dataset), "points": len(dataset.cloud),
             "raw_points": dataset.counts.registration.points_in}
@@ -255,7 +255,7 @@ def write_csv(table: pd.DataFrame, out_dir: str | os.PathLike[str], name: str) -
     return None if table.empty else write_tables_csv(table, out_dir, name, overwrite=True)
 
 
-def results(data: RealData, **parts: Any) -> dict[str, Any]:
+def results(data: RealData, **parts: object) -> dict[str, object]:
     """The notebook's results (tables as rows, datasets as tallies), or ``{"skipped":
     reason}`` alone when the data are absent."""
     if not data.available:
@@ -263,7 +263,7 @@ def results(data: RealData, **parts: Any) -> dict[str, Any]:
     return {"realdata_dir": str(data.root), **{k: _records(v) for k, v in parts.items()}}
 
 
-def _records(value: Any) -> Any:
+def _records(value: object) -> object:
     """Tables as lists of rows, datasets as their name and tallies, the rest as is."""
     if isinstance(value, pd.DataFrame):
         return value.to_dict(orient="records")

@@ -26,10 +26,10 @@ import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 import pandas as pd
+from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 from tqdm.auto import tqdm
 
@@ -50,7 +50,7 @@ __all__ = ["FRONT_COLUMNS", "FRONT_GRID", "SEQUENCE", "RealSequence", "front_tab
 SEQUENCE = "balm_seq"
 #: Settings per mapper for the real fronts: each spans its mapper's range of sizes on a
 #: 190 m scene (the cube over the data), from about 100 to 100,000 basis functions.
-FRONT_GRID: dict[str, list[dict[str, Any]]] = {
+FRONT_GRID: dict[str, list[dict[str, float]]] = {
     "quadtree": [{"max_points": v} for v in (10, 25, 50, 100, 200, 500, 1000)],
     "alte2d": [{"kappa": k, "max_res": r, "min_pts": 10} for k in (0.01, 0.1)
                for r in (5, 6, 7, 8)],
@@ -72,7 +72,7 @@ class RealSequence:
 
     name: str
     data: Registered
-    reference: np.ndarray
+    reference: NDArray[np.float64]
 
 
 def sequence_data(data: RealData, *, frames: int = 20, voxel: float = 0.2,
@@ -91,7 +91,7 @@ def sequence_data(data: RealData, *, frames: int = 20, voxel: float = 0.2,
     return RealSequence(name, some, np.asarray(every.cloud, dtype=np.float64))
 
 
-def _top_raster(points: np.ndarray, grid: Grid) -> np.ndarray:
+def _top_raster(points: NDArray[np.float64], grid: Grid) -> NDArray[np.float64]:
     """Highest point per pixel (NaN where none)."""
     ny, nx = grid.shape
     rc = grid.index(points[:, :2])
@@ -101,7 +101,7 @@ def _top_raster(points: np.ndarray, grid: Grid) -> np.ndarray:
     return np.where(np.isfinite(top), top, np.nan).reshape(grid.shape)
 
 
-def reference_metrics(cells: Cells, dims: int, reference: np.ndarray, *,
+def reference_metrics(cells: Cells, dims: int, reference: NDArray[np.float64], *,
                       tolerance: float = 0.2, step: float = 0.5,
                       samples: int = 50_000, seed: int = 0) -> dict[str, float]:
     """The map's distance to the reference cloud (module docstring); ``samples``
@@ -133,7 +133,7 @@ def reference_metrics(cells: Cells, dims: int, reference: np.ndarray, *,
 
 
 def front_table(sequence: RealSequence | None,
-                grid: Mapping[str, Sequence[Mapping[str, Any]]] | None = None, *,
+                grid: Mapping[str, Sequence[Mapping[str, object]]] | None = None, *,
                 tolerance: float = 0.2, progress: bool = True) -> pd.DataFrame:
     """One row per mapper and setting of ``grid`` (default :data:`FRONT_GRID`) on the
     sequence (:data:`FRONT_COLUMNS`); empty when ``sequence`` is None."""

@@ -20,6 +20,7 @@ all in per cent. Everything here takes and returns arrays.
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import NDArray
 from scipy import ndimage
 from scipy.spatial import cKDTree
 
@@ -33,8 +34,8 @@ __all__ = ["classify_ground", "ground_errors", "map_heights", "opened_surface",
 
 
 
-def reference_labels(points: np.ndarray, subset: np.ndarray,
-                     tolerance: float = 1e-3) -> np.ndarray:
+def reference_labels(points: NDArray[np.float64], subset: NDArray[np.float64],
+                     tolerance: float = 1e-3) -> NDArray[np.bool_]:
     """True for each point of ``points`` found in ``subset`` within ``tolerance`` metres."""
     pts, sub = np.asarray(points, np.float64), np.asarray(subset, np.float64)
     if pts.ndim != 2 or pts.shape[1] != 3 or sub.ndim != 2 or sub.shape[1] != 3:
@@ -46,7 +47,7 @@ def reference_labels(points: np.ndarray, subset: np.ndarray,
     return np.isfinite(dist)
 
 
-def map_heights(cells: Cells, xy: np.ndarray) -> np.ndarray:
+def map_heights(cells: Cells, xy: NDArray[np.float64]) -> NDArray[np.float64]:
     """Height of the 2D map's leaf holding each ``xy`` (NaN: unknown leaf or outside)."""
     idx = cell_at_xy(np.asarray(xy, np.float64)[:, :2], cells.centers, cells.sizes)
     out = np.full(len(idx), np.nan)
@@ -54,8 +55,8 @@ def map_heights(cells: Cells, xy: np.ndarray) -> np.ndarray:
     return out
 
 
-def opened_surface(xy: np.ndarray, heights: np.ndarray, step: float = 1.0,
-                   window: float = 20.0) -> np.ndarray:
+def opened_surface(xy: NDArray[np.float64], heights: NDArray[np.float64], step: float = 1.0,
+                   window: float = 20.0) -> NDArray[np.float64]:
     """Per point: the morphological opening (``window`` m square) of the per-pixel
     (``step`` m) minimum of ``heights``; NaN heights are ignored, NaN where none."""
     if not (np.isfinite(step) and step > 0 and np.isfinite(window) and window >= step):
@@ -77,16 +78,18 @@ def opened_surface(xy: np.ndarray, heights: np.ndarray, step: float = 1.0,
     return np.where(np.isfinite(out), out, np.nan)
 
 
-def classify_ground(points: np.ndarray, surface: np.ndarray, tolerance: float) -> np.ndarray:
+def classify_ground(points: NDArray[np.float64], surface: NDArray[np.float64],
+                    tolerance: float) -> NDArray[np.bool_]:
     """Ground = within ``tolerance`` metres of ``surface`` (per point; NaN -> not ground)."""
     if not (np.isfinite(tolerance) and tolerance >= 0):
         raise ParameterError(f"ground filter: tolerance={tolerance} must be >= 0 metres")
     with np.errstate(invalid="ignore"):
-        ground: np.ndarray = np.abs(np.asarray(points)[:, 2] - surface) <= tolerance
+        ground: NDArray[np.bool_] = np.abs(np.asarray(points)[:, 2] - surface) <= tolerance
     return ground
 
 
-def ground_errors(predicted: np.ndarray, reference: np.ndarray) -> dict[str, float]:
+def ground_errors(predicted: NDArray[np.bool_], reference: NDArray[np.bool_],
+                  ) -> dict[str, float]:
     """Sithole & Vosselman (2004) errors in %: type I (ground rejected / ground), type II
     (objects accepted / objects), total (misclassified / all); NaN for an empty class."""
     pred, ref = np.asarray(predicted, bool), np.asarray(reference, bool)

@@ -10,7 +10,7 @@ relative to the overall mean, ranks which parameters matter.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from typing import Any
+from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
@@ -22,7 +22,7 @@ __all__ = ["main_effects", "mapper_rows", "param_columns", "sensitivity_ranking"
 
 
 def mapper_rows(table: pd.DataFrame, mapper: str, terrain: str | None = None,
-                fixed: Mapping[str, Any] | None = None) -> pd.DataFrame:
+                fixed: Mapping[str, object] | None = None) -> pd.DataFrame:
     """Rows of ``mapper`` (on ``terrain``, with parameters ``fixed``); none is an error."""
     rows = table[table["mapper"] == mapper]
     if terrain is not None:
@@ -53,7 +53,7 @@ def _check(rows: pd.DataFrame, names: Sequence[str]) -> None:
 
 def sensitivity_table(table: pd.DataFrame, mapper: str, x: str, y: str, metric: str, *,
                       terrain: str | None = None,
-                      fixed: Mapping[str, Any] | None = None) -> pd.DataFrame:
+                      fixed: Mapping[str, object] | None = None) -> pd.DataFrame:
     """``metric`` over parameters ``x`` (columns) and ``y`` (index), mean over the others."""
     rows = mapper_rows(table, mapper, terrain, fixed)
     _check(rows, [f"p_{x}", f"p_{y}", metric])
@@ -78,14 +78,25 @@ def main_effects(table: pd.DataFrame, mapper: str, metric: str, *,
     return pd.concat(parts, ignore_index=True)
 
 
-def _ranking(rows: pd.DataFrame, mapper: str, metric: str) -> list[dict[str, Any]]:
+@dataclass(frozen=True)
+class _Spread:
+    """One row of :func:`sensitivity_ranking`."""
+
+    mapper: str
+    param: str
+    metric: str
+    spread: float
+    relative_spread: float
+
+
+def _ranking(rows: pd.DataFrame, mapper: str, metric: str) -> list[_Spread]:
     overall = abs(float(np.nanmean(rows[metric].astype(float))))
     out = []
     for column in param_columns(rows):
         means = rows.groupby(column)[metric].mean()
         spread = float(means.max() - means.min())
-        out.append({"mapper": mapper, "param": column[2:], "metric": metric, "spread": spread,
-                    "relative_spread": spread / overall if overall > 0 else np.nan})
+        out.append(_Spread(mapper, column[2:], metric, spread,
+                           spread / overall if overall > 0 else np.nan))
     return out
 
 

@@ -18,7 +18,7 @@ import dataclasses
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Protocol, TypeVar
 
 import pandas as pd
 from tqdm.auto import tqdm
@@ -36,9 +36,21 @@ CONNECT_TIMEOUT = "10s"
 #: ``scheduler`` values that run everything in this process.
 SERIAL = frozenset({"serial", "none"})
 
-#: Outcome of one task: (index into the submitted items, result, error or None).
-Outcome = tuple[int, Any, BaseException | None]
-MapUnordered = Callable[..., Iterator[Outcome]]
+if TYPE_CHECKING:
+    from distributed import Client
+
+_Item = TypeVar("_Item")
+_Result = TypeVar("_Result")
+
+#: Outcome of one task: (index into the submitted items, result or None, error or None).
+Outcome = tuple[int, _Result | None, BaseException | None]
+
+
+class MapUnordered(Protocol):
+    """Call ``fn(item, data_dir)`` for each item; yield each :data:`Outcome` as it ends."""
+
+    def __call__(self, fn: Callable[[_Item, str], _Result], items: Sequence[_Item],
+                 data_dir: str, /) -> Iterator[Outcome[_Result]]: ...
 
 
 @dataclass(frozen=True)
@@ -51,7 +63,7 @@ class SweepResult:
     skipped: int
     failed: list[tuple[SweepRun, str]] = field(default_factory=list)
 
-    def summary(self) -> dict[str, Any]:
+    def summary(self) -> dict[str, object]:
         """Counts and failures, JSON-ready (for ``save_results``)."""
         return {"output": str(self.output), "rows": len(self.table), "ran": self.ran,
                 "skipped": self.skipped,
@@ -65,20 +77,21 @@ def _ensure(run: SweepRun, data_dir: str) -> str:
     return str(input_data(run, data_dir).source.path)
 
 
-def _serial_map(fn: Callable[..., Any], items: Sequence[Any], *args: Any) -> Iterator[Outcome]:
+def _serial_map(fn: Callable[[_Item, str], _Result], items: Sequence[_Item],
+                data_dir: str, /) -> Iterator[Outcome[_Result]]:
     for i, item in enumerate(items):
         try:
-            yield i, fn(item, *args), None
+            yield i, fn(item, data_dir), None
         except Exception as err:  # a failed run is reported, the sweep goes on
             yield i, None, err
 
 
-def _dask_map(client: Any) -> MapUnordered:
+def _dask_map(client: Client) -> MapUnordered:
     from distributed import as_completed
 
-    def map_unordered(fn: Callable[..., Any], items: Sequence[Any],
-                      *args: Any) -> Iterator[Outcome]:
-        futures = [client.submit(fn, item, *args, pure=False) for item in items]
+    def map_unordered(fn: Callable[[_Item, str], _Result], items: Sequence[_Item],
+                      data_dir: str, /) -> Iterator[Outcome[_Result]]:
+        futures = [client.submit(fn, item, data_dir, pure=False) for item in items]
         index = {f.key: i for i, f in enumerate(futures)}
         for future in as_completed(futures):
             try:
@@ -148,7 +161,8 @@ def _map_all(pool: MapUnordered, runs: Sequence[SweepRun], data_dir: str, out: P
               smoothing=0) as bar:
         for i, done, err in pool(run_group, groups, data_dir):
             # err: the task itself failed (e.g. a lost worker), so did each of its runs
-            outcomes = done if err is None else [(r.run_id, None, err) for r in groups[i].runs]
+            outcomes = (done if err is None and done is not None
+                        else [(r.run_id, None, err) for r in groups[i].runs])
             for run_id, row, error in outcomes:
                 if error is None and row is not None:
                     write_row(out, row)

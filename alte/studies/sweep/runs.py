@@ -12,7 +12,6 @@ import hashlib
 import json
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Any
 
 from alte.metrics.maps import SetB, TruthOptions
 from alte.studies.sweep.spec import SweepSpec
@@ -29,7 +28,7 @@ class SweepRun:
     frames: int | None
     seed: int
     mapper: str
-    params: Mapping[str, Any]
+    params: Mapping[str, object]
     voxel: float | None = None
     truth: TruthOptions = field(default_factory=TruthOptions)
     domain: str = "auto"
@@ -39,11 +38,11 @@ class SweepRun:
     obstacles: bool = False
     poses: str = "recorded"
 
-    def key(self) -> dict[str, Any]:
+    def key(self) -> dict[str, object]:
         """Everything that determines the run's result, JSON-ready (``domain``, ``set_b``,
         ``sensor``, ``deskew``, ``obstacles`` and ``poses`` only when not the default, so
         earlier runs keep their ids)."""
-        key = {"terrain": self.terrain, "frames": self.frames, "seed": self.seed,
+        key: dict[str, object] = {"terrain": self.terrain, "frames": self.frames, "seed": self.seed,
                "mapper": self.mapper, "params": dict(sorted(self.params.items())),
                "voxel": self.voxel, "truth": dataclasses.asdict(self.truth)}
         if self.domain != "auto":

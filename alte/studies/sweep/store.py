@@ -11,7 +11,6 @@ from __future__ import annotations
 import os
 from collections.abc import Iterable, Mapping
 from pathlib import Path
-from typing import Any
 
 import pandas as pd
 import pyarrow as pa
@@ -39,7 +38,7 @@ def _part(out: Path, run_id: str) -> Path:
     return out / f"{_PREFIX}{run_id}{_SUFFIX}"
 
 
-def write_row(out: str | os.PathLike[str], row: Mapping[str, Any]) -> Path:
+def write_row(out: str | os.PathLike[str], row: Mapping[str, object]) -> Path:
     """Write one run's row to its own Parquet file in ``out`` (atomic; never overwrites)."""
     path = _part(Path(out), str(row["run_id"]))
     table = pa.Table.from_pylist([dict(row)])

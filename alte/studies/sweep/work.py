@@ -22,7 +22,6 @@ import json
 import time
 from collections.abc import Iterable
 from dataclasses import dataclass
-from typing import Any
 
 from alte.mappers import mapper_class
 from alte.metrics.maps import TruthOptions, measure_map
@@ -33,11 +32,12 @@ from alte.registration.odometry import OdometryParams
 from alte.studies.experiments import ground_truth, terrain, timed_run
 from alte.studies.obstacles import obstacle_columns, obstacle_options, obstacle_scores
 from alte.studies.sweep.runs import SweepRun
+from alte.types import JSONDict
 
 __all__ = ["MapGroup", "RunOutcome", "group_runs", "input_data", "run_group", "run_one"]
 
 #: One run's result: (run id, its row or None, the exception or None).
-RunOutcome = tuple[str, dict[str, Any] | None, Exception | None]
+RunOutcome = tuple[str, dict[str, object] | None, Exception | None]
 
 
 @dataclass(frozen=True)
@@ -50,7 +50,7 @@ class MapGroup:
         return len(self.runs)
 
 
-def _resolved(run: SweepRun) -> dict[str, Any]:
+def _resolved(run: SweepRun) -> dict[str, object]:
     """The run's mapper parameters, defaults filled in."""
     return mapper_class(run.mapper).Params.parse(run.params).as_dict()
 
@@ -107,8 +107,9 @@ def _inputs(run: SweepRun, data_dir: str) -> tuple[Registered, Reference]:
     return input_data(run, data_dir), _reference(run.input_key(), data_dir, run.truth).fresh()
 
 
-def _row(run: SweepRun, data: Registered, metrics: dict[str, Any],
-         cost: tuple[float, float]) -> dict[str, Any]:
+def _row(run: SweepRun, data: Registered, measured: tuple[dict[str, float], JSONDict],
+         cost: tuple[float, float]) -> dict[str, object]:
+    metrics, obstacles = measured
     return {
         "run_id": run.run_id, "terrain": run.terrain, "frames_requested": run.frames or 0,
         "seed": run.seed, "mapper": run.mapper,
@@ -117,15 +118,16 @@ def _row(run: SweepRun, data: Registered, metrics: dict[str, Any],
         "domain": run.domain, "set_b": str(run.set_b), "sensor": run.sensor, "deskew": run.deskew,
         "poses": run.poses,
         "frames": len(data), "points": len(data.cloud),
-        **{k: v for k, v in metrics.items() if k != "elapsed_s"},
+        **{k: v for k, v in metrics.items() if k != "elapsed_s"}, **obstacles,
         "cost_unit": mapper_class(run.mapper).cost_unit.value,
         "elapsed_s": float(metrics["elapsed_s"]), "wall_s": cost[0], "cpu_s": cost[1],
     }
 
 
 def _measure(made: tuple[MapRun, Timing], run: SweepRun, data: Registered,
-             reference: Reference) -> dict[str, Any]:
-    """The metrics of the map ``made`` (and its time) read with ``run``'s parameters."""
+             reference: Reference) -> tuple[dict[str, float], JSONDict]:
+    """The metrics of the map ``made`` (and its time) read with ``run``'s parameters, and
+    its obstacle columns."""
     result, timing = made
     fed, mine = result.mapper.params.as_dict(), _resolved(run)
     changes = {k: mine[k] for k in mapper_class(run.mapper).view_params if mine[k] != fed[k]}
@@ -135,7 +137,7 @@ def _measure(made: tuple[MapRun, Timing], run: SweepRun, data: Registered,
                           options=run.truth, set_b=run.set_b, reference=reference,
                           cells=cells).flat()
     options = obstacle_options(run.terrain) if run.obstacles else None
-    return {**metrics, **obstacle_columns(obstacle_scores(data, cells, mapper.dims, options))}
+    return metrics, obstacle_columns(obstacle_scores(data, cells, mapper.dims, options))
 
 
 def run_group(group: MapGroup, data_dir: str) -> list[RunOutcome]:
@@ -154,16 +156,16 @@ def run_group(group: MapGroup, data_dir: str) -> list[RunOutcome]:
     for run in group.runs:
         start, cpu = time.perf_counter(), time.process_time()
         try:
-            metrics = _measure(made, run, data, reference)
+            measured = _measure(made, run, data, reference)
         except Exception as err:  # a failed run is reported, the others go on
             out.append((run.run_id, None, err))
             continue
         cost = (share[0] + time.perf_counter() - start, share[1] + time.process_time() - cpu)
-        out.append((run.run_id, _row(run, data, metrics, cost), None))
+        out.append((run.run_id, _row(run, data, measured, cost), None))
     return out
 
 
-def run_one(run: SweepRun, data_dir: str) -> dict[str, Any]:
+def run_one(run: SweepRun, data_dir: str) -> dict[str, object]:
     """Map one run's terrain and return its flat row (keys, ``p_*`` params, metrics, and
     its cost: ``wall_s`` and ``cpu_s``, the CPU seconds of every thread of the process,
     which other load on the machine does not inflate). Raises what the run raised."""
