@@ -24,9 +24,11 @@ def test_save_figure(tmp_path):
     notebook.setup("static")
     import matplotlib.pyplot as plt
 
+    from alte.plot.figure import Caption, Plot
+
     fig, ax = plt.subplots()
     ax.plot([0, 1], [1, 0])
-    path = notebook.save_figure(fig, tmp_path, "line")
+    path = notebook.save_figure(Plot(fig, Caption("Line", "A line.")), tmp_path, "line")
     assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
@@ -34,9 +36,10 @@ def test_offscreen_pyvista_render(tmp_path):
     notebook.setup("static")
     import pyvista as pv
 
-    from alte.plot import new_plotter, show
+    from alte.plot import show, view
+    from alte.plot.figure import Caption
 
-    plotter = new_plotter(window_size=(160, 120))
-    plotter.add_mesh(pv.Cube())
-    assert show(plotter, tmp_path, "cube") is None  # a cell ending in show() prints nothing
+    cube = view(Caption("Cube", "A cube."), window_size=(160, 120))
+    cube.plotter.add_mesh(pv.Cube())
+    assert show(cube, tmp_path, "cube") is None  # a cell ending in show() prints nothing
     assert (tmp_path / "figures" / "cube.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
