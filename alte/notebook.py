@@ -177,7 +177,8 @@ def _jsonable(value: object) -> JSON:
         return str(value)
     if value is None or isinstance(value, str | int | float | bool):
         return value
-    raise ParameterError(f"save_results: a {type(value).__name__} is no JSON value")
+    raise ParameterError(f"save_results: {type(value).__name__} values cannot be written "
+                         "as JSON; pass numbers, text, lists, dicts, arrays or paths")
 
 
 def save_results(out_dir: str | os.PathLike[str], results: Mapping[str, object]) -> Path:

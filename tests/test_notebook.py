@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from alte import notebook
+from alte.errors import ParameterError
 
 
 def test_save_results_is_json_with_numpy_values(tmp_path):
@@ -11,6 +12,10 @@ def test_save_results_is_json_with_numpy_values(tmp_path):
                                                     "x": np.float32(0.5), "p": tmp_path})
     data = json.loads(path.read_text())
     assert data == {"n": 3, "a": [0, 1], "x": 0.5, "p": str(tmp_path)}
+    with pytest.raises(ParameterError, match="save_results: set values cannot be written as "
+                       "JSON"):
+        notebook.save_results(tmp_path / "bad", {"s": {1, 2}})
+    assert not (tmp_path / "bad" / "results.json").exists()
 
 
 def test_setup_static_and_bad_mode():

@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from alte.errors import ParameterError
+from alte.plot.arrays import Floats
 from alte.plot.figure import Caption, Plot
 from alte.studies.landing.detect import Centres, Detection
 from alte.studies.landing.experiment import LandingRun
@@ -35,7 +36,7 @@ LANDING_SITES = Caption(
 _UNKNOWN = (0.8, 0.8, 0.8, 1.0)
 
 
-def _site_colours(detection: Detection, truth: Centres | None) -> np.ndarray:
+def _site_colours(detection: Detection, truth: Centres | None) -> Floats:
     chosen = detection.chosen
     if truth is None or not len(chosen):
         return np.tile([0.5, 0.5, 0.5, 1.0], (len(chosen), 1))

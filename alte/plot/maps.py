@@ -9,13 +9,14 @@ cells without points) are drawn grey, never like ground.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from typing import TYPE_CHECKING, Protocol, cast
+from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from alte.mappers.base import Cells
 from alte.mappers.quad.quadmap import plane_height
+from alte.plot.arrays import Floats, polygons
 from alte.plot.figure import Caption, Plot, View
 from alte.plot.render import view
 from alte.studies.tradeoff import MAPPER_NAMES
@@ -75,19 +76,13 @@ _SIGNS_3D = np.array([[-1, -1, -1], [1, -1, -1], [1, 1, -1], [-1, 1, -1],
                       [-1, -1, 1], [1, -1, 1], [1, 1, 1], [-1, 1, 1]], dtype=np.float64)
 
 
-def _rectangles(cells: Cells) -> np.ndarray:
+def _rectangles(cells: Cells) -> Floats:
     """(K, 4, 2) footprints of the cells."""
     half = cells.sizes[:, None, :2] / 2
     return cells.centers[:, None, :2] + _SIGNS_2D[None] * half
 
 
-def _polygons(verts: np.ndarray) -> Sequence[np.ndarray]:
-    """``verts`` as ``PolyCollection`` takes them: the (K, 4, 2) array itself, which
-    matplotlib handles in one piece (its stubs ask for a sequence of polygons)."""
-    return cast("Sequence[np.ndarray]", verts)
-
-
-def _frame_axes(ax: Axes, verts: np.ndarray, title: str | None) -> None:
+def _frame_axes(ax: Axes, verts: Floats, title: str | None) -> None:
     if len(verts):
         lo, hi = verts.reshape(-1, 2).min(axis=0), verts.reshape(-1, 2).max(axis=0)
         ax.set_xlim(lo[0], hi[0])
@@ -99,8 +94,8 @@ def _frame_axes(ax: Axes, verts: np.ndarray, title: str | None) -> None:
         ax.set_title(title)
 
 
-def _occupancy_panel(cells: Cells, ax: Axes, verts: np.ndarray, height_threshold: float | None,
-                     ground: float | np.ndarray) -> PolyCollection:
+def _occupancy_panel(cells: Cells, ax: Axes, verts: Floats, height_threshold: float | None,
+                     ground: float | Floats) -> PolyCollection:
     """Black occupied, white free, grey unknown cells (occupancy from heights if asked)."""
     import matplotlib as mpl
     from matplotlib.collections import PolyCollection
@@ -112,7 +107,7 @@ def _occupancy_panel(cells: Cells, ax: Axes, verts: np.ndarray, height_threshold
         occupied = known & (np.nan_to_num(above, nan=-np.inf) > height_threshold)
     colours = np.where(occupied[:, None], (0.0, 0.0, 0.0, 1.0), (1.0, 1.0, 1.0, 1.0))
     colours[~known & ~occupied] = UNKNOWN_COLOR
-    occ = PolyCollection(_polygons(verts), facecolors=colours, edgecolors=(0.5, 0.5, 0.5, 1.0),
+    occ = PolyCollection(polygons(verts), facecolors=colours, edgecolors=(0.5, 0.5, 0.5, 1.0),
                          linewidths=0.2)
     ax.add_collection(occ)
     handles = [mpl.patches.Patch(facecolor=c, edgecolor="k", label=lab) for c, lab in
@@ -124,7 +119,7 @@ def _occupancy_panel(cells: Cells, ax: Axes, verts: np.ndarray, height_threshold
 def plot_map_2d(cells: Cells, ax_segments: Axes, ax_occupancy: Axes | None = None, *,
                 title: str | None = None, cmap: str = "viridis",
                 height_threshold: float | None = None,
-                ground: float | np.ndarray = 0.0) -> tuple[PolyCollection, PolyCollection | None]:
+                ground: float | Floats = 0.0) -> tuple[PolyCollection, PolyCollection | None]:
     """Segments coloured by height (left) and the occupancy grid (right), as fig. 4.17.
 
     Heights come from ``centers[:, 2]``; unknown cells are grey in both panels,
@@ -143,7 +138,7 @@ def plot_map_2d(cells: Cells, ax_segments: Axes, ax_occupancy: Axes | None = Non
     norm = mpl.colors.Normalize(*(np.nanmin(z), np.nanmax(z)) if known.any() else (0, 1))
     colours = np.tile(UNKNOWN_COLOR, (len(cells), 1))
     colours[known] = mpl.colormaps[cmap](norm(z[known]))
-    seg = PolyCollection(_polygons(verts), facecolors=colours, edgecolors="k", linewidths=0.2)
+    seg = PolyCollection(polygons(verts), facecolors=colours, edgecolors="k", linewidths=0.2)
     ax_segments.add_collection(seg)
     mappable = mpl.cm.ScalarMappable(norm=norm, cmap=cmap)
     ax_segments.figure.colorbar(mappable, ax=ax_segments, label="height [m]", shrink=0.8)

@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from alte.plot.arrays import Floats, polygons
 from alte.plot.figure import Caption, Plot, View
 from alte.plot.render import view
 from alte.studies.planning.experiment import TerrainPlans
@@ -34,26 +35,26 @@ POLICY_COLORS = {"free": "tab:orange", "occupied": "tab:blue"}
 _SIGNS = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]], dtype=np.float64)
 
 
-def _footprints(ax: Axes, centers: np.ndarray, sizes: np.ndarray,
+def _footprints(ax: Axes, centers: Floats, sizes: Floats,
                 vmax: float) -> PolyCollection:
     from matplotlib.collections import PolyCollection
 
     top = centers[:, 2] + sizes[:, 2] / 2
     order = np.argsort(top)
     verts = centers[order, None, :2] + _SIGNS[None] * sizes[order, None, :2] / 2
-    coll = PolyCollection(verts, array=top[order], cmap="Greys", clim=(0.0, vmax),
+    coll = PolyCollection(polygons(verts), array=top[order], cmap="Greys", clim=(0.0, vmax),
                           edgecolors="none")
     ax.add_collection(coll)
     return coll
 
 
-def _collisions(plans: TerrainPlans, path: np.ndarray) -> np.ndarray:
+def _collisions(plans: TerrainPlans, path: Floats) -> Floats:
     if plans.surface is None or len(path) < 2:
         return np.empty((0, 3))
     samples, _ = densify(path, max(plans.case.clearance / 4, 1e-3))
     bad = plans.surface.inside(samples) | (plans.surface.distance(samples)
                                            < plans.case.clearance)
-    colliding: np.ndarray = samples[bad]
+    colliding: Floats = samples[bad]
     return colliding
 
 

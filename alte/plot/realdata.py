@@ -19,6 +19,7 @@ import pandas as pd
 from matplotlib.colors import ListedColormap
 from matplotlib.figure import Figure
 
+from alte.plot.arrays import Bools, Ints
 from alte.plot.figure import Caption, Plot, View
 from alte.plot.render import save_figure as _save_figure
 from alte.plot.render import show, view
@@ -52,7 +53,7 @@ _COLORS = ListedColormap(["#c8b28a", "#9aa7b1", "#1f5fd6", "#e0241b"])
 _MAX_DOTS = 40_000
 
 
-def outcomes(ground: np.ndarray, reference: np.ndarray) -> np.ndarray:
+def outcomes(ground: Bools, reference: Bools) -> Ints:
     """Per point: 0 ground kept, 1 object removed, 2 type I error, 3 type II error."""
     ground, reference = np.asarray(ground, bool), np.asarray(reference, bool)
     return np.select([reference & ground, ~reference & ~ground, reference & ~ground],

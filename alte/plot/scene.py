@@ -23,6 +23,7 @@ import numpy as np
 import pandas as pd
 from scipy.spatial.transform import Rotation
 
+from alte.plot.arrays import Bools, Floats, Ints
 from alte.plot.figure import Caption, Plot, View
 from alte.plot.render import view
 from alte.types import Trajectory
@@ -35,7 +36,7 @@ if TYPE_CHECKING:
 ANGLE_NAMES = ("roll", "pitch", "yaw")
 
 
-def attitude_deg(quaternions: np.ndarray) -> np.ndarray:
+def attitude_deg(quaternions: Floats) -> Floats:
     """(F, 3) roll, pitch, yaw in degrees (intrinsic z-y-x; module docstring)."""
     rot = Rotation.from_quat(np.asarray(quaternions, dtype=np.float64).reshape(-1, 4))
     return rot.as_euler("ZYX", degrees=True)[:, ::-1]
@@ -77,8 +78,8 @@ POSE = Caption("Position and attitude", "Position and attitude against time.")
 OBSTACLE_MAP = Caption("Obstacle map (fig. 3.13)", "Centroid and radius of every obstacle cluster.")
 
 
-def add_scene(plotter: pv.Plotter, vertices: np.ndarray, triangles: np.ndarray,
-              class_ids: np.ndarray, *, class_names: Sequence[str],
+def add_scene(plotter: pv.Plotter, vertices: Floats, triangles: Ints,
+              class_ids: Ints, *, class_names: Sequence[str],
               opacity: float = 1.0) -> pv.PolyData:
     """Add a ground-truth mesh coloured by object class (one mesh, per-face scalars)."""
     import pyvista as pv
@@ -91,20 +92,20 @@ def add_scene(plotter: pv.Plotter, vertices: np.ndarray, triangles: np.ndarray,
     return mesh
 
 
-def add_cloud(plotter: pv.Plotter, points: np.ndarray, scalars: np.ndarray | None = None,
+def add_cloud(plotter: pv.Plotter, points: Floats, scalars: Floats | Ints | None = None,
               point_size: float = 2.0, cmap: ColormapOptions = "viridis", *,
               show_scalar_bar: bool = True) -> None:
     """Add a point cloud coloured by ``scalars`` (default: height)."""
     import pyvista as pv
 
     cloud = pv.PolyData(np.asarray(points, dtype=np.float64))
-    cloud["value"] = points[:, 2] if scalars is None else np.asarray(scalars)
+    cloud["value"] = np.asarray(points[:, 2] if scalars is None else scalars, dtype=np.float64)
     plotter.add_mesh(cloud, scalars="value", cmap=cmap, point_size=point_size,
                      render_points_as_spheres=False, show_scalar_bar=show_scalar_bar)
 
 
-def add_ground_and_clusters(plotter: pv.Plotter, points: np.ndarray, ground: np.ndarray,
-                            labels: np.ndarray) -> None:
+def add_ground_and_clusters(plotter: pv.Plotter, points: Floats, ground: Bools,
+                            labels: Ints) -> None:
     """Ground inliers in black, obstacle clusters coloured by label (thesis fig. 2.10)."""
     add_cloud(plotter, points[ground], scalars=np.zeros(int(ground.sum())), cmap="gray",
               show_scalar_bar=False)
@@ -114,7 +115,7 @@ def add_ground_and_clusters(plotter: pv.Plotter, points: np.ndarray, ground: np.
                   point_size=3.0, show_scalar_bar=False)
 
 
-def scene_view(vertices: np.ndarray, triangles: np.ndarray, class_ids: np.ndarray, *,
+def scene_view(vertices: Floats, triangles: Ints, class_ids: Ints, *,
                class_names: Sequence[str], zoom: float = 1.0) -> View:
     """The ground-truth mesh coloured by object class (:func:`add_scene`), zoomed in."""
     scene = view(SCENE)
@@ -123,21 +124,21 @@ def scene_view(vertices: np.ndarray, triangles: np.ndarray, class_ids: np.ndarra
     return scene
 
 
-def cloud_view(points: np.ndarray) -> View:
+def cloud_view(points: Floats) -> View:
     """The registered cloud coloured by height (thesis fig. 2.9)."""
     cloud = view(REGISTERED_CLOUD)
     add_cloud(cloud.plotter, points)
     return cloud
 
 
-def clusters_view(points: np.ndarray, ground: np.ndarray, labels: np.ndarray) -> View:
+def clusters_view(points: Floats, ground: Bools, labels: Ints) -> View:
     """Ground and obstacle clusters (:func:`add_ground_and_clusters`, thesis fig. 2.10)."""
     clusters = view(GROUND_AND_CLUSTERS)
     add_ground_and_clusters(clusters.plotter, points, ground, labels)
     return clusters
 
 
-def plot_trajectory(positions: np.ndarray, sensor: np.ndarray | None = None,
+def plot_trajectory(positions: Floats, sensor: Floats | None = None,
                     title: str = "Mission trajectory", *,
                     caption: Caption = MISSION_TRAJECTORY) -> Plot:
     """3D trajectory of the body (and sensor) with start/end marks (thesis fig. 2.7)."""
@@ -155,7 +156,7 @@ def plot_trajectory(positions: np.ndarray, sensor: np.ndarray | None = None,
     return Plot(fig, caption)
 
 
-def plot_scans(scans: Sequence[np.ndarray], times: Sequence[float],
+def plot_scans(scans: Sequence[Floats], times: Sequence[float],
                max_points: int = 4000) -> Plot:
     """Inertial scans at a few times, one 3D panel each (thesis fig. 2.8)."""
     import matplotlib.pyplot as plt
@@ -194,8 +195,8 @@ def plot_pose_history(trajectory: Trajectory, title: str = "", *,
     return Plot(fig, caption)
 
 
-def plot_obstacle_map(points: np.ndarray, obstacles: pd.DataFrame,
-                      ground: np.ndarray | None = None, max_points: int = 50_000) -> Plot:
+def plot_obstacle_map(points: Floats, obstacles: pd.DataFrame,
+                      ground: Bools | None = None, max_points: int = 50_000) -> Plot:
     """Top view: points, obstacle centroids and radius circles (thesis fig. 3.13).
 
     ``obstacles`` has columns ``x``, ``y``, ``radius`` (``alte.ground.clustering.obstacle_map``).

@@ -18,6 +18,7 @@ from matplotlib.collections import PolyCollection
 from matplotlib.figure import Figure
 
 from alte.mappers.base import Mapper
+from alte.plot.arrays import Floats
 from alte.plot.figure import Caption, Plot, View
 from alte.plot.render import view
 
@@ -47,7 +48,7 @@ SWEEPS = {
 _MAX_DOTS = 60_000
 
 
-def cloud_figure(points: np.ndarray, title: str = "registered cloud") -> Plot:
+def cloud_figure(points: Floats, title: str = "registered cloud") -> Plot:
     """Top view of a cloud coloured by height (thinned to at most 60 000 dots)."""
     step = max(1, len(points) // _MAX_DOTS)
     pts = points[::step]
@@ -97,7 +98,7 @@ def map_grid_figure(mappers: Sequence[Mapper], titles: Sequence[str], columns: i
     return Plot(fig, caption)
 
 
-def add_terrain(plotter: pv.Plotter, surface: TrueSurface, bounds: np.ndarray | None = None,
+def add_terrain(plotter: pv.Plotter, surface: TrueSurface, bounds: Floats | None = None,
                 opacity: float = 1.0) -> pv.Plotter:
     """Add a ground-truth mesh (a :class:`~alte.metrics.TrueSurface`) coloured by object,
     clipped to ``bounds`` (2, 3) when given (the control volume)."""
@@ -113,7 +114,7 @@ def add_terrain(plotter: pv.Plotter, surface: TrueSurface, bounds: np.ndarray | 
     return plotter
 
 
-def terrain_view(surface: TrueSurface, bounds: np.ndarray | None = None) -> View:
+def terrain_view(surface: TrueSurface, bounds: Floats | None = None) -> View:
     """The ground-truth mesh coloured by object, clipped to the control volume ``bounds``
     (figures 4.1, 4.7, 4.13, ...)."""
     terrain = view(TERRAIN)

@@ -60,16 +60,17 @@ FRONT = ("Each dot is one map (a parameter setting and seed); the line is the ma
 Draw = Callable[[], Plot]
 
 
-def panels(count: int, width: float = 4.2, height: float = 3.4) -> tuple[Figure, np.ndarray]:
+def panels(count: int, width: float = 4.2, height: float = 3.4) -> tuple[Figure, list[Axes]]:
     import matplotlib.pyplot as plt
 
     cols = min(count, 4)
     rows = -(-count // cols)
     fig, axes = plt.subplots(rows, cols, figsize=(width * cols, height * rows), squeeze=False,
                              layout="constrained")
-    for ax in axes.ravel()[count:]:
+    flat: list[Axes] = list(axes.ravel())
+    for ax in flat[count:]:
         ax.set_visible(False)
-    return fig, axes.ravel()
+    return fig, flat
 
 
 def legend(fig: Figure) -> None:
