@@ -19,16 +19,8 @@ import pandas as pd
 
 from alte.errors import ParameterError
 from alte.plot.figure import Caption, Plot
-from alte.plot.tradeoff import (
-    COLORS,
-    PAIRS,
-    Draw,
-    legend,
-    log_axis,
-    mean_front,
-    panels,
-    save_figures,
-)
+from alte.plot.render import Draw, save_figures
+from alte.plot.tradeoff import COLORS, PAIRS, legend, log_axis, mean_front, panels
 from alte.studies.thesis import TERRAIN_CASE
 from alte.studies.tradeoff import fronts, label, prepare
 
@@ -108,7 +100,7 @@ def save_ablation_figures(variants: pd.DataFrame, out_dir: str | os.PathLike[str
                           close: bool = True) -> dict[str, Path | str]:
     """:func:`ablation_figure` for each pair of mappers on the first ablated terrain of
     its case, saved as ``tradeoff_ablation_2d``/``_3d`` (see
-    :func:`alte.plot.tradeoff.save_figures`)."""
+    :func:`alte.plot.render.save_figures`)."""
     changed = variants[variants["variant"] != variants["variant"].iloc[0]] \
         if len(variants) else variants
     places = sorted(set(changed["terrain"]))

@@ -15,6 +15,7 @@ from __future__ import annotations
 import base64
 import io
 import os
+from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import TYPE_CHECKING, Protocol, runtime_checkable
 
@@ -25,7 +26,11 @@ from alte.plot.figure import Caption, Plot, View, figure_path, write_caption
 if TYPE_CHECKING:
     import pyvista as pv
 
-__all__ = ["interactive", "new_plotter", "save_figure", "show", "use_live_views", "view"]
+__all__ = ["Draw", "interactive", "new_plotter", "save_figure", "save_figures", "show",
+           "use_live_views", "view"]
+
+#: A function that draws one captioned figure (or raises ParameterError: nothing to draw).
+Draw = Callable[[], Plot]
 
 _STATE = {"interactive": False}
 
@@ -115,3 +120,23 @@ def save_figure(item: Plot | View, out_dir: str | os.PathLike[str], name: str) -
     if isinstance(item, View):
         _display(item.plotter, png)
     return path
+
+
+def save_figures(figures: Iterable[tuple[str, Draw]], out_dir: str | os.PathLike[str],
+                 close: bool = True) -> dict[str, Path | str]:
+    """Draw each (name, draw) and save it with :func:`save_figure`; a figure that cannot be
+    drawn (:class:`ParameterError`) is recorded as ``"not drawn: <reason>"``. ``close=False``
+    leaves the figures open."""
+    import matplotlib.pyplot as plt
+
+    out: dict[str, Path | str] = {}
+    for name, draw in figures:
+        try:
+            plot = draw()
+        except ParameterError as err:
+            out[name] = f"not drawn: {err}"
+            continue
+        out[name] = save_figure(plot, out_dir, name)
+        if close:
+            plt.close(plot.figure)
+    return out

@@ -10,7 +10,7 @@ and a star at the thesis' chosen setting. Size is on a log axis.
 from __future__ import annotations
 
 import os
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from functools import partial
 from pathlib import Path
@@ -21,7 +21,7 @@ import pandas as pd
 
 from alte.errors import ParameterError
 from alte.plot.figure import Caption, Plot
-from alte.plot.render import save_figure
+from alte.plot.render import Draw, save_figures
 from alte.studies.tradeoff import (
     MAPPER_NAMES,
     equal_fidelity,
@@ -40,8 +40,8 @@ if TYPE_CHECKING:
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
-__all__ = ["COLORS", "CURVES", "EQUAL_FIDELITY", "EQUAL_SIZE", "FRONT", "PAIRS", "Draw",
-           "TradeoffCurve", "equal_fidelity_figure", "equal_size_figure", "save_figures",
+__all__ = ["COLORS", "CURVES", "EQUAL_FIDELITY", "EQUAL_SIZE", "FRONT", "PAIRS",
+           "TradeoffCurve", "equal_fidelity_figure", "equal_size_figure",
            "save_tradeoff_figures", "tradeoff_figure"]
 
 #: One colour per mapper, the same in every figure.
@@ -56,10 +56,6 @@ FRONT = ("Each dot is one map (a parameter setting and seed); the line is the ma
          "band its 95 % bootstrap interval over seeds; the star marks the thesis' chosen "
          "setting. Size on a log axis, and errors and times too (they span decades over a "
          "grid); completeness on a linear one.")
-#: A function that draws one captioned figure (or raises ParameterError: nothing to draw).
-Draw = Callable[[], Plot]
-
-
 def panels(count: int, width: float = 4.2, height: float = 3.4) -> tuple[Figure, list[Axes]]:
     import matplotlib.pyplot as plt
 
@@ -290,26 +286,6 @@ def _figures(table: pd.DataFrame) -> Iterator[tuple[str, Draw]]:
                                               caption=EQUAL_SIZE[suffix])
         yield f"equal_fidelity_{suffix}", partial(equal_fidelity_figure, table, pair,
                                                   caption=EQUAL_FIDELITY[suffix])
-
-
-def save_figures(figures: Iterator[tuple[str, Draw]], out_dir: str | os.PathLike[str],
-                 close: bool = True) -> dict[str, Path | str]:
-    """Draw each (name, draw) and save it as ``out_dir/figures/<name>.png`` with its
-    caption; a figure that cannot be drawn (:class:`ParameterError`) is recorded as
-    ``"not drawn: <reason>"``."""
-    import matplotlib.pyplot as plt
-
-    out: dict[str, Path | str] = {}
-    for name, draw in figures:
-        try:
-            plot = draw()
-        except ParameterError as err:
-            out[name] = f"not drawn: {err}"
-            continue
-        out[name] = save_figure(plot, out_dir, name)
-        if close:
-            plt.close(plot.figure)
-    return out
 
 
 def save_tradeoff_figures(table: pd.DataFrame, out_dir: str | os.PathLike[str], *,

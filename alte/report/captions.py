@@ -20,15 +20,18 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
+from pathlib import Path
 
-from alte.plot.figure import Caption, SavedCaption, fill
+from alte.plot.figure import Caption, SavedCaption, fill, read_caption
 from alte.types import JSONMap
 
 __all__ = ["CHAPTERS", "KEY_TABLES", "TRADEOFF_PREFIXES", "Caption", "KeyTable", "caption",
-           "chapter_title"]
+           "chapter_title", "saved_figures"]
 
 #: Figure-name prefixes of the trade-off figures (see :mod:`alte.plot.tradeoff`).
 TRADEOFF_PREFIXES = ("tradeoff", "equal_size", "equal_fidelity")
+#: Sort rank of a figure saved without a caption (after every captioned one).
+_UNSAVED = 1 << 62
 
 
 #: Chapter title per source notebook stem.
@@ -122,3 +125,18 @@ def caption(figure: str, saved: SavedCaption | None, parameters: JSONMap,
     if saved:
         return saved.caption.filled(parameters)
     return Caption(title, "(no caption)")
+
+
+def saved_figures(folder: Path) -> list[tuple[Path, SavedCaption | None]]:
+    """The PNGs in ``folder`` with the captions saved beside them: trade-off prefixes
+    first (in the order of :data:`TRADEOFF_PREFIXES`), each group in the order the
+    figures were saved, figures without a caption last."""
+    saved = {png: read_caption(png) for png in (folder.glob("*.png") if folder.is_dir() else [])}
+
+    def order(png: Path) -> tuple[int, int, str]:
+        prefix = next((i for i, p in enumerate(TRADEOFF_PREFIXES) if png.stem.startswith(p)),
+                      -1)
+        known = saved[png]
+        return prefix, _UNSAVED if known is None else known.order, png.stem
+
+    return [(png, saved[png]) for png in sorted(saved, key=order)]

@@ -20,7 +20,6 @@ from pathlib import Path
 
 import pandas as pd
 
-from alte.plot.figure import read_caption
 from alte.report.answer import AnswerView, answer_view
 from alte.report.captions import (
     KEY_TABLES,
@@ -28,6 +27,7 @@ from alte.report.captions import (
     KeyTable,
     caption,
     chapter_title,
+    saved_figures,
 )
 from alte.report.plan import PLAN
 from alte.report.tableview import TableView, cell_text, header, table_view
@@ -44,8 +44,6 @@ MISSIONS_CSV = "claims_missions.csv"
 #: Tables up to this many rows are shown inline; longer ones are linked.
 INLINE_ROWS = 60
 _VERDICT_CSS = {"holds": "holds", "does not hold": "fails", "depends": "depends"}
-#: Sort rank of a figure saved without a caption (after every captioned one).
-_UNSAVED = 1 << 62
 
 
 @dataclass(frozen=True)
@@ -142,20 +140,14 @@ def _notebook(name: str) -> str:
 
 def _read_json(path: Path) -> JSONMap:
     try:
-        data = json.loads(path.read_text(encoding="utf-8"))
+        return _map(json.loads(path.read_text(encoding="utf-8")))
     except (OSError, ValueError):
         return {}
-    return data if isinstance(data, dict) else {}
 
 
 def _map(value: JSON) -> JSONMap:
     """``value`` if it is a JSON object, else an empty one."""
     return value if isinstance(value, Mapping) else {}
-
-
-def _maps(value: JSON) -> list[JSONMap]:
-    """The JSON objects of a JSON list (none for anything else)."""
-    return [v for v in _list(value) if isinstance(v, Mapping)]
 
 
 def _list(value: JSON) -> Sequence[JSON]:
@@ -188,21 +180,9 @@ def _results(data: JSONMap) -> list[tuple[str, str]]:
 
 
 def _figures(run_dir: Path, name: str, params: JSONMap, own: JSONMap) -> list[FigureItem]:
-    """A run's figures with their captions, trade-off prefixes first (in the order of
-    :data:`TRADEOFF_PREFIXES`), each group in the order the notebook saved them."""
-    folder = run_dir / name / "figures"
-    saved = {png: read_caption(png)
-             for png in (folder.glob("*.png") if folder.is_dir() else [])}
-
-    def order(png: Path) -> tuple[int, int, str]:
-        prefix = next((i for i, p in enumerate(TRADEOFF_PREFIXES) if png.stem.startswith(p)),
-                      -1)
-        known = saved[png]
-        return prefix, _UNSAVED if known is None else known.order, png.stem
-
     items = []
-    for png in sorted(saved, key=order):
-        text = caption(png.stem, saved[png], params, own)
+    for png, saved in saved_figures(run_dir / name / "figures"):
+        text = caption(png.stem, saved, params, own)
         items.append(FigureItem(png.relative_to(run_dir).as_posix(), text.title, text.text))
     return items
 
@@ -299,7 +279,7 @@ def run_page(record: JSONMap, run_dir: str | os.PathLike[str],
              tables: Sequence[Path]) -> RunPage:
     """The page model of the run in ``run_dir`` (its record, files and ``tables``)."""
     run_dir = Path(run_dir)
-    runs = _maps(record["runs"])
+    runs = [r for r in _list(record["runs"]) if isinstance(r, Mapping)]
     failed = [(str(r["name"]), str(r["status"])) for r in runs if r["status"] != "ok"]
     summary = (f"{record['mode']} mode, started {record['started']}: {len(runs)} notebooks, "
                f"{len(failed)} failed, {_seconds(record['seconds']):.1f} s in all")
