@@ -3,7 +3,9 @@
 Mapper parameters, sweep settings, landing limits, benchmark settings and the report's
 notebook parameters are all :class:`Record` subclasses. A field is declared with
 :func:`param` (default, check, rule, help); values given as text (``--set k=v``, YAML,
-notebook parameters) are coerced to the field's annotated type, and every failure is a
+notebook parameters) are coerced to the field's annotated type (numbers, text, booleans,
+``Literal`` choices, enums, paths, tuples and nested records from mappings, as YAML gives
+them), and every failure is a
 :class:`~alte.errors.ParameterError` that names the owner, the parameter and the rule:
 ``quadtree: max_points=0 out of range (max_points >= 1)``, ``alte2d: unknown
 parameter(s) kapa; valid: criterion, kappa, max_res, min_pts``.
@@ -12,11 +14,13 @@ parameter(s) kapa; valid: criterion, kappa, max_res, min_pts``.
 from __future__ import annotations
 
 import dataclasses
+import enum
 import math
 import types
 import typing
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any, ClassVar, Literal, Self, get_args, get_origin
 
 from alte.errors import ParameterError
@@ -83,8 +87,65 @@ def _float(owner: str, name: str, value: object) -> float:
     return number
 
 
+def _enum(owner: str, name: str, kind: type[enum.Enum], value: object) -> enum.Enum:
+    if isinstance(value, kind):
+        return value
+    try:
+        return kind(value)
+    except ValueError as err:
+        valid = "|".join(str(m.value) for m in kind)
+        raise ParameterError(f"{owner}: {name}={value!r} out of range ({valid})") from err
+
+
+def _tuple(owner: str, name: str, kind: object, value: object) -> tuple[object, ...]:
+    """A tuple from a list or tuple: ``tuple[X, ...]`` of any length, ``tuple[X, Y]`` fixed."""
+    args = get_args(kind)
+    if isinstance(value, str | bytes) or not isinstance(value, Sequence):
+        raise ParameterError(f"{owner}: {name}={value!r} is not a list")
+    items = list(value)
+    if len(args) == 2 and args[1] is Ellipsis:
+        kinds = [args[0]] * len(items)
+    elif len(args) != len(items):
+        raise ParameterError(f"{owner}: {name}={value!r}: expected {len(args)} values")
+    else:
+        kinds = list(args)
+    return tuple(coerce(owner, f"{name}[{i}]", k, v)
+                 for i, (k, v) in enumerate(zip(kinds, items, strict=True)))
+
+
+def _record(owner: str, name: str, kind: type[Record], value: object) -> Record:
+    """A nested record from a mapping (YAML), its errors prefixed with the field's name."""
+    if isinstance(value, kind):
+        return value
+    if not isinstance(value, Mapping):
+        raise ParameterError(f"{owner}: {name}={value!r} must be a mapping of "
+                             f"{kind.OWNER} parameters")
+    try:
+        return kind.parse({str(k): v for k, v in value.items()})
+    except ParameterError as err:
+        raise ParameterError(f"{owner}: {name}: {err}") from err
+
+
+def _text(owner: str, name: str, value: object) -> str:
+    if not isinstance(value, str | int | float) or isinstance(value, bool):
+        raise ParameterError(f"{owner}: {name}={value!r} is not a valid str")
+    return str(value)
+
+
+def _path(owner: str, name: str, value: object) -> Path:
+    if not isinstance(value, str | Path):
+        raise ParameterError(f"{owner}: {name}={value!r} is not a path")
+    return Path(value)
+
+
+_CONVERTERS: dict[object, Callable[[str, str, object], object]] = {
+    bool: _bool, int: _int, float: _float, str: _text, Path: _path}
+
+
 def coerce(owner: str, name: str, kind: Any, value: object) -> Any:
-    """``value`` as the annotated type ``kind`` (int, float, str, bool, Literal, X | None)."""
+    """``value`` as the annotated type ``kind``: int, float, str, bool, Path, Literal, an
+    enum, ``tuple[X, ...]``, a nested :class:`Record` (from a mapping), ``X | None``;
+    other types pass unchanged."""
     origin = get_origin(kind)
     if origin in (types.UnionType, typing.Union):
         options = [k for k in get_args(kind) if k is not type(None)]
@@ -97,21 +158,26 @@ def coerce(owner: str, name: str, kind: Any, value: object) -> Any:
             raise ParameterError(f"{owner}: {name}={value!r} out of range "
                                  f"({'|'.join(map(str, allowed))})")
         return value
-    converters: dict[Any, Callable[[str, str, object], Any]] = {
-        bool: _bool, int: _int, float: _float}
-    if kind in converters:
-        return converters[kind](owner, name, value)
-    if kind is str:
-        if not isinstance(value, str | int | float) or isinstance(value, bool):
-            raise ParameterError(f"{owner}: {name}={value!r} is not a valid str")
-        return str(value)
+    if origin is tuple:
+        return _tuple(owner, name, kind, value)
+    return _plain(owner, name, kind, value)
+
+
+def _plain(owner: str, name: str, kind: object, value: object) -> object:
+    """``value`` as a plain (not generic) type: a scalar, a path, an enum or a record."""
+    if kind in _CONVERTERS:
+        return _CONVERTERS[kind](owner, name, value)
+    if isinstance(kind, type) and issubclass(kind, enum.Enum):
+        return _enum(owner, name, kind, value)
+    if isinstance(kind, type) and issubclass(kind, Record):
+        return _record(owner, name, kind, value)
     return value
 
 
-_HINTS: dict[type, dict[str, Any]] = {}
+_HINTS: dict[type, dict[str, object]] = {}
 
 
-def _hints(cls: type) -> dict[str, Any]:
+def _hints(cls: type) -> dict[str, object]:
     """A record class's resolved field types, once per class (resolving them costs about
     0.7 ms, and every mapper and map run makes records)."""
     if cls not in _HINTS:
@@ -132,10 +198,13 @@ class Record:
     def __post_init__(self) -> None:
         hints = _hints(type(self))
         for spec in dataclasses.fields(self):
+            if not spec.init:
+                continue  # derived in the subclass's __post_init__
             value = coerce(self.OWNER, spec.name, hints[spec.name], getattr(self, spec.name))
             rule = spec.metadata.get("rule", Rule())
             if value is not None and not rule.check(value):
-                raise ParameterError(f"{self.OWNER}: {spec.name}={value!r} out of range "
+                shown = list(value) if isinstance(value, tuple) else value  # as YAML wrote it
+                raise ParameterError(f"{self.OWNER}: {spec.name}={shown!r} out of range "
                                      f"({rule.rule})")
             object.__setattr__(self, spec.name, value)
 
@@ -166,7 +235,21 @@ class Record:
     def help(cls) -> dict[str, str]:
         """What each parameter means and its rule, for ``--help`` texts and docs."""
         out = {}
+        hints = _hints(cls)
         for spec in dataclasses.fields(cls):
             rule = spec.metadata.get("rule", Rule())
-            out[spec.name] = f"{rule.help} ({rule.rule})" if rule.rule else rule.help
+            said = rule.rule or _choices(hints[spec.name])
+            out[spec.name] = f"{rule.help} ({said})" if said else rule.help
         return out
+
+
+def _choices(kind: object) -> str:
+    """``a|b|c`` for a Literal or enum type (optional or not), else ""."""
+    options = [k for k in get_args(kind) if k is not type(None)] \
+        if get_origin(kind) in (types.UnionType, typing.Union) else [kind]
+    kind = options[0] if len(options) == 1 else kind
+    if get_origin(kind) is Literal:
+        return "|".join(map(str, get_args(kind)))
+    if isinstance(kind, type) and issubclass(kind, enum.Enum):
+        return "|".join(str(m.value) for m in kind)
+    return ""

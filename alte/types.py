@@ -24,11 +24,11 @@ __all__ = ["JSON", "Box", "Counts", "Frame", "JSONDict", "JSONMap", "Mount", "Re
 _NS = 1_000_000_000
 
 #: A value that JSON can hold (what results.json, run records and summaries carry).
-JSON: TypeAlias = "str | int | float | bool | Sequence[JSON] | Mapping[str, JSON] | None"
+JSON: TypeAlias = str | int | float | bool | Sequence["JSON"] | Mapping[str, "JSON"] | None
 #: A JSON object alte builds (mutable).
-JSONDict: TypeAlias = "dict[str, JSON]"
+JSONDict: TypeAlias = dict[str, JSON]
 #: A JSON object alte reads (read-only, so a ``dict[str, float]`` fits).
-JSONMap: TypeAlias = "Mapping[str, JSON]"
+JSONMap: TypeAlias = Mapping[str, JSON]
 
 
 class Counts:

@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import enum
 from dataclasses import dataclass
-from typing import ClassVar
+from pathlib import Path
+from typing import ClassVar, Literal
 
 import pytest
 
@@ -66,3 +68,47 @@ def test_records_are_frozen_and_replace_revalidates():
 
 def test_help_names_rules():
     assert Sample.help()["kappa"] == "threshold (>= 0)"
+
+
+class Colour(enum.Enum):
+    RED = "red"
+    BLUE = "blue"
+
+
+@dataclass(frozen=True)
+class Outer(Record):
+    """A record with the structured kinds a spec holds: an enum, tuples, a path and a
+    nested record, each coerced from what YAML or a command line gives."""
+
+    OWNER: ClassVar[str] = "outer"
+    colour: Colour = param(Colour.RED, help="a colour")
+    shape: Literal["cube", "ball"] = param("cube", help="a shape")
+    seeds: tuple[int, ...] = param((0,), lambda v: len(v) > 0, "not empty")
+    at: tuple[float, float] = param((0.0, 0.0))
+    where: Path | None = param(None)
+    inner: Sample = param(Sample())
+
+
+def test_structured_kinds_are_coerced_from_yaml_values():
+    out = Outer.parse({"colour": "blue", "seeds": ["3", 4.0], "at": [1, "2.5"],
+                       "where": "a/b", "inner": {"kappa": "0.5"}})
+    assert out == Outer(Colour.BLUE, "cube", (3, 4), (1.0, 2.5), Path("a/b"), Sample(kappa=0.5))
+    assert Outer.parse({"inner": Sample(max_res=3)}).inner.max_res == 3
+    assert Outer.help()["colour"] == "a colour (red|blue)"
+    assert Outer.help()["shape"] == "a shape (cube|ball)"
+
+
+@pytest.mark.parametrize(("given", "pattern"), [
+    ({"colour": "green"}, r"outer: colour='green' out of range \(red\|blue\)"),
+    ({"shape": "cone"}, r"outer: shape='cone' out of range \(cube\|ball\)"),
+    ({"seeds": []}, r"outer: seeds=\[\] out of range \(not empty\)"),
+    ({"seeds": "3"}, r"outer: seeds='3' is not a list"),
+    ({"seeds": [1, "x"]}, r"outer: seeds\[1\]='x' is not a valid int"),
+    ({"at": [1.0]}, r"outer: at=\[1\.0\]: expected 2 values"),
+    ({"where": 3}, r"outer: where=3 is not a path"),
+    ({"inner": 3}, r"outer: inner=3 must be a mapping of alte2d parameters"),
+    ({"inner": {"kappa": -1}}, r"outer: inner: alte2d: kappa=-1\.0 out of range \(>= 0\)"),
+])
+def test_structured_kinds_name_the_field_in_errors(given, pattern):
+    with pytest.raises(ParameterError, match=pattern):
+        Outer.parse(given)

@@ -34,7 +34,7 @@ in thesis ch. 6 (mean height above a ground plane over a threshold).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import ClassVar
+from typing import ClassVar, Literal, get_args
 
 import numpy as np
 
@@ -44,7 +44,8 @@ from alte.params import Record, param
 
 __all__ = ["Alte2D", "Alte2DParams"]
 
-CRITERIA = ("thesis", "binev")
+Criterion = Literal["thesis", "binev"]
+CRITERIA: tuple[str, ...] = get_args(Criterion)
 
 
 @dataclass(frozen=True)
@@ -58,8 +59,7 @@ class Alte2DParams(Record):
                          "deepest level a cell may reach (root = 0)")
     min_pts: int = param(10, lambda v: v >= 1, "min_pts >= 1",
                          "fewest points a cell needs to split")
-    criterion: str = param("thesis", lambda v: v in CRITERIA, "thesis or binev",
-                           "refinement criterion")
+    criterion: Criterion = param("thesis", help="refinement criterion")
 
 
 class Alte2D(QuadMap):

@@ -25,7 +25,7 @@ from __future__ import annotations
 import copy
 from dataclasses import dataclass
 from pathlib import Path
-from typing import ClassVar
+from typing import ClassVar, Literal
 
 import numpy as np
 
@@ -68,8 +68,8 @@ class Alte3DParams(Record):
     min_pts_split: int = param(20, lambda v: v >= 1, ">= 1", "split above (MIN PTS 2)")
     occupancy_level: int = param(6, lambda v: 0 <= v <= 16, "0 <= level <= 16",
                                  "level at which min_pts applies; coarser cells scale it")
-    variant: str = param("cube", lambda v: v in {"cube", "fixed_altitude"},
-                         "cube|fixed_altitude", "cubes, or x/y cells in cell_height layers")
+    variant: Literal["cube", "fixed_altitude"] = param(
+        "cube", help="cubes, or x/y cells in cell_height layers")
     cell_height: float = param(1.0, lambda v: v > 0, "> 0", "layer height (fixed_altitude)")
 
 

@@ -38,7 +38,7 @@ after the build first fills in the rest; ``memory_bytes`` counts what is held.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import ClassVar
+from typing import ClassVar, Literal, get_args
 
 import numba
 import numpy as np
@@ -52,7 +52,8 @@ from alte.params import Record, param
 
 __all__ = ["Quadtree", "QuadtreeParams", "parse_ground"]
 
-RULES = ("mean", "max")
+Occupancy = Literal["mean", "max"]
+RULES: tuple[str, ...] = get_args(Occupancy)
 
 
 def parse_ground(text: str) -> np.ndarray | None:
@@ -99,8 +100,8 @@ class QuadtreeParams(Record):
                            "deepest level (guard against duplicate points)")
     height_threshold: float = param(0.5, lambda v: v >= 0, "height_threshold >= 0",
                                     "m above the ground plane for an occupied leaf")
-    occupancy: str = param("mean", lambda v: v in RULES, "mean or max",
-                           "statistic of the leaf's heights compared with the threshold")
+    occupancy: Occupancy = param("mean",
+                                 help="statistic of the leaf's heights compared with the threshold")
     ground: str = param("0", _ground_ok, "z0, a,b,c,d (non-vertical) or fit",
                         "ground plane the heights are measured from")
 

@@ -14,6 +14,7 @@ import enum
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import ClassVar
 
 import numpy as np
 
@@ -21,8 +22,7 @@ from alte.errors import ParameterError
 from alte.mappers import MapperClass, mapper_class
 from alte.mappers.base import Feed
 from alte.mappers.domain import Domain
-from alte.params import Record
-from alte.registration.grid import check_voxel
+from alte.params import Record, param
 from alte.registration.odometry import OdometryParams
 from alte.types import Box, Mount
 
@@ -78,8 +78,16 @@ def _file_identity(path: Path | None) -> list[object] | None:
     return [str(path.resolve()), stat.st_size if stat else 0, stat.st_mtime_ns if stat else 0]
 
 
+def _positive(value: float) -> bool:
+    return bool(np.isfinite(value) and value > 0)
+
+
+def _finite(values: tuple[float, ...]) -> bool:
+    return bool(np.isfinite(values).all())
+
+
 @dataclass(frozen=True)
-class FrameSpec:
+class FrameSpec(Record):
     """How the input becomes registered frames (module docstring).
 
     ``frames``: at most that many scans, evenly spaced over the cloud topic (None: all);
@@ -92,38 +100,30 @@ class FrameSpec:
     ``pose_file``: poses from a TUM file (``t x y z qx qy qz qw``) instead of a topic.
     """
 
-    frames: int | None = None
-    voxel: float | None = None
-    crop: Box | None = None
-    mount: Mount | None = None
-    cloud_topic: str | None = None
-    pose_topic: str | None = None
-    poses: PoseSource = PoseSource.AUTO
-    max_rate: float | None = None
-    max_offset: float | None = None
-    origin: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    OWNER: ClassVar[str] = "frame spec"
+    frames: int | None = param(None, lambda v: v >= 1, "frames >= 1",
+                               "scans kept, evenly spaced (None: all)")
+    voxel: float | None = param(None, _positive, "voxel > 0, finite",
+                                "grid-average size of each frame and of the cloud (m)")
+    crop: Box | None = param(None, help="the control volume points are kept in")
+    mount: Mount | None = param(None, help="the sensor's mount on the vehicle")
+    cloud_topic: str | None = param(None, help="the bag's point cloud topic")
+    pose_topic: str | None = param(None, help="the bag's pose topic")
+    poses: PoseSource = param(PoseSource.AUTO, help="where each scan's pose comes from")
+    max_rate: float | None = param(None, _positive, "max_rate > 0, finite",
+                                   "fast-manoeuvre filter: angular rate (rad/s)")
+    max_offset: float | None = param(None, _positive, "max_offset > 0, finite",
+                                     "fast-manoeuvre filter: pose-to-scan offset (s)")
+    origin: tuple[float, float, float] = param((0.0, 0.0, 0.0), _finite, "finite x,y,z",
+                                               "the sensor position of a point file (m)")
     odometry: OdometryParams = field(default_factory=OdometryParams)
-    deskew: bool = True
-    pose_file: Path | None = None
+    deskew: bool = param(True, help="deskew clouds that carry per-point time")
+    pose_file: Path | None = param(None, help="poses from a TUM file")
 
     def __post_init__(self) -> None:
-        if self.frames is not None and (isinstance(self.frames, bool)
-                                        or not isinstance(self.frames, int) or self.frames < 1):
-            raise ParameterError(f"frames={self.frames!r}: expected a positive integer or None")
-        if self.voxel is not None:
-            object.__setattr__(self, "voxel", check_voxel(self.voxel))
-        for name in ("max_rate", "max_offset"):
-            value = getattr(self, name)
-            if value is not None and not (np.isfinite(value) and value > 0):
-                raise ParameterError(f"{name}={value!r} must be a positive finite number")
-        origin = np.asarray(self.origin, dtype=np.float64).reshape(-1)
-        if origin.shape != (3,) or not np.isfinite(origin).all():
-            raise ParameterError(f"origin {self.origin!r}: expected 3 finite numbers x,y,z")
-        object.__setattr__(self, "origin", tuple(float(v) for v in origin))
-        if self.pose_file is not None:
-            object.__setattr__(self, "pose_file", Path(self.pose_file))
-            if self.pose_topic:
-                raise ParameterError("--pose-file and --pose-topic exclude each other")
+        super().__post_init__()
+        if self.pose_file is not None and self.pose_topic:
+            raise ParameterError("--pose-file and --pose-topic exclude each other")
 
     def key(self) -> dict[str, object]:
         """Everything that decides the registered frames, JSON-ready (the cache key)."""
@@ -138,7 +138,7 @@ class FrameSpec:
 
 
 @dataclass(frozen=True)
-class MapSpec:
+class MapSpec(Record):
     """Which map: mapper name and parameters, domain (or policy), feed, time-lapse.
 
     ``feed`` None uses the mapper's own protocol (``Mapper.default_feed``: the thesis
@@ -149,18 +149,18 @@ class MapSpec:
     bad parameter fails before any input is read.
     """
 
+    OWNER: ClassVar[str] = "map spec"
     mapper: str
     params: Mapping[str, object] | Record = field(default_factory=dict)
     domain: Domain | DomainPolicy = DomainPolicy.AUTO
     feed: Feed | None = None
-    snapshots: int = 0
+    snapshots: int = param(0, lambda v: v >= 0, "snapshots >= 0",
+                           "cell snapshots kept over the run (time-lapse figures)")
     cls: MapperClass = field(init=False, repr=False, compare=False)
     record: Record = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
-        if isinstance(self.snapshots, bool) or not isinstance(self.snapshots, int) \
-                or self.snapshots < 0:
-            raise ParameterError(f"snapshots={self.snapshots!r}: expected an integer >= 0")
+        super().__post_init__()
         cls = mapper_class(self.mapper)
         given = self.params
         record = given if isinstance(given, cls.Params) else cls.Params.parse(

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
-from typing import ClassVar
+from typing import ClassVar, Literal, get_args
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -22,7 +22,8 @@ __all__ = ["KEYS", "METHODS", "OdometryParams", "PoseCounts", "odometry_label",
            "odometry_params", "pose_matrix", "resolve_method"]
 
 #: Odometry backends (module docstring).
-METHODS = ("auto", "kiss", "plane", "lio")
+OdometryMethod = Literal["auto", "kiss", "plane", "lio"]
+METHODS: tuple[str, ...] = get_args(OdometryMethod)
 
 
 def _positive(value: float) -> bool:
@@ -39,8 +40,8 @@ class OdometryParams(Record):
     from KISS-ICP's defaults or the first scan's ranges (:mod:`~alte.registration.backends`)."""
 
     OWNER: ClassVar[str] = "odometry"
-    method: str = param("auto", lambda v: v in METHODS, "|".join(METHODS),
-                        "odometry backend (auto: lio with an IMU topic, else kiss)")
+    method: OdometryMethod = param("auto",
+                                   help="odometry backend (auto: lio with an IMU topic, else kiss)")
     max_range: float | None = param(None, _positive, "> 0",
                                     "m; points beyond are not used (kiss: 100, plane: 1.2 x "
                                     "the 99th percentile range of the first scan)")

@@ -14,10 +14,12 @@ import os
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import ClassVar
 
 from alte.errors import ParameterError, ReportError
+from alte.params import Record, param
 from alte.sim.terrains import TERRAINS as SIMULATED
+from alte.types import JSON, JSONDict, JSONMap
 
 __all__ = [
     "PLAN",
@@ -45,33 +47,37 @@ RUNNER_PARAMETERS: tuple[str, ...] = ("OUT_DIR", "TABLES_DIR", "DATA_DIR")
 
 
 @dataclass(frozen=True)
-class Entry:
+class Entry(Record):
     """One planned notebook run; ``quick``/``full`` are its parameters (None = skipped)."""
 
-    name: str
-    notebook: str
-    quick: Mapping[str, Any] | None = field(default_factory=dict)
-    full: Mapping[str, Any] | None = field(default_factory=dict)
-    terrains: tuple[str, ...] = ()
+    OWNER: ClassVar[str] = "plan entry"
+    name: str = param("", bool, "a non-empty name", "the run's name")
+    notebook: str = param("", lambda v: v.endswith(".ipynb"), "an .ipynb file name",
+                          "the notebook it runs")
+    quick: JSONMap | None = field(default_factory=dict)
+    full: JSONMap | None = field(default_factory=dict)
+    terrains: tuple[str, ...] = param((), help="the terrains it needs besides TERRAIN")
 
 
 @dataclass(frozen=True)
-class Run:
+class Run(Record):
     """A concrete run: notebook path, user parameters and the terrains it needs."""
 
-    name: str
-    notebook: Path
-    parameters: Mapping[str, Any]
-    defaults: Mapping[str, Any]
-    terrains: tuple[str, ...]
+    OWNER: ClassVar[str] = "run"
+    name: str = param("", help="the run's name")
+    notebook: Path = param(Path(), help="the notebook's path")
+    parameters: JSONMap = field(default_factory=dict)
+    defaults: JSONMap = field(default_factory=dict)
+    terrains: tuple[str, ...] = param((), help="the terrains it needs")
 
-    def value(self, name: str) -> Any:
+    def value(self, name: str) -> JSON:
         """The value ``name`` takes in this run (planned, else the notebook's default)."""
         return self.parameters.get(name, self.defaults.get(name))
 
 
 def _ch4(terrain: str) -> Entry:
-    quick = {"TERRAIN": terrain, "FRAMES": QUICK_FRAMES} if terrain in QUICK_TERRAINS else None
+    quick: JSONDict | None = ({"TERRAIN": terrain, "FRAMES": QUICK_FRAMES}
+                              if terrain in QUICK_TERRAINS else None)
     return Entry(f"ch4_{terrain}", "ch4_terrain.ipynb", quick,
                  {"TERRAIN": terrain, "FRAMES": None})
 
@@ -102,20 +108,20 @@ PLAN: tuple[Entry, ...] = (
 )
 
 
-def parse_param(text: str) -> tuple[str, Any]:
+def parse_param(text: str) -> tuple[str, JSON]:
     """``"NAME=VALUE"`` -> (NAME, value); VALUE is a Python literal or else a string."""
     name, sep, raw = text.partition("=")
     name = name.strip()
     if not sep or not name.isidentifier():
         raise ParameterError(f"--param {text!r}: expected NAME=VALUE")
     try:
-        value = ast.literal_eval(raw)
+        value: JSON = ast.literal_eval(raw)
     except (ValueError, SyntaxError):
         value = raw
     return name, value
 
 
-def notebook_parameters(path: str | os.PathLike[str]) -> dict[str, Any]:
+def notebook_parameters(path: str | os.PathLike[str]) -> JSONDict:
     """The parameters a notebook's ``parameters`` cell declares, with their default values."""
     import papermill
 
@@ -126,7 +132,7 @@ def notebook_parameters(path: str | os.PathLike[str]) -> dict[str, Any]:
         inferred = papermill.inspect_notebook(str(path))
     except Exception as err:
         raise ReportError(f"notebook {path}: cannot read its parameters ({err})") from err
-    out: dict[str, Any] = {}
+    out: JSONDict = {}
     for name, info in inferred.items():
         try:
             out[name] = ast.literal_eval(info["default"])
@@ -140,9 +146,10 @@ def load_plan(path: str | os.PathLike[str]) -> tuple[Entry, ...]:
     path = Path(path)
     try:
         items = json.loads(path.read_text())
-        return tuple(Entry(**{**item, "terrains": tuple(item.get("terrains", ()))})
-                     for item in items)
-    except (OSError, ValueError, TypeError) as err:
+        if not isinstance(items, list):
+            raise TypeError("expected a list of entries")
+        return tuple(Entry.parse(item) for item in items)
+    except (OSError, ValueError, TypeError, AttributeError, ParameterError) as err:
         raise ReportError(f"plan {path}: {err}") from err
 
 
@@ -159,7 +166,7 @@ def _select(entries: Sequence[Entry], quick: bool, only: Iterable[str]) -> list[
     return [e for e in mode if e.name in only or Path(e.notebook).stem in only]
 
 
-def _check_overrides(overrides: Mapping[str, Any], declared: Mapping[str, Iterable[str]]) -> None:
+def _check_overrides(overrides: JSONMap, declared: Mapping[str, Iterable[str]]) -> None:
     fixed = sorted(set(overrides) & set(RUNNER_PARAMETERS))
     if fixed:
         raise ParameterError(f"--param {', '.join(fixed)}: set by the runner (use --out/--data)")
@@ -170,7 +177,7 @@ def _check_overrides(overrides: Mapping[str, Any], declared: Mapping[str, Iterab
                              f"{', '.join(sorted(valid)) or '(none)'}")
 
 
-def _terrains(entry: Entry, params: Mapping[str, Any]) -> tuple[str, ...]:
+def _terrains(entry: Entry, params: JSONMap) -> tuple[str, ...]:
     terrain = params.get("TERRAIN")
     named = (terrain,) if isinstance(terrain, str) and terrain else ()
     return tuple(dict.fromkeys((*named, *entry.terrains)))
@@ -178,7 +185,7 @@ def _terrains(entry: Entry, params: Mapping[str, Any]) -> tuple[str, ...]:
 
 def build_plan(entries: Sequence[Entry] = PLAN, *, quick: bool,
                notebooks_dir: str | os.PathLike[str], only: Iterable[str] = (),
-               overrides: Mapping[str, Any] | None = None) -> list[Run]:
+               overrides: JSONMap | None = None) -> list[Run]:
     """Concrete runs for the mode, ``--only`` selection and ``--param`` overrides.
 
     Every plan parameter must be declared by its notebook and every override by at
@@ -202,5 +209,5 @@ def build_plan(entries: Sequence[Entry] = PLAN, *, quick: bool,
             raise ReportError(f"notebook {entry.notebook} declares no OUT_DIR parameter")
         planned |= {k: v for k, v in overrides.items() if k in defaults}
         runs.append(Run(entry.name, Path(notebooks_dir) / entry.notebook, planned,
-                        defaults, _terrains(entry, defaults | planned)))
+                        defaults, _terrains(entry, {**defaults, **planned})))
     return runs

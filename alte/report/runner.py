@@ -77,9 +77,10 @@ def _spec(runs: Sequence[Run], terrain: str, seed: int) -> tuple[int | None, int
     """
     users = [r for r in runs if terrain in r.terrains]
     wanted = [r.value("FRAMES") for r in users]
-    full = not wanted or any(not isinstance(f, int) or f <= 0 for f in wanted)
-    seeds = {r.value("SEED") for r in users if isinstance(r.value("SEED"), int)}
-    return (None if full else max(wanted)), (seeds.pop() if len(seeds) == 1 else seed)
+    counts = [f for f in wanted if isinstance(f, int) and f > 0]
+    full = not wanted or len(counts) < len(wanted)
+    seeds = {s for s in (r.value("SEED") for r in users) if isinstance(s, int)}
+    return (None if full else max(counts)), (seeds.pop() if len(seeds) == 1 else seed)
 
 
 def ensure_terrains(runs: Sequence[Run], data_dir: Path, ensure: EnsureTerrain | None = None,

@@ -28,7 +28,7 @@ from one pose, no per-point time, no IMU; the chapter tables are its reproductio
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import ClassVar
+from typing import ClassVar, Literal
 
 from alte.errors import ParameterError
 from alte.params import Record, param
@@ -60,8 +60,8 @@ class SensorProfile(Record):
     OWNER: ClassVar[str] = "sensor profile"
     sweep: bool = param(False, help="cast each firing from the pose at its instant and "
                                     "write per-point time")
-    time_field: str = param("time", lambda v: v in ("time", "t"), "time|t",
-                            "per-point time field: time (float32 s) or t (uint32 ns)")
+    time_field: Literal["time", "t"] = param(
+        "time", help="per-point time field: time (float32 s) or t (uint32 ns)")
     pose_hz: float = param(0.0, _non_negative, ">= 0",
                            "pose topic rate (Hz); 0: one pose per scan stamp (the thesis)")
     imu_hz: float = param(0.0, _non_negative, ">= 0", "IMU rate (Hz); 0: no IMU topic")

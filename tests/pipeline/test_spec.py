@@ -6,6 +6,7 @@ import pytest
 
 from alte.errors import ParameterError
 from alte.pipeline import DomainPolicy, FrameSpec, MapSpec, PoseSource
+from alte.registration.odometry import OdometryParams
 from alte.types import Box
 
 
@@ -20,20 +21,38 @@ def test_frame_spec_key_names_every_choice() -> None:
 
 
 @pytest.mark.parametrize(("kwargs", "match"), [
-    ({"frames": 0}, r"frames=0: expected a positive integer or None"),
-    ({"voxel": -1.0}, r"voxel=-1.0 must be a positive finite"),
-    ({"max_rate": float("nan")}, r"max_rate=nan must be a positive finite"),
-    ({"origin": (0.0, 1.0)}, r"origin"),
+    ({"frames": 0}, r"frame spec: frames=0 out of range \(frames >= 1\)"),
+    ({"frames": True}, r"frame spec: frames=True is not a valid int"),
+    ({"voxel": -1.0}, r"frame spec: voxel=-1.0 out of range \(voxel > 0, finite\)"),
+    ({"max_rate": float("nan")}, r"frame spec: max_rate=nan must be finite"),
+    ({"origin": (0.0, 1.0)}, r"frame spec: origin=\(0.0, 1.0\): expected 3 values"),
+    ({"origin": (0.0, 1.0, float("inf"))}, r"frame spec: origin\[2\]=inf must be finite"),
+    ({"poses": "gps"}, r"frame spec: poses='gps' out of range \(auto\|recorded\|odometry"),
 ])
 def test_frame_spec_rejects_bad_values(kwargs: dict[str, object], match: str) -> None:
     with pytest.raises(ParameterError, match=match):
         FrameSpec(**kwargs)  # type: ignore[arg-type]
 
 
+def test_frame_spec_parses_text_and_nested_settings() -> None:
+    """A frame spec from text values (a YAML file, a notebook parameter): numbers, the pose
+    source by name and the odometry's own record from a mapping, all coerced and checked."""
+    spec = FrameSpec.parse({"frames": "5", "voxel": "0.2", "poses": "odometry",
+                            "origin": ["1", 2, 3.5], "odometry": {"method": "kiss"}})
+    assert spec == FrameSpec(frames=5, voxel=0.2, poses=PoseSource.ODOMETRY,
+                             origin=(1.0, 2.0, 3.5), odometry=OdometryParams(method="kiss"))
+    assert spec.key() == FrameSpec(**spec.as_dict()).key()
+    with pytest.raises(ParameterError, match=r"frame spec: odometry: odometry: method='icp' "
+                                             r"out of range"):
+        FrameSpec.parse({"odometry": {"method": "icp"}})
+    with pytest.raises(ParameterError, match=r"frame spec: unknown parameter\(s\) frame; "):
+        FrameSpec.parse({"frame": 3})
+
+
 def test_map_spec_defaults_and_errors() -> None:
     spec = MapSpec("alte2d")
     assert spec.domain is DomainPolicy.AUTO and spec.feed is None and spec.snapshots == 0
-    with pytest.raises(ParameterError, match=r"snapshots=-1: expected an integer >= 0"):
+    with pytest.raises(ParameterError, match=r"map spec: snapshots=-1 out of range"):
         MapSpec("alte2d", snapshots=-1)
 
 

@@ -125,10 +125,16 @@ def test_load_plan_round_trip(tmp_path: Path) -> None:
     assert load_plan(path) == (Entry("a", "a.ipynb", None, {"X": 1}, ("sim_nav_1",)),)
 
 
-@pytest.mark.parametrize("text", ["[{", '[{"name": "a"}]', '[{"name": "a", "x": 1}]'])
-def test_load_plan_rejects_bad_files(tmp_path: Path, text: str) -> None:
+@pytest.mark.parametrize(("text", "why"), [
+    ("[{", "Expecting property name"),
+    ('{"name": "a"}', "expected a list of entries"),
+    ('[{"name": "a"}]', r"plan entry: notebook='' out of range \(an \.ipynb file name\)"),
+    ('[{"name": "a", "notebook": "a.ipynb", "x": 1}]', r"plan entry: unknown parameter\(s\) x"),
+    ('[{"name": "a", "notebook": "a.ipynb", "terrains": 3}]', "terrains=3 is not a list"),
+])
+def test_load_plan_rejects_bad_files(tmp_path: Path, text: str, why: str) -> None:
     (tmp_path / "plan.json").write_text(text)
-    with pytest.raises(ReportError, match=r"plan .*plan\.json"):
+    with pytest.raises(ReportError, match=rf"plan .*plan\.json: .*{why}"):
         load_plan(tmp_path / "plan.json")
 
 

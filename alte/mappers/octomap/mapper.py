@@ -15,7 +15,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import ClassVar, Protocol
+from typing import ClassVar, Literal, Protocol
 
 import numpy as np
 
@@ -83,10 +83,10 @@ class OctomapParams(Record):
 
     OWNER: ClassVar[str] = "octomap"
     resolution: float = param(5.0, lambda v: v > 0, "> 0", "cells per metre")
-    backend: str = param("native", lambda v: v in _BACKENDS, "native|reference",
-                         "our numba tree or the C++ OctoMap library")
-    sensor_model: str = param("matlab", lambda v: v in SENSOR_MODELS, "matlab|octomap",
-                              "defaults of the four probabilities")
+    backend: Literal["native", "reference"] = param(
+        "native", help="our numba tree or the C++ OctoMap library")
+    sensor_model: Literal["matlab", "octomap"] = param("matlab",
+                                                       help="defaults of the four probabilities")
     max_range: float = param(100.0, lambda v: v > 0 or v == -1, "> 0, or -1 = unlimited",
                              "longer rays are truncated and their end not marked occupied")
     prob_hit: float | None = param(None, _prob(0.5, 1), "0.5 < p < 1")

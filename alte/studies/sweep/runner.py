@@ -191,13 +191,15 @@ def override(spec: SweepSpec, **changes: object) -> SweepSpec:
     if unknown:
         raise ParameterError(f"sweep override {', '.join(unknown)}: valid: {', '.join(allowed)}")
     given = {k: v for k, v in changes.items() if k == "frames" or v is not None}
-    new = SweepSettings.parse(given)
-    return dataclasses.replace(
-        spec,
-        frames=new.frames if "frames" in given else spec.frames,
-        data_dir=new.data_dir if "data_dir" in given else spec.data_dir,
-        output=new.output or spec.output,
-        seeds=new.seed_list() if {"seed", "seeds"} & set(given) else spec.seeds)
+    new = SweepSettings.parse(given)  # checked alone first: errors name only what was given
+    kept = {**spec.settings.as_dict(), "output": spec.output}
+    if {"seed", "seeds"} & set(given):
+        kept |= {"seed": new.seed, "seeds": new.seeds}
+    changed: dict[str, object] = {k: getattr(new, k) for k in ("frames", "data_dir", "output")
+                                  if k in given}
+    if not changed.get("output", True):
+        del changed["output"]
+    return dataclasses.replace(spec, settings=SweepSettings.parse({**kept, **changed}))
 
 
 def variant_table(spec: SweepSpec, table: pd.DataFrame) -> pd.DataFrame:

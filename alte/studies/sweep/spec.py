@@ -16,14 +16,14 @@ import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, ClassVar, TypeVar
+from typing import ClassVar, TypeVar
 
 from alte.errors import AlteError, ParameterError
 from alte.mappers import make_mapper
 from alte.metrics.maps import TruthOptions
 from alte.params import Record, param
 from alte.sim import TERRAINS
-from alte.studies.sweep.variants import Variant, parse_variants
+from alte.studies.sweep.variants import Variant, parse_variants, spec_error
 
 __all__ = ["MapperGrid", "SweepSettings", "SweepSpec", "load_spec", "parse_spec"]
 
@@ -32,9 +32,12 @@ _SCALARS = (bool, int, float, str)
 _R = TypeVar("_R", bound=Record)
 
 
-def _seed_list(value: object) -> bool:
-    return isinstance(value, list | tuple) and bool(value) and all(
-        isinstance(s, int) and not isinstance(s, bool) and s >= 0 for s in value)
+def _seed_list(value: tuple[int, ...]) -> bool:
+    return bool(value) and all(s >= 0 for s in value)
+
+
+def _known(names: tuple[str, ...]) -> bool:
+    return bool(names) and all(n in TERRAINS for n in names)
 
 
 @dataclass(frozen=True)
@@ -74,137 +77,169 @@ _TOP_KEYS = (*SweepSettings.names(), "terrains", "truth", "mappers", "variants")
 
 
 @dataclass(frozen=True)
-class MapperGrid:
-    """A mapper's parameter rows (grid product and explicit rows) and its terrains."""
+class MapperGrid(Record):
+    """A mapper's parameter rows (grid product and explicit rows, coerced by the mapper's
+    own record) and its terrains."""
 
-    mapper: str
-    rows: tuple[Mapping[str, Any], ...]
-    terrains: tuple[str, ...]
+    OWNER: ClassVar[str] = "mapper grid"
+    mapper: str = param("", help="the mapper's name")
+    rows: tuple[Mapping[str, object], ...] = param((), help="its parameter rows")
+    terrains: tuple[str, ...] = param((), _known, "known terrain names", "its terrains")
 
 
 @dataclass(frozen=True)
-class SweepSpec:
-    """A validated sweep (see the module docstring); ``source`` names it in messages."""
+class SweepSpec(Record):
+    """A validated sweep (see the module docstring): its :class:`SweepSettings` and what
+    it runs; ``source`` names it in messages. ``name``, ``frames``, ``seeds``, ``voxel``,
+    ``data_dir``, ``output`` and ``obstacles`` read the settings (``name`` and ``output``
+    with their defaults filled in)."""
 
-    name: str
-    terrains: tuple[str, ...]
-    mappers: tuple[MapperGrid, ...]
-    frames: int | None = None
-    seeds: tuple[int, ...] = (0,)
-    voxel: float | None = None
-    data_dir: str = "data"
-    output: str = ""
+    OWNER: ClassVar[str] = "sweep"
+    terrains: tuple[str, ...] = param((), _known, "known terrain names", "the terrains")
+    mappers: tuple[MapperGrid, ...] = param((), help="each mapper's grid")
+    settings: SweepSettings = field(default_factory=SweepSettings)
     truth: TruthOptions = field(default_factory=TruthOptions)
-    source: str = "spec"
-    variants: tuple[Variant, ...] = ()
-    obstacles: bool = False
+    source: str = param("spec", help="where the spec came from (its file)")
+    variants: tuple[Variant, ...] = param((), help="the ablation variants")
+
+    @property
+    def name(self) -> str:
+        """The sweep's name: given, else the spec file's stem."""
+        return self.settings.name or Path(self.source).stem
+
+    @property
+    def frames(self) -> int | None:
+        """Scans kept per terrain (None: every scan)."""
+        return self.settings.frames
+
+    @property
+    def seeds(self) -> tuple[int, ...]:
+        """The simulation seeds."""
+        return self.settings.seed_list()
+
+    @property
+    def voxel(self) -> float | None:
+        """Voxel filter of the registered cloud (m)."""
+        return self.settings.voxel
+
+    @property
+    def data_dir(self) -> str:
+        """Folder of the simulated terrains."""
+        return self.settings.data_dir
+
+    @property
+    def output(self) -> str:
+        """Results folder."""
+        return self.settings.output or f"reports/sweeps/{self.name}"
+
+    @property
+    def obstacles(self) -> bool:
+        """Whether obstacle identification is scored too."""
+        return self.settings.obstacles
 
 
-def _fail(source: str, key: str, message: str) -> ParameterError:
-    return ParameterError(f"{source}: {key}: {message}")
-
-
-def _check_keys(source: str, where: str, given: Mapping[str, Any], valid: Sequence[str]) -> None:
+def _check_keys(source: str, where: str, given: Mapping[object, object],
+                valid: Sequence[str]) -> None:
     unknown = sorted(set(map(str, given)) - set(valid))
     if unknown:
-        raise _fail(source, where, f"unknown key(s) {', '.join(unknown)}; valid: "
-                    f"{', '.join(valid)}")
+        raise spec_error(source, where, f"unknown key(s) {', '.join(unknown)}; valid: "
+                         f"{', '.join(valid)}")
 
 
-def _terrains(source: str, key: str, value: Any) -> tuple[str, ...]:
+def _terrains(source: str, key: str, value: object) -> tuple[str, ...]:
     names = [value] if isinstance(value, str) else value
     if not isinstance(names, list) or not names:
-        raise _fail(source, key, f"{value!r} must be a terrain name or a non-empty list")
+        raise spec_error(source, key, f"{value!r} must be a terrain name or a non-empty list")
     bad = [n for n in names if n not in TERRAINS]
     if bad:
-        raise _fail(source, key, f"unknown terrain(s) {bad}; valid: {', '.join(TERRAINS)}")
+        raise spec_error(source, key, f"unknown terrain(s) {bad}; valid: {', '.join(TERRAINS)}")
     return tuple(dict.fromkeys(names))
 
 
-def _record(source: str, record: type[_R], given: Mapping[str, object]) -> _R:
+def _record(source: str, record: type[_R], given: Mapping[object, object]) -> _R:
     """``record`` parsed from ``given``; its errors (naming its owner and the key, as in
     ``sweep: frames=0 out of range``) are prefixed with the spec's source."""
     try:
-        return record.parse(given)
+        return record.parse({str(k): v for k, v in given.items()})
     except ParameterError as err:
         raise ParameterError(f"{source}: {err}") from err
 
 
-def _truth(source: str, value: Any) -> TruthOptions:
+def _truth(source: str, value: object) -> TruthOptions:
     if value is None:
         return TruthOptions()
     if not isinstance(value, Mapping):
-        raise _fail(source, "truth", f"{value!r} must be a mapping")
-    return _record(source, TruthOptions, {str(k): v for k, v in value.items()})
+        raise spec_error(source, "truth", f"{value!r} must be a mapping")
+    return _record(source, TruthOptions, value)
 
 
-def _grid_rows(source: str, key: str, grid: Any) -> list[dict[str, Any]]:
+def _grid_rows(source: str, key: str, grid: object) -> list[dict[str, object]]:
     if not isinstance(grid, Mapping) or not grid:
-        raise _fail(source, key, f"{grid!r} must map parameter names to lists of values")
+        raise spec_error(source, key, f"{grid!r} must map parameter names to lists of values")
     lists = {}
     for name, given in grid.items():
         values = given if isinstance(given, list) else [given]
         if not values:
-            raise _fail(source, f"{key}.{name}", "empty list of values")
+            raise spec_error(source, f"{key}.{name}", "empty list of values")
         lists[str(name)] = values
     return [dict(zip(lists, combo, strict=True)) for combo in itertools.product(*lists.values())]
 
 
-def _coerce_row(source: str, key: str, mapper: str, row: Any) -> dict[str, Any]:
+def _coerce_row(source: str, key: str, mapper: str, row: object) -> dict[str, object]:
     """Validate one parameter row by constructing the mapper; values come back coerced."""
     if not isinstance(row, Mapping):
-        raise _fail(source, key, f"{row!r} must map parameter names to values")
+        raise spec_error(source, key, f"{row!r} must map parameter names to values")
     for name, value in row.items():
         if not isinstance(value, _SCALARS):
-            raise _fail(source, f"{key}.{name}", f"{value!r} must be a number, string or bool")
+            raise spec_error(source, f"{key}.{name}", f"{value!r} must be a number, string or "
+                             "bool")
     try:
-        resolved = make_mapper(mapper, row).params.as_dict()
+        resolved = make_mapper(mapper, dict(row)).params.as_dict()
     except AlteError as err:
-        raise _fail(source, key, str(err)) from err
-    return {str(name): resolved[name] for name in row}
+        raise spec_error(source, key, str(err)) from err
+    return {str(name): resolved[str(name)] for name in row}
 
 
-def _mapper(source: str, name: str, body: Any, terrains: tuple[str, ...]) -> MapperGrid:
+def _mapper(source: str, name: str, body: object, terrains: tuple[str, ...]) -> MapperGrid:
     key = f"mappers.{name}"
     if not isinstance(body, Mapping) or not ({"grid", "rows"} & set(body)):
-        raise _fail(source, key, "needs a 'grid' of parameter lists and/or explicit 'rows'")
+        raise spec_error(source, key, "needs a 'grid' of parameter lists and/or explicit "
+                         "'rows'")
     _check_keys(source, key, body, _MAPPER_KEYS)
-    rows = _grid_rows(source, f"{key}.grid", body["grid"]) if "grid" in body else []
+    rows: list[object] = list(_grid_rows(source, f"{key}.grid", body["grid"])
+                              if "grid" in body else [])
     explicit = body.get("rows", [])
     if not isinstance(explicit, list):
-        raise _fail(source, f"{key}.rows", f"{explicit!r} must be a list of parameter mappings")
+        raise spec_error(source, f"{key}.rows", f"{explicit!r} must be a list of parameter "
+                         "mappings")
     rows += explicit
-    coerced = [_coerce_row(source, key, name, row) for row in rows]
+    coerced = tuple(_coerce_row(source, key, name, row) for row in rows)
     own = _terrains(source, f"{key}.terrains", body["terrains"]) if "terrains" in body else terrains
     outside = sorted(set(own) - set(terrains))
     if outside:
-        raise _fail(source, f"{key}.terrains", f"{outside} not in the top-level terrains")
-    return MapperGrid(name, tuple(coerced), own)
+        raise spec_error(source, f"{key}.terrains", f"{outside} not in the top-level terrains")
+    return MapperGrid(name, coerced, own)
 
 
-def parse_spec(raw: Any, source: str = "spec") -> SweepSpec:
+def parse_spec(raw: object, source: str = "spec") -> SweepSpec:
     """Validate a spec mapping (as read from YAML); errors name ``source`` and the key."""
     if not isinstance(raw, Mapping):
         raise ParameterError(f"{source}: expected a mapping of sweep settings, got {raw!r}")
     _check_keys(source, "top level", raw, _TOP_KEYS)
     for key in ("terrains", "mappers"):
         if key not in raw:
-            raise _fail(source, key, "missing (required)")
+            raise spec_error(source, key, "missing (required)")
     terrains = _terrains(source, "terrains", raw["terrains"])
     if not isinstance(raw["mappers"], Mapping) or not raw["mappers"]:
-        raise _fail(source, "mappers", "must map mapper names to their grids")
+        raise spec_error(source, "mappers", "must map mapper names to their grids")
     settings = _record(source, SweepSettings,
                        {k: raw[k] for k in SweepSettings.names() if k in raw})
-    name = settings.name or Path(source).stem
     mappers = tuple(_mapper(source, str(m), body, terrains) for m, body in raw["mappers"].items())
     return SweepSpec(
-        name=name, terrains=terrains, mappers=mappers, frames=settings.frames,
-        seeds=settings.seed_list(), voxel=settings.voxel, data_dir=settings.data_dir,
-        output=settings.output or f"reports/sweeps/{name}",
+        terrains=terrains, mappers=mappers, settings=settings,
         truth=_truth(source, raw.get("truth")), source=source,
         variants=parse_variants(source, raw.get("variants"), terrains,
-                                tuple(g.mapper for g in mappers)),
-        obstacles=settings.obstacles)
+                                tuple(g.mapper for g in mappers)))
 
 
 def load_spec(path: str | os.PathLike[str]) -> SweepSpec:

@@ -18,124 +18,117 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Any
+from typing import ClassVar, Literal, get_args
 
 from alte.errors import AlteError, ParameterError
 from alte.mappers import DomainUse, make_mapper, mapper_class
-from alte.metrics.maps import SET_B, SetB
-from alte.pipeline import DomainPolicy
+from alte.metrics.maps import SetB
+from alte.params import Record, param
 from alte.sim.profile import PROFILES
 
-__all__ = ["BASE", "DOMAINS", "POSES", "Variant", "parse_variants"]
+__all__ = ["BASE", "DOMAINS", "POSES", "Variant", "parse_variants", "spec_error"]
 
 #: The name of the grid as written (no change).
 BASE = "base"
-#: Valid ``domain`` values.
-DOMAINS = tuple(p.value for p in DomainPolicy)
-_KEYS = ("text", "domain", "set_b", "params", "terrains", "sensor", "deskew", "poses")
+DomainName = Literal["auto", "control", "data"]
+PosesName = Literal["recorded", "odometry"]
+#: Valid ``domain`` values (those of :class:`alte.pipeline.DomainPolicy`).
+DOMAINS: tuple[str, ...] = get_args(DomainName)
 #: Valid ``poses`` values.
-POSES = ("recorded", "odometry")
+POSES: tuple[str, ...] = get_args(PosesName)
+
+
+def _profile(value: str) -> bool:
+    return value in PROFILES
 
 
 @dataclass(frozen=True)
-class Variant:
+class Variant(Record):
     """One ablation: what it changes (module docstring) and a sentence saying so."""
 
-    name: str = BASE
-    text: str = "the grid as specified"
-    domain: str = DomainPolicy.AUTO.value
-    set_b: SetB = SetB.CORNERS
-    params: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)
-    terrains: tuple[str, ...] = ()
-    sensor: str = "thesis"
-    deskew: bool = True
-    poses: str = "recorded"
+    OWNER: ClassVar[str] = "variant"
+    name: str = param(BASE, help="the variant's name")
+    text: str = param("the grid as specified", help="what it changes, in words")
+    domain: DomainName = param("auto", help="the maps' root cell")
+    set_b: SetB = param(SetB.CORNERS, help="set B of HD/MHD")
+    params: Mapping[str, Mapping[str, object]] = field(default_factory=dict)
+    terrains: tuple[str, ...] = param((), help="the terrains it runs on (empty: the sweep's)")
+    sensor: str = param("thesis", _profile, "|".join(PROFILES), "the simulated sensor")
+    deskew: bool = param(True, help="deskew swept scans")
+    poses: PosesName = param("recorded", help="recorded poses or the odometry's")
 
     def domain_for(self, mapper: str) -> str:
         """The domain policy a run of ``mapper`` gets (``auto`` where it uses none)."""
-        return (DomainPolicy.AUTO.value if mapper_class(mapper).domain_use is DomainUse.UNUSED
-                else self.domain)
+        return "auto" if mapper_class(mapper).domain_use is DomainUse.UNUSED else self.domain
 
     def set_b_for(self, mapper: str) -> SetB:
         """The set B a run of ``mapper`` gets (``occupied`` is ``corners`` in 3D)."""
         return (SetB.CORNERS if self.set_b is SetB.OCCUPIED and mapper_class(mapper).dims == 3
                 else self.set_b)
 
-    def params_for(self, mapper: str, row: Mapping[str, Any]) -> dict[str, Any]:
+    def params_for(self, mapper: str, row: Mapping[str, object]) -> dict[str, object]:
         """``row`` with this variant's parameter changes for ``mapper``."""
         return {**row, **self.params.get(mapper, {})}
 
 
-def _fail(source: str, key: str, message: str) -> ParameterError:
+def spec_error(source: str, key: str, message: str) -> ParameterError:
+    """An error in a sweep spec, naming the spec and the key."""
     return ParameterError(f"{source}: {key}: {message}")
 
 
-def _choice(source: str, key: str, value: Any, valid: tuple[str, ...]) -> str:
-    if value not in valid:
-        raise _fail(source, key, f"{value!r}: expected one of {', '.join(valid)}")
-    return str(value)
-
-
-def _flag(source: str, key: str, value: Any) -> bool:
-    if not isinstance(value, bool):
-        raise _fail(source, key, f"{value!r}: expected true or false")
-    return value
-
-
-def _params(source: str, key: str, value: Any, mappers: tuple[str, ...]
-            ) -> dict[str, dict[str, Any]]:
+def _params(source: str, key: str, value: object, mappers: tuple[str, ...]
+            ) -> dict[str, dict[str, object]]:
     if not isinstance(value, Mapping):
-        raise _fail(source, key, f"{value!r} must map mapper names to parameter changes")
+        raise spec_error(source, key, f"{value!r} must map mapper names to parameter changes")
     out = {}
     for mapper, changes in value.items():
         where = f"{key}.{mapper}"
         if mapper not in mappers:
-            raise _fail(source, where, f"not a mapper of this sweep ({', '.join(mappers)})")
+            raise spec_error(source, where, f"not a mapper of this sweep ({', '.join(mappers)})")
         if not isinstance(changes, Mapping) or not changes:
-            raise _fail(source, where, f"{changes!r} must map parameter names to values")
+            raise spec_error(source, where, f"{changes!r} must map parameter names to values")
         try:
             resolved = make_mapper(str(mapper), dict(changes)).params.as_dict()
         except AlteError as err:
-            raise _fail(source, where, str(err)) from err
+            raise spec_error(source, where, str(err)) from err
         out[str(mapper)] = {str(k): resolved[str(k)] for k in changes}
     return out
 
 
-def _variant(source: str, name: str, body: Any, terrains: tuple[str, ...],
+def _variant(source: str, name: str, body: object, terrains: tuple[str, ...],
              mappers: tuple[str, ...]) -> Variant:
     key = f"variants.{name}"
     if name == BASE:
-        raise _fail(source, key, f"{BASE!r} is the grid as written; name the variant otherwise")
+        raise spec_error(source, key, f"{BASE!r} is the grid as written; name the variant "
+                         "otherwise")
     if not isinstance(body, Mapping) or not body:
-        raise _fail(source, key, "must say what changes (domain, set_b and/or params)")
-    unknown = sorted(set(map(str, body)) - set(_KEYS))
-    if unknown:
-        raise _fail(source, key, f"unknown key(s) {', '.join(unknown)}; valid: {', '.join(_KEYS)}")
+        raise spec_error(source, key, "must say what changes (domain, set_b and/or params)")
+    if "name" in body:
+        raise spec_error(source, key, "'name' is the variant's key, not a setting")
     own = body.get("terrains", list(terrains))
     own = [own] if isinstance(own, str) else own
     if not isinstance(own, list) or not own or set(own) - set(terrains):
-        raise _fail(source, f"{key}.terrains", f"{own!r} must be a non-empty list of the "
-                    "sweep's terrains")
-    variant = Variant(
-        name, str(body.get("text", "")),
-        _choice(source, f"{key}.domain", body.get("domain", "auto"), DOMAINS),
-        SetB(_choice(source, f"{key}.set_b", body.get("set_b", "corners"), SET_B)),
-        _params(source, f"{key}.params", body.get("params", {}), mappers),
-        tuple(dict.fromkeys(own)),
-        _choice(source, f"{key}.sensor", body.get("sensor", "thesis"), tuple(PROFILES)),
-        _flag(source, f"{key}.deskew", body.get("deskew", True)),
-        _choice(source, f"{key}.poses", body.get("poses", "recorded"), POSES))
-    if variant == Variant(variant.name, variant.text, terrains=variant.terrains):
-        raise _fail(source, key, "changes nothing (give domain, set_b, params, sensor or poses)")
+        raise spec_error(source, f"{key}.terrains", f"{own!r} must be a non-empty list of "
+                         "the sweep's terrains")
+    given = {**body, "name": name, "text": str(body.get("text", "")),
+             "terrains": tuple(dict.fromkeys(own)),
+             "params": _params(source, f"{key}.params", body.get("params", {}), mappers)}
+    try:
+        variant = Variant.parse({str(k): v for k, v in given.items()})
+    except ParameterError as err:
+        raise spec_error(source, key, str(err)) from err
+    if variant == Variant(name=variant.name, text=variant.text, terrains=variant.terrains):
+        raise spec_error(source, key, "changes nothing (give domain, set_b, params, sensor or "
+                         "poses)")
     return variant
 
 
-def parse_variants(source: str, raw: Any, terrains: tuple[str, ...],
+def parse_variants(source: str, raw: object, terrains: tuple[str, ...],
                    mappers: tuple[str, ...]) -> tuple[Variant, ...]:
     """The spec's ``variants`` mapping, validated (errors name the key)."""
     if raw is None:
         return ()
     if not isinstance(raw, Mapping):
-        raise _fail(source, "variants", f"{raw!r} must map variant names to their changes")
+        raise spec_error(source, "variants", f"{raw!r} must map variant names to their changes")
     return tuple(_variant(source, str(name), body, terrains, mappers)
                  for name, body in raw.items())
