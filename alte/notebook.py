@@ -24,7 +24,8 @@ Importing this module in a kernel also silences what third-party imports would
 send to the page and a person cannot act on (see :func:`quiet_kernel`), so a
 notebook imports ``alte.notebook`` before any other alte module.
 ``save_results`` writes the notebook's named results to JSON atomically (the
-report runner collects them).
+report runner collects them); ``save_figure`` (:func:`alte.plot.render.save_figure`)
+saves a figure with its caption.
 """
 
 from __future__ import annotations
@@ -36,27 +37,25 @@ import sys
 import warnings
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from alte.errors import ParameterError
 from alte.fsutil import atomic_path
 from alte.paths import REPO_ROOT
+from alte.plot.render import interactive, save_figure, use_live_views
+
+if TYPE_CHECKING:
+    from alte.types import JSON
 
 __all__ = [
     "INTERACTIVE_MODULES", "interactive", "live_frontend", "quiet_kernel", "save_figure",
     "save_results", "setup",
 ]
 
-_STATE = {"interactive": False}
 #: What pyvista's trame backend needs in the kernel (``pip install 'pyvista[jupyter]'``).
 INTERACTIVE_MODULES = ("trame", "trame_pyvista", "trame_vtk", "ipywidgets", "nest_asyncio2")
-
-
-def interactive() -> bool:
-    """True when 3D views should be live widgets (a page displays this kernel)."""
-    return _STATE["interactive"]
 
 
 def live_frontend() -> bool:
@@ -94,11 +93,14 @@ def quiet_kernel() -> None:
     if "dash._jupyter" in sys.modules or importlib.util.find_spec("dash") is None:
         return
     import comm
+    from comm.base_comm import BaseComm
 
     create = comm.create_comm
 
-    def no_dash_comm(*args: Any, **kwargs: Any) -> Any:
-        return None if kwargs.get("target_name") == "dash" else create(*args, **kwargs)
+    def no_dash_comm(*args: object, **kwargs: object) -> BaseComm:
+        if kwargs.get("target_name") == "dash":
+            return None  # type: ignore[return-value]  # dash's fallback without comms
+        return create(*args, **kwargs)
 
     comm.create_comm = no_dash_comm
     try:
@@ -136,7 +138,7 @@ def setup(mode: str | None = None) -> str:
     chosen = _render_mode(mode)
     if (REPO_ROOT / "pyproject.toml").is_file():  # a checkout, not an installed wheel
         os.chdir(REPO_ROOT)
-    _STATE["interactive"] = chosen == "interactive"
+    use_live_views(chosen == "interactive")
     if not os.environ.get("DISPLAY"):  # skip VTK's failing X attempt: render with EGL
         os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
     if chosen == "static":
@@ -162,7 +164,7 @@ def _show_figures_as_png() -> None:
         select_figure_formats(shell, {"png"}, bbox_inches="tight")
 
 
-def _jsonable(value: Any) -> Any:
+def _jsonable(value: object) -> JSON:
     if isinstance(value, Mapping):
         return {str(k): _jsonable(v) for k, v in value.items()}
     if isinstance(value, list | tuple):
@@ -170,33 +172,20 @@ def _jsonable(value: Any) -> Any:
     if isinstance(value, np.ndarray):
         return _jsonable(value.tolist())
     if isinstance(value, np.generic):
-        return value.item()
+        return _jsonable(value.item())
     if isinstance(value, Path):
         return str(value)
-    return value
+    if value is None or isinstance(value, str | int | float | bool):
+        return value
+    raise ParameterError(f"save_results: {type(value).__name__} values cannot be written "
+                         "as JSON; pass numbers, text, lists, dicts, arrays or paths")
 
 
-def save_results(out_dir: str | os.PathLike[str], results: Mapping[str, Any]) -> Path:
+def save_results(out_dir: str | os.PathLike[str], results: Mapping[str, object]) -> Path:
     """Write ``results`` to ``out_dir/results.json`` (sorted keys, atomic, overwrites)."""
     path = Path(out_dir) / "results.json"
     with atomic_path(path, overwrite=True) as tmp:
         tmp.write_text(json.dumps(_jsonable(results), indent=2, sort_keys=True) + "\n")
-    return path
-
-
-def save_figure(fig: Any, out_dir: str | os.PathLike[str], name: str) -> Path:
-    """Save a matplotlib figure as ``out_dir/figures/name.png`` (atomic, overwrites).
-
-    A figure with constrained layout already fits its canvas; trimming it to a tight box
-    as well would draw it twice (the layout solved each time), so only others are trimmed.
-    """
-    from matplotlib.layout_engine import ConstrainedLayoutEngine
-
-    path = Path(out_dir) / "figures" / f"{name}.png"
-    tight = not isinstance(fig.get_layout_engine(), ConstrainedLayoutEngine)
-    with atomic_path(path, overwrite=True) as tmp:
-        fig.savefig(tmp, format="png", dpi=110, bbox_inches="tight" if tight else None,
-                    metadata={"Software": None})
     return path
 
 

@@ -10,21 +10,33 @@ ground truth).
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from alte.errors import ParameterError
+from alte.plot.arrays import Floats
+from alte.plot.figure import Caption, Plot
 from alte.studies.landing.detect import Centres, Detection
 from alte.studies.landing.experiment import LandingRun
 from alte.studies.landing.params import LandingParams
 
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.image import AxesImage
+
 __all__ = ["plot_landing", "plot_landing_runs"]
+
+LANDING_SITES = Caption(
+    "Landing sites on the maps",
+    "Map height (grey: unknown), obstacles red, detected feasible centres inside the "
+    "blue outline, truly feasible ones inside the dashed green one; circles are the "
+    "chosen sites, green when truly safe and red when not.")
 
 _UNKNOWN = (0.8, 0.8, 0.8, 1.0)
 
 
-def _site_colours(detection: Detection, truth: Centres | None) -> np.ndarray:
+def _site_colours(detection: Detection, truth: Centres | None) -> Floats:
     chosen = detection.chosen
     if truth is None or not len(chosen):
         return np.tile([0.5, 0.5, 0.5, 1.0], (len(chosen), 1))
@@ -33,8 +45,8 @@ def _site_colours(detection: Detection, truth: Centres | None) -> np.ndarray:
     return np.where(safe[:, None], [0.0, 0.6, 0.0, 1.0], [0.85, 0.0, 0.0, 1.0])
 
 
-def plot_landing(detection: Detection, params: LandingParams, ax: Any, *,
-                 truth: Centres | None = None, title: str | None = None) -> Any:
+def plot_landing(detection: Detection, params: LandingParams, ax: Axes, *,
+                 truth: Centres | None = None, title: str | None = None) -> AxesImage:
     """Draw one detection on ``ax``: heights, obstacles (red), detected feasible centres
     (blue outline), truly feasible centres (green dashed) and the chosen sites."""
     import matplotlib as mpl
@@ -49,11 +61,11 @@ def plot_landing(detection: Detection, params: LandingParams, ax: Any, *,
     ax.imshow(detection.centres.obstacle.astype(float), origin="lower", extent=grid.extent,
               cmap=red, vmin=0, vmax=1, interpolation="nearest")
     xs, ys = grid.axes()
-    for mask, style in ((detection.centres.feasible, {"colors": "tab:blue"}),
-                        (None if truth is None else truth.feasible,
-                         {"colors": "lime", "linestyles": "dashed"})):
+    for mask, colour, line in ((detection.centres.feasible, "tab:blue", "solid"),
+                               (None if truth is None else truth.feasible, "lime", "dashed")):
         if mask is not None and mask.any() and not mask.all():
-            ax.contour(xs, ys, mask.astype(float), levels=[0.5], linewidths=1.0, **style)
+            ax.contour(xs, ys, mask.astype(float), levels=[0.5], linewidths=1.0, colors=colour,
+                       linestyles=line)
     chosen = detection.chosen
     xy = chosen[["x", "y"]].to_numpy()
     diameter = np.full(len(xy), 2 * params.disk)
@@ -74,7 +86,7 @@ def plot_landing(detection: Detection, params: LandingParams, ax: Any, *,
 
 
 def plot_landing_runs(runs: Sequence[LandingRun], ncols: int = 2, panel_size: float = 4.5,
-                      only: str | None = None) -> Any:
+                      only: str | None = None) -> Plot:
     """A figure with one :func:`plot_landing` panel per run, titled with its scores.
 
     ``only`` keeps the runs whose label starts with it (e.g. ``"ch4"``).
@@ -96,4 +108,4 @@ def plot_landing_runs(runs: Sequence[LandingRun], ncols: int = 2, panel_size: fl
     for ax in axes.flat[len(runs):]:
         ax.set_visible(False)
     fig.tight_layout()
-    return fig
+    return Plot(fig, LANDING_SITES)

@@ -8,23 +8,66 @@ cells without points) are drawn grey, never like ground.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from typing import Any, cast
+from collections.abc import Mapping, Sequence
+from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from alte.mappers.base import Cells
 from alte.mappers.quad.quadmap import plane_height
+from alte.plot.arrays import Floats, polygons
+from alte.plot.figure import Caption, Plot, View
+from alte.plot.render import view
+from alte.studies.tradeoff import MAPPER_NAMES
+
+if TYPE_CHECKING:
+    import pyvista as pv
+    from matplotlib.axes import Axes
+    from matplotlib.collections import PolyCollection
+    from matplotlib.lines import Line2D
+    from pyvista.plotting._typing import ColormapOptions, ScalarBarArgs
+
+    from alte.pipeline.maprun import MapRun
 
 __all__ = [
+    "ALTE2D_TIMELAPSE",
+    "ALTE3D_TIMELAPSE",
+    "OCTOMAP_TIMELAPSE",
+    "QUADTREE_TIMELAPSE",
     "UNKNOWN_COLOR",
     "add_cells_3d",
     "add_timelapse_3d",
+    "basis_functions_figure",
     "cells_mesh",
     "plot_basis_functions_over_time",
     "plot_map_2d",
     "plot_timelapse_2d",
+    "timelapse_view",
 ]
+
+#: Captions of the thesis' time-lapse figures, one per mapper (chapter 3).
+QUADTREE_TIMELAPSE = Caption("Quadtree over time (fig. 3.3)",
+                             "Quadtree rebuilt as the scans arrive.")
+OCTOMAP_TIMELAPSE = Caption("Octomap over time (fig. 3.7)",
+                            "Octomap's occupied voxels as scans arrive.")
+ALTE2D_TIMELAPSE = Caption(
+    "2D-ALTE over time (fig. 3.14)",
+    "2D-ALTE's cells as scans arrive; right: the binary grid proposed in chapter 6.")
+ALTE3D_TIMELAPSE = Caption("3D-ALTE over time (fig. 3.17)",
+                           "3D-ALTE's occupied cells as scans arrive.")
+BASIS_FUNCTIONS = Caption("Basis functions against mission time",
+                          "Map size as the mission proceeds: 2D mappers left, 3D mappers right.")
+
+
+class Snapshot(Protocol):
+    """A map at one mission time (:class:`alte.pipeline.maprun.Snapshot`)."""
+
+    @property
+    def time(self) -> float: ...
+
+    @property
+    def cells(self) -> Cells: ...
 
 UNKNOWN_COLOR = (0.8, 0.8, 0.8, 1.0)
 _SIGNS_2D = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]], dtype=np.float64)
@@ -33,19 +76,13 @@ _SIGNS_3D = np.array([[-1, -1, -1], [1, -1, -1], [1, 1, -1], [-1, 1, -1],
                       [-1, -1, 1], [1, -1, 1], [1, 1, 1], [-1, 1, 1]], dtype=np.float64)
 
 
-def _rectangles(cells: Cells) -> np.ndarray:
+def _rectangles(cells: Cells) -> Floats:
     """(K, 4, 2) footprints of the cells."""
     half = cells.sizes[:, None, :2] / 2
     return cells.centers[:, None, :2] + _SIGNS_2D[None] * half
 
 
-def _polygons(verts: np.ndarray) -> Sequence[np.ndarray]:
-    """``verts`` as ``PolyCollection`` takes them: the (K, 4, 2) array itself, which
-    matplotlib handles in one piece (its stubs ask for a sequence of polygons)."""
-    return cast("Sequence[np.ndarray]", verts)
-
-
-def _frame_axes(ax: Any, verts: np.ndarray, title: str | None) -> None:
+def _frame_axes(ax: Axes, verts: Floats, title: str | None) -> None:
     if len(verts):
         lo, hi = verts.reshape(-1, 2).min(axis=0), verts.reshape(-1, 2).max(axis=0)
         ax.set_xlim(lo[0], hi[0])
@@ -57,8 +94,8 @@ def _frame_axes(ax: Any, verts: np.ndarray, title: str | None) -> None:
         ax.set_title(title)
 
 
-def _occupancy_panel(cells: Cells, ax: Any, verts: np.ndarray, height_threshold: float | None,
-                     ground: float | np.ndarray) -> Any:
+def _occupancy_panel(cells: Cells, ax: Axes, verts: Floats, height_threshold: float | None,
+                     ground: float | Floats) -> PolyCollection:
     """Black occupied, white free, grey unknown cells (occupancy from heights if asked)."""
     import matplotlib as mpl
     from matplotlib.collections import PolyCollection
@@ -70,7 +107,7 @@ def _occupancy_panel(cells: Cells, ax: Any, verts: np.ndarray, height_threshold:
         occupied = known & (np.nan_to_num(above, nan=-np.inf) > height_threshold)
     colours = np.where(occupied[:, None], (0.0, 0.0, 0.0, 1.0), (1.0, 1.0, 1.0, 1.0))
     colours[~known & ~occupied] = UNKNOWN_COLOR
-    occ = PolyCollection(_polygons(verts), facecolors=colours, edgecolors=(0.5, 0.5, 0.5, 1.0),
+    occ = PolyCollection(polygons(verts), facecolors=colours, edgecolors=(0.5, 0.5, 0.5, 1.0),
                          linewidths=0.2)
     ax.add_collection(occ)
     handles = [mpl.patches.Patch(facecolor=c, edgecolor="k", label=lab) for c, lab in
@@ -79,10 +116,10 @@ def _occupancy_panel(cells: Cells, ax: Any, verts: np.ndarray, height_threshold:
     return occ
 
 
-def plot_map_2d(cells: Cells, ax_segments: Any, ax_occupancy: Any | None = None, *,
+def plot_map_2d(cells: Cells, ax_segments: Axes, ax_occupancy: Axes | None = None, *,
                 title: str | None = None, cmap: str = "viridis",
                 height_threshold: float | None = None,
-                ground: float | np.ndarray = 0.0) -> tuple[Any, Any | None]:
+                ground: float | Floats = 0.0) -> tuple[PolyCollection, PolyCollection | None]:
     """Segments coloured by height (left) and the occupancy grid (right), as fig. 4.17.
 
     Heights come from ``centers[:, 2]``; unknown cells are grey in both panels,
@@ -101,7 +138,7 @@ def plot_map_2d(cells: Cells, ax_segments: Any, ax_occupancy: Any | None = None,
     norm = mpl.colors.Normalize(*(np.nanmin(z), np.nanmax(z)) if known.any() else (0, 1))
     colours = np.tile(UNKNOWN_COLOR, (len(cells), 1))
     colours[known] = mpl.colormaps[cmap](norm(z[known]))
-    seg = PolyCollection(_polygons(verts), facecolors=colours, edgecolors="k", linewidths=0.2)
+    seg = PolyCollection(polygons(verts), facecolors=colours, edgecolors="k", linewidths=0.2)
     ax_segments.add_collection(seg)
     mappable = mpl.cm.ScalarMappable(norm=norm, cmap=cmap)
     ax_segments.figure.colorbar(mappable, ax=ax_segments, label="height [m]", shrink=0.8)
@@ -113,7 +150,8 @@ def plot_map_2d(cells: Cells, ax_segments: Any, ax_occupancy: Any | None = None,
     return seg, occ
 
 
-def cells_mesh(cells: Cells, occupied_only: bool = True, color_by: str = "height") -> Any:
+def cells_mesh(cells: Cells, occupied_only: bool = True,
+               color_by: str = "height") -> pv.UnstructuredGrid:
     """One pyvista ``UnstructuredGrid``: boxes for 3D cells, flat squares for 2D cells.
 
     ``color_by``: ``height`` (top of the cell, fig. 3.15), ``value`` or ``level``;
@@ -147,19 +185,22 @@ def cells_mesh(cells: Cells, occupied_only: bool = True, color_by: str = "height
     return grid
 
 
-def add_cells_3d(plotter: Any, cells: Cells, occupied_only: bool = True,
-                 color_by: str = "height", cmap: str = "viridis", **kwargs: Any) -> Any:
+def add_cells_3d(plotter: pv.Plotter, cells: Cells, occupied_only: bool = True,
+                 color_by: str = "height", cmap: ColormapOptions = "viridis", *,
+                 show_edges: bool = True,
+                 scalar_bar_args: ScalarBarArgs | None = None) -> pv.UnstructuredGrid:
     """Add the cells to a pyvista ``plotter`` coloured by ``color_by``; returns the mesh."""
     grid = cells_mesh(cells, occupied_only, color_by)
     if grid.n_cells == 0:
         return grid
-    options = {"show_edges": True, "edge_color": "black", "line_width": 0.5, **kwargs}
-    plotter.add_mesh(grid, scalars=color_by, cmap=cmap, **options)
+    plotter.add_mesh(grid, scalars=color_by, cmap=cmap, show_edges=show_edges,
+                     edge_color="black", line_width=0.5,
+                     scalar_bar_args=scalar_bar_args)
     return grid
 
 
-def plot_basis_functions_over_time(times: Any, counts: Any, ax: Any,
-                                   label: str | None = None) -> Any:
+def plot_basis_functions_over_time(times: ArrayLike, counts: ArrayLike, ax: Axes,
+                                   label: str | None = None) -> Line2D:
     """Step plot of the number of basis functions against mission time; returns the line."""
     (line,) = ax.step(np.asarray(times, dtype=np.float64), np.asarray(counts), where="post",
                       label=label)
@@ -170,31 +211,55 @@ def plot_basis_functions_over_time(times: Any, counts: Any, ax: Any,
     return line
 
 
-def plot_timelapse_2d(snapshots: Sequence[Any], title: str = "", **kwargs: Any) -> Any:
-    """One row per snapshot (``.time``, ``.cells``): segments left, occupancy right.
+def basis_functions_figure(runs: Mapping[str, MapRun]) -> Plot:
+    """Basis functions against mission time per run (mapper name -> a run made with
+    snapshots): 2D mappers left, 3D mappers right."""
+    import matplotlib.pyplot as plt
 
-    The thesis' time-lapse figures 3.3 and 3.14 (``kwargs`` go to :func:`plot_map_2d`);
-    returns the matplotlib figure.
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4))
+    for name, run in runs.items():
+        plot_basis_functions_over_time(run.log.times, run.log.basis_functions,
+                                       axes[0 if run.mapper.dims == 2 else 1],
+                                       MAPPER_NAMES.get(name, name))
+    return Plot(fig, BASIS_FUNCTIONS)
+
+
+def plot_timelapse_2d(snapshots: Sequence[Snapshot], title: str = "", *, caption: Caption,
+                      height_threshold: float | None = None) -> Plot:
+    """One row per snapshot: segments left, occupancy right (occupancy from heights with
+    ``height_threshold``, see :func:`plot_map_2d`).
+
+    The thesis' time-lapse figures 3.3 and 3.14 (``caption``: :data:`QUADTREE_TIMELAPSE`,
+    :data:`ALTE2D_TIMELAPSE`).
     """
     import matplotlib.pyplot as plt
 
     rows = max(len(snapshots), 1)
     fig, axes = plt.subplots(rows, 2, figsize=(11, 4.2 * rows), squeeze=False)
     for (ax_seg, ax_occ), snap in zip(axes, snapshots, strict=False):
-        plot_map_2d(snap.cells, ax_seg, ax_occ, title=f"{title} t = {snap.time:.1f} s", **kwargs)
+        plot_map_2d(snap.cells, ax_seg, ax_occ, title=f"{title} t = {snap.time:.1f} s",
+                    height_threshold=height_threshold)
     fig.tight_layout()
-    return fig
+    return Plot(fig, caption)
 
 
-def add_timelapse_3d(plotter: Any, snapshots: Sequence[Any], title: str = "",
-                     **kwargs: Any) -> None:
-    """Fill a ``(1, len(snapshots))`` plotter with the occupied cells of each snapshot.
-
-    The thesis' time-lapse figures 3.7 and 3.17 (cells coloured by height).
-    """
+def add_timelapse_3d(plotter: pv.Plotter, snapshots: Sequence[Snapshot],
+                     title: str = "") -> None:
+    """Fill a ``(1, len(snapshots))`` plotter with the occupied cells of each snapshot,
+    coloured by height."""
     for col, snap in enumerate(snapshots):
         plotter.subplot(0, col)
-        add_cells_3d(plotter, snap.cells, **kwargs)
+        add_cells_3d(plotter, snap.cells)
         plotter.add_text(f"{title} t = {snap.time:.1f} s", font_size=9)
-        plotter.show_axes()
+        plotter.renderer.show_axes()  # what Plotter.show_axes calls (typed)
     plotter.link_views()
+
+
+def timelapse_view(snapshots: Sequence[Snapshot], title: str = "", *,
+                   caption: Caption) -> View:
+    """The thesis' time-lapse figures 3.7 and 3.17: one linked panel per snapshot
+    (``caption``: :data:`OCTOMAP_TIMELAPSE`, :data:`ALTE3D_TIMELAPSE`)."""
+    panels = max(len(snapshots), 1)
+    lapse = view(caption, shape=(1, panels), window_size=(400 * panels, 400))
+    add_timelapse_3d(lapse.plotter, snapshots, title)
+    return lapse

@@ -8,43 +8,57 @@ policy's path a line, path samples that collide with the true mesh red dots.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
+from alte.plot.arrays import Floats, polygons
+from alte.plot.figure import Caption, Plot, View
+from alte.plot.render import view
 from alte.studies.planning.experiment import TerrainPlans
 from alte.studies.planning.score import densify
 
-__all__ = ["POLICY_COLORS", "add_plans_3d", "plot_plans"]
+if TYPE_CHECKING:
+    import pyvista as pv
+    from matplotlib.axes import Axes
+    from matplotlib.collections import PolyCollection
+
+__all__ = ["POLICY_COLORS", "add_plans_3d", "plans_view", "plot_plans"]
+
+PATHS = Caption("Paths over the maps (top view)",
+                "Occupied cells by height; a line per policy; red dots: path samples "
+                "too close to the true mesh or inside a solid.")
+PATHS_3D = Caption("Paths in 3D", "The planned paths over one terrain's map.")
 
 #: Line colour per unknown-space policy.
 POLICY_COLORS = {"free": "tab:orange", "occupied": "tab:blue"}
 _SIGNS = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]], dtype=np.float64)
 
 
-def _footprints(ax: Any, centers: np.ndarray, sizes: np.ndarray, vmax: float) -> Any:
+def _footprints(ax: Axes, centers: Floats, sizes: Floats,
+                vmax: float) -> PolyCollection:
     from matplotlib.collections import PolyCollection
 
     top = centers[:, 2] + sizes[:, 2] / 2
     order = np.argsort(top)
     verts = centers[order, None, :2] + _SIGNS[None] * sizes[order, None, :2] / 2
-    coll = PolyCollection(verts, array=top[order], cmap="Greys", clim=(0.0, vmax),
+    coll = PolyCollection(polygons(verts), array=top[order], cmap="Greys", clim=(0.0, vmax),
                           edgecolors="none")
     ax.add_collection(coll)
     return coll
 
 
-def _collisions(plans: TerrainPlans, path: np.ndarray) -> np.ndarray:
+def _collisions(plans: TerrainPlans, path: Floats) -> Floats:
     if plans.surface is None or len(path) < 2:
         return np.empty((0, 3))
     samples, _ = densify(path, max(plans.case.clearance / 4, 1e-3))
     bad = plans.surface.inside(samples) | (plans.surface.distance(samples)
                                            < plans.case.clearance)
-    colliding: np.ndarray = samples[bad]
+    colliding: Floats = samples[bad]
     return colliding
 
 
-def _panel(ax: Any, plans: TerrainPlans, mapper: str) -> None:
+def _panel(ax: Axes, plans: TerrainPlans, mapper: str) -> None:
     box = plans.case.box
     centers, sizes = plans.occupied[mapper]
     _footprints(ax, centers, sizes, float(box[1, 2]))
@@ -64,11 +78,11 @@ def _panel(ax: Any, plans: TerrainPlans, mapper: str) -> None:
     ax.set_ylim(box[0, 1], box[1, 1])
     ax.set_aspect("equal")
     ax.set_title(f"{plans.terrain} / {mapper}\n" + ", ".join(notes), fontsize=8)
-    if any(line.get_label()[:1] != "_" for line in ax.get_lines()):
+    if any(not str(line.get_label()).startswith("_") for line in ax.get_lines()):
         ax.legend(fontsize=7, loc="lower right")
 
 
-def plot_plans(plans: Sequence[TerrainPlans], panel_size: float = 4.0) -> Any:
+def plot_plans(plans: Sequence[TerrainPlans], panel_size: float = 4.0) -> Plot:
     """Top views: one row per terrain, one column per mapper; returns the figure."""
     import matplotlib.pyplot as plt
 
@@ -83,10 +97,11 @@ def plot_plans(plans: Sequence[TerrainPlans], panel_size: float = 4.0) -> Any:
             else:
                 ax.set_visible(False)
     fig.tight_layout()
-    return fig
+    return Plot(fig, PATHS)
 
 
-def add_plans_3d(plotter: Any, plans: TerrainPlans, mapper: str, opacity: float = 0.5) -> Any:
+def add_plans_3d(plotter: pv.Plotter, plans: TerrainPlans, mapper: str,
+                 opacity: float = 0.5) -> pv.Plotter:
     """The true mesh (clipped to the planning domain) and ``mapper``'s paths, start and goal."""
     import pyvista as pv
 
@@ -105,3 +120,10 @@ def add_plans_3d(plotter: Any, plans: TerrainPlans, mapper: str, opacity: float 
     plotter.add_mesh(pv.Sphere(radius, plans.case.start), color="green")
     plotter.add_mesh(pv.Sphere(radius, plans.case.goal), color="red")
     return plotter
+
+
+def plans_view(plans: TerrainPlans, mapper: str) -> View:
+    """``mapper``'s paths over the true mesh of one terrain (:func:`add_plans_3d`)."""
+    paths = view(PATHS_3D)
+    add_plans_3d(paths.plotter, plans, mapper)
+    return paths

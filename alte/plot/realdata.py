@@ -3,9 +3,9 @@
 :func:`ground_figure` shows every ISPRS sample x filter from above, each point
 coloured by its outcome against the reference (ground kept, object removed, type I,
 type II); :func:`fronts_figure` draws the real sequence's fronts (size against MHD and
-against the distance to the reference cloud, per pair of mappers); :func:`show_maps`
-puts 3D maps side by side in one pyvista plotter, shown
-through :func:`alte.plot.render.show` (a PNG headless, trame in JupyterLab).
+against the distance to the reference cloud, per pair of mappers); :func:`maps_view`
+puts 3D maps side by side in one pyvista plotter, which :func:`show_maps` saves and shows
+(a PNG headless, trame in JupyterLab).
 """
 
 from __future__ import annotations
@@ -13,19 +13,38 @@ from __future__ import annotations
 import os
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 import pandas as pd
 from matplotlib.colors import ListedColormap
 from matplotlib.figure import Figure
 
-from alte.notebook import save_figure as _save_figure
+from alte.plot.arrays import Bools, Ints
+from alte.plot.figure import Caption, Plot, View
+from alte.plot.render import save_figure as _save_figure
+from alte.plot.render import show, view
 from alte.studies.experiments import Measured
 from alte.studies.realdata.data import GroundRun
 
-__all__ = ["FRONT_PANELS", "OUTCOMES", "fronts_figure", "ground_figure", "outcomes", "save_figure",
-           "show_maps"]
+__all__ = ["FRONT_PANELS", "OUTCOMES", "SCAN_MAPS", "VLP16_MAPS", "fronts_figure",
+           "ground_figure", "maps_view", "outcomes", "save_figure", "show_maps"]
+
+GROUND_FILTER = Caption("Ground filter (fig. 6.1)", "Ground filter errors on the ISPRS samples.")
+REAL_FRONTS = Caption(
+    "The fronts on a real sequence (balm_seq)",
+    "Real scans mapped with their reference poses (bundle adjustment): every map one "
+    "dot, the line each mapper's Pareto front (one recording: no seeds, no band). "
+    "MHD is the thesis' metric against the cloud the map was made from; height RMSE, "
+    "mean accuracy and completeness are measured against the reference cloud (every "
+    "scan with its reference pose), the real stand-in for the simulator's truth.")
+#: The 3D maps of the OctoMap scan (:func:`maps_view`).
+SCAN_MAPS = Caption("3D maps of the OctoMap scan (fig. 6.2)",
+                    "Occupied cells of each 3D map of the real OctoMap scan (scan.dat, one "
+                    "scan, sensor at the origin), coloured by height, side by side.")
+#: The 3D maps of the VLP-16 packet bag (:func:`maps_view`).
+VLP16_MAPS = Caption("3D maps of the VLP-16 bag (fig. 6.3)",
+                     "Occupied cells of each 3D map of the decoded VLP-16 packet bag "
+                     "(stationary sensor, identity pose), coloured by height, side by side.")
 
 #: Outcome classes of a ground filter, in the order of :func:`outcomes`' codes.
 OUTCOMES = ("ground kept", "object removed", "type I (ground removed)",
@@ -34,14 +53,14 @@ _COLORS = ListedColormap(["#c8b28a", "#9aa7b1", "#1f5fd6", "#e0241b"])
 _MAX_DOTS = 40_000
 
 
-def outcomes(ground: np.ndarray, reference: np.ndarray) -> np.ndarray:
+def outcomes(ground: Bools, reference: Bools) -> Ints:
     """Per point: 0 ground kept, 1 object removed, 2 type I error, 3 type II error."""
     ground, reference = np.asarray(ground, bool), np.asarray(reference, bool)
     return np.select([reference & ground, ~reference & ~ground, reference & ~ground],
                      [0, 1, 2], default=3)
 
 
-def ground_figure(runs: Sequence[GroundRun]) -> Figure | None:
+def ground_figure(runs: Sequence[GroundRun]) -> Plot | None:
     """Top views, one row per sample, one column per filter (None for no runs)."""
     if not runs:
         return None
@@ -64,23 +83,24 @@ def ground_figure(runs: Sequence[GroundRun]) -> Figure | None:
     handles = [ax.scatter([], [], color=_COLORS(i), label=name)
                for i, name in enumerate(OUTCOMES)]
     fig.legend(handles=handles, loc="outside lower center", ncol=4, fontsize=8)
-    return fig
+    return Plot(fig, GROUND_FILTER)
 
 
-def save_figure(fig: Figure | None, out_dir: str | os.PathLike[str], name: str) -> Path | None:
-    """:func:`alte.notebook.save_figure`, or nothing for a skipped figure (None)."""
-    return None if fig is None else _save_figure(fig, out_dir, name)
+def save_figure(item: Plot | View | None, out_dir: str | os.PathLike[str],
+                name: str) -> Path | None:
+    """:func:`alte.plot.render.save_figure`, or nothing for a skipped figure (None)."""
+    return None if item is None else _save_figure(item, out_dir, name)
 
 
-def show_maps(runs: Sequence[Measured], out_dir: str | os.PathLike[str] | None = None,
-              name: str | None = None, title: str = "") -> None:
-    """Occupied cells of each map side by side (linked cameras); nothing for no runs."""
+def maps_view(runs: Sequence[Measured], title: str = "", *, caption: Caption) -> View | None:
+    """Occupied cells of each map side by side (linked cameras; ``caption``:
+    :data:`SCAN_MAPS` or :data:`VLP16_MAPS`); None for no runs."""
     if not runs:
-        return
+        return None
     from alte.plot.maps import add_cells_3d
-    from alte.plot.render import new_plotter, show
 
-    plotter: Any = new_plotter(shape=(1, len(runs)), window_size=(480 * len(runs), 480))
+    maps = view(caption, shape=(1, len(runs)), window_size=(480 * len(runs), 480))
+    plotter = maps.plotter
     for i, run in enumerate(runs):
         plotter.subplot(0, i)
         add_cells_3d(plotter, run.mapper.cells(), show_edges=False,
@@ -88,7 +108,16 @@ def show_maps(runs: Sequence[Measured], out_dir: str | os.PathLike[str] | None =
         plotter.add_text(f"{title} {run.name}: {run.metrics.occupied_cells} occupied",
                          font_size=9)
     plotter.link_views()
-    show(plotter, out_dir, name)
+    return maps
+
+
+def show_maps(runs: Sequence[Measured], out_dir: str | os.PathLike[str] | None = None,
+              name: str | None = None, title: str = "", *, caption: Caption) -> None:
+    """:func:`maps_view`, saved as ``out_dir/figures/name.png`` (and shown) when both are
+    given, else only shown; nothing for no runs."""
+    maps = maps_view(runs, title, caption=caption)
+    if maps is not None:
+        show(maps, out_dir, name)
 
 
 #: Panels of :func:`fronts_figure`: (mappers, metric, higher is better).
@@ -98,7 +127,7 @@ FRONT_PANELS: tuple[tuple[tuple[str, str], str, bool], ...] = (
     (("octomap", "alte3d"), "completeness", True))
 
 
-def fronts_figure(table: pd.DataFrame) -> Figure | None:
+def fronts_figure(table: pd.DataFrame) -> Plot | None:
     """The real sequence's maps, one dot each, and each mapper's Pareto front, per panel of
     :data:`FRONT_PANELS` (size on a log axis); None for an empty table."""
     if table.empty:
@@ -126,4 +155,4 @@ def fronts_figure(table: pd.DataFrame) -> Figure | None:
     name = str(table["terrain"].iloc[0])
     fig.suptitle(f"{name}: real scans with reference poses, {int(table['frames'].iloc[0])} "
                  f"scans mapped, {int(table['reference_points'].iloc[0]):,} reference points")
-    return fig
+    return Plot(fig, REAL_FRONTS)

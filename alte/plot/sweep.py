@@ -7,15 +7,22 @@ log-spaced values (``kappa`` 0.01, 0.1, 1) are evenly spaced as they were swept.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pandas as pd
 
 from alte.errors import ParameterError
+from alte.plot.figure import Caption, Plot
 from alte.studies.sweep.analysis import main_effects, mapper_rows, param_columns, sensitivity_table
+from alte.studies.tradeoff import MAPPER_NAMES
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
 
 __all__ = ["effects_figure", "sensitivity_figure"]
+
+MAIN_EFFECTS = Caption("Main effects", "Each metric's mean at each level of each swept parameter.")
 
 #: Axis labels of the usual metrics (others are shown by column name).
 LABELS = {"mhd_m": "MHD (m)", "hd_m": "HD (m)", "basis_functions": "basis functions",
@@ -23,7 +30,7 @@ LABELS = {"mhd_m": "MHD (m)", "hd_m": "HD (m)", "basis_functions": "basis functi
           "accuracy_mean_m": "mean accuracy (m)", "memory_bytes": "memory (bytes)"}
 
 
-def _label(value: Any) -> str:
+def _label(value: object) -> str:
     return f"{value:g}" if isinstance(value, float | np.floating) else str(value)
 
 
@@ -33,29 +40,30 @@ def _number(value: float) -> str:
     return f"{value:.0f}" if abs(value) >= 1000 else f"{value:.3g}"
 
 
-def _heatmap(ax: Any, grid: pd.DataFrame, metric: str) -> None:
+def _heatmap(ax: Axes, grid: pd.DataFrame, metric: str) -> None:
     values = grid.to_numpy(dtype=float)
     image = ax.imshow(values, origin="lower", aspect="auto", cmap="viridis")
     ax.figure.colorbar(image, ax=ax, label=LABELS.get(metric, metric))
     finite = values[np.isfinite(values)]
     if min(values.shape) > 1 and finite.size and np.ptp(finite) > 0:
         ax.contour(values, levels=5, colors="white", linewidths=0.7, alpha=0.8)
-    rows, cols = np.indices(values.shape)
-    for r, c, v in zip(rows.ravel(), cols.ravel(), values.ravel(), strict=True):
-        light = np.isfinite(v) and image.norm(v) > 0.6  # dark text on the yellow end
-        ax.text(c, r, _number(v), ha="center", va="center", fontsize=7,
+    shades = np.asarray(image.norm(values), dtype=float)
+    for (r, c), v in np.ndenumerate(values):
+        light = bool(np.isfinite(v) and shades[r, c] > 0.6)  # dark text on the yellow end
+        ax.text(c, r, _number(float(v)), ha="center", va="center", fontsize=7,
                 color="k" if light else "w")
     ax.set_xticks(range(values.shape[1]), [_label(v) for v in grid.columns])
     ax.set_yticks(range(values.shape[0]), [_label(v) for v in grid.index])
-    ax.set_xlabel(grid.columns.name)
-    ax.set_ylabel(grid.index.name)
+    ax.set_xlabel("" if grid.columns.name is None else str(grid.columns.name))
+    ax.set_ylabel("" if grid.index.name is None else str(grid.index.name))
     ax.set_title(LABELS.get(metric, metric))
 
 
 def sensitivity_figure(table: pd.DataFrame, mapper: str, x: str, y: str,
                        metrics: Sequence[str], *, terrain: str | None = None,
-                       fixed: Mapping[str, Any] | None = None) -> Any:
-    """One heatmap per metric over parameters ``x`` and ``y`` (mean over other parameters)."""
+                       fixed: Mapping[str, object] | None = None) -> Plot:
+    """One heatmap per metric over parameters ``x`` and ``y`` (mean over other parameters),
+    captioned with the mapper and the two parameters."""
     import matplotlib.pyplot as plt
 
     fig, axes = plt.subplots(1, len(metrics), figsize=(4.6 * len(metrics), 3.6),
@@ -66,7 +74,8 @@ def sensitivity_figure(table: pd.DataFrame, mapper: str, x: str, y: str,
     where = f" on {terrain}" if terrain else ""
     fixed_text = ", ".join(f"{k}={v}" for k, v in (fixed or {}).items())
     fig.suptitle(f"{mapper}{where}" + (f" ({fixed_text})" if fixed_text else ""))
-    return fig
+    return Plot(fig, Caption(f"{MAPPER_NAMES.get(mapper, mapper)}: {x} x {y}",
+                             f"Each metric over the {x} x {y} grid."))
 
 
 def _effects_panels(table: pd.DataFrame, metrics: Sequence[str],
@@ -77,7 +86,7 @@ def _effects_panels(table: pd.DataFrame, metrics: Sequence[str],
 
 
 def effects_figure(table: pd.DataFrame, metrics: Sequence[str], *,
-                   mappers: Sequence[str] | None = None) -> Any:
+                   mappers: Sequence[str] | None = None) -> Plot:
     """Main effects: each metric's mean at each level of each swept parameter.
 
     One column per (mapper, parameter), one row per metric; the columns of one mapper
@@ -92,7 +101,7 @@ def effects_figure(table: pd.DataFrame, metrics: Sequence[str], *,
                              figsize=(3.2 * len(panels), 2.5 * len(metrics)))
     for i, metric in enumerate(metrics):
         effects = {name: main_effects(table, name, metric) for name in dict(panels)}
-        first: dict[str, Any] = {}
+        first: dict[str, Axes] = {}
         for ax, (name, param) in zip(axes[i], panels, strict=True):
             if name in first:
                 ax.sharey(first[name])
@@ -103,4 +112,4 @@ def effects_figure(table: pd.DataFrame, metrics: Sequence[str], *,
             ax.set(xlabel=f"{name}: {param}", ylabel=LABELS.get(metric, metric))
             ax.grid(alpha=0.3)
     fig.suptitle("main effects (mean over the other swept parameters)")
-    return fig
+    return Plot(fig, MAIN_EFFECTS)

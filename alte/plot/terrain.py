@@ -1,8 +1,9 @@
 """Figures of chapters 4-5: the terrain, the registered cloud and map views from above.
 
-Figures take arrays (or a mapper / true surface) and
-return a ``matplotlib.figure.Figure``; the notebooks display and save them with
-:func:`alte.notebook.save_figure`. Maps are drawn from above: every known cell as a
+Figures take arrays (or a mapper / true surface) and return a
+:class:`~alte.plot.figure.Plot` (a ``matplotlib.figure.Figure`` with its caption), 3D views
+a :class:`~alte.plot.figure.View`; the notebooks display and save them with
+:func:`alte.plot.render.save_figure`. Maps are drawn from above: every known cell as a
 rectangle coloured by height (2D maps) or by its top (occupied 3D cells, drawn low to
 high so the highest cell of a column shows), which is how figures 5.2-5.5 read.
 """
@@ -10,18 +11,44 @@ high so the highest cell of a column shows), which is how figures 5.2-5.5 read.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 from matplotlib.collections import PolyCollection
 from matplotlib.figure import Figure
 
-__all__ = ["add_terrain", "cloud_figure", "map_grid_figure"]
+from alte.mappers.base import Mapper
+from alte.plot.arrays import Floats
+from alte.plot.figure import Caption, Plot, View
+from alte.plot.render import view
+
+if TYPE_CHECKING:
+    import pyvista as pv
+    from matplotlib.axes import Axes
+
+    from alte.metrics.surface import TrueSurface
+
+__all__ = ["MAPS", "SWEEPS", "add_terrain", "cloud_figure", "map_grid_figure", "terrain_view"]
+
+TERRAIN = Caption("Terrain (figs. 4.1, 4.7, 4.13, ...)",
+                  "The simulated terrain {TERRAIN} and its control volume.")
+CLOUD = Caption("Registered cloud", "The registered point cloud of {TERRAIN}.")
+#: A terrain's maps with the thesis' chapter 4 parameters (the default of
+#: :func:`map_grid_figure`).
+MAPS = Caption("Maps with the chapter 4 parameters",
+               "The two mappers of this case with the thesis' chapter 4 parameters.")
+#: The thesis' sweep figures 5.2-5.5, per mapper.
+SWEEPS = {
+    "quadtree": Caption("Quadtree sweep (fig. 5.2)", "Quadtree maps over max_points."),
+    "octomap": Caption("Octomap sweep (fig. 5.3)", "Octomap maps over resolution."),
+    "alte2d": Caption("2D-ALTE sweep (fig. 5.4)", "2D-ALTE maps for the thesis' settings."),
+    "alte3d": Caption("3D-ALTE sweep (fig. 5.5)", "3D-ALTE maps for the thesis' settings."),
+}
 
 _MAX_DOTS = 60_000
 
 
-def cloud_figure(points: np.ndarray, title: str = "registered cloud") -> Figure:
+def cloud_figure(points: Floats, title: str = "registered cloud") -> Plot:
     """Top view of a cloud coloured by height (thinned to at most 60 000 dots)."""
     step = max(1, len(points) // _MAX_DOTS)
     pts = points[::step]
@@ -31,10 +58,10 @@ def cloud_figure(points: np.ndarray, title: str = "registered cloud") -> Figure:
     fig.colorbar(dots, ax=ax, label="z [m]")
     ax.set_aspect("equal")
     ax.set_title(title)
-    return fig
+    return Plot(fig, CLOUD)
 
 
-def _draw_cells(ax: Any, mapper: Any) -> Any:
+def _draw_cells(ax: Axes, mapper: Mapper) -> PolyCollection:
     cells = mapper.cells()
     keep = np.isfinite(cells.centers).all(axis=1)
     if mapper.dims == 3:
@@ -54,8 +81,10 @@ def _draw_cells(ax: Any, mapper: Any) -> Any:
     return coll
 
 
-def map_grid_figure(mappers: Sequence[Any], titles: Sequence[str], columns: int = 3) -> Figure:
-    """Maps side by side from above, one panel per mapper (figures 4.x and 5.2-5.5)."""
+def map_grid_figure(mappers: Sequence[Mapper], titles: Sequence[str], columns: int = 3, *,
+                    caption: Caption = MAPS) -> Plot:
+    """Maps side by side from above, one panel per mapper (figures 4.x and 5.2-5.5:
+    ``caption`` :data:`MAPS` or one of :data:`SWEEPS`)."""
     rows = max(1, -(-len(mappers) // columns))
     cols = min(columns, max(1, len(mappers)))
     fig = Figure(figsize=(4.2 * cols, 3.8 * rows))
@@ -66,11 +95,11 @@ def map_grid_figure(mappers: Sequence[Any], titles: Sequence[str], columns: int 
         ax.set_title(title, fontsize=9)
     for ax in axes[len(mappers):]:
         ax.set_visible(False)
-    return fig
+    return Plot(fig, caption)
 
 
-def add_terrain(plotter: Any, surface: Any, bounds: np.ndarray | None = None,
-                opacity: float = 1.0) -> Any:
+def add_terrain(plotter: pv.Plotter, surface: TrueSurface, bounds: Floats | None = None,
+                opacity: float = 1.0) -> pv.Plotter:
     """Add a ground-truth mesh (a :class:`~alte.metrics.TrueSurface`) coloured by object,
     clipped to ``bounds`` (2, 3) when given (the control volume)."""
     import pyvista as pv
@@ -83,3 +112,11 @@ def add_terrain(plotter: Any, surface: Any, bounds: np.ndarray | None = None,
                              invert=False)
     plotter.add_mesh(mesh, scalars="object", cmap="tab20", opacity=opacity, show_scalar_bar=False)
     return plotter
+
+
+def terrain_view(surface: TrueSurface, bounds: Floats | None = None) -> View:
+    """The ground-truth mesh coloured by object, clipped to the control volume ``bounds``
+    (figures 4.1, 4.7, 4.13, ...)."""
+    terrain = view(TERRAIN)
+    add_terrain(terrain.plotter, surface, bounds)
+    return terrain

@@ -11,13 +11,17 @@ from __future__ import annotations
 
 import os
 from collections.abc import Iterator, Sequence
+from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pandas as pd
 
 from alte.errors import ParameterError
+from alte.plot.figure import Caption, Plot
+from alte.plot.render import Draw, save_figures
 from alte.studies.tradeoff import (
     MAPPER_NAMES,
     equal_fidelity,
@@ -31,8 +35,14 @@ from alte.studies.tradeoff import (
 )
 from alte.studies.uncertainty import bootstrap_columns
 
-__all__ = ["COLORS", "CURVES", "PAIRS", "equal_fidelity_figure", "equal_size_figure",
-           "save_figures", "save_tradeoff_figures", "tradeoff_figure"]
+if TYPE_CHECKING:
+    from matplotlib.artist import Artist
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
+__all__ = ["COLORS", "CURVES", "EQUAL_FIDELITY", "EQUAL_SIZE", "FRONT", "PAIRS",
+           "TradeoffCurve", "equal_fidelity_figure", "equal_size_figure",
+           "save_tradeoff_figures", "tradeoff_figure"]
 
 #: One colour per mapper, the same in every figure.
 COLORS = {"quadtree": "tab:blue", "alte2d": "tab:orange", "octomap": "tab:green",
@@ -40,26 +50,33 @@ COLORS = {"quadtree": "tab:blue", "alte2d": "tab:orange", "octomap": "tab:green"
 _GRID_POINTS = 25
 
 
-def panels(count: int, width: float = 4.2, height: float = 3.4) -> tuple[Any, np.ndarray]:
+#: How to read a trade-off figure, the end of each one's caption.
+FRONT = ("Each dot is one map (a parameter setting and seed); the line is the mapper's Pareto "
+         "front (no other of its maps is both smaller and better) averaged over seeds, the "
+         "band its 95 % bootstrap interval over seeds; the star marks the thesis' chosen "
+         "setting. Size on a log axis, and errors and times too (they span decades over a "
+         "grid); completeness on a linear one.")
+def panels(count: int, width: float = 4.2, height: float = 3.4) -> tuple[Figure, list[Axes]]:
     import matplotlib.pyplot as plt
 
     cols = min(count, 4)
     rows = -(-count // cols)
     fig, axes = plt.subplots(rows, cols, figsize=(width * cols, height * rows), squeeze=False,
                              layout="constrained")
-    for ax in axes.ravel()[count:]:
+    flat: list[Axes] = list(axes.ravel())
+    for ax in flat[count:]:
         ax.set_visible(False)
-    return fig, axes.ravel()
+    return fig, flat
 
 
-def legend(fig: Any) -> None:
+def legend(fig: Figure) -> None:
     """One legend below the panels with every label once."""
-    handles: dict[str, Any] = {}
+    handles: dict[str, Artist] = {}
     for ax in fig.axes:
         for handle, text in zip(*ax.get_legend_handles_labels(), strict=True):
             handles.setdefault(text, handle)
     if handles:
-        fig.legend(handles.values(), handles.keys(), loc="outside lower center",
+        fig.legend(list(handles.values()), list(handles.keys()), loc="outside lower center",
                    ncols=min(len(handles), 4), fontsize=8)
 
 
@@ -75,7 +92,7 @@ def _select(table: pd.DataFrame, mappers: Sequence[str] | None,
                                                                   if t in present]
 
 
-def mean_front(ax: Any, rows: pd.DataFrame, mapper: str, axes: tuple[str, str],
+def mean_front(ax: Axes, rows: pd.DataFrame, mapper: str, axes: tuple[str, str],
                 higher_is_better: bool) -> None:
     """The mean front over seeds, read at sizes every seed's maps span, with its band."""
     size, metric = axes
@@ -102,7 +119,7 @@ def log_axis(metric: str) -> bool:
     return metric.endswith(("_m", "_s"))
 
 
-def _thesis_star(ax: Any, rows: pd.DataFrame, mapper: str, axes: tuple[str, str]) -> None:
+def _thesis_star(ax: Axes, rows: pd.DataFrame, mapper: str, axes: tuple[str, str]) -> None:
     setting = thesis_setting(mapper)
     chosen = rows[matching(rows, setting)] if setting else rows.iloc[:0]
     if not chosen.empty:
@@ -114,10 +131,10 @@ def _thesis_star(ax: Any, rows: pd.DataFrame, mapper: str, axes: tuple[str, str]
 def tradeoff_figure(table: pd.DataFrame, metric: str = "mhd_m", *,
                     size: str = "basis_functions", mappers: Sequence[str] | None = None,
                     terrains: Sequence[str] | None = None,
-                    higher_is_better: bool = False) -> Any:
+                    higher_is_better: bool = False, caption: Caption | None = None) -> Plot:
     """One panel per terrain: ``metric`` against ``size`` (log) for each mapper, every map
     as a dot, the mean Pareto front over seeds with its bootstrap band, the thesis' setting
-    starred."""
+    starred (``caption``: by default how to read it, see :data:`CURVES` for the page's)."""
     rows, names, places = _select(prepare(table), mappers, terrains)
     fig, axes = panels(len(places))
     for ax, terrain in zip(axes, places, strict=False):
@@ -141,11 +158,12 @@ def tradeoff_figure(table: pd.DataFrame, metric: str = "mhd_m", *,
     seeds = rows["seed"].nunique()
     fig.suptitle(f"{label(metric)} against {label(size)}: Pareto fronts, mean over {seeds} "
                  f"seed{'s' if seeds != 1 else ''} with 95 % bootstrap band")
-    return fig
+    return Plot(fig, caption or Caption(f"{label(metric, False)} against {label(size, False)}",
+                                        FRONT))
 
 
 def _levelpanels(summary: pd.DataFrame, names: Sequence[str], ylabel: str, xlabel: str,
-                  title: str) -> Any:
+                  title: str) -> Figure:
     places = sorted(set(summary["terrain"]))
     if not places:
         raise ParameterError("no terrain has every mapper over a common range to compare")
@@ -170,80 +188,110 @@ def _levelpanels(summary: pd.DataFrame, names: Sequence[str], ylabel: str, xlabe
 
 def equal_size_figure(table: pd.DataFrame, mappers: Sequence[str], metric: str = "mhd_m", *,
                       size: str = "basis_functions", levels: Sequence[float] | None = None,
-                      higher_is_better: bool = False) -> Any:
+                      higher_is_better: bool = False, caption: Caption | None = None) -> Plot:
     """``metric`` of each mapper read off its front at equal ``size`` (mean over seeds,
-    95 % bootstrap interval), one panel per terrain."""
+    95 % bootstrap interval), one panel per terrain (``caption``: see :data:`EQUAL_SIZE`)."""
     reads = equal_size(prepare(table), mappers, metric, size=size, levels=levels,
                        higher_is_better=higher_is_better)
-    return _levelpanels(interval_table(reads.dropna(subset=["value"])), mappers,
-                         label(metric), label(size),
-                         f"{label(metric)} at equal {label(size, False)}")
+    title = f"{label(metric)} at equal {label(size, False)}"
+    fig = _levelpanels(interval_table(reads.dropna(subset=["value"])), mappers,
+                       label(metric), label(size), title)
+    return Plot(fig, caption or Caption(title, _READ))
 
 
 def equal_fidelity_figure(table: pd.DataFrame, mappers: Sequence[str],
                           metric: str = "basis_functions", *, fidelity: str = "mhd_m",
-                          levels: Sequence[float] | None = None) -> Any:
-    """The ``metric`` (size or time) each mapper needs for equal ``fidelity`` (log axis)."""
+                          levels: Sequence[float] | None = None,
+                          caption: Caption | None = None) -> Plot:
+    """The ``metric`` (size or time) each mapper needs for equal ``fidelity`` (log axis;
+    ``caption``: see :data:`EQUAL_FIDELITY`)."""
     reads = equal_fidelity(prepare(table), mappers, metric, fidelity=fidelity, levels=levels)
+    title = f"{label(metric)} needed for equal {label(fidelity)}"
     fig = _levelpanels(interval_table(reads.dropna(subset=["value"])), mappers,
-                        label(metric), label(fidelity),
-                        f"{label(metric)} needed for equal {label(fidelity)}")
+                       label(metric), label(fidelity), title)
     for ax in fig.axes:
         ax.set_yscale("log")
-    return fig
+    return Plot(fig, caption or Caption(title, _READ + " Log axis."))
 
 
-#: The front page's trade-off figures: name -> (metric, size, higher is better).
-CURVES: dict[str, tuple[str, str, bool]] = {
-    "tradeoff_mhd": ("mhd_m", "basis_functions", False),
-    "tradeoff_accuracy": ("accuracy_mean_m", "basis_functions", False),
-    "tradeoff_completeness": ("completeness", "basis_functions", True),
-    "tradeoff_height_rmse": ("height_rmse_m", "basis_functions", False),
-    "tradeoff_time": ("elapsed_s", "basis_functions", False),
-    "tradeoff_memory": ("mhd_m", "memory_bytes", False),
-    "tradeoff_obstacle_recall": ("obstacle_recall", "basis_functions", True),
-    "tradeoff_obstacle_precision": ("obstacle_precision", "basis_functions", True),
+_READ = "Read off each mapper's front; mean over seeds with 95 % bootstrap intervals."
+
+
+@dataclass(frozen=True)
+class TradeoffCurve:
+    """A front-page trade-off figure: ``metric`` against ``size``, and its caption."""
+
+    metric: str
+    size: str
+    higher_is_better: bool
+    caption: Caption
+
+
+#: The front page's trade-off figures by name.
+CURVES: dict[str, TradeoffCurve] = {
+    "tradeoff_mhd": TradeoffCurve("mhd_m", "basis_functions", False,
+                                  Caption("MHD against map size", FRONT)),
+    "tradeoff_accuracy": TradeoffCurve(
+        "accuracy_mean_m", "basis_functions", False,
+        Caption("Mean accuracy against map size", "Ground-truth accuracy (distance of each "
+                "occupied cell to the true surface). " + FRONT)),
+    "tradeoff_completeness": TradeoffCurve(
+        "completeness", "basis_functions", True,
+        Caption("Completeness against map size", "Share of the true surface the map covers "
+                "(higher is better: the front is the upper-left envelope). " + FRONT)),
+    "tradeoff_height_rmse": TradeoffCurve(
+        "height_rmse_m", "basis_functions", False,
+        Caption("Height RMSE against map size (2D maps)",
+                "RMSE of the map height against the true top surface. " + FRONT)),
+    "tradeoff_time": TradeoffCurve(
+        "elapsed_s", "basis_functions", False,
+        Caption("Mapping time against map size", "Time spent in the mapper calls only. "
+                + FRONT)),
+    "tradeoff_memory": TradeoffCurve("mhd_m", "memory_bytes", False,
+                                     Caption("MHD against memory", FRONT)),
+    "tradeoff_obstacle_recall": TradeoffCurve(
+        "obstacle_recall", "basis_functions", True,
+        Caption("Obstacle recall against map size",
+                "Share of the true obstacles the map shows (simulator objects standing at "
+                "least the landing study's obstacle step above the ground, 0.3 m at urban "
+                "scale and 0.06 m in the lab, seen from above; higher is better). " + FRONT)),
+    "tradeoff_obstacle_precision": TradeoffCurve(
+        "obstacle_precision", "basis_functions", True,
+        Caption("Obstacle precision against map size",
+                "Share of the map's obstacles (connected areas more than that step above its "
+                "ground) that lie on a true object (higher is better). " + FRONT)),
 }
 #: Pairs compared at equal size / fidelity: figure suffix -> mappers.
 PAIRS = {"2d": ("quadtree", "alte2d"), "3d": ("octomap", "alte3d")}
+#: Captions of the pairs' equal-size figures (``equal_size_<suffix>``).
+EQUAL_SIZE = {s: Caption(f"{s.upper()} maps at equal size",
+                         f"MHD each {s.upper()} mapper reaches at the same number of basis "
+                         "functions, read off its front; mean over seeds with 95 % bootstrap "
+                         "intervals.") for s in PAIRS}
+#: Captions of the pairs' equal-fidelity figures (``equal_fidelity_<suffix>``).
+EQUAL_FIDELITY = {s: Caption(f"{s.upper()} maps at equal fidelity",
+                             f"Basis functions each {s.upper()} mapper needs for the same MHD "
+                             "(log axis); mean over seeds with 95 % bootstrap intervals.")
+                  for s in PAIRS}
 
 
-def _figures(table: pd.DataFrame) -> Iterator[tuple[str, Any]]:
-    for name, (metric, size, higher) in CURVES.items():
-        if metric in table and table[metric].notna().any():
-            rows = table[table[metric].notna()]
-            yield name, lambda r=rows, m=metric, s=size, h=higher: tradeoff_figure(
-                r, m, size=s, higher_is_better=h)
+def _figures(table: pd.DataFrame) -> Iterator[tuple[str, Draw]]:
+    for name, curve in CURVES.items():
+        if curve.metric in table and table[curve.metric].notna().any():
+            yield name, partial(tradeoff_figure, table[table[curve.metric].notna()],
+                                curve.metric, size=curve.size,
+                                higher_is_better=curve.higher_is_better, caption=curve.caption)
     for suffix, pair in PAIRS.items():
-        yield f"equal_size_{suffix}", lambda p=pair: equal_size_figure(table, p)
-        yield f"equal_fidelity_{suffix}", lambda p=pair: equal_fidelity_figure(table, p)
-
-
-def save_figures(figures: Iterator[tuple[str, Any]], out_dir: str | os.PathLike[str],
-                 close: bool = True) -> dict[str, Path | str]:
-    """Draw each (name, draw) and save it as ``out_dir/figures/<name>.png``; a figure that
-    cannot be drawn (:class:`ParameterError`) is recorded as ``"not drawn: <reason>"``."""
-    import matplotlib.pyplot as plt
-
-    from alte.notebook import save_figure
-
-    out: dict[str, Path | str] = {}
-    for name, draw in figures:
-        try:
-            fig = draw()
-        except ParameterError as err:
-            out[name] = f"not drawn: {err}"
-            continue
-        out[name] = save_figure(fig, out_dir, name)
-        if close:
-            plt.close(fig)
-    return out
+        yield f"equal_size_{suffix}", partial(equal_size_figure, table, pair,
+                                              caption=EQUAL_SIZE[suffix])
+        yield f"equal_fidelity_{suffix}", partial(equal_fidelity_figure, table, pair,
+                                                  caption=EQUAL_FIDELITY[suffix])
 
 
 def save_tradeoff_figures(table: pd.DataFrame, out_dir: str | os.PathLike[str], *,
                           close: bool = True) -> dict[str, Path | str]:
-    """Draw and save every trade-off figure the front page shows (names as in
-    :mod:`alte.report.captions`) as ``out_dir/figures/<name>.png``; returns name -> path,
+    """Draw and save every trade-off figure the front page shows (:data:`CURVES`, the
+    pairs at equal size and fidelity) as ``out_dir/figures/<name>.png``; returns name -> path,
     or the reason a figure could not be drawn (e.g. a mapper absent from the table).
     ``close=False`` leaves the figures open (a notebook then shows them)."""
     return save_figures(_figures(table), out_dir, close)

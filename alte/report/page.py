@@ -14,25 +14,25 @@ from __future__ import annotations
 
 import json
 import os
-from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from collections.abc import Hashable, Mapping, Sequence
+from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any
 
 import pandas as pd
 
 from alte.report.answer import AnswerView, answer_view
 from alte.report.captions import (
-    FIGURES,
     KEY_TABLES,
     TRADEOFF_PREFIXES,
     KeyTable,
     caption,
     chapter_title,
+    saved_figures,
 )
 from alte.report.plan import PLAN
 from alte.report.tableview import TableView, cell_text, header, table_view
 from alte.studies.claims.questions import QUESTIONS, question
+from alte.types import JSON, JSONMap
 
 __all__ = ["CLAIMS_CSV", "MISSIONS_CSV", "ClaimGroup", "ClaimRow", "FigureItem", "RunPage",
            "RunSection", "TableItem", "run_page"]
@@ -138,15 +138,28 @@ def _notebook(name: str) -> str:
     return name
 
 
-def _read_json(path: Path) -> Mapping[str, Any]:
+def _read_json(path: Path) -> JSONMap:
     try:
-        data = json.loads(path.read_text(encoding="utf-8"))
+        return _map(json.loads(path.read_text(encoding="utf-8")))
     except (OSError, ValueError):
         return {}
-    return data if isinstance(data, dict) else {}
 
 
-def _scalar_text(key: str, value: Any) -> str | None:
+def _map(value: JSON) -> JSONMap:
+    """``value`` if it is a JSON object, else an empty one."""
+    return value if isinstance(value, Mapping) else {}
+
+
+def _list(value: JSON) -> Sequence[JSON]:
+    """``value`` if it is a JSON list, else an empty one."""
+    return value if isinstance(value, Sequence) and not isinstance(value, str) else []
+
+
+def _seconds(value: JSON) -> float:
+    return float(value) if isinstance(value, int | float) else 0.0
+
+
+def _scalar_text(key: str, value: JSON) -> str | None:
     """A headline value as text, or None for what is no headline (nested data, paths)."""
     if isinstance(value, list) and len(value) <= 8 and all(
             isinstance(v, int | float | str) for v in value):
@@ -157,7 +170,7 @@ def _scalar_text(key: str, value: Any) -> str | None:
     return None
 
 
-def _results(data: Mapping[str, Any]) -> list[tuple[str, str]]:
+def _results(data: JSONMap) -> list[tuple[str, str]]:
     out = []
     for key, value in data.items():
         text = _scalar_text(key, value) if key != "captions" else None
@@ -166,21 +179,10 @@ def _results(data: Mapping[str, Any]) -> list[tuple[str, str]]:
     return out
 
 
-def _figures(run_dir: Path, name: str, params: Mapping[str, Any],
-             own: Mapping[str, Any]) -> list[FigureItem]:
-    folder = run_dir / name / "figures"
-    notebook = _notebook(name)
-    known = list(FIGURES.get(notebook, {}))
-
-    def order(png: Path) -> tuple[int, int, str]:
-        prefix = next((i for i, p in enumerate(TRADEOFF_PREFIXES) if png.stem.startswith(p)),
-                      -1)
-        rank = known.index(png.stem) if png.stem in known else len(known)
-        return prefix, rank, png.stem
-
+def _figures(run_dir: Path, name: str, params: JSONMap, own: JSONMap) -> list[FigureItem]:
     items = []
-    for png in sorted(folder.glob("*.png"), key=order) if folder.is_dir() else []:
-        text = caption(notebook, png.stem, params, own)
+    for png, saved in saved_figures(run_dir / name / "figures"):
+        text = caption(png.stem, saved, params, own)
         items.append(FigureItem(png.relative_to(run_dir).as_posix(), text.title, text.text))
     return items
 
@@ -189,20 +191,19 @@ def _is_tradeoff(item: FigureItem) -> bool:
     return Path(item.src).stem.startswith(TRADEOFF_PREFIXES)
 
 
-def _section(run: Mapping[str, Any], run_dir: Path) -> RunSection:
+def _section(run: JSONMap, run_dir: Path) -> RunSection:
     name = str(run["name"])
-    params = run.get("parameters") or {}
+    params = _map(run.get("parameters"))
     data = _read_json(run_dir / name / "results.json")
-    own = data.get("captions") if isinstance(data.get("captions"), dict) else None
     links = [(label, str(run[key])) for key, label in (("html", "executed notebook"),
                                                        ("notebook", "notebook (.ipynb)"))
              if run.get(key)]
     return RunSection(name, chapter_title(_notebook(name), name, params), str(run["status"]),
-                      float(run.get("seconds") or 0.0), links, str(run.get("error") or ""),
-                      _results(data), _figures(run_dir, name, params, own or {}))
+                      _seconds(run.get("seconds")), links, str(run.get("error") or ""),
+                      _results(data), _figures(run_dir, name, params, _map(data.get("captions"))))
 
 
-def _whole_missions(tables_dir: Path) -> dict[str, Mapping[Any, Any]]:
+def _whole_missions(tables_dir: Path) -> dict[str, Mapping[Hashable, object]]:
     """Per claim id, its row of ``claims_missions.csv`` (empty without that table)."""
     path = tables_dir / MISSIONS_CSV
     if not path.is_file():
@@ -274,23 +275,23 @@ def _counts(claims: Sequence[ClaimRow]) -> list[tuple[str, int, str]]:
     return [(v, n, _VERDICT_CSS.get(v, "untested")) for v, n in counts.items() if n]
 
 
-def run_page(record: Mapping[str, Any], run_dir: str | os.PathLike[str],
+def run_page(record: JSONMap, run_dir: str | os.PathLike[str],
              tables: Sequence[Path]) -> RunPage:
     """The page model of the run in ``run_dir`` (its record, files and ``tables``)."""
     run_dir = Path(run_dir)
-    runs = list(record["runs"])
+    runs = [r for r in _list(record["runs"]) if isinstance(r, Mapping)]
     failed = [(str(r["name"]), str(r["status"])) for r in runs if r["status"] != "ok"]
     summary = (f"{record['mode']} mode, started {record['started']}: {len(runs)} notebooks, "
-               f"{len(failed)} failed, {record['seconds']:.1f} s in all")
+               f"{len(failed)} failed, {_seconds(record['seconds']):.1f} s in all")
     claims = _claims(run_dir / "tables")
     page = RunPage(f"alte report {run_dir.name}", summary, failed,
-                   [str(p) for p in record.get("problems", [])], claims, _counts(claims),
+                   [str(p) for p in _list(record.get("problems"))], claims, _counts(claims),
                    answer_view(run_dir / "tables"), _groups(claims))
     for run in runs:
         section = _section(run, run_dir)
         page.tradeoff += [f for f in section.figures if _is_tradeoff(f)]
-        page.sections.append(RunSection(**{**section.__dict__, "figures": [
-            f for f in section.figures if not _is_tradeoff(f)]}))
+        page.sections.append(replace(section, figures=[
+            f for f in section.figures if not _is_tradeoff(f)]))
     by_name = {t.stem: t for t in tables}
     page.key_tables = [_table(by_name[k.name], run_dir, k) for k in KEY_TABLES
                        if k.name in by_name]

@@ -30,7 +30,8 @@ import json
 import ipywidgets
 import pyvista as pv
 import alte.notebook
-from alte.plot.render import new_plotter, show
+from alte.plot.figure import Caption
+from alte.plot.render import show, view
 
 from IPython.display import display
 from matplotlib.figure import Figure
@@ -39,9 +40,9 @@ mode = alte.notebook.setup()
 figure = Figure()
 figure.add_subplot().plot([0, 1], [1, 0])
 display(figure)  # a 2D figure: always a PNG
-plotter = new_plotter(window_size=(320, 240))
-plotter.add_mesh(pv.Sphere())
-show(plotter, {out!r}, "sphere")
+sphere = view(Caption("Sphere", "A sphere."), window_size=(320, 240))
+sphere.plotter.add_mesh(pv.Sphere())
+show(sphere, {out!r}, "sphere")
 views = [w for w in list(ipywidgets.Widget.widgets.values()) if hasattr(w, "src")]
 print("RESULT" + json.dumps({{"mode": mode, "views": [type(v).__module__ + "."
       + type(v).__name__ for v in views], "src": [v.src for v in views]}}))

@@ -11,6 +11,7 @@ import matplotlib.pyplot as plt
 
 from alte.mappers.base import Cells
 from alte.plot.maps import (
+    QUADTREE_TIMELAPSE,
     UNKNOWN_COLOR,
     add_cells_3d,
     add_timelapse_3d,
@@ -114,7 +115,7 @@ def test_timelapse_figures() -> None:
 
     snaps = [SimpleNamespace(time=1.0, cells=cells_2d()),
              SimpleNamespace(time=2.5, cells=cells_3d())]
-    fig = plot_timelapse_2d(snaps, title="demo")
+    fig = plot_timelapse_2d(snaps, title="demo", caption=QUADTREE_TIMELAPSE).figure
     assert len(fig.axes) >= 4 and "t = 2.5 s" in fig.axes[2].get_title()
     plt.close(fig)
     plotter = pv.Plotter(off_screen=True, shape=(1, 2), window_size=[300, 150])

@@ -25,8 +25,11 @@ def _table():
 
 
 def test_sensitivity_figure_draws_one_annotated_heatmap_per_metric():
-    fig = sensitivity_figure(_table(), "alte2d", "kappa", "max_res",
-                             ["mhd_m", "basis_functions"])
+    plot = sensitivity_figure(_table(), "alte2d", "kappa", "max_res",
+                              ["mhd_m", "basis_functions"])
+    assert plot.caption.title == "2D-ALTE: kappa x max_res"
+    assert plot.caption.text == "Each metric over the kappa x max_res grid."
+    fig = plot.figure
     heatmaps = [ax for ax in fig.axes if ax.images]
     assert len(heatmaps) == 2
     values = heatmaps[0].images[0].get_array()
@@ -37,7 +40,7 @@ def test_sensitivity_figure_draws_one_annotated_heatmap_per_metric():
 
 
 def test_effects_figure_has_a_panel_per_metric_and_parameter():
-    fig = effects_figure(_table(), ["mhd_m", "basis_functions"])
+    fig = effects_figure(_table(), ["mhd_m", "basis_functions"]).figure
     assert [ax.get_xlabel() for ax in fig.axes[:3]] == ["alte2d: kappa", "alte2d: max_res",
                                                        "quadtree: max_points"]
     assert len(fig.axes) == 6

@@ -21,6 +21,6 @@ def test_map_grid_figure_draws_one_panel_per_map() -> None:
         mapper = make_mapper("alte2d", {"max_res": max_res}, domain=Domain(0, 0, -1, 16))
         mapper.build(cloud)
         maps.append(mapper)
-    fig = map_grid_figure(maps, ["a", "b"], columns=3)
+    fig = map_grid_figure(maps, ["a", "b"], columns=3).figure
     visible = [ax for ax in fig.axes if ax.get_visible() and ax.get_title()]
     assert [ax.get_title() for ax in visible] == ["a", "b"]

@@ -12,8 +12,12 @@ import pytest
 from support.tradeoff import Curve, synthetic_tradeoff
 
 from alte.errors import ParameterError
+from alte.plot.figure import read_caption
 from alte.plot.tradeoff import (
     COLORS,
+    CURVES,
+    EQUAL_FIDELITY,
+    EQUAL_SIZE,
     equal_fidelity_figure,
     equal_size_figure,
     save_tradeoff_figures,
@@ -30,8 +34,11 @@ def _visible(fig):
     return [ax for ax in fig.axes if ax.get_visible()]
 
 
+
+
+
 def test_tradeoff_figure_has_a_log_panel_per_terrain_and_a_front_per_mapper(table):
-    fig = tradeoff_figure(table)
+    fig = tradeoff_figure(table).figure
     axes = _visible(fig)
     assert [ax.get_title() for ax in axes] == ["sim_lan_1", "sim_lan_2", "sim_nav_1",
                                                "sim_nav_2"]
@@ -54,7 +61,7 @@ def test_tradeoff_figure_has_a_log_panel_per_terrain_and_a_front_per_mapper(tabl
 
 def test_tradeoff_figure_selects_and_reports_empty_selections(table):
     fig = tradeoff_figure(table, "completeness", mappers=["octomap"], terrains=["sim_nav_1"],
-                          higher_is_better=True)
+                          higher_is_better=True).figure
     (ax,) = _visible(fig)
     assert ax.get_title() == "sim_nav_1" and ax.get_ylabel() == "completeness"
     assert ax.get_yscale() == "linear"  # a share, not an error spanning decades
@@ -64,7 +71,7 @@ def test_tradeoff_figure_selects_and_reports_empty_selections(table):
 
 
 def test_equal_size_figure_places_each_mapper_at_each_level(table):
-    fig = equal_size_figure(table, ("quadtree", "alte2d"), levels=(1000, 5000, 20000))
+    fig = equal_size_figure(table, ("quadtree", "alte2d"), levels=(1000, 5000, 20000)).figure
     axes = _visible(fig)
     assert len(axes) == 2 and axes[0].get_xlabel() == "basis functions"
     labels = [t.get_text() for t in axes[0].get_xticklabels()]
@@ -73,7 +80,7 @@ def test_equal_size_figure_places_each_mapper_at_each_level(table):
 
 
 def test_equal_fidelity_figure_uses_a_log_size_axis(table):
-    fig = equal_fidelity_figure(table, ("octomap", "alte3d"))
+    fig = equal_fidelity_figure(table, ("octomap", "alte3d")).figure
     axes = _visible(fig)
     assert all(ax.get_yscale() == "log" for ax in axes)
     assert axes[0].get_xlabel() == "MHD [m]"
@@ -84,8 +91,6 @@ def test_equal_fidelity_figure_uses_a_log_size_axis(table):
 
 @pytest.mark.slow
 def test_save_tradeoff_figures_writes_every_captioned_figure(tmp_path):
-    from alte.report.captions import FIGURES
-
     small = synthetic_tradeoff({"alte2d": Curve(scale=0.5)}, seeds=(0, 1), terrains={
         m: ("sim_lan_1",) for m in ("quadtree", "alte2d")} | {"octomap": ("sim_nav_1",)})
     out = save_tradeoff_figures(small.query("mapper != 'alte3d'"), tmp_path)
@@ -96,4 +101,9 @@ def test_save_tradeoff_figures_writes_every_captioned_figure(tmp_path):
                      "equal_size_2d", "equal_fidelity_2d"}
     assert out["equal_size_3d"].startswith("not drawn: no terrain has every mapper")
     assert all((tmp_path / "figures" / f"{k}.png").stat().st_size > 1000 for k in drawn)
-    assert set(out) <= set(FIGURES["ch5_analysis"])
+    captions = {**{k: c.caption for k, c in CURVES.items()},
+                **{f"equal_size_{k}": c for k, c in EQUAL_SIZE.items()},
+                **{f"equal_fidelity_{k}": c for k, c in EQUAL_FIDELITY.items()}}
+    assert set(out) <= set(captions)
+    assert {k: read_caption(tmp_path / "figures" / f"{k}.png").caption
+            for k in drawn} == {k: captions[k] for k in drawn}

@@ -9,6 +9,8 @@ import nbformat
 import pandas as pd
 import pytest
 
+from alte.plot.figure import Caption, Plot
+
 GOOD_PARAMS = ('OUT_DIR = "reports/scratch/good"\nTABLES_DIR = "reports/scratch/tables"\n'
                "SEED = 0\nROWS = 3\n")
 GOOD_BODY = """\
@@ -19,6 +21,7 @@ import matplotlib.pyplot as plt
 from pathlib import Path
 from alte.fsutil import atomic_path
 from alte.notebook import save_figure, save_results
+from alte.plot.figure import Caption, Plot
 rng = np.random.default_rng(SEED)
 values = rng.normal(size=(ROWS, 2))
 path = Path(TABLES_DIR) / "table_5_1.csv"
@@ -26,7 +29,7 @@ with atomic_path(path, overwrite=True) as tmp:
     np.savetxt(tmp, values, delimiter=",", header="a,b", comments="", fmt="%.12g")
 fig, ax = plt.subplots()
 ax.plot(values[:, 0])
-save_figure(fig, OUT_DIR, "curve")
+save_figure(Plot(fig, Caption("Curve", "The first column, row by row.")), OUT_DIR, "curve")
 print("rows", ROWS)
 """
 BAD_PARAMS = 'OUT_DIR = "reports/scratch/bad"\nMESSAGE = "boom"\n'
@@ -73,8 +76,9 @@ def write_plan(path: Path, entries: list[dict]) -> Path:
     return path
 
 
-def _png(folder: Path, name: str) -> None:
-    """A small real PNG (browsers must be able to decode it)."""
+def _png(folder: Path, name: str, caption: Caption | None = None) -> None:
+    """A small real PNG (browsers must be able to decode it) saved with ``caption``
+    (one in the figure's name by default)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -84,7 +88,8 @@ def _png(folder: Path, name: str) -> None:
 
     fig, ax = plt.subplots(figsize=(2, 1.5))
     ax.plot([0, 1], [1, 0])
-    save_figure(fig, folder, name)
+    text = Caption(name.replace("_", " ").capitalize(), f"The {name} figure of {{TERRAIN}}.")
+    save_figure(Plot(fig, caption or text), folder, name)
     plt.close(fig)
 
 
@@ -116,10 +121,15 @@ def make_front_run(run_dir: Path) -> dict:
                   "set_b_centers": ["holds", "does not hold", "holds"],
                   "moves": ["", "set_b_centers", ""]}).to_csv(tables / "ablation.csv",
                                                               index=False)
-    for name in ("terrain", "cloud", "mystery"):
-        _png(run_dir / "ch4_sim_lan_1", name)
-    for name in ("fig_5_2", "tradeoff_mhd", "equal_size_2d"):
-        _png(run_dir / "ch5_analysis", name)
+    from alte.plot.terrain import CLOUD, SWEEPS, TERRAIN
+    from alte.plot.tradeoff import CURVES, EQUAL_SIZE
+
+    for name, caption in (("terrain", TERRAIN), ("cloud", CLOUD), ("mystery", None)):
+        _png(run_dir / "ch4_sim_lan_1", name, caption)
+    for name, caption in (("fig_5_2", SWEEPS["quadtree"]),
+                          ("tradeoff_mhd", CURVES["tradeoff_mhd"].caption),
+                          ("equal_size_2d", EQUAL_SIZE["2d"])):
+        _png(run_dir / "ch5_analysis", name, caption)
     (run_dir / "ch4_sim_lan_1" / "results.json").write_text(json.dumps(
         {"terrain": "sim_lan_1", "frames": 40, "points": 120161, "rows": [0, 1, 2],
          "maps": {"quadtree": {"params": {"max_points": 200}}},

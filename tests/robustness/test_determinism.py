@@ -127,6 +127,7 @@ from pathlib import Path
 from alte.fsutil import atomic_path
 from alte.mappers import make_mapper
 from alte.notebook import save_figure, save_results, setup
+from alte.plot.figure import Caption, Plot
 import matplotlib.pyplot as plt
 setup()
 rng = np.random.default_rng(SEED)
@@ -140,7 +141,7 @@ with atomic_path(Path(TABLES_DIR) / "table_robust.csv", overwrite=True) as tmp:
     tmp.write_text("mapper,basis_functions,memory_bytes\\n" + "\\n".join(rows) + "\\n")
 fig, ax = plt.subplots()
 ax.plot(np.sort(cloud[:, 2]))
-save_figure(fig, OUT_DIR, "heights")
+save_figure(Plot(fig, Caption("Heights", "Point heights, sorted.")), OUT_DIR, "heights")
 save_results(OUT_DIR, {"rows": rows, "mean": float(cloud.mean())})
 """
 
@@ -177,4 +178,5 @@ def test_report_tables_identical_across_runs_and_quick_full(bags, capsys, tmp_pa
         outputs.append({**_digest(run / "robust"),
                         "table": _digest(tmp_path / out / "tables")["table_robust.csv"]})
     assert outputs[0] == outputs[1] == outputs[2]
-    assert set(outputs[0]) == {"results.json", "figures/heights.png", "table"}
+    assert set(outputs[0]) == {"results.json", "figures/heights.png", "figures/heights.json",
+                               "table"}

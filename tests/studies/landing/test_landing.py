@@ -311,7 +311,7 @@ def test_landing_table_rows_summary_and_csv(tiny_table, tmp_path):
 
 def test_sites_are_drawn_one_panel_per_run(tiny_table):
     _, runs = tiny_table
-    fig = plot_landing_runs(runs, only="ch4")
+    fig = plot_landing_runs(runs, only="ch4").figure
     titles = [ax.get_title() for ax in fig.axes if ax.get_visible() and ax.get_title()]
     assert len(titles) == 2 and titles[0].startswith("sim_lan_1 quadtree (ch4 quadtree)")
     rings = [c for ax in fig.axes for c in ax.collections if isinstance(c, EllipseCollection)]

@@ -276,6 +276,6 @@ def test_plan_maps_scores_and_plots_synthetic_terrain() -> None:
     assert rows["seen", "free"]["colliding_length_m"] == 0.0
     assert rows["blind", "free"]["inside_samples"] > 0
     assert rows["blind", "free"]["colliding_length_m"] == pytest.approx(2.0, abs=0.2)
-    fig = plot_plans([plans])
+    fig = plot_plans([plans]).figure
     assert len([ax for ax in fig.axes if ax.get_visible()]) == 2
     assert "seen" in fig.axes[0].get_title()

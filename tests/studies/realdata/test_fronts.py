@@ -70,6 +70,6 @@ def test_the_real_sequence_gives_fronts_in_the_trade_off_schema(tmp_path: Path):
     assert (table["basis_functions"] > 0).all() and (table["mhd_m"] > 0).all()
     assert table["height_rmse_m"].iloc[:2].notna().all()
     assert table["completeness"].between(0, 1).all()
-    fig = realdata_plot.fronts_figure(table)
-    assert len(fig.axes) == len(realdata_plot.FRONT_PANELS)
+    plot = realdata_plot.fronts_figure(table)
+    assert plot is not None and len(plot.figure.axes) == len(realdata_plot.FRONT_PANELS)
     assert isinstance(table, pd.DataFrame) and set(table["terrain"]) == {"balm_seq"}

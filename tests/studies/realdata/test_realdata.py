@@ -64,7 +64,7 @@ def test_absent_folder_skips_everything(tmp_path: Path) -> None:
     assert realdata.ground_table([]).empty and realdata.map_table([]).empty
     assert realdata_plot.ground_figure([]) is None
     assert realdata_plot.save_figure(None, tmp_path, "fig") is None
-    assert realdata_plot.show_maps([], tmp_path, "maps") is None
+    assert realdata_plot.show_maps([], tmp_path, "maps", caption=realdata_plot.SCAN_MAPS) is None
     assert realdata.write_csv(pd.DataFrame(), tmp_path, "table") is None
     assert realdata.results(data, table=pd.DataFrame({"a": [1]})) == {"skipped": data.reason}
     assert not list(tmp_path.iterdir())
@@ -195,10 +195,11 @@ def test_ground_runs_on_a_synthetic_sample(fake_root: Path, tmp_path: Path) -> N
     assert (table["total_pct"] < 3.0).all(), table
     assert (table["type_ii_pct"] < 5.0).all(), table
     assert table.loc[1, "params"] == "kappa=5.0, max_res=7, min_pts=10"
-    fig = realdata_plot.ground_figure(runs)
-    assert len(fig.axes) == 3
-    path = realdata_plot.save_figure(fig, tmp_path, "ground")
-    assert path.read_bytes()[:4] == b"\x89PNG"
+    plot = realdata_plot.ground_figure(runs)
+    assert plot is not None and len(plot.figure.axes) == 3
+    path = realdata_plot.save_figure(plot, tmp_path, "ground")
+    assert path is not None and path.read_bytes()[:4] == b"\x89PNG"
+    assert path.with_suffix(".json").is_file()  # its caption beside it
 
 
 # ------------------------------------------------------------------ the real recordings
