@@ -75,8 +75,14 @@ class Sample:
         return self.runs / self.cpu_s if self.cpu_s else float("nan")
 
 
+def _size(run: SweepRun) -> float:
+    """The run's size parameter (a number, as the spec's rows were coerced)."""
+    value = run.params.get(SIZE_PARAM[run.mapper], 0)
+    return float(value) if isinstance(value, int | float) else float("nan")
+
+
 def _stratum(run: SweepRun) -> tuple[str, float, str]:
-    return run.mapper, float(run.params.get(SIZE_PARAM[run.mapper], 0)), run.domain
+    return run.mapper, _size(run), run.domain
 
 
 def stratified_groups(spec: SweepSpec, seed: int = 0) -> list[tuple[MapGroup, int]]:
@@ -143,7 +149,7 @@ def measure_sample(spec: SweepSpec, data_dir: str, *, seed: int = 0, strata: int
         # the stratum's runs in the grid cost what these cost per run
         runs, cpu, estimate = runs + len(group), cpu + used, estimate + used / len(group) * in_grid
         sampled_in_grid += in_grid
-        rows.append({"mapper": first.mapper, "size": first.params.get(SIZE_PARAM[first.mapper]),
+        rows.append({"mapper": first.mapper, "size": _size(first),
                      "domain": first.domain, "terrain": first.terrain, "runs": len(group),
                      "cpu_s": round(used, 3), "runs_in_grid": in_grid})
     grid_runs = sum(n for _, n in every)  # strata left out cost what the sampled ones do
