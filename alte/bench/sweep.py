@@ -78,7 +78,7 @@ class Sample:
 def _size(run: SweepRun) -> float:
     """The run's size parameter (a number, as the spec's rows were coerced)."""
     value = run.params.get(SIZE_PARAM[run.mapper], 0)
-    return float(value) if isinstance(value, int | float) else float("nan")
+    return value if isinstance(value, int | float) else float("nan")
 
 
 def _stratum(run: SweepRun) -> tuple[str, float, str]:
