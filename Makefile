@@ -42,7 +42,7 @@ reference: bootstrap
 # Mutation testing of the verdict logic and the metrics (tests/README.md): mutmut, one
 # module at a time with its own tests (tests/mutation_run.py); results in mutants/<name>/,
 # a rerun retests only what changed; MODULES='checks truth' picks modules,
-# MUTANTS='alte.studies.evidence.x__outcome*' narrows them; rm -rf mutants starts afresh.
+# MUTANTS='alte.studies.analysis.evidence.x__outcome*' narrows them; rm -rf mutants starts afresh.
 MUTANTS ?=
 MODULES ?=
 mutants: bootstrap

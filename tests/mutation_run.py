@@ -18,7 +18,7 @@ the repository::
     .venv/bin/python tests/mutation_run.py [NAME ...] [--mutants GLOB ...] [--max-children 2]
 
 with NAME among :data:`MODULES` (default: all) and GLOB a mutmut mutant name pattern,
-e.g. ``'alte.studies.evidence.x__outcome*'``.
+e.g. ``'alte.studies.analysis.evidence.x__outcome*'``.
 """
 
 from __future__ import annotations
@@ -45,23 +45,26 @@ MODULES: dict[str, tuple[str, tuple[str, ...]]] = {
         "tests/metrics/test_truth_cases.py", "-k",
         "not hausdorff and not directed and not to_the_last_bit")),
     "trajectory": ("alte/metrics/trajectory.py", ("tests/metrics/test_trajectory.py",)),
-    "checks": ("alte/studies/checks.py", (
-        "tests/studies/test_checks.py", "tests/studies/test_verdicts.py",
-        "tests/studies/test_measures.py", "tests/studies/test_evidence.py")),
-    "comparisons": ("alte/studies/comparisons.py", (
-        "tests/studies/test_verdicts.py", "tests/studies/test_measures.py",
-        "tests/studies/test_evidence.py", "tests/studies/test_comparisons_cases.py")),
-    "measures": ("alte/studies/measures.py", (
-        "tests/studies/test_verdicts.py", "tests/studies/test_measures.py",
-        "tests/studies/test_evidence.py", "tests/studies/test_conditions.py",
-        "tests/studies/test_measures_cases.py")),
-    "evidence": ("alte/studies/evidence.py", (
-        "tests/studies/test_verdicts.py", "tests/studies/test_evidence.py",
-        "tests/studies/test_evidence_tables.py", "tests/studies/test_conditions.py")),
-    "tradeoff": ("alte/studies/tradeoff.py", (
-        "tests/studies/test_tradeoff.py", "tests/studies/test_verdicts.py",
-        "tests/studies/test_measures.py", "tests/studies/test_tradeoff_cases.py")),
-    "claims": ("alte/studies/claims/__init__.py", ("tests/studies/test_claims.py",)),
+    "checks": ("alte/studies/analysis/checks.py", (
+        "tests/studies/analysis/test_checks.py", "tests/studies/analysis/test_verdicts.py",
+        "tests/studies/analysis/test_measures.py", "tests/studies/analysis/test_evidence.py")),
+    "comparisons": ("alte/studies/analysis/comparisons.py", (
+        "tests/studies/analysis/test_verdicts.py", "tests/studies/analysis/test_measures.py",
+        "tests/studies/analysis/test_evidence.py",
+        "tests/studies/analysis/test_comparisons_cases.py")),
+    "measures": ("alte/studies/analysis/measures.py", (
+        "tests/studies/analysis/test_verdicts.py", "tests/studies/analysis/test_measures.py",
+        "tests/studies/analysis/test_evidence.py", "tests/studies/analysis/test_conditions.py",
+        "tests/studies/analysis/test_measures_cases.py")),
+    "evidence": ("alte/studies/analysis/evidence.py", (
+        "tests/studies/analysis/test_verdicts.py", "tests/studies/analysis/test_evidence.py",
+        "tests/studies/analysis/test_evidence_tables.py",
+        "tests/studies/analysis/test_conditions.py")),
+    "tradeoff": ("alte/studies/analysis/tradeoff.py", (
+        "tests/studies/analysis/test_tradeoff.py", "tests/studies/analysis/test_verdicts.py",
+        "tests/studies/analysis/test_measures.py",
+        "tests/studies/analysis/test_tradeoff_cases.py")),
+    "claims": ("alte/studies/thesis/claims/__init__.py", ("tests/studies/thesis/test_claims.py",)),
 }
 
 

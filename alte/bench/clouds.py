@@ -20,7 +20,7 @@ from alte.bench.core import LIMITS, Context, Result
 from alte.bench.maps import NAV, mapper_setup, octomap_passes
 from alte.bench.timing import measure
 from alte.bench.workload import Points
-from alte.studies.thesis import mapper_params
+from alte.studies.thesis.numbers import mapper_params
 from alte.types import JSONDict
 
 if TYPE_CHECKING:

@@ -23,7 +23,7 @@ from tqdm.auto import tqdm
 from alte.bench.core import LIMITS, Context, Result
 from alte.bench.timing import interleave, measure
 from alte.bench.workload import Points, Scan
-from alte.studies.thesis import mapper_params
+from alte.studies.thesis.numbers import mapper_params
 from alte.types import JSONDict
 
 if TYPE_CHECKING:

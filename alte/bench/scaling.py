@@ -22,7 +22,7 @@ from alte.bench.core import Context, Result
 from alte.bench.maps import NAV, TERRAIN_OF
 from alte.bench.timing import fit_exponent, measure, nlogn_exponent, peak_rss_bytes
 from alte.bench.workload import Points, Scan, tile_points
-from alte.studies.thesis import mapper_params
+from alte.studies.thesis.numbers import mapper_params
 from alte.types import JSONDict
 
 __all__ = ["EXPONENT_SLACK", "predicted_seconds", "scaling", "scaling_cases", "whole_scans"]

@@ -104,7 +104,7 @@ def streaming_chain(ctx: Context) -> list[Result]:
     """Row 10: real-time factor and per-frame latency of ``alte map BAG`` per mapper."""
     from alte.mappers import Feed
     from alte.pipeline import DomainPolicy, MapSpec
-    from alte.studies.thesis import mapper_params
+    from alte.studies.thesis.numbers import mapper_params
 
     cfg = ctx.config
     out: list[Result] = []

@@ -11,7 +11,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from alte.bench.core import Context, Result
-from alte.studies.thesis import COMPARISONS, SWEEPS
+from alte.studies.thesis.numbers import COMPARISONS, SWEEPS
 from alte.types import JSON, JSONDict, JSONMap
 
 __all__ = ["report_wall_time", "stage_shares", "thesis_total_s"]

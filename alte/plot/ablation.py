@@ -21,8 +21,8 @@ from alte.errors import ParameterError
 from alte.plot.figure import Caption, Plot
 from alte.plot.render import Draw, save_figures
 from alte.plot.tradeoff import COLORS, PAIRS, legend, log_axis, mean_front, panels
-from alte.studies.thesis import TERRAIN_CASE
-from alte.studies.tradeoff import fronts, label, prepare
+from alte.studies.analysis.tradeoff import fronts, label, prepare
+from alte.studies.thesis.numbers import TERRAIN_CASE
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes

@@ -19,7 +19,7 @@ from alte.mappers.quad.quadmap import plane_height
 from alte.plot.arrays import Floats, polygons
 from alte.plot.figure import Caption, Plot, View
 from alte.plot.render import view
-from alte.studies.tradeoff import MAPPER_NAMES
+from alte.studies.analysis.tradeoff import MAPPER_NAMES
 
 if TYPE_CHECKING:
     import pyvista as pv

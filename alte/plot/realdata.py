@@ -133,7 +133,7 @@ def fronts_figure(table: pd.DataFrame) -> Plot | None:
     if table.empty:
         return None
     from alte.plot.tradeoff import COLORS, log_axis
-    from alte.studies.tradeoff import MAPPER_NAMES, fronts, label
+    from alte.studies.analysis.tradeoff import MAPPER_NAMES, fronts, label
 
     fig = Figure(figsize=(4.0 * len(FRONT_PANELS), 3.6), layout="constrained")
     axes = np.asarray(fig.subplots(1, len(FRONT_PANELS), squeeze=False)).ravel()

@@ -14,8 +14,8 @@ import pandas as pd
 
 from alte.errors import ParameterError
 from alte.plot.figure import Caption, Plot
+from alte.studies.analysis.tradeoff import MAPPER_NAMES
 from alte.studies.sweep.analysis import main_effects, mapper_rows, param_columns, sensitivity_table
-from alte.studies.tradeoff import MAPPER_NAMES
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes

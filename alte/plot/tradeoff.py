@@ -3,7 +3,7 @@ mappers compared at equal size and at equal fidelity.
 
 :func:`tradeoff_figure` draws, per terrain panel, every map as a faint dot (one per
 setting and seed), each mapper's Pareto front as its mean over seeds (read at common
-sizes, see :mod:`alte.studies.tradeoff`) with a shaded 95 % bootstrap band over seeds,
+sizes, see :mod:`alte.studies.analysis.tradeoff`) with a shaded 95 % bootstrap band over seeds,
 and a star at the thesis' chosen setting. Size is on a log axis.
 """
 
@@ -22,7 +22,7 @@ import pandas as pd
 from alte.errors import ParameterError
 from alte.plot.figure import Caption, Plot
 from alte.plot.render import Draw, save_figures
-from alte.studies.tradeoff import (
+from alte.studies.analysis.tradeoff import (
     MAPPER_NAMES,
     equal_fidelity,
     equal_size,
@@ -33,7 +33,7 @@ from alte.studies.tradeoff import (
     prepare,
     thesis_setting,
 )
-from alte.studies.uncertainty import bootstrap_columns
+from alte.studies.analysis.uncertainty import bootstrap_columns
 
 if TYPE_CHECKING:
     from matplotlib.artist import Artist

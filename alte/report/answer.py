@@ -16,9 +16,9 @@ from pathlib import Path
 
 import pandas as pd
 
+from alte.studies.analysis.tradeoff import MAPPER_NAMES
 from alte.studies.answer import Choice, UseAnswer, bottom_line, interval_text, pick_text
 from alte.studies.answer.orders import metric_words
-from alte.studies.tradeoff import MAPPER_NAMES
 
 __all__ = ["REAL_CSV", "TRADEOFF_CSV", "AnswerView", "ChoiceRow", "UseView", "answer_view"]
 

@@ -31,7 +31,7 @@ from alte.report.captions import (
 )
 from alte.report.plan import PLAN
 from alte.report.tableview import TableView, cell_text, header, table_view
-from alte.studies.claims.questions import QUESTIONS, question
+from alte.studies.thesis.claims.questions import QUESTIONS, question
 from alte.types import JSON, JSONMap
 
 __all__ = ["CLAIMS_CSV", "MISSIONS_CSV", "ClaimGroup", "ClaimRow", "FigureItem", "RunPage",
@@ -236,7 +236,7 @@ def _claims(tables_dir: Path) -> list[ClaimRow]:
 def _question(claim_id: str) -> str:
     """The question of a claim by id (claims tables written before the column existed)."""
     from alte.errors import ParameterError
-    from alte.studies.claims import claim
+    from alte.studies.thesis.claims import claim
 
     try:
         return question(claim(claim_id))

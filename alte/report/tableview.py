@@ -15,8 +15,8 @@ from dataclasses import dataclass
 
 import pandas as pd
 
-from alte.studies.thesis import SWEEPS
-from alte.studies.tradeoff import MAPPER_NAMES, METRICS
+from alte.studies.analysis.tradeoff import MAPPER_NAMES, METRICS
+from alte.studies.thesis.numbers import SWEEPS
 
 __all__ = ["TableView", "cell_text", "header", "table_view"]
 

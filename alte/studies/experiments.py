@@ -40,7 +40,7 @@ from alte.pipeline import (
     run,
 )
 from alte.registration.odometry import OdometryParams
-from alte.studies.thesis import SWEEPS, sweep_table
+from alte.studies.thesis.numbers import SWEEPS, sweep_table
 
 __all__ = ["CACHE_DIR", "REPEATS", "REPEAT_BELOW_S", "Measured", "ground_truth", "measure",
            "sweep", "terrain", "timed_run"]

@@ -28,9 +28,10 @@ import numpy as np
 import pandas as pd
 
 from alte.errors import ParameterError
-from alte.studies.claims import CLAIMS, Claim
-from alte.studies.evidence import EvidenceOptions, cells_table, evaluate_all
-from alte.studies.evidence_tables import EQUAL_SIZE, SIZES, ablation_verdicts
+from alte.studies.analysis.evidence import EvidenceOptions, cells_table, evaluate_all
+from alte.studies.analysis.evidence_tables import EQUAL_SIZE, SIZES, ablation_verdicts
+from alte.studies.analysis.tables import write_csv
+from alte.studies.analysis.tradeoff import equal_size, matching, prepare
 from alte.studies.obstacles import OBJECTS_COLUMN, write_obstacle_tables
 from alte.studies.sweep import (
     BASE,
@@ -41,9 +42,8 @@ from alte.studies.sweep import (
     run_sweep,
     variant_table,
 )
-from alte.studies.tables import write_csv
-from alte.studies.thesis import CASE_MAPPERS, SWEEPS, TERRAIN_CASE
-from alte.studies.tradeoff import equal_size, matching, prepare
+from alte.studies.thesis.claims import CLAIMS, Claim
+from alte.studies.thesis.numbers import CASE_MAPPERS, SWEEPS, TERRAIN_CASE
 
 __all__ = ["OCCUPIED_SIZE", "THESIS_ROWS", "TRADEOFF_COLUMNS", "Grid", "GridTables", "ablations",
            "front_order", "grid_of", "run_grid",
@@ -209,7 +209,7 @@ def _lead(first: float, second: float, higher: bool, names: tuple[str, str]) -> 
 def front_order(short: pd.DataFrame, whole: pd.DataFrame, *,
                 sizes: Sequence[float] = SIZES) -> pd.DataFrame:
     """Which mapper of each pair the thesis compares leads at equal size (the fidelity
-    metrics of :data:`~alte.studies.evidence_tables.EQUAL_SIZE`, means over seeds), in two
+    metrics of :data:`~alte.studies.analysis.evidence_tables.EQUAL_SIZE`, means over seeds), in two
     trade-off tables (e.g. short and whole missions), on the terrains and sizes both
     reach: one row per (terrain, metric, size) with both reads and ``same`` order."""
     rows = []

@@ -33,9 +33,9 @@ import pandas as pd
 
 from alte import __version__
 from alte.errors import ReportError
-from alte.studies.evidence_tables import EQUAL_SIZE, write_evidence
-from alte.studies.tables import write_csv
-from alte.studies.tradeoff import fronts, prepare
+from alte.studies.analysis.evidence_tables import EQUAL_SIZE, write_evidence
+from alte.studies.analysis.tables import write_csv
+from alte.studies.analysis.tradeoff import fronts, prepare
 from alte.types import JSONDict
 
 __all__ = ["CELLS", "EVIDENCE_TABLES", "PROVENANCE", "WHOLE_MISSIONS", "MissionEvidence",

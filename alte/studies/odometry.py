@@ -39,8 +39,8 @@ from alte.errors import ParameterError
 from alte.metrics.trajectory import cloud_distance, rigid_alignment, trajectory_errors
 from alte.pipeline import FrameSpec, PoseSource, Registered, Source, open_input, prepare
 from alte.registration.odometry import OdometryParams
+from alte.studies.analysis.tables import write_csv
 from alte.studies.experiments import CACHE_DIR
-from alte.studies.tables import write_csv
 
 __all__ = ["COLUMNS", "REAL_SEQUENCE", "SOURCES", "BenchInput", "bench_input", "odometry_table",
            "pose_benchmark", "realdata_table", "write_odometry_table"]

@@ -99,9 +99,9 @@ def make_front_run(run_dir: Path) -> dict:
     table from a synthetic trade-off table, key and other tables. Returns its record."""
     from support.tradeoff import Curve, synthetic_tradeoff
 
-    from alte.studies.claims import CLAIMS
-    from alte.studies.evidence import claims_table, evaluate_all
-    from alte.studies.tables import write_csv
+    from alte.studies.analysis.evidence import claims_table, evaluate_all
+    from alte.studies.analysis.tables import write_csv
+    from alte.studies.thesis.claims import CLAIMS
 
     tables = run_dir / "tables"
     trade = synthetic_tradeoff({"alte2d": Curve(scale=0.5), "alte3d": Curve(scale=0.5)})

@@ -9,7 +9,7 @@ from support.tradeoff import Curve, synthetic_tradeoff
 
 from alte.report.answer import answer_view
 from alte.report.html import run_index_html
-from alte.studies.tables import write_csv
+from alte.studies.analysis.tables import write_csv
 
 from .conftest import make_front_run
 

@@ -10,7 +10,7 @@ import pytest
 from support.tradeoff import Curve, synthetic_tradeoff
 
 from alte.errors import ParameterError
-from alte.studies.claims import claim
+from alte.studies.analysis.tradeoff import prepare
 from alte.studies.grid import (
     OCCUPIED_SIZE,
     THESIS_ROWS,
@@ -24,7 +24,7 @@ from alte.studies.grid import (
     write_grid,
 )
 from alte.studies.sweep import BASE, parse_spec
-from alte.studies.tradeoff import prepare
+from alte.studies.thesis.claims import claim
 
 _SPEC = {"terrains": ["sim_lan_1", "sim_lan_2", "sim_nav_1", "sim_nav_2"],
          "mappers": {m: {"rows": [{}]} for m in ("quadtree", "alte2d", "octomap", "alte3d")},

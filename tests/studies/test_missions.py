@@ -12,7 +12,6 @@ import pytest
 
 from alte.cli import main
 from alte.errors import ReportError
-from alte.studies.claims import CLAIMS
 from alte.studies.missions import (
     CELLS,
     EVIDENCE_TABLES,
@@ -23,6 +22,7 @@ from alte.studies.missions import (
     outcome_summary,
     write_comparison,
 )
+from alte.studies.thesis.claims import CLAIMS
 
 SPEC = """\
 name: tiny

@@ -19,6 +19,8 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
+from alte.studies.analysis.tradeoff import MAPPER_NAMES, METRICS
+from alte.studies.analysis.uncertainty import Interval
 from alte.studies.answer.choose import (
     GROUPS,
     USES,
@@ -30,9 +32,7 @@ from alte.studies.answer.choose import (
     choose,
 )
 from alte.studies.answer.orders import Order, agreement, metric_words, order
-from alte.studies.thesis import TERRAIN_CASE
-from alte.studies.tradeoff import MAPPER_NAMES, METRICS
-from alte.studies.uncertainty import Interval
+from alte.studies.thesis.numbers import TERRAIN_CASE
 
 __all__ = ["BottomLine", "RealCheck", "UseAnswer", "bottom_line", "interval_text", "pick_text"]
 

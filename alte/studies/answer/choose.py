@@ -34,9 +34,9 @@ from typing import Literal
 import numpy as np
 import pandas as pd
 
+from alte.studies.analysis.tradeoff import MAPPER_NAMES, METRICS
+from alte.studies.analysis.uncertainty import Interval, bootstrap_ci
 from alte.studies.obstacles import setting_text
-from alte.studies.tradeoff import MAPPER_NAMES, METRICS
-from alte.studies.uncertainty import Interval, bootstrap_ci
 
 __all__ = ["GROUPS", "MIN_COMPLETENESS", "SIZE_BUDGETS", "USES", "Budget", "Choice", "Pick",
            "Use", "budgets", "candidates", "choose", "ms_per_scan"]

@@ -1,7 +1,7 @@
 """Which of a use's two mappers leads at equal size, by one metric, over a set of terrains.
 
 The fronts of both mappers are read at three sizes inside the range both cover, per
-terrain (:func:`alte.studies.tradeoff.equal_size`); at each (terrain, size) read the
+terrain (:func:`alte.studies.analysis.tradeoff.equal_size`); at each (terrain, size) read the
 paired difference over seeds gets a 95 % bootstrap interval, and the read *goes to* a
 mapper when the interval lies wholly on its side (a single recording has no interval:
 its read goes to whichever is better). :func:`order` counts the reads; :func:`agreement`
@@ -16,9 +16,9 @@ from dataclasses import dataclass, field
 
 import pandas as pd
 
+from alte.studies.analysis.tradeoff import MAPPER_NAMES, equal_size, label, prepare
+from alte.studies.analysis.uncertainty import bootstrap_ci
 from alte.studies.answer.choose import Use
-from alte.studies.tradeoff import MAPPER_NAMES, equal_size, label, prepare
-from alte.studies.uncertainty import bootstrap_ci
 
 __all__ = ["HIGHER", "Order", "agreement", "metric_words", "order"]
 

@@ -21,13 +21,13 @@ from tqdm.auto import tqdm
 
 from alte.errors import MetricsError, ParameterError
 from alte.pipeline import MapRun, MapSpec, Registered, run
+from alte.studies.analysis.tables import write_csv
 from alte.studies.experiments import ground_truth, terrain
 from alte.studies.landing.detect import Centres, Detection, detect_sites
 from alte.studies.landing.params import LandingParams, landing_params
 from alte.studies.landing.raster import Grid, rasterise
 from alte.studies.landing.truth import score_detection, truth_centres
-from alte.studies.tables import write_csv
-from alte.studies.thesis import SWEEPS, mapper_params
+from alte.studies.thesis.numbers import SWEEPS, mapper_params
 from alte.types import JSONDict
 
 __all__ = ["LANDING_MAPPERS", "SWEEP_ROWS", "LandingRun", "evaluate_landing", "landing_grid",

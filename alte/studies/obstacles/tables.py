@@ -18,8 +18,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from alte.studies.analysis.tables import write_csv
 from alte.studies.obstacles.identify import OBJECT_COLUMNS, SCORE_COLUMNS, ObstacleScores
-from alte.studies.tables import write_csv
 from alte.types import JSONDict
 
 __all__ = ["OBJECTS_COLUMN", "OBSTACLE_COLUMNS", "object_table", "obstacle_columns",

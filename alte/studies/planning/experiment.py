@@ -3,7 +3,7 @@
 Start and goal per terrain are fixed points (:data:`PLANNING_CASES`) chosen so that
 the straight line between them crosses obstacles below the flight altitude, where
 the sensor looked: the planner must go around, under or over something. Each map is
-built with the chapter 4 parameters (:func:`alte.studies.thesis.mapper_params`), planned on
+built with the chapter 4 parameters (:func:`alte.studies.thesis.numbers.mapper_params`), planned on
 with both policies, and every found path is scored against the true mesh.
 """
 
@@ -22,12 +22,12 @@ from tqdm.auto import tqdm
 from alte.errors import ParameterError
 from alte.metrics import TrueSurface
 from alte.pipeline import MapSpec, Registered, run
+from alte.studies.analysis.tables import write_csv
 from alte.studies.experiments import ground_truth, terrain
 from alte.studies.planning.lattice import POLICIES, PlanningMap, planning_map
 from alte.studies.planning.score import PathScore, score_path
 from alte.studies.planning.search import PlanResult, plan_path
-from alte.studies.tables import write_csv
-from alte.studies.thesis import mapper_params
+from alte.studies.thesis.numbers import mapper_params
 from alte.types import JSONDict
 
 __all__ = ["PLANNING_CASES", "PlanningCase", "TerrainPlans", "plan_maps", "planning_case",

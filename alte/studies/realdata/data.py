@@ -36,6 +36,7 @@ from alte.pipeline import (
     open_input,
     prepare,
 )
+from alte.studies.analysis.tables import write_csv as write_tables_csv
 from alte.studies.experiments import Measured, measure
 from alte.studies.realdata.ground import (
     classify_ground,
@@ -44,7 +45,6 @@ from alte.studies.realdata.ground import (
     opened_surface,
     reference_labels,
 )
-from alte.studies.tables import write_csv as write_tables_csv
 
 __all__ = [
     "BASELINE",

@@ -7,7 +7,7 @@ stand-in for the simulator's true surface; ``frames`` scans of it, evenly spaced
 what the maps are made from, as the simulated grid maps 20 scans per mission. Every
 mapper's settings (:data:`FRONT_GRID`, over the cube of the data) give one row in the
 schema of the trade-off table (``terrain`` = the sequence, ``seed`` 0), so its fronts
-and equal-size reads are those of :mod:`alte.studies.tradeoff`:
+and equal-size reads are those of :mod:`alte.studies.analysis.tradeoff`:
 
 * the thesis' MHD (and HD) against the cloud the map was made from;
 * the distance to the reference cloud (:func:`reference_metrics`), defined as the
@@ -41,7 +41,7 @@ from alte.studies.experiments import measure
 from alte.studies.landing import Grid
 from alte.studies.obstacles import map_raster
 from alte.studies.realdata.data import RealData
-from alte.studies.thesis import CASE_MAPPERS
+from alte.studies.thesis.numbers import CASE_MAPPERS
 
 __all__ = ["FRONT_COLUMNS", "FRONT_GRID", "SEQUENCE", "RealSequence", "front_table",
            "reference_metrics", "sequence_data"]
