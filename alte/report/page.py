@@ -5,9 +5,8 @@ the run's tables, and returns a :class:`RunPage` the template renders: the botto
 first (:mod:`alte.report.answer`, from the run's tables), then the claims
 (``tables/claims.csv``) grouped by the thesis' question they bear on, each "depends"
 with its condition, the trade-off figures and tables, the key tables with the thesis'
-values beside ours, then one section per notebook run with its headline results,
-captioned figures and links. Nothing on it is a raw dict or JSON: results are shown as
-labelled scalars, tables through :mod:`alte.report.tableview`.
+values beside ours, then one section per notebook run with its headline results, captioned
+figures and links; results as labelled scalars, tables via :mod:`alte.report.tableview`.
 """
 
 from __future__ import annotations

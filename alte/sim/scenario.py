@@ -17,13 +17,14 @@ import os
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, NotRequired, TypedDict
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from alte.errors import AlteError, SimulationError
 from alte.fsutil import atomic_dir
 from alte.sim.groundtruth import GROUND_TRUTH_FILE, load_ground_truth, write_ground_truth
+from alte.sim.meta import MountMeta, ScenarioMeta
 from alte.sim.mission import Simulation, simulate
 from alte.sim.profile import PROFILES, SensorProfile
 from alte.sim.scene import Scene
@@ -91,28 +92,6 @@ def _file_table(root: Path) -> dict[str, dict[str, int | str]]:
             table[rel] = {"size": path.stat().st_size,
                           "sha256": hashlib.sha256(path.read_bytes()).hexdigest()}
     return table
-
-
-class MountMeta(TypedDict):
-    """A sensor mount in ``scenario.json``: offset (m), quaternion (x, y, z, w) and the
-    ``--mount`` string ``x,y,z,roll,pitch,yaw``."""
-
-    translation: list[float]
-    quaternion: list[float]
-    xyz_rpy_deg: str
-
-
-class ScenarioMeta(TypedDict):
-    """What the pipeline reads of ``scenario.json`` (:func:`load_metadata` checks these keys
-    are there; the file holds more: the spec, sensor, counts, files, ...)."""
-
-    name: str
-    case: str
-    bag: str
-    crop_box: list[float]
-    registration_voxel: float
-    mount: MountMeta
-    title: NotRequired[str]
 
 
 def _mount_dict(mount: Mount) -> MountMeta:

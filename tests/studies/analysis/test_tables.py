@@ -15,9 +15,9 @@ from alte.studies.analysis.tables import (
     rule_pick,
     rule_picks,
     thesis_metrics,
-    trend_table,
     write_table,
 )
+from alte.studies.analysis.trends import trend_table
 
 
 def test_comparison_rule_on_the_thesis_numbers():
