@@ -41,6 +41,7 @@ from alte.metrics.truth import (
     probe_grid,
     seen_mask,
 )
+from alte.types import rows_all
 
 if TYPE_CHECKING:
     from alte.mappers.base import Cells
@@ -170,7 +171,7 @@ class Reference:
         check_truth_args(dims, opts.tolerance)
         leaves = self.leaf_truth(cells)
         surface = self._truth().surface
-        finite = np.isfinite(cells.centers).all(axis=1)
+        finite = rows_all(np.isfinite(cells.centers))
         occ = finite if dims == 2 else finite & cells.occupied.astype(bool)
         out: dict[str, Any] = leaves.accuracy(occ, surface, opts.tolerance)
         if dims == 2:
