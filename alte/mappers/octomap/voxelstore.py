@@ -167,7 +167,7 @@ def _apply(store: tuple[NDArray[np.uint64], NDArray[np.int64], NDArray[np.uint64
         if q + 1 < order.size and at[order[q + 1]] >> _PAGE_SHIFT == current:
             ahead = (at[order[q + 1]] & (PAGE - 1)) * 512
             for line in range(0, 512, 16):
-                prefetch(page, ahead + line)  # type: ignore[call-arg]  # numba intrinsic
+                prefetch(page, ahead + line)  # type: ignore[call-arg, arg-type]  # numba intrinsic
         _block(page[row & (PAGE - 1)], scan_bits[order[q]], model)
     return n
 
