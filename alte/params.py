@@ -238,6 +238,7 @@ class Record:
                                  f"valid: {', '.join(sorted(cls.names()))}")
         return cls(**given)
 
+    # Any, not object: the mappers read their parameters from this dict as typed values.
     def as_dict(self) -> dict[str, Any]:
         """Parameters by name (JSON-ready scalars)."""
         return {name: getattr(self, name) for name in self.names()}
