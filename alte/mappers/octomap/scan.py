@@ -46,6 +46,8 @@ DENSE_MAX_WORDS = 1 << 24
 #: fast as hashed).
 DENSE_ANY_WORDS = 1 << 21
 WORDS_PER_STEP = 8
+#: A scan's block codes and their bit rows (8 free, then 8 occupied words).
+_Blocks = tuple[NDArray[np.uint64], NDArray[np.uint64]]
 #: :class:`ScanWork`'s arrays as the kernels take them: the bit grid, cell rows, flags.
 _Work = tuple[NDArray[np.uint64], NDArray[np.int64], NDArray[np.uint64]]
 #: A scan's blocks and bit rows, then the :data:`_Work` arrays (grown where it needed more).
@@ -227,8 +229,7 @@ def _dense(rays: Ray, res: float, box: NDArray[np.int64], work: _Work,
 
 
 @numba.njit(cache=True)
-def _rays_hashed(rays: Ray, res: float, capacity: int,
-                 ) -> tuple[NDArray[np.uint64], NDArray[np.uint64]]:
+def _rays_hashed(rays: Ray, res: float, capacity: int) -> _Blocks:
     """Blocks and bit rows of ``rays`` (origin, its key, ends, their keys), walked into a
     hash table."""
     origin, okey, ends, ekeys = rays
@@ -247,7 +248,7 @@ def _rays_hashed(rays: Ray, res: float, capacity: int,
 
 @numba.njit(cache=True)
 def _finish(blocks: NDArray[np.uint64], bits: NDArray[np.uint64], ekeys: NDArray[np.int64],
-            hit: NDArray[np.bool_]) -> tuple[NDArray[np.uint64], NDArray[np.uint64]]:
+            hit: NDArray[np.bool_]) -> _Blocks:
     """Union of the rays' blocks plus the occupied end voxels; free bits lose occupied ones."""
     table, n_blocks = union(blocks, bits, blocks.size + 64)
     table = reserve(table, n_blocks, ekeys.shape[0])
@@ -285,8 +286,7 @@ def _scan(cloud: tuple[NDArray[np.float32], NDArray[np.float32]], res: float, ma
 
 
 def scan_blocks(points: NDArray[np.float32], origin: NDArray[np.float32], res: float,
-                max_range: float, work: ScanWork | None = None,
-                ) -> tuple[NDArray[np.uint64], NDArray[np.uint64]]:
+                max_range: float, work: ScanWork | None = None) -> _Blocks:
     """One scan's update as (block codes, rows of 8 free + 8 occupied words).
 
     Free bits: every voxel a ray crosses before its end voxel; occupied bits: end
