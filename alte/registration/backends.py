@@ -18,6 +18,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 if TYPE_CHECKING:
     from alte.registration.settings import OdometryParams, PoseCounts
@@ -25,7 +26,7 @@ if TYPE_CHECKING:
 __all__ = ["Kiss", "Plane", "PlaneMap", "kiss_config", "kiss_voxel", "scene_scale"]
 
 
-def scene_scale(points: np.ndarray, params: OdometryParams) -> tuple[float, float]:
+def scene_scale(points: NDArray[np.float64], params: OdometryParams) -> tuple[float, float]:
     """(max range, voxel) for a scan in the sensor frame: ``max_range`` (default KISS-ICP's
     100 m for ``kiss``, 1.2 x the 99th percentile range for ``plane``) and ``voxel``
     (default ``max_range / 100`` for ``kiss``, the median range / 70 for ``plane``)."""
@@ -46,7 +47,7 @@ def kiss_voxel(params: OdometryParams) -> float:
     return params.voxel or (params.max_range or 100.0) / 100.0
 
 
-def kiss_config(points: np.ndarray, params: OdometryParams, timed: bool = False) -> Any:
+def kiss_config(points: NDArray[np.float64], params: OdometryParams, timed: bool = False) -> Any:
     """KISS-ICP's configuration for ``params`` (unset values: KISS-ICP's own defaults);
     deskewing only for scans with per-point time (``timed``)."""
     from kiss_icp.config import KISSConfig
@@ -68,7 +69,7 @@ def kiss_config(points: np.ndarray, params: OdometryParams, timed: bool = False)
 class Kiss:
     """KISS-ICP's own pipeline, with the sparse-sensor switches (module docstring)."""
 
-    def __init__(self, points: np.ndarray, params: OdometryParams, timed: bool) -> None:
+    def __init__(self, points: NDArray[np.float64], params: OdometryParams, timed: bool) -> None:
         from kiss_icp.kiss_icp import KissICP
         from kiss_icp.voxelization import voxel_down_sample
 
@@ -77,18 +78,20 @@ class Kiss:
         if params.single_downsample:
             voxel = config.mapping.voxel_size
 
-            def single(frame: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            def single(frame: NDArray[np.float64],
+                       ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
                 down = voxel_down_sample(frame, 0.5 * voxel)
                 return down, down
 
             self.pipeline.voxelize = single
 
-    def deskews(self, times: np.ndarray | None) -> bool:
+    def deskews(self, times: NDArray[np.float64] | None) -> bool:
         """Whether a scan with these per-point ``times`` is deskewed (they must vary)."""
         return bool(times is not None and self.config.data.deskew and len(times)
                     and np.ptp(times) > 0)
 
-    def step(self, points: np.ndarray, times: np.ndarray | None) -> np.ndarray:
+    def step(self, points: NDArray[np.float64], times: NDArray[np.float64] | None,
+             ) -> NDArray[np.float64]:
         """The sensor pose of this scan in the first scan's sensor frame (deskewed with
         ``times`` when given and ``deskew`` is on)."""
         stamps = times if times is not None and self.deskews(times) else np.zeros(len(points))
@@ -107,17 +110,17 @@ class PlaneMap:
     def __init__(self, voxel: float, radius: float, rebuild: int) -> None:
         self.voxel, self.radius, self.rebuild = voxel, radius, rebuild
         self.points = np.empty((0, 3))
-        self.pending: list[np.ndarray] = []
+        self.pending: list[NDArray[np.float64]] = []
         self.target: Any = None
 
-    def source(self, scan: np.ndarray) -> Any:
+    def source(self, scan: NDArray[np.float64]) -> Any:
         """The scan (sensor frame) down-sampled on the map's voxel."""
         import open3d as o3d
 
         cloud = o3d.geometry.PointCloud(o3d.utility.Vector3dVector(scan))
         return cloud.voxel_down_sample(self.voxel)
 
-    def add(self, source: Any, sensor: np.ndarray) -> None:
+    def add(self, source: Any, sensor: NDArray[np.float64]) -> None:
         """Queue the aligned scan; rebuild the target when ``rebuild`` scans are queued."""
         import open3d as o3d
 
@@ -131,7 +134,7 @@ class PlaneMap:
         target.estimate_normals(o3d.geometry.KDTreeSearchParamHybrid(6.0 * self.voxel, 40))
         self.points, self.pending, self.target = np.asarray(target.points), [], target
 
-    def align(self, source: Any, guess: np.ndarray) -> tuple[np.ndarray, float]:
+    def align(self, source: Any, guess: NDArray[np.float64]) -> tuple[NDArray[np.float64], float]:
         """The sensor pose placing ``source`` on the map, from ``guess``; inlier fraction."""
         import open3d as o3d
 
@@ -147,13 +150,15 @@ class PlaneMap:
 class Plane:
     """Point-to-plane scan-to-map odometry from a constant-velocity guess."""
 
-    def __init__(self, points: np.ndarray, params: OdometryParams, counts: PoseCounts) -> None:
+    def __init__(self, points: NDArray[np.float64], params: OdometryParams,
+                 counts: PoseCounts) -> None:
         max_range, voxel = scene_scale(points, params)
         self.map = PlaneMap(voxel, max_range, params.rebuild)
         self.params, self.counts = params, counts
         self.pose, self.motion = np.eye(4), np.eye(4)
 
-    def step(self, points: np.ndarray, times: np.ndarray | None) -> np.ndarray:
+    def step(self, points: NDArray[np.float64], times: NDArray[np.float64] | None,
+             ) -> NDArray[np.float64]:
         """The sensor pose of this scan (``times`` unused: no deskew)."""
         del times
         source = self.map.source(points)

@@ -22,6 +22,7 @@ from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, replace
 
 import numpy as np
+from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
 from alte.io.pose import PoseTrack
@@ -44,15 +45,16 @@ class DeskewCounts(Counts):
     points_clamped: int = 0
 
 
-def _groups(times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _groups(times: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.intp]]:
     """Grid times (G,) in seconds and each point's group index (N,)."""
     keys = np.round(np.asarray(times, dtype=np.float64) / DESKEW_STEP_S).astype(np.int64)
     unique, index = np.unique(keys, return_inverse=True)
-    return unique * DESKEW_STEP_S, index.reshape(-1)
+    return np.asarray(unique * DESKEW_STEP_S, dtype=np.float64), index.reshape(-1)
 
 
-def deskew_points(points: np.ndarray, times: np.ndarray, rotations: Rotation,
-                  translations: np.ndarray, index: np.ndarray) -> np.ndarray:
+def deskew_points(points: NDArray[np.float64], times: NDArray[np.float64],
+                  rotations: Rotation[tuple[int]], translations: NDArray[np.float64],
+                  index: NDArray[np.intp]) -> NDArray[np.float64]:
     """Apply the per-group motion (rotation ``rotations[g]``, translation ``translations[g]``
     taking the sensor at time g to the sensor at the stamp) to each point of group
     ``index[i]``: ``R_g p + t_g``. ``times`` is unused beyond its length check."""
@@ -60,12 +62,13 @@ def deskew_points(points: np.ndarray, times: np.ndarray, rotations: Rotation,
     if len(times) != len(pts) or len(index) != len(pts):
         raise ValueError(f"deskew: {len(pts)} points but {len(times)} times")
     mats = rotations.as_matrix().reshape(-1, 3, 3)
-    moved: np.ndarray = np.einsum("nij,nj->ni", mats[index], pts) + translations[index]
+    moved: NDArray[np.float64] = np.einsum("nij,nj->ni", mats[index], pts) + translations[index]
     return moved
 
 
-def _sensor_poses(track: PoseTrack, stamps: np.ndarray, mount: Mount,
-                  max_gap_s: float) -> tuple[Rotation, np.ndarray, np.ndarray]:
+def _sensor_poses(track: PoseTrack, stamps: NDArray[np.int64], mount: Mount,
+                  max_gap_s: float,
+                  ) -> tuple[Rotation[tuple[int]], NDArray[np.float64], NDArray[np.bool_]]:
     """Sensor rotations and positions at ``stamps`` (ns) from the body track; the mask of
     stamps the track could not give (outside or in a gap: nearest valid pose used)."""
     samples = track.interpolate(stamps, max_gap_s)
@@ -107,8 +110,8 @@ def deskew_frames(frames: Iterable[Frame], track: PoseTrack, mount: Mount, *,
         yield replace(frame, points=moved, times=None)
 
 
-def deskew_constant_velocity(points: np.ndarray, times: np.ndarray,
-                             motion: np.ndarray, period_s: float) -> np.ndarray:
+def deskew_constant_velocity(points: NDArray[np.float64], times: NDArray[np.float64],
+                             motion: NDArray[np.float64], period_s: float) -> NDArray[np.float64]:
     """Points moved to the stamp under a constant sensor twist: ``motion`` (4x4) is the
     sensor's displacement over ``period_s`` seconds (previous scan -> this one)."""
     grid, index = _groups(times)

@@ -8,6 +8,7 @@ so every operation is O(n log n) and deterministic (output sorted by cell key).
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import NDArray
 
 from alte.errors import ParameterError
 
@@ -29,8 +30,8 @@ def check_voxel(voxel: float) -> float:
 
 
 def grid_average_with_counts(
-    points: np.ndarray, voxel: float, weights: np.ndarray | None = None
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    points: NDArray[np.float64], voxel: float, weights: NDArray[np.float64] | None = None
+) -> tuple[NDArray[np.int64], NDArray[np.float64], NDArray[np.float64]]:
     """Group points by cell ``floor(p / voxel)``: (keys (K,3) int64, sums (K,3), counts (K,)).
 
     Cells come sorted by key (lexicographic x, y, z). ``weights`` counts each
@@ -45,7 +46,7 @@ def grid_average_with_counts(
     return _reduce(keys, pts * w[:, None], w)
 
 
-def _sort_keys(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _sort_keys(keys: NDArray[np.int64]) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
     """Order sorting integer cell keys lexicographically, and where each run of equal keys starts.
 
     Keys are packed into one int64 when their spans allow (one argsort instead of
@@ -65,8 +66,8 @@ def _sort_keys(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _reduce(
-    keys: np.ndarray, sums: np.ndarray, counts: np.ndarray
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    keys: NDArray[np.int64], sums: NDArray[np.float64], counts: NDArray[np.float64]
+) -> tuple[NDArray[np.int64], NDArray[np.float64], NDArray[np.float64]]:
     """Add up rows with equal integer keys; output sorted by key."""
     if len(keys) == 0:
         return np.empty((0, 3), np.int64), np.empty((0, 3)), np.empty(0)
@@ -78,14 +79,15 @@ def _reduce(
     )
 
 
-def grid_average(points: np.ndarray, voxel: float) -> np.ndarray:
+def grid_average(points: NDArray[np.float64], voxel: float) -> NDArray[np.float64]:
     """Grid-average down-sample (thesis 2.1.3): each cell's points merge into their mean."""
     _keys, sums, counts = grid_average_with_counts(points, voxel)
-    means: np.ndarray = sums / counts[:, None]
+    means: NDArray[np.float64] = sums / counts[:, None]
     return means
 
 
-def box_grid_merge(cloud_a: np.ndarray, cloud_b: np.ndarray, voxel: float) -> np.ndarray:
+def box_grid_merge(cloud_a: NDArray[np.float64], cloud_b: NDArray[np.float64],
+                   voxel: float) -> NDArray[np.float64]:
     """MATLAB ``pcmerge``-style pairwise merge: concatenate, then box-grid average."""
     a = np.asarray(cloud_a, dtype=np.float64).reshape(-1, 3)
     b = np.asarray(cloud_b, dtype=np.float64).reshape(-1, 3)
@@ -105,10 +107,10 @@ class GridAccumulator:
         self._keys = np.empty((0, 3), np.int64)
         self._sums = np.empty((0, 3))
         self._counts = np.empty(0)
-        self._pending: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
+        self._pending: list[tuple[NDArray[np.int64], NDArray[np.float64], NDArray[np.float64]]] = []
         self._pending_rows = 0
 
-    def add(self, points: np.ndarray, weights: np.ndarray | None = None) -> int:
+    def add(self, points: NDArray[np.float64], weights: NDArray[np.float64] | None = None) -> int:
         """Accumulate points (each standing for ``weights`` raw points, default 1).
 
         Returns the number of cells the points fall in (the frame's down-sampled size).
@@ -131,12 +133,12 @@ class GridAccumulator:
         )
         self._pending, self._pending_rows = [], 0
 
-    def points(self) -> np.ndarray:
+    def points(self) -> NDArray[np.float64]:
         """Cell means (K, 3), sorted by cell key."""
         self._fold()
         return self._sums / self._counts[:, None]
 
-    def counts(self) -> np.ndarray:
+    def counts(self) -> NDArray[np.float64]:
         """Raw points behind each cell mean (K,)."""
         self._fold()
         return self._counts.copy()

@@ -22,6 +22,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
 __all__ = ["GRAVITY", "ImuNoise", "InertialFilter", "NavState", "hat", "integrate"]
@@ -29,7 +30,7 @@ __all__ = ["GRAVITY", "ImuNoise", "InertialFilter", "NavState", "hat", "integrat
 GRAVITY = np.array([0.0, 0.0, -9.81])
 
 
-def hat(v: np.ndarray) -> np.ndarray:
+def hat(v: NDArray[np.float64]) -> NDArray[np.float64]:
     """Skew-symmetric matrix of a 3-vector (``hat(a) @ b == cross(a, b)``)."""
     return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
 
@@ -53,11 +54,11 @@ class NavState:
     velocity, gyroscope and accelerometer biases."""
 
     stamp: int
-    rotation: Rotation
-    position: np.ndarray
-    velocity: np.ndarray
-    gyro_bias: np.ndarray
-    accel_bias: np.ndarray
+    rotation: Rotation[tuple[()]]
+    position: NDArray[np.float64]
+    velocity: NDArray[np.float64]
+    gyro_bias: NDArray[np.float64]
+    accel_bias: NDArray[np.float64]
 
     def copy(self) -> NavState:
         """An independent copy."""
@@ -65,7 +66,7 @@ class NavState:
                         self.position.copy(), self.velocity.copy(), self.gyro_bias.copy(),
                         self.accel_bias.copy())
 
-    def matrix(self) -> np.ndarray:
+    def matrix(self) -> NDArray[np.float64]:
         """The IMU pose as a 4x4 transform (world from IMU)."""
         out = np.eye(4)
         out[:3, :3] = self.rotation.as_matrix()
@@ -73,7 +74,8 @@ class NavState:
         return out
 
 
-def _steps(stamps: np.ndarray, start: int, end: int) -> tuple[np.ndarray, np.ndarray]:
+def _steps(stamps: NDArray[np.int64], start: int, end: int,
+           ) -> tuple[NDArray[np.int64], NDArray[np.intp]]:
     """Sub-intervals of ``[start, end]`` (ns) split at the midpoints between samples, and the
     index of the sample that covers each (the one whose stamp is nearest its middle)."""
     mids = (stamps[:-1] + stamps[1:]) // 2
@@ -84,9 +86,11 @@ def _steps(stamps: np.ndarray, start: int, end: int) -> tuple[np.ndarray, np.nda
     return bounds, index
 
 
-def integrate(state: NavState, end: int, stamps: np.ndarray, gyro: np.ndarray,
-              accel: np.ndarray, *, visit: Callable[[NavState, np.ndarray, np.ndarray, float],
-                                                 None] | None = None) -> NavState:
+def integrate(state: NavState, end: int, stamps: NDArray[np.int64], gyro: NDArray[np.float64],
+              accel: NDArray[np.float64], *,
+              visit: Callable[[NavState, NDArray[np.float64], NDArray[np.float64], float],
+                              None] | None = None,
+              ) -> NavState:
     """The nominal state carried from ``state.stamp`` to ``end`` (ns) by the samples
     (module docstring); ``visit(state, w, f, dt)`` sees each step before it is applied."""
     out = state.copy()
@@ -119,7 +123,7 @@ class InertialFilter:
                      np.full(3, noise.accel_bias**2)]
         self.cov = np.diag(diag)
 
-    def _covariance_step(self, state: NavState, w: np.ndarray, f: np.ndarray,
+    def _covariance_step(self, state: NavState, w: NDArray[np.float64], f: NDArray[np.float64],
                          dt: float) -> None:
         """Propagate the error covariance over one step (state before the step)."""
         n = self.noise
@@ -134,13 +138,13 @@ class InertialFilter:
                   np.full(3, n.gyro_walk**2 * dt), np.full(3, n.accel_walk**2 * dt)]
         self.cov = jac @ self.cov @ jac.T + np.diag(q)
 
-    def predict(self, end: int, stamps: np.ndarray, gyro: np.ndarray,
-                accel: np.ndarray) -> None:
+    def predict(self, end: int, stamps: NDArray[np.int64], gyro: NDArray[np.float64],
+                accel: NDArray[np.float64]) -> None:
         """Carry state and covariance to ``end`` (ns) with the IMU samples."""
         self.state = integrate(self.state, end, stamps, gyro, accel,
                                visit=self._covariance_step)
 
-    def apply(self, delta: np.ndarray, base: NavState) -> NavState:
+    def apply(self, delta: NDArray[np.float64], base: NavState) -> NavState:
         """``base`` moved by the 15-dimensional error ``delta``."""
         out = base.copy()
         out.rotation = base.rotation * Rotation.from_rotvec(delta[0:3])
@@ -150,7 +154,8 @@ class InertialFilter:
         out.accel_bias = base.accel_bias + delta[12:15]
         return out
 
-    def update(self, residuals: Callable[[NavState], tuple[np.ndarray, np.ndarray]],
+    def update(self,
+               residuals: Callable[[NavState], tuple[NDArray[np.float64], NDArray[np.float64]]],
                sigma: float, iterations: int = 5, tolerance: float = 1e-4) -> int:
         """Iterated update with ``residuals(state) -> (r (M,), J (M, 6))``: residuals and
         their Jacobian in (rotation, position) of the IMU, of noise ``sigma``, down-weighted
@@ -158,7 +163,7 @@ class InertialFilter:
         Returns the count of residuals of the last iteration (0: no update)."""
         prior = self.state
         info_prior = np.linalg.inv(self.cov)
-        delta = np.zeros(15)
+        delta: NDArray[np.float64] = np.zeros(15)
         count = 0
         for _ in range(iterations):
             r, jac = residuals(self.apply(delta, prior))
@@ -170,7 +175,7 @@ class InertialFilter:
             weight = 1.0 / (1.0 + (r / sigma) ** 2) / sigma**2
             info = info_prior + h.T @ (h * weight[:, None])
             rhs = h.T @ (weight * (h @ delta - r))
-            new = np.linalg.solve(info, rhs)
+            new = np.asarray(np.linalg.solve(info, rhs), dtype=np.float64)
             step, delta = new - delta, new
             if np.linalg.norm(step[:6]) < tolerance:
                 break

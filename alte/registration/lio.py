@@ -27,6 +27,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation
 
@@ -54,20 +55,20 @@ class LioSettings:
     noise: ImuNoise = field(default_factory=ImuNoise)
 
 
-def _matrix(position: np.ndarray, rotation: Rotation) -> np.ndarray:
+def _matrix(position: NDArray[np.float64], rotation: Rotation[tuple[()]]) -> NDArray[np.float64]:
     out = np.eye(4)
     out[:3, :3], out[:3, 3] = rotation.as_matrix(), position
     return out
 
 
-def _cells(points: np.ndarray, voxel: float) -> np.ndarray:
+def _cells(points: NDArray[np.float64], voxel: float) -> NDArray[np.int64]:
     """One int64 key per ``voxel`` cell (21 bits an axis: +-500 km at 0.25 m)."""
     index = np.floor(points / voxel).astype(np.int64) + (1 << 20)
-    keys: np.ndarray = (index[:, 0] << 42) | (index[:, 1] << 21) | index[:, 2]
+    keys: NDArray[np.int64] = (index[:, 0] << 42) | (index[:, 1] << 21) | index[:, 2]
     return keys
 
 
-def _voxel_first(points: np.ndarray, voxel: float) -> np.ndarray:
+def _voxel_first(points: NDArray[np.float64], voxel: float) -> NDArray[np.float64]:
     """One point per ``voxel`` cell (the first): a cheap, deterministic down-sampling."""
     if len(points) == 0:
         return points
@@ -84,7 +85,7 @@ class LocalMap:
         self.keys = np.empty(0, np.int64)
         self.tree: cKDTree | None = None
 
-    def add(self, points: np.ndarray, centre: np.ndarray) -> None:
+    def add(self, points: NDArray[np.float64], centre: NDArray[np.float64]) -> None:
         """Add ``points`` (world) in cells not yet filled; drop what lies beyond ``radius``
         of ``centre``."""
         new = _voxel_first(points, self.voxel)
@@ -99,8 +100,8 @@ class LocalMap:
         self.tree = cKDTree(self.points, balanced_tree=False, compact_nodes=False) \
             if len(self.points) >= 5 else None
 
-    def planes(self, query: np.ndarray, max_distance: float, k: int = 5
-               ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def planes(self, query: NDArray[np.float64], max_distance: float, k: int = 5
+               ) -> tuple[NDArray[np.intp], NDArray[np.float64], NDArray[np.float64]]:
         """For each query point with five map neighbours within ``max_distance`` lying on
         a plane (thinner than ``thickness``, and not a line as a ring's points are): its
         index, the plane's unit normal and a point of the plane."""
@@ -132,7 +133,7 @@ class LioOdometry:
     """The filter, the map and the LiDAR's pose on the IMU (module docstring)."""
 
     def __init__(self, imu: ImuSamples, lidar: Mount, settings: LioSettings,
-                 start: tuple[np.ndarray, np.ndarray] | None, first: int) -> None:
+                 start: tuple[NDArray[np.float64], NDArray[np.float64]] | None, first: int) -> None:
         self.imu, self.settings = imu, settings
         imu_mount = imu.mount or Mount()
         self.body_imu = _matrix(imu_mount.translation, imu_mount.rotation)
@@ -146,7 +147,7 @@ class LioOdometry:
         self.filter = InertialFilter(state, settings.noise)
         self.map = LocalMap(settings.voxel / 2, settings.max_range)
 
-    def _level(self, stamp: int) -> np.ndarray:
+    def _level(self, stamp: int) -> NDArray[np.float64]:
         """A body pose at the origin, level by the mean specific force of the first 0.1 s."""
         near = np.abs(self.imu.stamps - stamp) <= 50_000_000
         force = self.imu.linear_acceleration[near].mean(axis=0) if near.any() \
@@ -155,13 +156,14 @@ class LioOdometry:
         tilt, _ = Rotation.align_vectors([[0.0, 0.0, 1.0]], [up])
         return _matrix(np.zeros(3), tilt)
 
-    def _window(self, start: int, end: int) -> slice:
+    def _window(self, start: int, end: int) -> slice[int, int]:
         """Samples that can cover ``[start, end]`` (one either side)."""
         lo = max(int(np.searchsorted(self.imu.stamps, start)) - 1, 0)
         hi = int(np.searchsorted(self.imu.stamps, end)) + 1
         return slice(lo, hi)
 
-    def deskew(self, points: np.ndarray, times: np.ndarray | None) -> np.ndarray:
+    def deskew(self, points: NDArray[np.float64], times: NDArray[np.float64] | None,
+               ) -> NDArray[np.float64]:
         """Scan points (LiDAR frame) in the IMU frame at the stamp, moved with the sweep's
         mean rate and acceleration from each point's instant (``times``, s)."""
         state = self.filter.state
@@ -175,14 +177,14 @@ class LioOdometry:
         tau = np.asarray(times, dtype=np.float64)[:, None]
         rot = Rotation.from_rotvec(tau * gyro)
         shift = state.rotation.inv().apply(state.velocity * tau + 0.5 * accel * tau**2)
-        moved: np.ndarray = rot.apply(lidar) + shift
+        moved: NDArray[np.float64] = rot.apply(lidar) + shift
         return moved
 
-    def _residuals(self, scan: np.ndarray) -> Callable[[NavState],
-                                                       tuple[np.ndarray, np.ndarray]]:
+    def _residuals(self, scan: NDArray[np.float64],
+                   ) -> Callable[[NavState], tuple[NDArray[np.float64], NDArray[np.float64]]]:
         settings = self.settings
 
-        def residuals(state: NavState) -> tuple[np.ndarray, np.ndarray]:
+        def residuals(state: NavState) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
             rot = state.rotation.as_matrix()
             world = scan @ rot.T + state.position
             index, normal, centre = self.map.planes(world, settings.max_distance,
@@ -197,7 +199,7 @@ class LioOdometry:
 
         return residuals
 
-    def step(self, frame: Frame) -> np.ndarray:
+    def step(self, frame: Frame) -> NDArray[np.float64]:
         """The body pose (4x4, world) at the frame's stamp."""
         check_overlap(self.imu, frame.stamp)
         span = self._window(self.filter.state.stamp, frame.stamp)
@@ -218,8 +220,8 @@ class LioOdometry:
 
 
 def lio_frames(frames: Iterable[Frame], lidar: Mount, imu: ImuSamples, settings: LioSettings,
-               start: tuple[np.ndarray, np.ndarray] | None = None) -> Iterator[
-                   tuple[Frame, np.ndarray]]:
+               start: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None) -> Iterator[
+                   tuple[Frame, NDArray[np.float64]]]:
     """Each frame with its body pose (4x4) from LIO, anchored at ``start``."""
     odometry: LioOdometry | None = None
     for frame in frames:

@@ -59,7 +59,7 @@ def lio_settings(params: OdometryParams) -> LioSettings:
                        max_distance=params.plane_reach, neighbours=params.plane_points)
 
 
-def _rate(previous: Frame | None, quaternion: np.ndarray, stamp: int) -> float:
+def _rate(previous: Frame | None, quaternion: NDArray[np.float64], stamp: int) -> float:
     """Body angular rate (rad/s) from the previous odometry pose (0 for the first)."""
     if previous is None or stamp == previous.stamp:
         return 0.0
@@ -67,7 +67,7 @@ def _rate(previous: Frame | None, quaternion: np.ndarray, stamp: int) -> float:
     return float(turn.magnitude() / abs(stamp - previous.stamp) * 1e9)
 
 
-def _posed(frame: Frame, body: np.ndarray, previous: Frame | None) -> Frame:
+def _posed(frame: Frame, body: NDArray[np.float64], previous: Frame | None) -> Frame:
     """``frame`` with the body pose ``body`` (4x4) and the rate since ``previous``."""
     quaternion = Rotation.from_matrix(body[:3, :3]).as_quat()
     return replace(frame, position=body[:3, 3].copy(), quaternion=quaternion,
@@ -76,7 +76,7 @@ def _posed(frame: Frame, body: np.ndarray, previous: Frame | None) -> Frame:
 
 def _lio_frames(frames: Iterable[Frame], mount: Mount, imu: ImuSamples | None, *,
                 counts: PoseCounts, params: OdometryParams,
-                start: tuple[np.ndarray, np.ndarray] | None) -> Iterator[Frame]:
+                start: tuple[NDArray[np.float64], NDArray[np.float64]] | None) -> Iterator[Frame]:
     """``frames`` posed by LiDAR-inertial odometry (:mod:`alte.registration.lio`)."""
     if imu is None:
         raise ParameterError("--odometry lio needs an IMU topic (sensor_msgs/msg/Imu) in the "
@@ -99,7 +99,7 @@ def _lio_frames(frames: Iterable[Frame], mount: Mount, imu: ImuSamples | None, *
 
 def odometry_frames(frames: Iterable[Frame], mount: Mount, *, counts: PoseCounts,
                     params: OdometryParams | None = None,
-                    start: tuple[np.ndarray, np.ndarray] | None = None,
+                    start: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None,
                     imu: ImuSamples | None = None) -> Iterator[Frame]:
     """``frames`` with body poses from LiDAR (or LiDAR-inertial, with ``imu``) odometry,
     anchored at ``start``."""

@@ -31,6 +31,7 @@ from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
 from alte.registration.backends import scene_scale
@@ -85,10 +86,10 @@ class DenseMap:
         self.voxel, self.radius, self.rebuild = voxel, radius, rebuild
         self.threads = _threads(threads)
         self.points = np.empty((0, 3))
-        self.pending: list[np.ndarray] = []
+        self.pending: list[NDArray[np.float64]] = []
         self.target: Any = None
 
-    def source(self, scan: np.ndarray) -> Any:
+    def source(self, scan: NDArray[np.float64]) -> Any:
         """The scan down-sampled on the map voxel, at most :data:`MAX_SOURCE` points evenly
         spaced (a small_gicp cloud)."""
         import small_gicp
@@ -100,7 +101,7 @@ class DenseMap:
         keep = np.linspace(0, len(points) - 1, MAX_SOURCE).astype(np.int64)
         return small_gicp.PointCloud(np.ascontiguousarray(points[keep]))
 
-    def add(self, scan: np.ndarray, sensor: np.ndarray) -> None:
+    def add(self, scan: NDArray[np.float64], sensor: NDArray[np.float64]) -> None:
         """Queue the scan (sensor frame, on a ``voxel / 2`` grid) placed at ``sensor``;
         rebuild the target every ``rebuild`` scans."""
         import small_gicp
@@ -121,7 +122,7 @@ class DenseMap:
         small_gicp.estimate_normals(target, tree, num_neighbors=20, num_threads=self.threads)
         self.target = (target, tree)
 
-    def align(self, source: Any, guess: np.ndarray) -> Any:
+    def align(self, source: Any, guess: NDArray[np.float64]) -> Any:
         """small_gicp's point-to-plane alignment of ``source`` from ``guess``."""
         import small_gicp
 
@@ -130,7 +131,7 @@ class DenseMap:
                                 max_correspondence_distance=_REACH * self.voxel,
                                 num_threads=self.threads, max_iterations=30)
 
-    def cost(self, points: np.ndarray, pose: np.ndarray) -> tuple[float, float]:
+    def cost(self, points: NDArray[np.float64], pose: NDArray[np.float64]) -> tuple[float, float]:
         """Inlier fraction and truncated point-to-plane cost (m^2, outliers at the reach)
         of sensor-frame ``points`` placed at ``pose``."""
         target, tree = self.target
@@ -147,7 +148,7 @@ class DenseMap:
             if len(cost) else reach
 
 
-def _constraint(hessian: np.ndarray, length: float) -> float:
+def _constraint(hessian: NDArray[np.float64], length: float) -> float:
     """Smallest over largest eigenvalue of the Hessian (rotation first, as small_gicp
     orders it) with rotation scaled to metres at ``length``."""
     scale = np.diag([1.0 / length] * 3 + [1.0] * 3)
@@ -155,15 +156,15 @@ def _constraint(hessian: np.ndarray, length: float) -> float:
     return float(max(values[0], 0.0) / values[-1]) if values[-1] > 0 else 0.0
 
 
-def _correction(guess: np.ndarray, aligned: np.ndarray) -> tuple[float, float]:
+def _correction(guess: NDArray[np.float64], aligned: NDArray[np.float64]) -> tuple[float, float]:
     """Size of ``guess -> aligned``: metres and degrees."""
     delta = np.linalg.inv(guess) @ aligned
     angle = Rotation.from_matrix(delta[:3, :3]).magnitude()
     return float(np.linalg.norm(delta[:3, 3])), float(np.degrees(angle))
 
 
-def _decide(local: DenseMap, source: Any, guess: np.ndarray, length: float,
-            params: OdometryParams, *, stamp: int) -> tuple[np.ndarray, ScanDecision]:
+def _decide(local: DenseMap, source: Any, guess: NDArray[np.float64], length: float,
+            params: OdometryParams, *, stamp: int) -> tuple[NDArray[np.float64], ScanDecision]:
     """The pose to use for the scan and why (module docstring)."""
     result = local.align(source, guess)
     aligned = np.asarray(result.T_target_source)

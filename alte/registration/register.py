@@ -20,6 +20,7 @@ from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import NDArray
 from tqdm import tqdm
 
 from alte.errors import ParameterError, RegistrationError
@@ -40,7 +41,8 @@ __all__ = [
 ]
 
 
-def crop_mask(points: np.ndarray, box: tuple[float, ...] | np.ndarray) -> np.ndarray:
+def crop_mask(points: NDArray[np.float64], box: tuple[float, ...] | NDArray[np.float64],
+              ) -> NDArray[np.bool_]:
     """Points inside ``box = (xmin, ymin, zmin, xmax, ymax, zmax)``, bounds inclusive."""
     arr = np.asarray(box, dtype=np.float64).reshape(-1)
     if arr.shape != (6,) or not np.isfinite(arr).all() or np.any(arr[:3] > arr[3:]):
@@ -52,10 +54,11 @@ def crop_mask(points: np.ndarray, box: tuple[float, ...] | np.ndarray) -> np.nda
     return rows_all((pts >= arr[:3]) & (pts <= arr[3:]))
 
 
-def crop(points: np.ndarray, box: tuple[float, ...] | np.ndarray) -> np.ndarray:
+def crop(points: NDArray[np.float64], box: tuple[float, ...] | NDArray[np.float64],
+         ) -> NDArray[np.float64]:
     """Keep only the points inside the control volume (thesis 2.2.4)."""
     pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
-    kept: np.ndarray = pts[crop_mask(pts, box)]
+    kept: NDArray[np.float64] = pts[crop_mask(pts, box)]
     return kept
 
 
@@ -119,8 +122,8 @@ class RegistrationCounts(Counts):
 
 
 def _frame_points(
-    frame: Frame, mount: Mount, box: np.ndarray | None, counts: RegistrationCounts
-) -> tuple[np.ndarray, np.ndarray]:
+    frame: Frame, mount: Mount, box: NDArray[np.float64] | None, counts: RegistrationCounts
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Registered, finite, cropped points of one frame and the sensor origin (one pose)."""
     raw = np.asarray(frame.points, dtype=np.float64)
     if raw.ndim != 2 or raw.shape[1] != 3:
@@ -148,7 +151,7 @@ def _iterate(
     gate: ManoeuvreFilter,
     merge: GridAccumulator | None,
     progress: bool,
-) -> Iterator[tuple[Frame, np.ndarray, np.ndarray]]:
+) -> Iterator[tuple[Frame, NDArray[np.float64], NDArray[np.float64]]]:
     box = None if crop_box is None else np.asarray(crop_box, dtype=np.float64)
     for frame in tqdm(frames, desc="register", unit="frame", disable=not progress):
         counts.frames_in += 1
@@ -194,7 +197,7 @@ def register_frames(
     progress: bool = False,
     counts: RegistrationCounts | None = None,
     merge: GridAccumulator | None = None,
-) -> Iterator[tuple[Frame, np.ndarray, np.ndarray]]:
+) -> Iterator[tuple[Frame, NDArray[np.float64], NDArray[np.float64]]]:
     """Yield ``(frame, inertial points, sensor origin)`` per kept frame, for incremental mappers.
 
     Points are registered (eq. 2.2), stripped of NaN/inf, cropped to ``crop_box``
@@ -220,10 +223,10 @@ class Registration:
     ``counts`` frames/points in, dropped by reason, and out.
     """
 
-    points: np.ndarray
-    origins: np.ndarray
-    frame_points: np.ndarray
-    stamps: np.ndarray
+    points: NDArray[np.float64]
+    origins: NDArray[np.float64]
+    frame_points: NDArray[np.int64]
+    stamps: NDArray[np.int64]
     counts: RegistrationCounts
 
 
@@ -245,7 +248,7 @@ def register(
     """
     counts = RegistrationCounts()
     merged = GridAccumulator(voxel) if voxel is not None else None
-    parts: list[np.ndarray] = []
+    parts: list[NDArray[np.float64]] = []
     origins, stamps, sizes = [], [], []
     stream = register_frames(
         frames, mount, voxel=None, crop_box=crop_box, max_rate=max_rate,

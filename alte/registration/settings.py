@@ -12,6 +12,7 @@ from dataclasses import dataclass, field, replace
 from typing import ClassVar, Literal, get_args
 
 import numpy as np
+from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
 from alte.errors import ParameterError
@@ -155,7 +156,8 @@ class PoseCounts(Counts):
     scans: list[dict[str, object]] = field(default_factory=list)
 
 
-def pose_matrix(position: np.ndarray, quaternion: np.ndarray) -> np.ndarray:
+def pose_matrix(position: NDArray[np.float64], quaternion: NDArray[np.float64],
+                ) -> NDArray[np.float64]:
     """4x4 homogeneous transform of a position and an (x, y, z, w) quaternion."""
     out = np.eye(4)
     out[:3, :3] = Rotation.from_quat(quaternion).as_matrix()
