@@ -15,15 +15,38 @@ one scan at a time, returning the sensor pose in the first scan's sensor frame.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
 from numpy.typing import NDArray
 
 if TYPE_CHECKING:
+    import open3d as o3d
+
     from alte.registration.settings import OdometryParams, PoseCounts
 
 __all__ = ["Kiss", "Plane", "PlaneMap", "kiss_config", "kiss_voxel", "scene_scale"]
+
+
+class _KissData(Protocol):
+    """What is read of KISS-ICP's ``config.data``."""
+
+    deskew: bool
+
+
+class _KissMapping(Protocol):
+    """What is read of KISS-ICP's ``config.mapping``."""
+
+    voxel_size: float
+
+
+class KissSettings(Protocol):
+    """What alte reads of a ``kiss_icp.config.KISSConfig`` (kiss-icp ships no types)."""
+
+    @property
+    def data(self) -> _KissData: ...
+    @property
+    def mapping(self) -> _KissMapping: ...
 
 
 def scene_scale(points: NDArray[np.float64], params: OdometryParams) -> tuple[float, float]:
@@ -47,7 +70,8 @@ def kiss_voxel(params: OdometryParams) -> float:
     return params.voxel or (params.max_range or 100.0) / 100.0
 
 
-def kiss_config(points: NDArray[np.float64], params: OdometryParams, timed: bool = False) -> Any:
+def kiss_config(points: NDArray[np.float64], params: OdometryParams,
+                timed: bool = False) -> KissSettings:
     """KISS-ICP's configuration for ``params`` (unset values: KISS-ICP's own defaults);
     deskewing only for scans with per-point time (``timed``)."""
     from kiss_icp.config import KISSConfig
@@ -63,7 +87,8 @@ def kiss_config(points: NDArray[np.float64], params: OdometryParams, timed: bool
     config.adaptive_threshold.min_motion_th = params.min_motion_th
     config.adaptive_threshold.fixed_threshold = params.fixed_threshold
     config.registration.max_num_threads = params.threads
-    return config
+    settings: KissSettings = config
+    return settings
 
 
 class Kiss:
@@ -111,16 +136,16 @@ class PlaneMap:
         self.voxel, self.radius, self.rebuild = voxel, radius, rebuild
         self.points = np.empty((0, 3))
         self.pending: list[NDArray[np.float64]] = []
-        self.target: Any = None
+        self.target: o3d.geometry.PointCloud | None = None
 
-    def source(self, scan: NDArray[np.float64]) -> Any:
+    def source(self, scan: NDArray[np.float64]) -> o3d.geometry.PointCloud:
         """The scan (sensor frame) down-sampled on the map's voxel."""
         import open3d as o3d
 
         cloud = o3d.geometry.PointCloud(o3d.utility.Vector3dVector(scan))
         return cloud.voxel_down_sample(self.voxel)
 
-    def add(self, source: Any, sensor: NDArray[np.float64]) -> None:
+    def add(self, source: o3d.geometry.PointCloud, sensor: NDArray[np.float64]) -> None:
         """Queue the aligned scan; rebuild the target when ``rebuild`` scans are queued."""
         import open3d as o3d
 
@@ -134,12 +159,13 @@ class PlaneMap:
         target.estimate_normals(o3d.geometry.KDTreeSearchParamHybrid(6.0 * self.voxel, 40))
         self.points, self.pending, self.target = np.asarray(target.points), [], target
 
-    def align(self, source: Any, guess: NDArray[np.float64]) -> tuple[NDArray[np.float64], float]:
+    def align(self, source: o3d.geometry.PointCloud, guess: NDArray[np.float64],
+              ) -> tuple[NDArray[np.float64], float]:
         """The sensor pose placing ``source`` on the map, from ``guess``; inlier fraction."""
         import open3d as o3d
 
+        assert self.target is not None  # Plane aligns only once the map has a target
         reg = o3d.pipelines.registration
-
         reach = 6.0 * self.voxel
         method = reg.TransformationEstimationPointToPlane(reg.TukeyLoss(k=reach / 2))
         result = reg.registration_icp(source, self.target, reach, guess, method,

@@ -28,7 +28,7 @@ import os
 import time
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
 from numpy.typing import NDArray
@@ -50,6 +50,29 @@ _REACH = 4.0
 #: Most points of a scan aligned (evenly spaced after the voxel grid): a few thousand
 #: constrain six degrees of freedom as well as tens of thousands, at a fraction of the cost.
 MAX_SOURCE = 5000
+
+
+class GicpCloud(Protocol):
+    """What is read of a small_gicp point cloud (small_gicp ships no types)."""
+
+    def size(self) -> int: ...
+    def points(self) -> NDArray[np.float64]: ...
+    def normals(self) -> NDArray[np.float64]: ...
+
+
+class _GicpTree(Protocol):
+    """What is read of a small_gicp k-d tree."""
+
+    def batch_nearest_neighbor_search(self, pts: NDArray[np.float64], num_threads: int = 1,
+                                      ) -> tuple[list[int], list[float]]: ...
+
+
+class GicpResult(Protocol):
+    """What is read of a small_gicp registration result: the aligned pose (4x4) and the
+    Gauss-Newton Hessian (6x6, rotation first)."""
+
+    T_target_source: NDArray[np.float64]
+    H: NDArray[np.float64]
 
 
 def _threads(wanted: int) -> int:
@@ -87,19 +110,21 @@ class DenseMap:
         self.threads = _threads(threads)
         self.points = np.empty((0, 3))
         self.pending: list[NDArray[np.float64]] = []
-        self.target: Any = None
+        self.target: tuple[GicpCloud, _GicpTree] | None = None
 
-    def source(self, scan: NDArray[np.float64]) -> Any:
+    def source(self, scan: NDArray[np.float64]) -> GicpCloud:
         """The scan down-sampled on the map voxel, at most :data:`MAX_SOURCE` points evenly
         spaced (a small_gicp cloud)."""
         import small_gicp
 
-        grid = small_gicp.voxelgrid_sampling(scan, self.voxel, num_threads=self.threads)
+        grid: GicpCloud = small_gicp.voxelgrid_sampling(scan, self.voxel,
+                                                        num_threads=self.threads)
         if grid.size() <= MAX_SOURCE:
             return grid
         points = np.asarray(grid.points())[:, :3]
         keep = np.linspace(0, len(points) - 1, MAX_SOURCE).astype(np.int64)
-        return small_gicp.PointCloud(np.ascontiguousarray(points[keep]))
+        spaced: GicpCloud = small_gicp.PointCloud(np.ascontiguousarray(points[keep]))
+        return spaced
 
     def add(self, scan: NDArray[np.float64], sensor: NDArray[np.float64]) -> None:
         """Queue the scan (sensor frame, on a ``voxel / 2`` grid) placed at ``sensor``;
@@ -122,22 +147,26 @@ class DenseMap:
         small_gicp.estimate_normals(target, tree, num_neighbors=20, num_threads=self.threads)
         self.target = (target, tree)
 
-    def align(self, source: Any, guess: NDArray[np.float64]) -> Any:
+    def align(self, source: GicpCloud, guess: NDArray[np.float64]) -> GicpResult:
         """small_gicp's point-to-plane alignment of ``source`` from ``guess``."""
         import small_gicp
 
+        assert self.target is not None  # refine_frames aligns only once the map has a target
         target, tree = self.target
-        return small_gicp.align(target, source, tree, guess, registration_type="PLANE_ICP",
-                                max_correspondence_distance=_REACH * self.voxel,
-                                num_threads=self.threads, max_iterations=30)
+        result: GicpResult = small_gicp.align(
+            target, source, tree, guess, registration_type="PLANE_ICP",
+            max_correspondence_distance=_REACH * self.voxel, num_threads=self.threads,
+            max_iterations=30)
+        return result
 
     def cost(self, points: NDArray[np.float64], pose: NDArray[np.float64]) -> tuple[float, float]:
         """Inlier fraction and truncated point-to-plane cost (m^2, outliers at the reach)
         of sensor-frame ``points`` placed at ``pose``."""
+        assert self.target is not None  # refine_frames aligns only once the map has a target
         target, tree = self.target
         placed = points @ pose[:3, :3].T + pose[:3, 3]
-        index, sq = tree.batch_nearest_neighbor_search(placed, num_threads=self.threads)
-        index = np.asarray(index, dtype=np.int64)
+        found, sq = tree.batch_nearest_neighbor_search(placed, num_threads=self.threads)
+        index = np.asarray(found, dtype=np.int64)
         reach = (_REACH * self.voxel) ** 2
         inlier = (np.asarray(sq) <= reach) & (index >= 0)
         ref = np.asarray(target.points())[:, :3][np.maximum(index, 0)]
@@ -163,7 +192,7 @@ def _correction(guess: NDArray[np.float64], aligned: NDArray[np.float64]) -> tup
     return float(np.linalg.norm(delta[:3, 3])), float(np.degrees(angle))
 
 
-def _decide(local: DenseMap, source: Any, guess: NDArray[np.float64], length: float,
+def _decide(local: DenseMap, source: GicpCloud, guess: NDArray[np.float64], length: float,
             params: OdometryParams, *, stamp: int) -> tuple[NDArray[np.float64], ScanDecision]:
     """The pose to use for the scan and why (module docstring)."""
     result = local.align(source, guess)
