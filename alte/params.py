@@ -21,11 +21,14 @@ import typing
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, ClassVar, Literal, Self, get_args, get_origin
+from typing import Any, ClassVar, Generic, Literal, Self, TypeVar, get_args, get_origin, overload
 
 from alte.errors import ParameterError
 
 __all__ = ["Record", "Rule", "coerce", "param"]
+
+_T = TypeVar("_T")
+_V_contra = TypeVar("_V_contra", contravariant=True)
 
 _TRUE = {"true", "1", "yes"}
 _FALSE = {"false", "0", "no"}
@@ -36,17 +39,29 @@ def _always(_value: object) -> bool:
 
 
 @dataclass(frozen=True)
-class Rule:
+class Rule(Generic[_V_contra]):
     """How one field is checked and explained: ``check(value)`` must hold; ``rule`` says what."""
 
-    check: Callable[[Any], bool] = _always
+    check: Callable[[_V_contra], bool] = _always
     rule: str = ""
     help: str = ""
 
 
-def param(default: Any, check: Callable[[Any], bool] = _always, rule: str = "",
-          help: str = "") -> Any:
-    """A :class:`Record` field with its default and validity rule."""
+# A None default takes its type from the field it declares (a check that accepts anything,
+# like ``bool``, says nothing about it); a check sees the coerced value, never None.
+@overload
+def param(default: None, check: Callable[[object], bool], rule: str = "",
+          help: str = "") -> _T | None: ...
+@overload
+def param(default: None, check: Callable[[_T], bool] = _always, rule: str = "",
+          help: str = "") -> _T | None: ...
+@overload
+def param(default: _T, check: Callable[[_T], bool] = _always, rule: str = "",
+          help: str = "") -> _T: ...
+def param(default: object, check: Callable[[_T], bool] = _always, rule: str = "",
+          help: str = "") -> object:
+    """A :class:`Record` field with its default and validity rule; ``check`` sees the
+    coerced value, never None (an optional field's None is always valid)."""
     return field(default=default, metadata={"rule": Rule(check, rule, help)})
 
 
@@ -142,7 +157,7 @@ _CONVERTERS: dict[object, Callable[[str, str, object], object]] = {
     bool: _bool, int: _int, float: _float, str: _text, Path: _path}
 
 
-def coerce(owner: str, name: str, kind: Any, value: object) -> Any:
+def coerce(owner: str, name: str, kind: object, value: object) -> object:
     """``value`` as the annotated type ``kind``: int, float, str, bool, Path, Literal, an
     enum, ``tuple[X, ...]``, a nested :class:`Record` (from a mapping), ``X | None``;
     other types pass unchanged."""
@@ -201,8 +216,8 @@ class Record:
             if not spec.init:
                 continue  # derived in the subclass's __post_init__
             value = coerce(self.OWNER, spec.name, hints[spec.name], getattr(self, spec.name))
-            rule = spec.metadata.get("rule", Rule())
-            if value is not None and not rule.check(value):
+            rule = spec.metadata.get("rule")
+            if value is not None and isinstance(rule, Rule) and not rule.check(value):
                 shown = list(value) if isinstance(value, tuple) else value  # as YAML wrote it
                 raise ParameterError(f"{self.OWNER}: {spec.name}={shown!r} out of range "
                                      f"({rule.rule})")
@@ -223,6 +238,7 @@ class Record:
                                  f"valid: {', '.join(sorted(cls.names()))}")
         return cls(**given)
 
+    # Any, not object: the mappers read their parameters from this dict as typed values.
     def as_dict(self) -> dict[str, Any]:
         """Parameters by name (JSON-ready scalars)."""
         return {name: getattr(self, name) for name in self.names()}
@@ -237,7 +253,8 @@ class Record:
         out = {}
         hints = _hints(cls)
         for spec in dataclasses.fields(cls):
-            rule = spec.metadata.get("rule", Rule())
+            rule = spec.metadata.get("rule")
+            rule = rule if isinstance(rule, Rule) else Rule()
             said = rule.rule or _choices(hints[spec.name])
             out[spec.name] = f"{rule.help} ({said})" if said else rule.help
         return out

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 from typing import TypeAlias
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
 from alte.errors import ParameterError, PoseError
@@ -41,7 +42,8 @@ class Counts:
 
 
 def as_points(points: object, name: str = "points", *, owner: str = "",
-              error: type[Exception] = ValueError, finite: bool = False) -> np.ndarray:
+              error: type[Exception] = ValueError, finite: bool = False,
+              ) -> NDArray[np.float64]:
     """Return ``points`` as a C-contiguous float64 (N, 3) array or raise ``error``.
 
     ``owner`` prefixes the message (the function or mapper at the user's end);
@@ -56,7 +58,7 @@ def as_points(points: object, name: str = "points", *, owner: str = "",
     return arr
 
 
-def rows_all(mask: np.ndarray) -> np.ndarray:
+def rows_all(mask: NDArray[np.bool_]) -> NDArray[np.bool_]:
     """Row-wise ``all`` of an (N, K) boolean mask, column by column: for a few columns
     numpy's ``mask.all(axis=1)`` is several times slower (it reduces K values at a time)."""
     out = mask[:, 0].copy()
@@ -65,7 +67,7 @@ def rows_all(mask: np.ndarray) -> np.ndarray:
     return out
 
 
-def finite_rows(points: np.ndarray) -> np.ndarray | None:
+def finite_rows(points: NDArray[np.float64]) -> NDArray[np.bool_] | None:
     """Mask of the rows of (N, K) ``points`` with every value finite; None when all are
     (the common case, found with one fast reduction)."""
     finite = np.isfinite(points)
@@ -76,8 +78,8 @@ def finite_rows(points: np.ndarray) -> np.ndarray | None:
 class Box:
     """An axis-aligned box ``lo <= p <= hi`` (metres), e.g. a control volume (thesis 2.2.4)."""
 
-    lo: np.ndarray
-    hi: np.ndarray
+    lo: NDArray[np.float64]
+    hi: NDArray[np.float64]
 
     def __post_init__(self) -> None:
         lo = np.asarray(self.lo, dtype=np.float64).reshape(-1)
@@ -101,7 +103,7 @@ class Box:
         return cls(arr[:3], arr[3:])
 
     @classmethod
-    def around(cls, points: np.ndarray) -> Box:
+    def around(cls, points: ArrayLike) -> Box:
         """The bounding box of (N, 3) points (N >= 1)."""
         pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
         return cls(pts.min(axis=0), pts.max(axis=0))
@@ -110,7 +112,7 @@ class Box:
         """``(xmin, ymin, zmin, xmax, ymax, zmax)``."""
         return tuple(float(v) for v in (*self.lo, *self.hi))
 
-    def array(self) -> np.ndarray:
+    def array(self) -> NDArray[np.float64]:
         """The (2, 3) array ``[lo, hi]``."""
         return np.array([self.lo, self.hi])
 
@@ -140,13 +142,13 @@ class Frame:
     """
 
     stamp: int
-    points: np.ndarray
-    position: np.ndarray
-    quaternion: np.ndarray
+    points: NDArray[np.float64]
+    position: NDArray[np.float64]
+    quaternion: NDArray[np.float64]
     pose_offset_s: float = 0.0
     angular_rate: float = 0.0
     dropped_points: int = 0
-    times: np.ndarray | None = None
+    times: NDArray[np.float64] | None = None
 
     @property
     def time(self) -> float:
@@ -154,7 +156,7 @@ class Frame:
         return self.stamp / _NS
 
     @property
-    def rotation(self) -> Rotation:
+    def rotation(self) -> Rotation[tuple[()]]:
         """Body-to-inertial rotation, ``[DCM]_B^I``."""
         return Rotation.from_quat(self.quaternion)
 
@@ -179,11 +181,11 @@ class RegisteredFrame:
     points' other values by name (a point file's intensity, colours, ...), when kept."""
 
     stamp: int
-    points: np.ndarray
-    origin: np.ndarray
-    position: np.ndarray
-    quaternion: np.ndarray
-    fields: dict[str, np.ndarray] | None = None
+    points: NDArray[np.float64]
+    origin: NDArray[np.float64]
+    position: NDArray[np.float64]
+    quaternion: NDArray[np.float64]
+    fields: dict[str, NDArray[np.generic[object]]] | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -191,16 +193,16 @@ class Trajectory:
     """The poses scans were registered with: ``stamps`` (F,) int64 ns, body ``positions``
     (F, 3) and ``quaternions`` (F, 4, x y z w), sensor ``origins`` (F, 3)."""
 
-    stamps: np.ndarray
-    positions: np.ndarray
-    quaternions: np.ndarray
-    origins: np.ndarray
+    stamps: NDArray[np.int64]
+    positions: NDArray[np.float64]
+    quaternions: NDArray[np.float64]
+    origins: NDArray[np.float64]
 
     def __len__(self) -> int:
         return int(self.stamps.shape[0])
 
     @property
-    def times(self) -> np.ndarray:
+    def times(self) -> NDArray[np.float64]:
         """Seconds since the first stamp (F,)."""
         return (self.stamps - self.stamps[0]) / _NS if len(self) else np.empty(0)
 
@@ -224,8 +226,8 @@ class Trajectory:
 class Mount:
     """Fixed sensor pose on the body: offset ``R_S/B^B`` and rotation ``[DCM]_S^B``."""
 
-    translation: np.ndarray = field(default_factory=lambda: np.zeros(3))
-    quaternion: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, 0.0, 1.0]))
+    translation: NDArray[np.float64] = field(default_factory=lambda: np.zeros(3))
+    quaternion: NDArray[np.float64] = field(default_factory=lambda: np.array([0.0, 0.0, 0.0, 1.0]))
 
     def __post_init__(self) -> None:
         t = np.asarray(self.translation, dtype=np.float64).reshape(-1)
@@ -239,7 +241,7 @@ class Mount:
         object.__setattr__(self, "quaternion", q / norm)
 
     @property
-    def rotation(self) -> Rotation:
+    def rotation(self) -> Rotation[tuple[()]]:
         """Sensor-to-body rotation, ``[DCM]_S^B``."""
         return Rotation.from_quat(self.quaternion)
 

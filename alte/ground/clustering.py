@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 import pandas as pd
+from numpy.typing import ArrayLike, NDArray
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
@@ -27,13 +28,13 @@ OBSTACLE_COLUMNS = (
 )
 
 
-def _check(points: object, owner: str) -> np.ndarray:
+def _check(points: object, owner: str) -> NDArray[np.float64]:
     return as_points(points, owner=owner, error=ParameterError, finite=True)
 
 
 def euclidean_clusters(
-    points: np.ndarray, tolerance: float, min_size: int = 1, max_size: int | None = None
-) -> np.ndarray:
+    points: NDArray[np.float64], tolerance: float, min_size: int = 1, max_size: int | None = None
+) -> NDArray[np.int64]:
     """Label every point with its cluster (N,) int64; -1 for clusters outside the size range.
 
     Clusters are numbered 0, 1, ... by decreasing size (ties: the cluster holding
@@ -67,8 +68,8 @@ def euclidean_clusters(
 
 
 def _ground_height(
-    pts: np.ndarray, starts: np.ndarray, ground: PlaneFit | float | None
-) -> np.ndarray:
+    pts: NDArray[np.float64], starts: NDArray[np.intp], ground: PlaneFit | float | None
+) -> NDArray[np.float64]:
     """Top of each cluster above the ground plane, a ground level, or its own bottom."""
     if isinstance(ground, PlaneFit):
         return np.maximum.reduceat(height_above(pts, ground), starts)
@@ -81,7 +82,7 @@ def _ground_height(
 
 
 def obstacle_map(
-    points: np.ndarray, labels: np.ndarray, ground: PlaneFit | float | None = None
+    points: NDArray[np.float64], labels: ArrayLike, ground: PlaneFit | float | None = None
 ) -> pd.DataFrame:
     """One row per cluster: size, centroid, radius, bounding box and height (thesis fig. 3.13).
 

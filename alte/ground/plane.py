@@ -13,6 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import NDArray
 
 from alte.errors import GroundError, ParameterError
 from alte.types import as_points
@@ -38,14 +39,14 @@ class PlaneFit:
     cost of the plane and ``iterations`` how many candidate planes were drawn.
     """
 
-    normal: np.ndarray
+    normal: NDArray[np.float64]
     d: float
-    inliers: np.ndarray
+    inliers: NDArray[np.bool_]
     cost: float
     iterations: int = 0
 
 
-def _check_cloud(points: object, owner: str) -> np.ndarray:
+def _check_cloud(points: object, owner: str) -> NDArray[np.float64]:
     arr = as_points(points, owner=owner, error=ParameterError, finite=True)
     if len(arr) < 3:
         raise GroundError(f"{owner}: a plane needs at least 3 points, got {len(arr)}")
@@ -63,8 +64,9 @@ def _trials(inlier_ratio: float, confidence: float) -> float:
 
 
 def _candidates(
-    pts: np.ndarray, idx: np.ndarray, reference: np.ndarray | None, min_cos: float
-) -> tuple[np.ndarray, np.ndarray]:
+    pts: NDArray[np.float64], idx: NDArray[np.int64], reference: NDArray[np.float64] | None,
+    min_cos: float,
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Unit normals (K, 3) and offsets (K,) of the usable triples in ``idx``.
 
     Collinear or repeated triples are dropped, and so are planes tilted more than
@@ -84,14 +86,14 @@ def _candidates(
 
 
 def _search(
-    pts: np.ndarray,
+    pts: NDArray[np.float64],
     *,
     threshold: float,
     max_iterations: int,
     confidence: float,
     rng: np.random.Generator,
-    constraint: tuple[np.ndarray | None, float],
-) -> tuple[np.ndarray | None, float, int]:
+    constraint: tuple[NDArray[np.float64] | None, float],
+) -> tuple[NDArray[np.float64] | None, float, int]:
     """Best (normal, d) by MSAC cost over adaptively many random triples; also draws made."""
     n, t2 = len(pts), threshold * threshold
     batch = int(max(1, min(_BATCH, _MAX_ELEMENTS // n)))
@@ -113,22 +115,24 @@ def _search(
     return best, best_cost, drawn
 
 
-def _refine(pts: np.ndarray, model: np.ndarray, threshold: float) -> np.ndarray:
+def _refine(pts: NDArray[np.float64], model: NDArray[np.float64], threshold: float,
+            ) -> NDArray[np.float64]:
     """Least-squares plane (SVD) through the inliers of ``model``."""
     inliers = pts[np.abs(pts @ model[:3] + model[3]) < threshold]
     if len(inliers) < 3:
         return model
     mean = inliers.mean(axis=0)
     normal = np.linalg.svd(inliers - mean, full_matrices=False)[2][-1]
-    refined: np.ndarray = np.r_[normal, -normal @ mean]
+    refined: NDArray[np.float64] = np.r_[normal, -normal @ mean]
     return refined
 
 
-def _msac_cost(pts: np.ndarray, model: np.ndarray, threshold: float) -> float:
+def _msac_cost(pts: NDArray[np.float64], model: NDArray[np.float64], threshold: float) -> float:
     return float(np.minimum((pts @ model[:3] + model[3]) ** 2, threshold**2).sum())
 
 
-def _finish(pts: np.ndarray, model: np.ndarray, threshold: float, drawn: int) -> PlaneFit:
+def _finish(pts: NDArray[np.float64], model: NDArray[np.float64], threshold: float,
+            drawn: int) -> PlaneFit:
     """Orient the normal up and score the plane on the original points."""
     normal, d = model[:3] / np.linalg.norm(model[:3]), model[3] / np.linalg.norm(model[:3])
     if normal[2] < 0:
@@ -146,7 +150,7 @@ def _finish(pts: np.ndarray, model: np.ndarray, threshold: float, drawn: int) ->
 def _check_fit_params(
     threshold: float, max_iterations: int, confidence: float,
     reference_normal: object, max_angle_deg: float | None,
-) -> tuple[np.ndarray | None, float]:
+) -> tuple[NDArray[np.float64] | None, float]:
     """Validate MSAC parameters; return the (unit reference, min |cos|) constraint."""
     if not np.isfinite(threshold) or threshold <= 0:
         raise ParameterError(f"fit_plane_msac: threshold={threshold!r} must be > 0")
@@ -170,13 +174,13 @@ def _check_fit_params(
 
 
 def fit_plane_msac(
-    points: np.ndarray,
+    points: NDArray[np.float64],
     *,
     threshold: float = 0.1,
     max_iterations: int = 1000,
     confidence: float = 0.99,
     seed: int | None = 0,
-    reference_normal: np.ndarray | None = None,
+    reference_normal: NDArray[np.float64] | None = None,
     max_angle_deg: float | None = None,
 ) -> PlaneFit:
     """Fit the dominant plane (the ground) with MSAC, MATLAB ``pcfitplane``-style.
@@ -210,7 +214,8 @@ def fit_plane_msac(
 
 
 def fit_plane_open3d(
-    points: np.ndarray, threshold: float = 0.1, *, max_iterations: int = 1000, seed: int = 0
+    points: NDArray[np.float64], threshold: float = 0.1, *, max_iterations: int = 1000,
+    seed: int = 0,
 ) -> PlaneFit:
     """The same fit with Open3D's RANSAC ``segment_plane``, for comparison."""
     import open3d as o3d
@@ -227,14 +232,15 @@ def fit_plane_open3d(
     return _finish(pts, model, threshold, int(max_iterations))
 
 
-def height_above(points: np.ndarray, plane: PlaneFit) -> np.ndarray:
+def height_above(points: NDArray[np.float64], plane: PlaneFit) -> NDArray[np.float64]:
     """Signed distance of every point to the plane (N,), positive above (normal side)."""
     pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
-    height: np.ndarray = pts @ plane.normal + plane.d
+    height: NDArray[np.float64] = pts @ plane.normal + plane.d
     return height
 
 
-def obstacle_mask(points: np.ndarray, plane: PlaneFit, height: float = 0.3) -> np.ndarray:
+def obstacle_mask(points: NDArray[np.float64], plane: PlaneFit, height: float = 0.3,
+                  ) -> NDArray[np.bool_]:
     """Points higher than ``height`` above the ground plane: the obstacles (thesis 3.3.1)."""
     if not np.isfinite(height):
         raise ParameterError(f"obstacle_mask: height={height!r} must be finite")

@@ -32,6 +32,7 @@ from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
+from numpy.typing import NDArray
 from scipy import ndimage
 
 from alte.ground.plane import fit_plane_msac
@@ -77,9 +78,9 @@ class PlaneFeatures:
     NaN where the window's known pixels do not fix a plane (fewer than 3, collinear).
     """
 
-    slope_deg: np.ndarray
-    roughness: np.ndarray
-    count: np.ndarray
+    slope_deg: NDArray[np.float64]
+    roughness: NDArray[np.float64]
+    count: NDArray[np.int64]
 
 
 @dataclass(frozen=True)
@@ -87,13 +88,13 @@ class Surface:
     """Per pixel of a raster: ``free`` (landable), ``occupied`` (known, not landable) and
     the tests behind them (``slope_deg``, ``roughness``, ``obstacle``)."""
 
-    free: np.ndarray
-    occupied: np.ndarray
-    slope_deg: np.ndarray
-    roughness: np.ndarray
-    obstacle: np.ndarray
+    free: NDArray[np.bool_]
+    occupied: NDArray[np.bool_]
+    slope_deg: NDArray[np.float64]
+    roughness: NDArray[np.float64]
+    obstacle: NDArray[np.bool_]
 
-    def occupancy(self) -> np.ndarray:
+    def occupancy(self) -> NDArray[np.int8]:
         """``nav_msgs/OccupancyGrid`` values: 0 free, 100 occupied, -1 unknown (int8)."""
         out = np.full(self.free.shape, -1, dtype=np.int8)
         out[self.free] = 0
@@ -101,7 +102,7 @@ class Surface:
         return out
 
 
-def plane_features(height: np.ndarray, step: float, radius: float) -> PlaneFeatures:
+def plane_features(height: NDArray[np.float64], step: float, radius: float) -> PlaneFeatures:
     """Least-squares plane over the square window of half-side ``radius`` (m) at every pixel."""
     known = np.isfinite(height)
     half = max(int(np.ceil(radius / step - 1e-9)), 1)
@@ -112,7 +113,7 @@ def plane_features(height: np.ndarray, step: float, radius: float) -> PlaneFeatu
     w = known.astype(np.float64)
     z = np.where(known, height - np.median(height[known]), 0.0) if known.any() else w
 
-    def mean(values: np.ndarray) -> np.ndarray:
+    def mean(values: NDArray[np.float64]) -> NDArray[np.float64]:
         return ndimage.uniform_filter(values * w, size=size, mode="constant", cval=0.0)
 
     s1 = mean(np.ones_like(z))
@@ -133,16 +134,16 @@ def plane_features(height: np.ndarray, step: float, radius: float) -> PlaneFeatu
     return PlaneFeatures(slope, np.sqrt(residual), np.rint(s1 * size * size).astype(np.int64))
 
 
-def planar(feats: PlaneFeatures, rule: SurfaceRule) -> np.ndarray:
+def planar(feats: PlaneFeatures, rule: SurfaceRule) -> NDArray[np.bool_]:
     """Pixels whose window plane is within the slope and roughness limits (NaN: not)."""
     with np.errstate(invalid="ignore"):
-        flat: np.ndarray = (feats.slope_deg <= rule.max_slope_deg) & \
+        flat: NDArray[np.bool_] = (feats.slope_deg <= rule.max_slope_deg) & \
                            (feats.roughness <= rule.max_roughness)
     return flat
 
 
-def pixel_centres(origin: tuple[float, float] | np.ndarray, step: float,
-                  shape: tuple[int, int]) -> np.ndarray:
+def pixel_centres(origin: tuple[float, float] | NDArray[np.float64], step: float,
+                  shape: tuple[int, int]) -> NDArray[np.float64]:
     """Pixel centres (ny * nx, 2), row-major (y slow, x fast), of a raster whose lower-left
     corner is ``origin``."""
     ny, nx = shape
@@ -152,15 +153,16 @@ def pixel_centres(origin: tuple[float, float] | np.ndarray, step: float,
     return np.column_stack([gx.ravel(), gy.ravel()])
 
 
-def ground_obstacles(height: np.ndarray, centres: np.ndarray, obstacle_height: float,
-                     ground: float | None = None, seed: int = 0) -> np.ndarray:
+def ground_obstacles(height: NDArray[np.float64], centres: NDArray[np.float64],
+                     obstacle_height: float, ground: float | None = None, seed: int = 0,
+                     ) -> NDArray[np.bool_]:
     """Known pixels more than ``obstacle_height`` above or below the ground plane.
 
     ``centres`` are the pixel centres (:func:`pixel_centres`); ``ground`` is a height (m),
     None fits the ground plane with MSAC (thesis 2.1.4) to the known pixels (at most
     50 000 of them, drawn with a seeded generator).
     """
-    known: np.ndarray = np.isfinite(height)
+    known: NDArray[np.bool_] = np.isfinite(height)
     if ground is not None:
         return known & (np.abs(np.where(known, height, ground) - ground) > obstacle_height)
     if known.sum() < 3:
@@ -171,12 +173,13 @@ def ground_obstacles(height: np.ndarray, centres: np.ndarray, obstacle_height: f
     plane = fit_plane_msac(pts, threshold=obstacle_height / 2, seed=seed,
                            reference_normal=np.array([0.0, 0.0, 1.0]), max_angle_deg=30.0)
     above = centres @ plane.normal[:2] + height.ravel() * plane.normal[2] + plane.d
-    obstacles: np.ndarray = known & (np.abs(np.nan_to_num(above.reshape(height.shape)))
+    obstacles: NDArray[np.bool_] = known & (np.abs(np.nan_to_num(above.reshape(height.shape)))
                                      > obstacle_height)
     return obstacles
 
 
-def local_ground(height: np.ndarray, step: float, window: float) -> np.ndarray:
+def local_ground(height: NDArray[np.float64], step: float, window: float,
+                 ) -> NDArray[np.float64]:
     """Grey opening of the known heights over a square of side ``window`` (m, odd pixel
     count, at least 3); unknown pixels and the outside of the raster take no part; NaN
     where no known pixel is near."""
@@ -189,8 +192,9 @@ def local_ground(height: np.ndarray, step: float, window: float) -> np.ndarray:
     return np.where(np.isfinite(ground), ground, np.nan)
 
 
-def _obstacles(height: np.ndarray, origin: tuple[float, float] | np.ndarray, step: float,
-               rule: SurfaceRule, slope_deg: np.ndarray, *, seed: int) -> np.ndarray:
+def _obstacles(height: NDArray[np.float64], origin: tuple[float, float] | NDArray[np.float64],
+               step: float, rule: SurfaceRule, slope_deg: NDArray[np.float64], *, seed: int,
+               ) -> NDArray[np.bool_]:
     """Obstacle pixels: off the MSAC plane, or above the local ground by more than
     ``obstacle_height`` plus the rise the terrain's slope explains over half the ground
     window (module docstring)."""
@@ -206,11 +210,13 @@ def _obstacles(height: np.ndarray, origin: tuple[float, float] | np.ndarray, ste
         mean_grade = np.where(weight > 1e-6, ndimage.uniform_filter(
             grade, size=size, mode="constant") / weight, 0.0)
         allowed = rule.obstacle_height + mean_grade * rule.ground_window / 2
-        step_up: np.ndarray = np.isfinite(height) & (np.nan_to_num(height - ground) > allowed)
+        step_up: NDArray[np.bool_] = np.isfinite(height) & (
+            np.nan_to_num(height - ground) > allowed)
     return step_up
 
 
-def classify_surface(height: np.ndarray, origin: tuple[float, float] | np.ndarray,
+def classify_surface(height: NDArray[np.float64],
+                     origin: tuple[float, float] | NDArray[np.float64],
                      step: float, rule: SurfaceRule | None = None, seed: int = 0) -> Surface:
     """Free / occupied / unknown for every pixel of a height raster (module docstring).
 

@@ -20,9 +20,11 @@ targets crowd the cells (:data:`MAX_LOAD`) a pykdtree KD-tree answers the rest
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TypeAlias
 
 import numba
 import numpy as np
+from numpy.typing import NDArray
 
 from alte._numba import threads_for
 
@@ -47,6 +49,9 @@ _TOL = 1e-9
 _FAR = 2.0**40
 #: Cell index ranges (first, last along x, then y, then z).
 Range = tuple[int, int, int, int, int, int]
+#: Coordinates and distances (float64), cell counts and starts (int64), as the kernels take them.
+Floats: TypeAlias = NDArray[np.float64]
+Ints: TypeAlias = NDArray[np.int64]
 
 @dataclass(frozen=True)
 class Grid:
@@ -56,17 +61,17 @@ class Grid:
     ``scale`` the largest absolute target coordinate (for the walls' tolerance).
     """
 
-    lo: np.ndarray
+    lo: Floats
     h: float
-    dims: np.ndarray
-    start: np.ndarray
-    points: np.ndarray
+    dims: Ints
+    start: Ints
+    points: Floats
     load: float
     scale: float
 
 
 @numba.njit(cache=True)
-def bounds(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def bounds(points: Floats) -> tuple[Floats, Floats]:
     """Per-axis minimum and maximum of (N, 3) points, N >= 1 (one pass; numpy's axis-0
     reductions of an (N, 3) array are several times slower)."""
     lo, hi = points[0].copy(), points[0].copy()
@@ -81,8 +86,8 @@ def bounds(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 @numba.njit(cache=True)
-def _bucket(points: np.ndarray, lo: np.ndarray, h: float,
-            dims: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
+def _bucket(points: Floats, lo: Floats, h: float,
+            dims: Ints) -> tuple[Ints, Floats, float]:
     """Counting sort of ``points`` by cell: (cell starts, points in cell order, load)."""
     n = points.shape[0]
     cell = np.empty(n, np.int64)
@@ -123,7 +128,7 @@ def _gap2(q: float, lo: float, h: float, j: int, tol: float) -> float:
 
 @numba.njit(cache=True, inline="always")
 def _scan(  # noqa: PLR0917 - a numba kernel's scalars and arrays
-    q0: float, q1: float, q2: float, pts: np.ndarray, first: int, last: int, best: float,
+    q0: float, q1: float, q2: float, pts: Floats, first: int, last: int, best: float,
 ) -> float:
     """Smallest squared distance from ``q`` to ``pts[first:last]``, or ``best``."""
     for p in range(first, last):
@@ -138,7 +143,7 @@ def _scan(  # noqa: PLR0917 - a numba kernel's scalars and arrays
 @numba.njit(cache=True, inline="always")
 def _block(  # noqa: PLR0917 - a numba kernel's scalars and arrays
     q0: float, q1: float, q2: float, c0: int, c1: int, c2: int, skip: int, rng: Range,
-    lo: np.ndarray, h: float, dims: np.ndarray, start: np.ndarray, pts: np.ndarray,
+    lo: Floats, h: float, dims: Ints, start: Ints, pts: Floats,
     best: float, tol: float,
 ) -> float:
     """Scan the cells in ``rng`` (first, last along x, y, z) nearer than ``best``, except
@@ -163,7 +168,7 @@ def _block(  # noqa: PLR0917 - a numba kernel's scalars and arrays
 
 @numba.njit(cache=True, inline="always")
 def _around(  # noqa: PLR0917 - a numba kernel's scalars and arrays
-    q0: float, q1: float, q2: float, r: float, lo: np.ndarray, h: float, dims: np.ndarray,
+    q0: float, q1: float, q2: float, r: float, lo: Floats, h: float, dims: Ints,
 ) -> Range:
     """Cell ranges (first, last along x, y, z) of the grid meeting the cube ``q`` +- ``r``."""
     return (max(_cell(q0 - r, lo[0], h), 0), min(_cell(q0 + r, lo[0], h), dims[0] - 1),
@@ -173,8 +178,8 @@ def _around(  # noqa: PLR0917 - a numba kernel's scalars and arrays
 
 @numba.njit(cache=True)
 def _first_hit(  # noqa: PLR0917 - a numba kernel's scalars and arrays
-    q0: float, q1: float, q2: float, c0: int, c1: int, c2: int, lo: np.ndarray, h: float,
-    dims: np.ndarray, start: np.ndarray, pts: np.ndarray, rings: int, tol: float,
+    q0: float, q1: float, q2: float, c0: int, c1: int, c2: int, lo: Floats, h: float,
+    dims: Ints, start: Ints, pts: Floats, rings: int, tol: float,
 ) -> tuple[float, int]:
     """(best squared distance, ring) from the first of rings 1..``rings`` around cell ``c``
     that holds a target; (inf, rings) when none does."""
@@ -190,8 +195,8 @@ def _first_hit(  # noqa: PLR0917 - a numba kernel's scalars and arrays
 
 @numba.njit(cache=True, inline="always")
 def _nearest(  # noqa: PLR0917 - a numba kernel's scalars and arrays
-    q0: float, q1: float, q2: float, lo: np.ndarray, h: float, dims: np.ndarray,
-    start: np.ndarray, pts: np.ndarray, rings: int, scale: float,
+    q0: float, q1: float, q2: float, lo: Floats, h: float, dims: Ints,
+    start: Ints, pts: Floats, rings: int, scale: float,
 ) -> float:
     """Squared distance to the nearest target, or inf when none lies within ``rings`` rings.
 
@@ -214,9 +219,9 @@ def _nearest(  # noqa: PLR0917 - a numba kernel's scalars and arrays
 
 @numba.njit(cache=True, parallel=True)
 def _query(  # noqa: PLR0917 - a numba kernel's scalars and arrays
-    queries: np.ndarray, lo: np.ndarray, h: float, dims: np.ndarray, start: np.ndarray,
-    pts: np.ndarray, rings: int, scale: float,
-) -> tuple[np.ndarray, np.ndarray]:
+    queries: Floats, lo: Floats, h: float, dims: Ints, start: Ints,
+    pts: Floats, rings: int, scale: float,
+) -> tuple[Floats, NDArray[np.bool_]]:
     m = queries.shape[0]
     dist = np.empty(m)
     settled = np.empty(m, np.bool_)
@@ -228,7 +233,7 @@ def _query(  # noqa: PLR0917 - a numba kernel's scalars and arrays
     return dist, settled
 
 
-def _side_for_cells(extent: np.ndarray, cells: float, smallest: float) -> float:
+def _side_for_cells(extent: Floats, cells: float, smallest: float) -> float:
     """Smallest cell side (at least ``smallest``) whose grid over ``extent`` has at most
     ``cells`` cells."""
     top = float(extent.max())
@@ -245,14 +250,14 @@ def _side_for_cells(extent: np.ndarray, cells: float, smallest: float) -> float:
     return hi
 
 
-def first_side(box: tuple[np.ndarray, np.ndarray], n: int) -> float:
+def first_side(box: tuple[Floats, Floats], n: int) -> float:
     """Cell side of the first grid of ``n`` targets in ``box`` (module docstring); never
     below a thousand times the wall tolerance, where pruning cells would stop paying."""
     scale = float(max(np.abs(box[0]).max(), np.abs(box[1]).max()))
     return _side_for_cells(box[1] - box[0], CELLS_PER_TARGET * n, 1e3 * _TOL * (1.0 + scale))
 
 
-def build_grid(points: np.ndarray, h: float, box: tuple[np.ndarray, np.ndarray]) -> Grid:
+def build_grid(points: Floats, h: float, box: tuple[Floats, Floats]) -> Grid:
     """Bucket ``points`` (N, 3) into cells of side ``h`` over their bounding ``box``."""
     lo, hi = box
     dims = np.maximum(np.ceil((hi - lo) / h), 1).astype(np.int64)
@@ -261,7 +266,8 @@ def build_grid(points: np.ndarray, h: float, box: tuple[np.ndarray, np.ndarray])
     return Grid(lo, h, dims, start, ordered, load, scale)
 
 
-def query_grid(grid: Grid, queries: np.ndarray, rings: int) -> tuple[np.ndarray, np.ndarray]:
+def query_grid(grid: Grid, queries: Floats, rings: int,
+               ) -> tuple[Floats, NDArray[np.bool_]]:
     """(distance to the nearest target, settled) for every query (M, 3): exact where
     settled, inf where no target lies within ``rings`` rings of the query's cell."""
     with threads_for(len(queries), PARALLEL_MIN):

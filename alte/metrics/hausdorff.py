@@ -16,6 +16,7 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass
 
 import numpy as np
+from numpy.typing import NDArray
 
 from alte.errors import MetricsError
 from alte.metrics.nearest import nearest_distances
@@ -44,7 +45,7 @@ class HausdorffResult:
         return asdict(self)
 
 
-def _as_set(points: object, name: str) -> np.ndarray:
+def _as_set(points: object, name: str) -> NDArray[np.float64]:
     arr = np.ascontiguousarray(points, dtype=np.float64)
     if arr.ndim != 2 or arr.shape[1] != 3:
         raise MetricsError(f"Hausdorff: set {name} must have shape (N, 3), got {arr.shape}")
@@ -55,7 +56,7 @@ def _as_set(points: object, name: str) -> np.ndarray:
     return arr
 
 
-def directed_distances(source: object, target: object) -> np.ndarray:
+def directed_distances(source: object, target: object) -> NDArray[np.float64]:
     """Distance from every point of ``source`` (N, 3) to its nearest point of ``target``
     (M, 3); empty or non-finite sets raise :class:`MetricsError`."""
     return nearest_distances(_as_set(source, "source"), _as_set(target, "target"))
@@ -68,7 +69,7 @@ def hausdorff(a: object, b: object) -> HausdorffResult:
     return summarise(nearest_distances(set_a, set_b), nearest_distances(set_b, set_a))
 
 
-def summarise(d_ab: np.ndarray, d_ba: np.ndarray) -> HausdorffResult:
+def summarise(d_ab: NDArray[np.float64], d_ba: NDArray[np.float64]) -> HausdorffResult:
     """HD, MHD and the directed values from the distances of every point of A to B
     (``d_ab``) and of B to A (``d_ba``), both non-empty."""
     h_ab, h_ba = float(d_ab.max()), float(d_ba.max())

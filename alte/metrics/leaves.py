@@ -13,35 +13,37 @@ distance of the same candidate pair.
 from __future__ import annotations
 
 from collections.abc import Callable, Hashable
-from typing import TYPE_CHECKING, Any, TypeVar
+from typing import TYPE_CHECKING, Generic, TypeVar
 
 import numpy as np
+from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 
-from alte.metrics.truth import accuracy_of, size_groups
+from alte.metrics.truth import TruthValues, accuracy_of, size_groups
 
 if TYPE_CHECKING:
     from alte.metrics.surface import TrueSurface
 
 __all__ = ["LeafTruth", "PerLeaf"]
 
-_T = TypeVar("_T")
+#: What a :class:`PerLeaf` holds: distances or inside flags.
+_V = TypeVar("_V", np.float64, np.bool_)
 
 
-class PerLeaf:
+class PerLeaf(Generic[_V]):
     """Values of some leaves (sorted leaf rows), computed on first request."""
 
-    def __init__(self, dtype: type[np.generic]) -> None:
-        self.rows = np.empty(0, np.int64)
-        self.values = np.empty(0, dtype)
+    def __init__(self, dtype: type[_V]) -> None:
+        self.rows = np.empty(0, np.intp)
+        self.values: NDArray[_V] = np.empty(0, dtype)
 
-    def _positions(self, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def _positions(self, rows: NDArray[np.intp]) -> tuple[NDArray[np.intp], NDArray[np.bool_]]:
         pos = np.minimum(np.searchsorted(self.rows, rows), max(len(self.rows) - 1, 0))
         have = (self.rows[pos] == rows) if len(self.rows) else np.zeros(len(rows), bool)
         return pos, have
 
-    def get(self, rows: np.ndarray, compute: Callable[[np.ndarray], np.ndarray]
-            ) -> np.ndarray:
+    def get(self, rows: NDArray[np.intp], compute: Callable[[NDArray[np.intp]], NDArray[_V]]
+            ) -> NDArray[_V]:
         """The values of ``rows`` (int, any order, repeats allowed); ``compute`` gets the
         sorted rows not known yet and returns their values."""
         pos, have = self._positions(rows)
@@ -52,26 +54,27 @@ class PerLeaf:
             self.rows = keys[order]
             self.values = np.concatenate([self.values, compute(new)])[order]
             pos, _ = self._positions(rows)
-        out: np.ndarray = self.values[pos]
+        out: NDArray[_V] = self.values[pos]
         return out
 
 
 class LeafTruth:
     """Per-leaf truth of the leaves with these ``centers`` and ``sizes`` (module docstring)."""
 
-    def __init__(self, centers: np.ndarray, sizes: np.ndarray) -> None:
+    def __init__(self, centers: NDArray[np.float64], sizes: NDArray[np.float64]) -> None:
         self.centers, self.sizes = centers, sizes
         self._distance = PerLeaf(np.float64)
         self._inside = PerLeaf(np.bool_)
         self._paired = np.zeros(len(centers), bool)  # leaves whose sample pairs are known
-        self._pairs: list[tuple[np.ndarray, np.ndarray]] = []  # (sample, leaf) within tol
+        # (sample, leaf) pairs within the tolerance
+        self._pairs: list[tuple[NDArray[np.int64], NDArray[np.int64]]] = []
         self._tolerance: float | None = None
-        self._memo: dict[Hashable, Any] = {}
+        self._memo: dict[Hashable, TruthValues] = {}
 
     def __len__(self) -> int:
         return len(self.centers)
 
-    def matches(self, centers: np.ndarray, sizes: np.ndarray) -> bool:
+    def matches(self, centers: NDArray[np.float64], sizes: NDArray[np.float64]) -> bool:
         """True for the same leaves (the same arrays, or equal ones)."""
         if centers is self.centers and sizes is self.sizes:
             return True
@@ -79,26 +82,25 @@ class LeafTruth:
                 and np.array_equal(centers, self.centers, equal_nan=True)
                 and np.array_equal(sizes, self.sizes, equal_nan=True))
 
-    def memo(self, key: Hashable, compute: Callable[[], _T]) -> _T:
+    def memo(self, key: Hashable, compute: Callable[[], TruthValues]) -> TruthValues:
         """``compute()``, once per ``key`` for these leaves."""
         if key not in self._memo:
             self._memo[key] = compute()
-        value: _T = self._memo[key]
-        return value
+        return self._memo[key]
 
-    def accuracy(self, mask: np.ndarray, surface: TrueSurface, tolerance: float
-                 ) -> dict[str, float]:
+    def accuracy(self, mask: NDArray[np.bool_], surface: TrueSurface, tolerance: float
+                 ) -> TruthValues:
         """:func:`~alte.metrics.truth.accuracy` of the leaves in ``mask``."""
         rows = np.flatnonzero(mask)
         dist = self._distance.get(rows, lambda r: surface.distance(self.centers[r]))
         return accuracy_of(dist, self.sizes[rows], tolerance)
 
-    def inside(self, rows: np.ndarray, surface: TrueSurface) -> np.ndarray:
+    def inside(self, rows: NDArray[np.intp], surface: TrueSurface) -> NDArray[np.bool_]:
         """:meth:`TrueSurface.inside` of the centres of leaves ``rows``."""
         return self._inside.get(rows, lambda r: surface.inside(self.centers[r]))
 
-    def covered(self, mask: np.ndarray, points: np.ndarray, tree: cKDTree,
-                tolerance: float) -> np.ndarray:
+    def covered(self, mask: NDArray[np.bool_], points: NDArray[np.float64], tree: cKDTree,
+                tolerance: float) -> NDArray[np.bool_]:
         """Per sample (``points``, ``tree`` over them): is a box of ``mask`` within
         ``tolerance`` (:func:`~alte.metrics.truth.completeness`)?"""
         if self._tolerance not in (None, tolerance):
@@ -113,14 +115,14 @@ class LeafTruth:
             out[sample[mask[leaf]]] = True
         return out
 
-    def _near_pairs(self, points: np.ndarray, tree: cKDTree, rows: np.ndarray,
-                    tolerance: float) -> tuple[np.ndarray, np.ndarray]:
+    def _near_pairs(self, points: NDArray[np.float64], tree: cKDTree, rows: NDArray[np.intp],
+                    tolerance: float) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
         """(sample, leaf) pairs of the leaves ``rows`` whose box lies within ``tolerance``:
         :func:`~alte.metrics.truth.distance_to_boxes`' candidates (per size group, centres
         within half a diagonal plus the tolerance) and its box distance."""
         half = np.asarray(self.sizes[rows], dtype=np.float64) / 2.0
         groups, inverse = size_groups(half)
-        found: list[tuple[np.ndarray, np.ndarray]] = []
+        found: list[tuple[NDArray[np.intp], NDArray[np.intp]]] = []
         for g, h in enumerate(groups):
             sel = rows[inverse.reshape(-1) == g]
             radius = float(np.linalg.norm(h)) + tolerance

@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import NDArray
 
 from alte.errors import MetricsError
 from alte.mappers.quad.quadmap import rectangle_corners
@@ -137,7 +138,8 @@ def _size_spread(cells: Cells) -> tuple[float, float, float]:
     return lo, hi, float(np.log2(hi / lo))
 
 
-def set_b_points(mapper: Mapper, cells: Cells, rule: SetB = SetB.CORNERS) -> np.ndarray:
+def set_b_points(mapper: Mapper, cells: Cells, rule: SetB = SetB.CORNERS,
+                 ) -> NDArray[np.float64]:
     """Set B of the thesis' HD/MHD by ``rule`` (see :class:`SetB`), (M, 3)."""
     rule = set_b_rule(rule)
     if rule is SetB.CORNERS or (rule is SetB.OCCUPIED and mapper.dims == 3):
@@ -150,7 +152,7 @@ def set_b_points(mapper: Mapper, cells: Cells, rule: SetB = SetB.CORNERS) -> np.
     return np.asarray(cells.centers[keep], dtype=np.float64)
 
 
-def _thesis(points: np.ndarray, cloud: np.ndarray,
+def _thesis(points: NDArray[np.float64], cloud: NDArray[np.float64],
             reference: Reference | None = None) -> dict[str, float]:
     """HD/MHD between the cloud and set B; NaN when set B is empty (nothing occupied)."""
     names = ("hd_m", "mhd_m", "hd_minus_mhd_m", "h_ab_m", "h_ba_m", "mh_ab_m", "mh_ba_m")
@@ -161,7 +163,7 @@ def _thesis(points: np.ndarray, cloud: np.ndarray,
                             hd.mh_ba), strict=True))
 
 
-def measure_map(mapper: Mapper, cloud: np.ndarray, *, elapsed_s: float | Timing,
+def measure_map(mapper: Mapper, cloud: NDArray[np.float64], *, elapsed_s: float | Timing,
                 truth: GroundTruth | None = None, options: TruthOptions | None = None,
                 set_b: SetB = SetB.CORNERS, reference: Reference | None = None,
                 cells: Cells | None = None) -> MapMetrics:

@@ -7,6 +7,7 @@ The one nearest-neighbour search of the metrics (HD/MHD, a reference's cloud).
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import NDArray
 from pykdtree.kdtree import KDTree
 
 from alte.metrics._gridnn import (
@@ -30,13 +31,13 @@ class NearestIndex:
     sweep measures every map of one input against the same cloud: one build, not one per
     map). The distances are :func:`nearest_distances`'s."""
 
-    def __init__(self, targets: np.ndarray) -> None:
+    def __init__(self, targets: NDArray[np.float64]) -> None:
         self.targets = targets
         self.box = bounds(targets)
         self.grids = [build_grid(targets, first_side(self.box, len(targets)), self.box)]
         self._tree: KDTree | None = None
 
-    def _kdtree(self, queries: np.ndarray) -> np.ndarray:
+    def _kdtree(self, queries: NDArray[np.float64]) -> NDArray[np.float64]:
         """The queries the grids leave to pykdtree (its tree built once, then kept)."""
         if self._tree is None:
             self._tree = KDTree(self.targets)
@@ -47,7 +48,7 @@ class NearestIndex:
             self.grids.append(build_grid(self.targets, self.grids[-1].h * COARSER, self.box))
         return self.grids[i]
 
-    def distances(self, queries: np.ndarray) -> np.ndarray:
+    def distances(self, queries: NDArray[np.float64]) -> NDArray[np.float64]:
         """Distance from every query (M, 3) to its nearest target (finite float64)."""
         grid = self.grids[0]
         if grid.load > MAX_LOAD:
@@ -67,6 +68,7 @@ class NearestIndex:
         return dist
 
 
-def nearest_distances(queries: np.ndarray, targets: np.ndarray) -> np.ndarray:
+def nearest_distances(queries: NDArray[np.float64], targets: NDArray[np.float64],
+                      ) -> NDArray[np.float64]:
     """Distance from every query (M, 3) to its nearest target (N, 3); finite float64 sets."""
     return NearestIndex(targets).distances(queries)

@@ -24,10 +24,10 @@ call), and the reductions run over the same values in the same order.
 from __future__ import annotations
 
 import functools
-from collections.abc import Callable
-from typing import TYPE_CHECKING, Any, TypeVar
+from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 
 from alte.metrics.hausdorff import HausdorffResult, _as_set, summarise
@@ -35,6 +35,7 @@ from alte.metrics.leaves import LeafTruth
 from alte.metrics.nearest import NearestIndex
 from alte.metrics.options import GroundTruth, TruthOptions
 from alte.metrics.truth import (
+    TruthValues,
     cell_at_xy,
     completeness_by_class,
     completeness_by_object,
@@ -44,14 +45,59 @@ from alte.metrics.truth import (
 
 if TYPE_CHECKING:
     from alte.mappers.base import Cells
-    from alte.metrics.surface import SurfaceSamples
+    from alte.metrics.surface import SurfaceSamples, TrueSurface
 
 __all__ = ["Reference"]
 
-_T = TypeVar("_T")
-
 #: Leaves of the geometries a reference keeps per-leaf truth for (about 100 bytes each).
 LEAF_BUDGET = 8_000_000
+
+
+class _Shared:
+    """What a :class:`Reference` prepares, each part on first use; its
+    :meth:`~Reference.fresh` copies share one."""
+
+    def __init__(self, cloud: NDArray[np.float64], truth: GroundTruth | None,
+                 options: TruthOptions) -> None:
+        self.cloud, self.truth, self.options = cloud, truth, options
+
+    def ground_truth(self) -> GroundTruth:
+        if self.truth is None:
+            from alte.errors import MetricsError
+
+            raise MetricsError("reference: made without a ground truth")
+        return self.truth
+
+    @functools.cached_property
+    def set_a(self) -> NDArray[np.float64]:
+        return _as_set(self.cloud, "A")
+
+    @functools.cached_property
+    def cloud_index(self) -> NearestIndex:
+        return NearestIndex(self.set_a)
+
+    @functools.cached_property
+    def box(self) -> NDArray[np.float64]:
+        return np.asarray(self.ground_truth().bounds.array(), dtype=np.float64)
+
+    @functools.cached_property
+    def samples(self) -> SurfaceSamples:
+        o = self.options
+        return self.ground_truth().surface.sample(o.n_samples, seed=o.seed, bounds=self.box)
+
+    @functools.cached_property
+    def seen(self) -> NDArray[np.bool_]:
+        cloud = np.asarray(self.cloud, dtype=np.float64).reshape(-1, 3)
+        return seen_mask(self.samples, cloud, self.options.tolerance)
+
+    @functools.cached_property
+    def sample_tree(self) -> cKDTree:
+        return cKDTree(self.samples.points)
+
+    @functools.cached_property
+    def probes(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        xy = probe_grid(self.box, self.options.grid_step)
+        return xy, self.ground_truth().surface.top_height(xy, z_start=float(self.box[1, 2]))
 
 
 class Reference:
@@ -59,28 +105,22 @@ class Reference:
     docstring). ``truth`` and ``options`` as :func:`~alte.metrics.maps.measure_map` takes
     them; :meth:`fresh` gives one sharing the prepared parts with no per-leaf memory."""
 
-    def __init__(self, cloud: np.ndarray, truth: GroundTruth | None = None,
+    def __init__(self, cloud: NDArray[np.float64], truth: GroundTruth | None = None,
                  options: TruthOptions | None = None) -> None:
         self.cloud = cloud
         self.truth = truth
         self.options = options or TruthOptions()
-        self._prepared: dict[str, Any] = {}  # shared with fresh() copies
+        self._shared = _Shared(cloud, truth, self.options)  # shared with fresh() copies
         self._leaves: list[LeafTruth] = []
 
     def fresh(self) -> Reference:
         """The same prepared cloud and truth, with no per-leaf truth kept yet (a sweep
         starts one per feed, so no map's leaves outlive its runs)."""
         other = Reference(self.cloud, self.truth, self.options)
-        other._prepared = self._prepared
+        other._shared = self._shared
         return other
 
-    def _once(self, name: str, make: Callable[[], _T]) -> _T:
-        if name not in self._prepared:
-            self._prepared[name] = make()
-        value: _T = self._prepared[name]
-        return value
-
-    def matches(self, cloud: np.ndarray, truth: GroundTruth | None,
+    def matches(self, cloud: NDArray[np.float64], truth: GroundTruth | None,
                 options: TruthOptions | None) -> bool:
         """True when made from this ``cloud``, ``truth`` and ``options``."""
         same_cloud = cloud is self.cloud or (np.shape(cloud) == np.shape(self.cloud)
@@ -90,14 +130,14 @@ class Reference:
 
     # -- set A ------------------------------------------------------------------------
     @property
-    def set_a(self) -> np.ndarray:
+    def set_a(self) -> NDArray[np.float64]:
         """The cloud as HD/MHD's set A (validated once)."""
-        return self._once("set_a", lambda: _as_set(self.cloud, "A"))
+        return self._shared.set_a
 
     @property
     def cloud_index(self) -> NearestIndex:
         """The cloud's nearest-neighbour grids."""
-        return self._once("cloud_index", lambda: NearestIndex(self.set_a))
+        return self._shared.cloud_index
 
     def hausdorff(self, b: object) -> HausdorffResult:
         """:func:`~alte.metrics.hausdorff.hausdorff` of the cloud and ``b``."""
@@ -107,44 +147,32 @@ class Reference:
 
     # -- truth --------------------------------------------------------------------------
     def _truth(self) -> GroundTruth:
-        if self.truth is None:
-            from alte.errors import MetricsError
-
-            raise MetricsError("reference: made without a ground truth")
-        return self.truth
+        return self._shared.ground_truth()
 
     @property
-    def box(self) -> np.ndarray:
+    def box(self) -> NDArray[np.float64]:
         """The control volume (2, 3): where samples and probes are taken."""
-        return self._once("box", lambda: np.asarray(self._truth().bounds.array(),
-                                                    dtype=np.float64))
+        return self._shared.box
 
     @property
     def samples(self) -> SurfaceSamples:
         """The surface samples of the 3D metrics."""
-        o = self.options
-        return self._once("samples", lambda: self._truth().surface.sample(
-            o.n_samples, seed=o.seed, bounds=self.box))
+        return self._shared.samples
 
     @property
-    def seen(self) -> np.ndarray:
+    def seen(self) -> NDArray[np.bool_]:
         """Samples with a registered point within the tolerance."""
-        cloud = np.asarray(self.cloud, dtype=np.float64).reshape(-1, 3)
-        return self._once("seen", lambda: seen_mask(self.samples, cloud,
-                                                    self.options.tolerance))
+        return self._shared.seen
 
     @property
     def sample_tree(self) -> cKDTree:
         """KD-tree over the samples (the candidate search of box distances)."""
-        return self._once("sample_tree", lambda: cKDTree(self.samples.points))
+        return self._shared.sample_tree
 
     @property
-    def probes(self) -> tuple[np.ndarray, np.ndarray]:
+    def probes(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """The 2D metrics' x/y probe grid and the true top height under each probe."""
-        def make() -> tuple[np.ndarray, np.ndarray]:
-            xy = probe_grid(self.box, self.options.grid_step)
-            return xy, self._truth().surface.top_height(xy, z_start=float(self.box[1, 2]))
-        return self._once("probes", make)
+        return self._shared.probes
 
     def leaf_truth(self, cells: Cells) -> LeafTruth:
         """The per-leaf truth of ``cells``' geometry (kept for the next map with it)."""
@@ -162,7 +190,7 @@ class Reference:
                 break
         return made
 
-    def truth_metrics(self, cells: Cells, dims: int) -> dict[str, Any]:
+    def truth_metrics(self, cells: Cells, dims: int) -> TruthValues:
         """What :func:`~alte.metrics.truth.ground_truth_metrics` returns for ``cells``."""
         from alte.metrics.truth import check_truth_args
 
@@ -172,14 +200,14 @@ class Reference:
         surface = self._truth().surface
         finite = np.isfinite(cells.centers).all(axis=1)
         occ = finite if dims == 2 else finite & cells.occupied.astype(bool)
-        out: dict[str, Any] = leaves.accuracy(occ, surface, opts.tolerance)
+        out = leaves.accuracy(occ, surface, opts.tolerance)
         if dims == 2:
             out.update(leaves.memo("heights", lambda: self._heights(cells)))
             return out
         return out | leaves.memo(("3d", occ.tobytes()), lambda: self._volume(
             leaves, cells, occ, surface))
 
-    def _heights(self, cells: Cells) -> dict[str, float]:
+    def _heights(self, cells: Cells) -> TruthValues:
         """:func:`~alte.metrics.truth.height_metrics_2d` on the prepared probes."""
         from alte.metrics.truth import height_summary
 
@@ -189,15 +217,15 @@ class Reference:
         map_h = np.where(idx >= 0, cells.centers[known][np.maximum(idx, 0), 2], np.nan)
         return height_summary(idx, map_h, true_h, self.options.tolerance)
 
-    def _volume(self, leaves: LeafTruth, cells: Cells, occ: np.ndarray,
-                surface: Any) -> dict[str, Any]:
+    def _volume(self, leaves: LeafTruth, cells: Cells, occ: NDArray[np.bool_],
+                surface: TrueSurface) -> TruthValues:
         """The 3D metrics beyond accuracy: completeness (all, seen, per object and
         class) and the free-space truth."""
         from alte.metrics.truth import free_space_share
 
         samples, seen, opts = self.samples, self.seen, self.options
         covered = leaves.covered(occ, samples.points, self.sample_tree, opts.tolerance)
-        out: dict[str, Any] = {
+        out: TruthValues = {
             "completeness": float(covered.mean()) if len(samples) else np.nan,
             "completeness_seen": float(covered[seen].mean()) if seen.any() else np.nan,
             "seen_share": float(seen.mean()) if len(samples) else np.nan,

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import NDArray
 
 from alte.errors import MetricsError
 from alte.tensors import to_array, to_tensor
@@ -30,13 +31,13 @@ _UP = np.array([1.3e-3, 2.1e-3, 1.0]) / np.linalg.norm([1.3e-3, 2.1e-3, 1.0])
 class SurfaceSamples:
     """Points drawn on the true surface and the object id of the triangle each lies on."""
 
-    points: np.ndarray
-    object_ids: np.ndarray
+    points: NDArray[np.float64]
+    object_ids: NDArray[np.int64]
 
     def __len__(self) -> int:
         return int(self.points.shape[0])
 
-    def subset(self, mask: np.ndarray) -> SurfaceSamples:
+    def subset(self, mask: NDArray[np.bool_]) -> SurfaceSamples:
         """The samples where ``mask`` is true."""
         return SurfaceSamples(self.points[mask], self.object_ids[mask])
 
@@ -74,18 +75,18 @@ class TrueSurface:
         mesh.vertex.positions = to_tensor(self.vertices)
         mesh.triangle.indices = to_tensor(self.triangles, np.uint32)
         self._scene.add_triangles(mesh)
-        self._objects: list[tuple[np.ndarray, np.ndarray,
+        self._objects: list[tuple[NDArray[np.float64], NDArray[np.float64],
                                   o3d.t.geometry.RaycastingScene]] | None = None
 
-    def triangle_areas(self) -> np.ndarray:
+    def triangle_areas(self) -> NDArray[np.float64]:
         """Area of every triangle (m^2)."""
         v = self.vertices[self.triangles]
-        areas: np.ndarray = 0.5 * np.linalg.norm(np.cross(v[:, 1] - v[:, 0], v[:, 2] - v[:, 0]),
-                                                 axis=1)
+        areas: NDArray[np.float64] = 0.5 * np.linalg.norm(
+            np.cross(v[:, 1] - v[:, 0], v[:, 2] - v[:, 0]), axis=1)
         return areas
 
     def sample(self, count: int, seed: int = 0,
-               bounds: np.ndarray | None = None) -> SurfaceSamples:
+               bounds: NDArray[np.float64] | None = None) -> SurfaceSamples:
         """``count`` points drawn uniformly by area with a seeded generator.
 
         ``bounds`` (2, 3) = min/max corner: samples outside are dropped afterwards, so
@@ -108,13 +109,13 @@ class TrueSurface:
         lo, hi = np.asarray(bounds, dtype=np.float64)
         return samples.subset(np.all((pts >= lo) & (pts <= hi), axis=1))
 
-    def distance(self, points: np.ndarray) -> np.ndarray:
+    def distance(self, points: NDArray[np.float64]) -> NDArray[np.float64]:
         """Unsigned distance from each point (N, 3) to the nearest triangle."""
         if len(points) == 0:
             return np.zeros(0)
         return to_array(self._scene.compute_distance(to_tensor(points)), np.float64)
 
-    def _object_scenes(self) -> list[tuple[np.ndarray, np.ndarray,
+    def _object_scenes(self) -> list[tuple[NDArray[np.float64], NDArray[np.float64],
                                            o3d.t.geometry.RaycastingScene]]:
         """Per object: x/y bounds, top height and a raycasting scene of its triangles alone."""
         if self._objects is None:
@@ -131,7 +132,7 @@ class TrueSurface:
                 self._objects.append((verts.min(0), verts.max(0), scene))
         return self._objects
 
-    def inside(self, points: np.ndarray) -> np.ndarray:
+    def inside(self, points: NDArray[np.float64]) -> NDArray[np.bool_]:
         """True where a point lies inside a solid object (or below an open ground sheet).
 
         Per object, a near-vertical ray is cast upwards and its crossings with that
@@ -151,7 +152,8 @@ class TrueSurface:
             out[cand[(hits % 2) == 1]] = True
         return out
 
-    def top_height(self, xy: np.ndarray, z_start: float | None = None) -> np.ndarray:
+    def top_height(self, xy: NDArray[np.float64], z_start: float | None = None,
+                   ) -> NDArray[np.float64]:
         """Height of the highest surface below ``z_start`` at each (x, y); NaN where none."""
         top = float(self.vertices[:, 2].max()) + 1.0 if z_start is None else z_start
         origin = np.column_stack([xy, np.full(len(xy), top)])

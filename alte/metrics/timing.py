@@ -20,13 +20,14 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import NDArray
 
 from alte.errors import MetricsError
 
 __all__ = ["Timing", "log_spread"]
 
 
-def log_spread(readings: Sequence[float] | np.ndarray) -> float:
+def log_spread(readings: Sequence[float] | NDArray[np.float64]) -> float:
     """Half the natural log of max/min of positive ``readings``; NaN for fewer than two
     (or any reading <= 0, which a timer of ns resolution gives only for no work)."""
     values = np.asarray(readings, dtype=np.float64)

@@ -21,6 +21,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import NDArray
 
 from alte.errors import MetricsError
 from alte.metrics.hausdorff import directed_distances
@@ -49,7 +50,8 @@ class CloudDistance:
     p90_m: float
 
 
-def _trajectory(stamps: np.ndarray, positions: np.ndarray, quaternions: np.ndarray) -> object:
+def _trajectory(stamps: NDArray[np.int64], positions: NDArray[np.float64],
+                quaternions: NDArray[np.float64]) -> object:
     from evo.core.trajectory import PoseTrajectory3D
 
     xyzw = np.asarray(quaternions, dtype=np.float64)
@@ -69,8 +71,9 @@ def _rpe(reference: object, estimate: object, relation: object,
     return float(rpe.get_statistic(metrics.StatisticsType.mean)), len(rpe.error)
 
 
-def trajectory_errors(stamps: np.ndarray, positions: np.ndarray, quaternions: np.ndarray,
-                      reference_positions: np.ndarray, reference_quaternions: np.ndarray,
+def trajectory_errors(stamps: NDArray[np.int64], positions: NDArray[np.float64],
+                      quaternions: NDArray[np.float64], reference_positions: NDArray[np.float64],
+                      reference_quaternions: NDArray[np.float64],
                       *, delta_m: float = 1.0) -> TrajectoryErrors:
     """ATE and RPE of matched poses (module docstring); quaternions are x, y, z, w."""
     import copy
@@ -104,14 +107,16 @@ def trajectory_errors(stamps: np.ndarray, positions: np.ndarray, quaternions: np
     return TrajectoryErrors(ate, 100.0 * trans / delta_m, rot / delta_m, delta_m, pairs)
 
 
-def cloud_distance(cloud: np.ndarray, reference: np.ndarray) -> CloudDistance:
+def cloud_distance(cloud: NDArray[np.float64], reference: NDArray[np.float64],
+                   ) -> CloudDistance:
     """Median and p90 distance of every ``cloud`` point to its nearest ``reference`` point."""
     distances = directed_distances(cloud, reference)
     median, p90 = np.percentile(distances, [50, 90])
     return CloudDistance(float(median), float(p90))
 
 
-def rigid_alignment(positions: np.ndarray, reference_positions: np.ndarray) -> np.ndarray:
+def rigid_alignment(positions: NDArray[np.float64], reference_positions: NDArray[np.float64],
+                    ) -> NDArray[np.float64]:
     """4x4 transform taking ``positions`` onto ``reference_positions`` in the least-squares
     sense (Umeyama, rotation and translation, no scale: what ATE aligns with); on a
     straight or single-point path, where the turn about it is unobservable, the shift of

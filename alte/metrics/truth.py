@@ -29,10 +29,11 @@ Definitions (``tol`` = ``tolerance`` in metres; "occupied" = ``Cells.occupied``)
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, TypedDict
 
 import numba
 import numpy as np
+from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 
 from alte.errors import MetricsError
@@ -43,6 +44,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "FREE_SPACE_CELLS",
+    "TruthValues",
     "accuracy",
     "accuracy_of",
     "cell_at_xy",
@@ -66,13 +68,30 @@ __all__ = [
 FREE_SPACE_CELLS = 200_000
 
 
-def size_groups(half: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+class TruthValues(TypedDict, total=False):
+    """Ground-truth metrics by name (module docstring), as
+    :class:`~alte.metrics.maps.TruthMetrics` takes them; each function gives its own."""
+
+    accuracy_mean_m: float
+    accuracy_p95_m: float
+    phantom_share: float
+    completeness: float
+    completeness_seen: float
+    seen_share: float
+    height_rmse_m: float
+    unknown_share: float
+    free_truly_free_share: float
+    completeness_by_class: dict[str, float]
+    completeness_by_object: dict[str, float]
+
+
+def size_groups(half: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.intp]]:
     """Distinct half sizes and, per cell, the index of its group (trees have few sizes)."""
     return np.unique(np.round(half, 9), axis=0, return_inverse=True)
 
 
-def distance_to_boxes(points: np.ndarray, centers: np.ndarray, sizes: np.ndarray,
-                      max_distance: float) -> np.ndarray:
+def distance_to_boxes(points: NDArray[np.float64], centers: NDArray[np.float64],
+                      sizes: NDArray[np.float64], max_distance: float) -> NDArray[np.float64]:
     """Distance from each point to the nearest axis-aligned box; inf beyond ``max_distance``.
 
     Cells are grouped by size; in each group a KD-tree on the centres finds every box
@@ -99,13 +118,14 @@ def distance_to_boxes(points: np.ndarray, centers: np.ndarray, sizes: np.ndarray
     return out
 
 
-def _lattice_keys(ij: np.ndarray) -> np.ndarray:
+def _lattice_keys(ij: NDArray[np.int64]) -> NDArray[np.int64]:
     """One int64 per (i, j) lattice index pair (each shifted into 32 bits)."""
     shifted = np.clip(ij, -(1 << 30), (1 << 30) - 1) + (1 << 30)
     return np.asarray((shifted[:, 0] << 32) | shifted[:, 1], dtype=np.int64)
 
 
-def cell_at_xy(xy: np.ndarray, centers: np.ndarray, sizes: np.ndarray) -> np.ndarray:
+def cell_at_xy(xy: NDArray[np.float64], centers: NDArray[np.float64], sizes: NDArray[np.float64],
+               ) -> NDArray[np.int64]:
     """Index of the 2D cell whose x/y rectangle holds each point, -1 where none does.
 
     Within one size group the cells of a tree lie on a lattice, so a point's lattice
@@ -142,15 +162,16 @@ def cell_at_xy(xy: np.ndarray, centers: np.ndarray, sizes: np.ndarray) -> np.nda
     return found
 
 
-def accuracy(centers: np.ndarray, sizes: np.ndarray, surface: TrueSurface,
-             tolerance: float) -> dict[str, float]:
+def accuracy(centers: NDArray[np.float64], sizes: NDArray[np.float64], surface: TrueSurface,
+             tolerance: float) -> TruthValues:
     """Mean / 95th percentile centre-to-surface distance and the phantom-cell share."""
     if len(centers) == 0:
         return accuracy_of(np.empty(0), sizes, tolerance)
     return accuracy_of(surface.distance(centers), sizes, tolerance)
 
 
-def accuracy_of(dist: np.ndarray, sizes: np.ndarray, tolerance: float) -> dict[str, float]:
+def accuracy_of(dist: NDArray[np.float64], sizes: NDArray[np.float64], tolerance: float,
+                ) -> TruthValues:
     """:func:`accuracy` from the cells' centre distances ``dist`` and their ``sizes``."""
     if len(dist) == 0:
         return {"accuracy_mean_m": np.nan, "accuracy_p95_m": np.nan, "phantom_share": np.nan}
@@ -162,14 +183,15 @@ def accuracy_of(dist: np.ndarray, sizes: np.ndarray, tolerance: float) -> dict[s
     }
 
 
-def completeness(samples: SurfaceSamples, centers: np.ndarray, sizes: np.ndarray,
-                 tolerance: float) -> np.ndarray:
+def completeness(samples: SurfaceSamples, centers: NDArray[np.float64],
+                 sizes: NDArray[np.float64], tolerance: float) -> NDArray[np.bool_]:
     """Per sample: True when an occupied box lies within ``tolerance`` of it."""
-    covered: np.ndarray = np.isfinite(distance_to_boxes(samples.points, centers, sizes, tolerance))
+    covered: NDArray[np.bool_] = np.isfinite(
+        distance_to_boxes(samples.points, centers, sizes, tolerance))
     return covered
 
 
-def completeness_by_object(samples: SurfaceSamples, covered: np.ndarray,
+def completeness_by_object(samples: SurfaceSamples, covered: NDArray[np.bool_],
                            labels: dict[int, str]) -> dict[str, float]:
     """Share of covered samples per object id, keyed by label (or ``object_<id>``)."""
     out = {}
@@ -179,7 +201,7 @@ def completeness_by_object(samples: SurfaceSamples, covered: np.ndarray,
     return out
 
 
-def completeness_by_class(samples: SurfaceSamples, covered: np.ndarray,
+def completeness_by_class(samples: SurfaceSamples, covered: NDArray[np.bool_],
                           classes: dict[int, str]) -> dict[str, float]:
     """Share of covered samples per object class (objects without a class are skipped)."""
     names = sorted(set(classes.values()))
@@ -192,7 +214,8 @@ def completeness_by_class(samples: SurfaceSamples, covered: np.ndarray,
             if c >= 0}
 
 
-def seen_mask(samples: SurfaceSamples, cloud: np.ndarray, tolerance: float) -> np.ndarray:
+def seen_mask(samples: SurfaceSamples, cloud: NDArray[np.float64], tolerance: float,
+              ) -> NDArray[np.bool_]:
     """True for samples with a registered point within ``tolerance`` (surfaces the sensor saw)."""
     if len(cloud) == 0:
         return np.zeros(len(samples), dtype=bool)
@@ -201,8 +224,8 @@ def seen_mask(samples: SurfaceSamples, cloud: np.ndarray, tolerance: float) -> n
     return np.isfinite(dist)
 
 
-def height_metrics_2d(cells: Cells, surface: TrueSurface, bounds: np.ndarray,
-                      grid_step: float, tolerance: float) -> dict[str, float]:
+def height_metrics_2d(cells: Cells, surface: TrueSurface, bounds: NDArray[np.float64],
+                      grid_step: float, tolerance: float) -> TruthValues:
     """Height RMSE, unknown share and completeness of a 2D map on an x/y grid (see module)."""
     xy = probe_grid(bounds, grid_step)
     known = np.isfinite(cells.centers[:, 2])
@@ -212,7 +235,7 @@ def height_metrics_2d(cells: Cells, surface: TrueSurface, bounds: np.ndarray,
     return height_summary(idx, map_h, true_h, tolerance)
 
 
-def probe_grid(bounds: np.ndarray, grid_step: float) -> np.ndarray:
+def probe_grid(bounds: NDArray[np.float64], grid_step: float) -> NDArray[np.float64]:
     """The x/y probes of the 2D metrics: a grid of step ``grid_step`` over ``bounds``."""
     lo, hi = bounds
     xs = np.arange(lo[0] + grid_step / 2, hi[0], grid_step)
@@ -222,8 +245,8 @@ def probe_grid(bounds: np.ndarray, grid_step: float) -> np.ndarray:
     return np.stack(np.meshgrid(xs, ys, indexing="xy"), axis=-1).reshape(-1, 2)
 
 
-def height_summary(idx: np.ndarray, map_h: np.ndarray, true_h: np.ndarray,
-                   tolerance: float) -> dict[str, float]:
+def height_summary(idx: NDArray[np.int64], map_h: NDArray[np.float64],
+                   true_h: NDArray[np.float64], tolerance: float) -> TruthValues:
     """The 2D metrics from each probe's cell (-1: none), map height and true height."""
     has_truth = np.isfinite(true_h)
     both = has_truth & (idx >= 0)
@@ -250,7 +273,8 @@ def free_space_truth(cells: Cells, surface: TrueSurface, max_cells: int | None =
 
 
 @numba.njit(cache=True)
-def _free_volumes(occupied: np.ndarray, sizes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _free_volumes(occupied: NDArray[np.bool_], sizes: NDArray[np.float64],
+                  ) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
     """Indices of the free cells and their volumes (edges multiplied left to right, as
     ``np.prod(axis=1)``), one pass: an Octomap flight at 0.1 m has tens of millions."""
     free, volume = np.empty(occupied.shape[0], np.int64), np.empty(occupied.shape[0])
@@ -262,7 +286,8 @@ def _free_volumes(occupied: np.ndarray, sizes: np.ndarray) -> tuple[np.ndarray, 
     return free[:m], volume[:m]
 
 
-def free_space_share(cells: Cells, inside: Callable[[np.ndarray], np.ndarray],
+def free_space_share(cells: Cells,
+                     inside: Callable[[NDArray[np.int64]], NDArray[np.bool_]],
                      max_cells: int | None = None, seed: int = 0) -> float:
     """:func:`free_space_truth` with ``inside(rows)``: whether the centres of the cells
     ``rows`` lie inside a solid."""
@@ -286,10 +311,10 @@ def check_truth_args(dims: int, tolerance: float) -> None:
         raise MetricsError(f"ground-truth metrics: tolerance must be > 0, got {tolerance}")
 
 
-def ground_truth_metrics(cells: Cells, surface: TrueSurface, *, dims: int, cloud: np.ndarray,
-                         bounds: np.ndarray | None = None, tolerance: float = 0.2,
-                         n_samples: int = 100_000, grid_step: float = 0.2,
-                         seed: int = 0) -> dict[str, Any]:
+def ground_truth_metrics(cells: Cells, surface: TrueSurface, *, dims: int,
+                         cloud: NDArray[np.float64], bounds: NDArray[np.float64] | None = None,
+                         tolerance: float = 0.2, n_samples: int = 100_000,
+                         grid_step: float = 0.2, seed: int = 0) -> TruthValues:
     """Every ground-truth metric of one map (definitions in the module docstring).
 
     ``cloud`` is the registered cloud (for ``completeness_seen``); ``bounds`` (2, 3) the
@@ -301,7 +326,7 @@ def ground_truth_metrics(cells: Cells, surface: TrueSurface, *, dims: int, cloud
     finite = np.isfinite(cells.centers).all(axis=1)
     # 2D maps: every cell with a height is part of the surface estimate, obstacle or not.
     occ = finite if dims == 2 else finite & cells.occupied.astype(bool)
-    out: dict[str, Any] = accuracy(cells.centers[occ], cells.sizes[occ], surface, tolerance)
+    out = accuracy(cells.centers[occ], cells.sizes[occ], surface, tolerance)
     if dims == 2:
         out.update(height_metrics_2d(cells, surface, box, grid_step, tolerance))
         return out

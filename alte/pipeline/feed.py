@@ -15,6 +15,7 @@ from collections.abc import Callable, Iterator
 from typing import Protocol
 
 import numpy as np
+from numpy.typing import NDArray
 from tqdm.auto import tqdm
 
 from alte.errors import ParameterError, RegistrationError
@@ -59,11 +60,11 @@ class FrameInput(Protocol):
         """How many frames the loop gets (known once the first frame arrived)."""
         ...
 
-    def anchor(self, first: RegisteredFrame) -> np.ndarray:
+    def anchor(self, first: RegisteredFrame) -> NDArray[np.float64]:
         """The point the local origin is chosen near."""
         ...
 
-    def cloud(self) -> np.ndarray | None:
+    def cloud(self) -> NDArray[np.float64] | None:
         """The merged cloud (None when not kept)."""
         ...
 
@@ -94,7 +95,7 @@ def resolve_domain(cls: type[Mapper], choice: Domain | DomainPolicy, control: Bo
     return Domain.over(data()), DomainChoice.DATA
 
 
-def local_shift(cls: type[Mapper], first: Callable[[], np.ndarray]) -> np.ndarray:
+def local_shift(cls: type[Mapper], first: Callable[[], NDArray[np.float64]]) -> NDArray[np.float64]:
     """Local origin (1 km grid) for mappers with a key space of their own (UTM-scale data)."""
     if cls.domain_use is not DomainUse.UNUSED:
         return np.zeros(3)
@@ -104,7 +105,7 @@ def local_shift(cls: type[Mapper], first: Callable[[], np.ndarray]) -> np.ndarra
 class Feeder:
     """Feeds frames to a mapper, timing each, keeping snapshots (the run's inner loop)."""
 
-    def __init__(self, mapper: Mapper, spec: MapSpec, feed: Feed, shift: np.ndarray,
+    def __init__(self, mapper: Mapper, spec: MapSpec, feed: Feed, shift: NDArray[np.float64],
                  total: int, *, observer: FrameObserver | None = None) -> None:
         self.mapper, self.feed, self.shift, self.total = mapper, feed, shift, total
         self.observer = observer
@@ -131,8 +132,8 @@ class Feeder:
         if self.observer is not None:
             self.observer(i, f, self.mapper, self.shift)
 
-    def run(self, frames: Iterator[RegisteredFrame], cloud: Callable[[], np.ndarray | None],
-            progress: bool) -> FrameLog:
+    def run(self, frames: Iterator[RegisteredFrame],
+            cloud: Callable[[], NDArray[np.float64] | None], progress: bool) -> FrameLog:
         """Feed every frame (insert, or record then build once on the merged cloud)."""
         bar = tqdm(_timed(frames), total=self.total or None, desc=self.mapper.name,
                    unit="frame", disable=not progress, leave=False)

@@ -11,6 +11,7 @@ import functools
 from collections.abc import Iterator
 
 import numpy as np
+from numpy.typing import NDArray
 
 from alte.mappers import Feed
 from alte.pipeline.source import InputKind, Source, StreamCounts, stream_frames
@@ -35,14 +36,14 @@ class _Cloud:
 
     def __init__(self, voxel: float | None, wanted: bool) -> None:
         self.grid = GridAccumulator(voxel) if wanted and voxel is not None else None
-        self.parts: list[np.ndarray] | None = [] if wanted and voxel is None else None
+        self.parts: list[NDArray[np.float64]] | None = [] if wanted and voxel is None else None
 
     def keep(self, frame: RegisteredFrame) -> RegisteredFrame:
         if self.parts is not None:
             self.parts.append(frame.points)
         return frame
 
-    def points(self) -> np.ndarray | None:
+    def points(self) -> NDArray[np.float64] | None:
         if self.grid is not None:
             return self.grid.points()
         if self.parts is not None:
@@ -73,11 +74,11 @@ class LiveFrames:
     def expected(self) -> int:
         return self._counts.selected
 
-    def anchor(self, first: RegisteredFrame) -> np.ndarray:
+    def anchor(self, first: RegisteredFrame) -> NDArray[np.float64]:
         points = first.points if self.source.kind is InputKind.POINTS else first.origin
         return np.asarray(np.median(np.reshape(points, (-1, 3)), axis=0))
 
-    def _cloud(self) -> np.ndarray | None:
+    def _cloud(self) -> NDArray[np.float64] | None:
         return self._merged.points()
 
     def counts(self) -> StreamCounts:

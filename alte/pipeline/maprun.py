@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 from typing import Protocol
 
 import numpy as np
+from numpy.typing import NDArray
 
 from alte import __version__
 from alte.mappers import Cells, Domain, Feed, Mapper
@@ -39,7 +40,7 @@ class FrameObserver(Protocol):
     were mapped with (an exporter writes the growing map from here)."""
 
     def __call__(self, index: int, frame: RegisteredFrame, mapper: Mapper,
-                 shift: np.ndarray) -> None: ...
+                 shift: NDArray[np.float64]) -> None: ...
 
 
 @dataclass(frozen=True, eq=False)
@@ -47,15 +48,15 @@ class FrameLog:
     """Per mapped frame: stamp (ns), points, seconds in the mapper, whole-chain seconds,
     (with snapshots) basis functions after the frame, and CPU seconds in the mapper."""
 
-    stamps: np.ndarray
-    points: np.ndarray
-    insert_s: np.ndarray
-    latency_s: np.ndarray
-    basis_functions: np.ndarray
-    insert_cpu_s: np.ndarray
+    stamps: NDArray[np.int64]
+    points: NDArray[np.int64]
+    insert_s: NDArray[np.float64]
+    latency_s: NDArray[np.float64]
+    basis_functions: NDArray[np.int64]
+    insert_cpu_s: NDArray[np.float64]
 
     @property
-    def times(self) -> np.ndarray:
+    def times(self) -> NDArray[np.float64]:
         """Seconds since the first frame."""
         return (self.stamps - self.stamps[0]) / 1e9 if len(self.stamps) else np.empty(0)
 
@@ -86,7 +87,7 @@ class MapRun:
     log: FrameLog
     counts: StreamCounts
     trajectory: Trajectory
-    cloud: np.ndarray | None
+    cloud: NDArray[np.float64] | None
     wall_s: float
     snapshots: list[Snapshot] = field(default_factory=list)
 

@@ -11,6 +11,7 @@ import itertools
 from collections.abc import Iterator
 
 import numpy as np
+from numpy.typing import NDArray
 
 from alte.errors import PoseError
 from alte.io.bag import FrameStream
@@ -28,7 +29,8 @@ from alte.types import Frame
 __all__ = ["odometry_poses"]
 
 
-def _start(probe: FrameStream, stamp: int) -> tuple[np.ndarray, np.ndarray] | None:
+def _start(probe: FrameStream, stamp: int,
+           ) -> tuple[NDArray[np.float64], NDArray[np.float64]] | None:
     """The recorded pose at the first scan, or None (no track, or one on another clock)."""
     if probe.track is None:
         return None

@@ -16,14 +16,16 @@ from collections.abc import Iterator
 from contextlib import ExitStack
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, BinaryIO
+from typing import BinaryIO
 
 import numpy as np
+from numpy.typing import NDArray
 
 from alte import __version__
 from alte.errors import AlteError, RegistrationError
 from alte.fsutil import atomic_dir
 from alte.io.bag import ReadCounts
+from alte.io.pcd import Fields
 from alte.pipeline.source import Source, StreamCounts, stream_frames
 from alte.pipeline.spec import FrameSpec
 from alte.registration.deskew import DeskewCounts
@@ -45,10 +47,10 @@ class Registered:
 
     source: Source
     spec: FrameSpec
-    points: np.ndarray
-    offsets: np.ndarray
+    points: NDArray[np.float64]
+    offsets: NDArray[np.int64]
     trajectory: Trajectory
-    cloud: np.ndarray
+    cloud: NDArray[np.float64]
     counts: StreamCounts
     key: str = ""
 
@@ -79,12 +81,12 @@ def cache_key(source: Source, spec: FrameSpec) -> str:
 
 
 def _collect(source: Source, spec: FrameSpec, sink: BinaryIO | None,
-             progress: bool) -> tuple[list[np.ndarray], np.ndarray, Trajectory, np.ndarray,
-                                      StreamCounts]:
+             progress: bool) -> tuple[list[NDArray[np.float64]], NDArray[np.int64], Trajectory,
+                                      NDArray[np.float64], StreamCounts]:
     """Stream the frames once: points to ``sink`` (or a list), trajectory, merged cloud."""
     counts = StreamCounts()
     merge = GridAccumulator(spec.voxel) if spec.voxel is not None else None
-    parts: list[np.ndarray] = []
+    parts: list[NDArray[np.float64]] = []
     sizes: list[int] = []
     poses: list[RegisteredFrame] = []
     for frame in stream_frames(source, spec, counts, merge=merge, progress=progress):
@@ -120,8 +122,10 @@ def _write(target: Path, source: Source, spec: FrameSpec, progress: bool) -> Non
         (tmp / _META).write_text(json.dumps(_meta(source, spec, counts), indent=1))
 
 
-def _counts(raw: dict[str, Any]) -> StreamCounts:
-    """The counts of a cache's metadata (parsed JSON, as ``StreamCounts.as_dict`` wrote it)."""
+def _counts(folder: Path) -> StreamCounts:
+    """The counts of a cache's metadata (as ``StreamCounts.as_dict`` wrote them: JSON, whose
+    parser gives untyped values; the counts' constructors take them by name)."""
+    raw = json.loads((folder / _META).read_text())["counts"]
     read = ReadCounts(**raw["read"])
     reg = RegistrationCounts(**raw["registration"])
     poses = PoseCounts(**raw.get("poses", {}))
@@ -131,7 +135,7 @@ def _counts(raw: dict[str, Any]) -> StreamCounts:
 
 
 def _load(folder: Path, source: Source, spec: FrameSpec, key: str) -> Registered:
-    meta = json.loads((folder / _META).read_text())
+    counts = _counts(folder)
     with np.load(folder / _ARRAYS) as arrays:
         a = {k: arrays[k] for k in arrays.files}
     total = int(a["offsets"][-1])
@@ -139,8 +143,7 @@ def _load(folder: Path, source: Source, spec: FrameSpec, key: str) -> Registered
         if total else np.empty((0, 3))
     cloud = a["cloud"] if spec.voxel is not None else points
     traj = Trajectory(a["stamps"], a["positions"], a["quaternions"], a["origins"])
-    return Registered(source, spec, points, a["offsets"], traj, cloud, _counts(meta["counts"]),
-                      key)
+    return Registered(source, spec, points, a["offsets"], traj, cloud, counts, key)
 
 
 def prepare(source: Source, spec: FrameSpec | None = None, *, cache: Path | None = None,
@@ -169,8 +172,8 @@ class Merged:
     """An input's merged registered cloud, its points' other fields (a point file's, kept
     while every point is) and the counts."""
 
-    points: np.ndarray
-    fields: dict[str, np.ndarray]
+    points: NDArray[np.float64]
+    fields: Fields
     counts: StreamCounts
 
 
@@ -195,7 +198,7 @@ def merge_frames(source: Source, spec: FrameSpec | None = None, *,
 
 
 def merged_cloud(source: Source, spec: FrameSpec | None = None, *,
-                 progress: bool = False) -> tuple[np.ndarray, StreamCounts]:
+                 progress: bool = False) -> tuple[NDArray[np.float64], StreamCounts]:
     """The points and counts of :func:`merge_frames`."""
     merged = merge_frames(source, spec, progress=progress)
     return merged.points, merged.counts

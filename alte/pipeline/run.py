@@ -14,6 +14,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import NDArray
 
 from alte.errors import ParameterError
 from alte.mappers import Feed
@@ -57,12 +58,12 @@ class PreparedFrames:
     def expected(self) -> int:
         return len(self.reg)
 
-    def anchor(self, first: RegisteredFrame) -> np.ndarray:
+    def anchor(self, first: RegisteredFrame) -> NDArray[np.float64]:
         if self.reg.source.kind is InputKind.POINTS:
             return np.asarray(np.median(self.reg.cloud, axis=0))
         return np.asarray(self.reg.trajectory.origins[0])
 
-    def cloud(self) -> np.ndarray | None:
+    def cloud(self) -> NDArray[np.float64] | None:
         return self.reg.cloud
 
     def counts(self) -> StreamCounts:
