@@ -20,6 +20,7 @@ from numpy.typing import NDArray
 from alte.export.grids import height_colours
 from alte.export.rosmsg import blank, header, pose, typestore
 from alte.mappers import Cells, Octomap
+from alte.types import rows_all
 
 if TYPE_CHECKING:  # rosbags declares its message classes' type for checkers only
     from rosbags.typesys.store import MsgType
@@ -35,7 +36,7 @@ _BT_DATA = b"\ndata\n"
 def shown_cells(cells: Cells, dims: int, everything: bool = False) -> NDArray[np.bool_]:
     """Mask of the cells drawn: occupied (3D maps) or known (2D height maps: a free leaf is
     ground at its height); ``everything`` adds the free cells of a 3D map."""
-    known: NDArray[np.bool_] = np.isfinite(cells.centers).all(axis=1)
+    known: NDArray[np.bool_] = rows_all(np.isfinite(cells.centers))
     if dims == 2 or everything:
         return known
     shown: NDArray[np.bool_] = known & np.asarray(cells.occupied, dtype=bool)

@@ -6,6 +6,7 @@ from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import NDArray
 
 from alte.errors import MapperError
 from alte.fsutil import atomic_path, refuse_overwrite
@@ -62,7 +63,7 @@ def check_export(path: Path, mapper: type[Mapper] | Mapper, overwrite: bool) -> 
 
 
 def export_map(mapper: Mapper, path: Path, overwrite: bool = False,
-               shift: np.ndarray | None = None) -> Path:
+               shift: NDArray[np.float64] | None = None) -> Path:
     """Write the cells (``.npz``, centres shifted back by ``shift``) or the native format.
 
     ``shift`` is the local origin the points were mapped relative to; a native file

@@ -11,12 +11,18 @@ same array, value for value and in the same order (``x``, then ``y``, then ``z``
 
 from __future__ import annotations
 
+from typing import TypeVar
+
 import numpy as np
+from numpy.typing import NDArray
 
 __all__ = ["unique_rows", "unique_sorted"]
 
+#: The values sorted here: point coordinates, integer voxel keys and packed keys.
+_V = TypeVar("_V", np.float64, np.int64)
 
-def unique_sorted(values: np.ndarray) -> np.ndarray:
+
+def unique_sorted(values: NDArray[_V]) -> NDArray[_V]:
     """The distinct values of a 1D array, ascending (a sort and one comparison pass)."""
     ordered = np.sort(values)
     keep = np.empty(len(ordered), bool)
@@ -25,12 +31,12 @@ def unique_sorted(values: np.ndarray) -> np.ndarray:
     return ordered[keep]
 
 
-def unique_rows(points: np.ndarray) -> np.ndarray:
+def unique_rows(points: NDArray[_V]) -> NDArray[_V]:
     """The distinct rows of ``points`` (N, 3), sorted lexicographically: what
     ``np.unique(points, axis=0)`` returns, for finite floats or integers."""
     pts = np.asarray(points)
     if pts.dtype.kind == "f":
-        pts = pts + 0.0  # -0.0 == 0.0: one value, one rank
+        pts = np.asarray(pts + 0.0, dtype=pts.dtype)  # -0.0 == 0.0: one value, one rank
     if len(pts) == 0:
         return pts.reshape(0, 3)
     axes = [unique_sorted(pts[:, a]) for a in range(3)]

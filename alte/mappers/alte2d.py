@@ -37,9 +37,10 @@ from dataclasses import dataclass
 from typing import ClassVar, Literal, get_args
 
 import numpy as np
+from numpy.typing import NDArray
 
 from alte.mappers.base import Cells
-from alte.mappers.quad.quadmap import QuadMap, plane_height
+from alte.mappers.quad.quadmap import LeafValues, QuadMap, Rows, plane_height
 from alte.params import Record, param
 
 __all__ = ["Alte2D", "Alte2DParams"]
@@ -76,18 +77,18 @@ class Alte2D(QuadMap):
         """``max_res``: the deepest level."""
         return int(self._params["max_res"])
 
-    def _values(self, points: np.ndarray) -> np.ndarray:
+    def _values(self, points: NDArray[np.float64]) -> NDArray[np.float64]:
         return points[:, 2:3]
 
-    def _split(self, level: int, rows: np.ndarray | slice) -> np.ndarray:
+    def _split(self, level: int, rows: Rows) -> NDArray[np.bool_]:
         """Thesis rule (eq. 3.2): ``M2 > kappa`` with enough points, below ``max_res``."""
         n = self.stats.column(level, "n")[rows]
         m2 = self.stats.column(level, "m2")[rows]
-        split: np.ndarray = ((n >= self._params["min_pts"]) & (level < self.depth)
+        split: NDArray[np.bool_] = ((n >= self._params["min_pts"]) & (level < self.depth)
                              & (m2 > self._params["kappa"]))
         return split
 
-    def _update_splits(self, touched: list[np.ndarray] | None) -> None:
+    def _update_splits(self, touched: list[NDArray[np.int64]] | None) -> None:
         if self._params["criterion"] == "thesis":
             super()._update_splits(touched)
             return
@@ -106,7 +107,7 @@ class Alte2D(QuadMap):
         m = float(self.stats.column(0, "n").sum())
         return self._params["kappa"] * np.sqrt(np.log(m) / m) if m > 0 else 0.0
 
-    def _binev_indicator(self, level: int, rows: np.ndarray) -> np.ndarray:
+    def _binev_indicator(self, level: int, rows: NDArray[np.int64]) -> NDArray[np.float64]:
         """``sum_J n_J (c_J - c_I)^2 / m`` for the cells ``rows`` of ``level``."""
         out = np.zeros(len(rows))
         if level >= self.depth or not len(rows):
@@ -118,15 +119,16 @@ class Alte2D(QuadMap):
         dev = self.stats.column(level + 1, "mean") - c_parent
         terms = self.stats.column(level + 1, "n") * dev * dev
         per_parent = np.bincount(parent_pos, terms, minlength=len(self.stats.keys[level]))
-        share: np.ndarray = per_parent[rows] / m
+        share: NDArray[np.float64] = per_parent[rows] / m
         return share
 
-    def _leaf_values(self, level: np.ndarray, rows: np.ndarray, centers: np.ndarray,
-                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def _leaf_values(self, level: NDArray[np.int64], rows: NDArray[np.int64],
+                     centers: NDArray[np.float64]) -> LeafValues:
         c = self.leaf_stat(level, rows, "mean")
         return c, c, rows >= 0
 
-    def occupancy_grid(self, height_threshold: float, ground: float | np.ndarray = 0.0) -> Cells:
+    def occupancy_grid(self, height_threshold: float,
+                       ground: float | NDArray[np.float64] = 0.0) -> Cells:
         """Binary grid (thesis ch. 6): occupied where ``c_I`` rises over ``height_threshold``
         above ``ground`` (a z value or a plane ``a,b,c,d``); ``value`` = height above ground,
         NaN and free for unknown cells."""

@@ -28,6 +28,7 @@ from pathlib import Path
 from typing import ClassVar, Literal
 
 import numpy as np
+from numpy.typing import NDArray
 
 from alte.errors import MapperError
 from alte.mappers._rows import unique_rows
@@ -133,7 +134,7 @@ class Alte3D:
     def _branching(self) -> int:
         return 4 if self._params["variant"] == "fixed_altitude" else 8
 
-    def insert(self, points: np.ndarray, origin: np.ndarray) -> None:
+    def insert(self, points: NDArray[np.float64], origin: NDArray[np.float64]) -> None:
         """Add one frame's points (``origin`` is checked but 3D-ALTE does not use it)."""
         pts = check_points(points, "alte3d")
         check_origin(origin, "alte3d")
@@ -142,7 +143,8 @@ class Alte3D:
                               "on it); give one, or use build, which takes the data's cube")
         self._add(pts)
 
-    def build(self, points: np.ndarray, origins: np.ndarray | None = None) -> None:
+    def build(self, points: NDArray[np.float64],
+              origins: NDArray[np.float64] | None = None) -> None:
         """Rebuild from a whole cloud (``origins`` unused)."""
         pts = check_points(points, "alte3d")
         if self._fixed is None:
@@ -163,7 +165,7 @@ class Alte3D:
         self._shared = other._shared = True
         return other
 
-    def _add(self, pts: np.ndarray) -> None:
+    def _add(self, pts: NDArray[np.float64]) -> None:
         if self._shared:
             raise MapperError("alte3d: this map was re-read with other parameters and shares "
                               "its counts with the copy; build it afresh to add points")
@@ -180,7 +182,7 @@ class Alte3D:
                 self._keys[level], self._counts[level], keys, counts
             )
 
-    def _finest_keys(self, pts: np.ndarray) -> np.ndarray:
+    def _finest_keys(self, pts: NDArray[np.float64]) -> NDArray[np.int64]:
         """Packed cell keys at level max_res; points outside the domain are dropped, counted."""
         dom = self._domain
         assert dom is not None  # insert and build set the domain first
@@ -197,13 +199,13 @@ class Alte3D:
             idx[:, 2] = layer[inside]
         return pack_keys(idx[:, 0], idx[:, 1], idx[:, 2])
 
-    def _at_level(self, finest: np.ndarray, shift: int) -> np.ndarray:
+    def _at_level(self, finest: NDArray[np.int64], shift: int) -> NDArray[np.int64]:
         ix, iy, iz = unpack_keys(finest)
         if self._params["variant"] == "cube":
             iz = iz >> shift
         return pack_keys(ix >> shift, iy >> shift, iz)
 
-    def _count(self, level: int, keys: np.ndarray) -> np.ndarray:
+    def _count(self, level: int, keys: NDArray[np.int64]) -> NDArray[np.int64]:
         """Point counts of ``keys`` at ``level`` (0 for cells never seen)."""
         table, counts = self._keys[level], self._counts[level]
         if table.size == 0:
@@ -211,7 +213,7 @@ class Alte3D:
         pos = np.minimum(np.searchsorted(table, keys), table.size - 1)
         return np.where(table[pos] == keys, counts[pos], 0)
 
-    def _leaves(self) -> tuple[list[np.ndarray], list[np.ndarray]]:
+    def _leaves(self) -> tuple[list[NDArray[np.int64]], list[NDArray[np.int64]]]:
         """Leaf keys and counts per level, walking down from the root(s) through split cells."""
         p = self._params
         leaves, counts = [], []
@@ -240,15 +242,16 @@ class Alte3D:
             empty = np.empty((0, 3))
             return Cells(empty, empty, np.empty(0), np.empty(0, bool), np.empty(0, np.int64))
         keys, counts = self._leaves()
-        lo, hi = zip(*(self._bounds(k, lv) for lv, k in enumerate(keys)), strict=True)
-        lo, hi = np.concatenate(lo), np.concatenate(hi)
+        los, his = zip(*(self._bounds(k, lv) for lv, k in enumerate(keys)), strict=True)
+        lo, hi = np.concatenate(los), np.concatenate(his)
         level = np.concatenate([np.full(k.size, lv) for lv, k in enumerate(keys)])
         value = np.concatenate(counts)
         need = self._params["min_pts"] * self._branching ** np.maximum(
             0, self._params["occupancy_level"] - level)
         return Cells((lo + hi) / 2, hi - lo, value.astype(np.float64), value >= need, level)
 
-    def _bounds(self, keys: np.ndarray, level: int) -> tuple[np.ndarray, np.ndarray]:
+    def _bounds(self, keys: NDArray[np.int64], level: int,
+                ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         assert self._domain is not None  # cells() returns early without one
         xmin, ymin, zmin, size = (self._domain.xmin, self._domain.ymin, self._domain.zmin,
                                   self._domain.size)
@@ -274,7 +277,7 @@ class Alte3D:
     def memory_bytes(self) -> int:
         return int(sum(k.nbytes + c.nbytes for k, c in zip(self._keys, self._counts, strict=True)))
 
-    def corners(self) -> np.ndarray:
+    def corners(self) -> NDArray[np.float64]:
         """The 8 corners of every occupied leaf, de-duplicated."""
         cells = self.cells()
         lo = cells.centers[cells.occupied] - cells.sizes[cells.occupied] / 2

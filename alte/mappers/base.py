@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import ClassVar, Protocol, TypeVar, runtime_checkable
 
 import numpy as np
+from numpy.typing import NDArray
 
 from alte.errors import MapperError
 from alte.mappers.domain import Domain, DomainUse
@@ -34,16 +35,16 @@ class Cells:
     binary state and ``level`` the tree depth (0 = root).
     """
 
-    centers: np.ndarray
-    sizes: np.ndarray
-    value: np.ndarray
-    occupied: np.ndarray
-    level: np.ndarray
+    centers: NDArray[np.float64]
+    sizes: NDArray[np.float64]
+    value: NDArray[np.float64]
+    occupied: NDArray[np.bool_]
+    level: NDArray[np.int64]
 
     def __len__(self) -> int:
         return int(self.centers.shape[0])
 
-    def as_dict(self) -> dict[str, np.ndarray]:
+    def as_dict(self) -> dict[str, NDArray[np.float64] | NDArray[np.bool_] | NDArray[np.int64]]:
         """Arrays by name, as written by ``alte map --export cells.npz``."""
         return {
             "centers": self.centers,
@@ -139,11 +140,12 @@ class Mapper(Protocol):
         every ``insert`` since creation or the last ``build``, which starts it afresh."""
         ...
 
-    def insert(self, points: np.ndarray, origin: np.ndarray) -> None:
+    def insert(self, points: NDArray[np.float64], origin: NDArray[np.float64]) -> None:
         """Add one registered frame (N, 3) seen from sensor ``origin`` (3,)."""
         ...
 
-    def build(self, points: np.ndarray, origins: np.ndarray | None = None) -> None:
+    def build(self, points: NDArray[np.float64],
+              origins: NDArray[np.float64] | None = None) -> None:
         """Replace the map by one built from a whole cloud (origins: (3,) or (N, 3))."""
         ...
 
@@ -166,7 +168,7 @@ class Mapper(Protocol):
         """Bytes held by the map's data structures."""
         ...
 
-    def corners(self) -> np.ndarray:
+    def corners(self) -> NDArray[np.float64]:
         """Corners of the occupied basis functions (M, 3): set B of thesis fig. 5.1."""
         ...
 
@@ -181,7 +183,7 @@ class Mapper(Protocol):
         ...
 
 
-def check_points(points: object, owner: str, name: str = "points") -> np.ndarray:
+def check_points(points: object, owner: str, name: str = "points") -> NDArray[np.float64]:
     """Return finite float64 (N, 3) points or raise :class:`MapperError` naming the problem."""
     return as_points(points, name, owner=owner, error=MapperError, finite=True)
 

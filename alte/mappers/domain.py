@@ -13,6 +13,7 @@ import enum
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import NDArray
 
 from alte.errors import MapperError, ParameterError
 from alte.types import Box, rows_all
@@ -75,7 +76,7 @@ class Domain:
         return cls(*values)
 
     @property
-    def lo(self) -> np.ndarray:
+    def lo(self) -> NDArray[np.float64]:
         """Minimum corner (3,)."""
         return np.array([self.xmin, self.ymin, self.zmin])
 
@@ -84,7 +85,7 @@ class Domain:
         """The cube as a :class:`~alte.types.Box`."""
         return Box(self.lo, self.lo + self.size)
 
-    def inside(self, points: np.ndarray, dims: int = 3) -> np.ndarray:
+    def inside(self, points: NDArray[np.float64], dims: int = 3) -> NDArray[np.bool_]:
         """Mask of the (N, 3) points in the closed cube (first ``dims`` axes only)."""
         rel = (np.asarray(points, dtype=np.float64)[:, :dims] - self.lo[:dims]) / self.size
         return rows_all((rel >= 0.0) & (rel <= 1.0))

@@ -42,12 +42,13 @@ from typing import ClassVar, Literal, get_args
 
 import numba
 import numpy as np
+from numpy.typing import NDArray
 
 from alte._numba import CLOUD_MIN, threads_for
 from alte.errors import AlteError, MapperError
 from alte.mappers.base import Feed
 from alte.mappers.domain import Domain
-from alte.mappers.quad.quadmap import QuadMap, plane_height
+from alte.mappers.quad.quadmap import LeafValues, QuadMap, Rows, plane_height
 from alte.params import Record, param
 
 __all__ = ["Quadtree", "QuadtreeParams", "parse_ground"]
@@ -56,7 +57,7 @@ Occupancy = Literal["mean", "max"]
 RULES: tuple[str, ...] = get_args(Occupancy)
 
 
-def parse_ground(text: str) -> np.ndarray | None:
+def parse_ground(text: str) -> NDArray[np.float64] | None:
     """``"z0"`` -> plane (0, 0, 1, -z0); ``"a,b,c,d"`` -> that plane; ``"fit"`` -> None."""
     if text.strip().lower() == "fit":
         return None
@@ -68,7 +69,7 @@ def parse_ground(text: str) -> np.ndarray | None:
 
 
 @numba.njit(cache=True, parallel=True)
-def _z_and_above(points: np.ndarray, plane: np.ndarray) -> np.ndarray:
+def _z_and_above(points: NDArray[np.float64], plane: NDArray[np.float64]) -> NDArray[np.float64]:
     """``z, z - plane_height(plane, xy)`` of every point, in one pass (the same arithmetic,
     in the same order, as the numpy expression; every thread for a cloud). Allocated
     here: numpy asks the kernel for huge pages for arrays from 4 MiB, and on this kind
@@ -121,21 +122,22 @@ class Quadtree(QuadMap):
                  **given: object) -> None:
         super().__init__(domain, record=record, **given)
         #: Ground plane (a, b, c, d); None until ``build`` fits it (``ground="fit"``).
-        self.plane: np.ndarray | None = parse_ground(self._params["ground"])
+        self.plane: NDArray[np.float64] | None = parse_ground(self._params["ground"])
 
     @property
     def depth(self) -> int:
         """``max_depth``: the deepest level."""
         return int(self._params["max_depth"])
 
-    def insert(self, points: np.ndarray, origin: np.ndarray) -> None:
+    def insert(self, points: NDArray[np.float64], origin: NDArray[np.float64]) -> None:
         """Add one frame; needs a fixed ground plane (not ``ground=fit``)."""
         if self.plane is None:
             raise MapperError("quadtree: ground=fit needs the whole cloud (build); give "
                               "insert a fixed plane, e.g. --set ground=0 or ground=a,b,c,d")
         super().insert(points, origin)
 
-    def build(self, points: np.ndarray, origins: np.ndarray | None = None) -> None:
+    def build(self, points: NDArray[np.float64],
+              origins: NDArray[np.float64] | None = None) -> None:
         """Build from a whole cloud, fitting the ground plane first when ``ground=fit``."""
         if self._params["ground"].strip().lower() == "fit" and len(np.atleast_2d(points)) >= 3:
             from alte.ground import fit_plane_msac
@@ -150,22 +152,22 @@ class Quadtree(QuadMap):
             raise MapperError("quadtree: ground=fit needs at least 3 points")
         super().build(points, origins)
 
-    def _values(self, points: np.ndarray) -> np.ndarray:
+    def _values(self, points: NDArray[np.float64]) -> NDArray[np.float64]:
         assert self.plane is not None  # insert and build refuse to go on without one
         with threads_for(len(points), CLOUD_MIN):
-            values: np.ndarray = _z_and_above(points, self.plane)
+            values: NDArray[np.float64] = _z_and_above(points, self.plane)
         return values
 
-    def _split(self, level: int, rows: np.ndarray | slice) -> np.ndarray:
+    def _split(self, level: int, rows: Rows) -> NDArray[np.bool_]:
         n = self.stats.column(level, "n")[rows]
-        split: np.ndarray = (n > self._split_above()) & (level < self.depth)
+        split: NDArray[np.bool_] = (n > self._split_above()) & (level < self.depth)
         return split
 
     def _split_above(self) -> float:
         return float(self._params["max_points"])
 
-    def _leaf_values(self, level: np.ndarray, rows: np.ndarray, centers: np.ndarray,
-                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def _leaf_values(self, level: NDArray[np.int64], rows: NDArray[np.int64],
+                     centers: NDArray[np.float64]) -> LeafValues:
         z = self.leaf_stat(level, rows, "mean", 0)
         value = self.leaf_stat(level, rows, self._params["occupancy"], 1)
         occupied = np.isfinite(value) & (value > self._params["height_threshold"])

@@ -22,6 +22,7 @@ from alte.mappers.quad.quadmap import rectangle_corners
 from alte.metrics.hausdorff import hausdorff
 from alte.metrics.options import GroundTruth, TruthOptions
 from alte.metrics.timing import Timing
+from alte.types import rows_all
 
 if TYPE_CHECKING:
     from alte.mappers.base import Cells, Mapper
@@ -144,7 +145,7 @@ def set_b_points(mapper: Mapper, cells: Cells, rule: SetB = SetB.CORNERS,
     rule = set_b_rule(rule)
     if rule is SetB.CORNERS or (rule is SetB.OCCUPIED and mapper.dims == 3):
         return mapper.corners()
-    keep = np.isfinite(cells.centers).all(axis=1)
+    keep = rows_all(np.isfinite(cells.centers))
     if mapper.dims == 3 or rule is SetB.OCCUPIED:
         keep &= cells.occupied.astype(bool)
     if rule is SetB.OCCUPIED:

@@ -42,6 +42,7 @@ from alte.metrics.truth import (
     probe_grid,
     seen_mask,
 )
+from alte.types import rows_all
 
 if TYPE_CHECKING:
     from alte.mappers.base import Cells
@@ -198,7 +199,7 @@ class Reference:
         check_truth_args(dims, opts.tolerance)
         leaves = self.leaf_truth(cells)
         surface = self._truth().surface
-        finite = np.isfinite(cells.centers).all(axis=1)
+        finite = rows_all(np.isfinite(cells.centers))
         occ = finite if dims == 2 else finite & cells.occupied.astype(bool)
         out = leaves.accuracy(occ, surface, opts.tolerance)
         if dims == 2:

@@ -72,7 +72,9 @@ def _draw_cells(ax: Axes, mapper: Mapper) -> PolyCollection:
     c, h, top = c[order], h[order], top[order]
     signs = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]])
     quads = c[:, None, :2] + signs[None] * h[:, None, :2]
-    coll = PolyCollection(quads, array=top, cmap="viridis", edgecolors="k", linewidths=0.1)
+    # matplotlib's stub asks for a sequence of (4, 2) arrays; it takes one (K, 4, 2) array
+    coll = PolyCollection(quads, array=top, cmap="viridis",  # type: ignore[arg-type]
+                          edgecolors="k", linewidths=0.1)
     ax.add_collection(coll)
     if len(c):
         ax.set_xlim(quads[..., 0].min(), quads[..., 0].max())

@@ -22,7 +22,7 @@ import numpy as np
 if TYPE_CHECKING:
     from alte.registration.settings import OdometryParams, PoseCounts
 
-__all__ = ["Kiss", "Plane", "PlaneMap", "kiss_config", "scene_scale"]
+__all__ = ["Kiss", "Plane", "PlaneMap", "kiss_config", "kiss_voxel", "scene_scale"]
 
 
 def scene_scale(points: np.ndarray, params: OdometryParams) -> tuple[float, float]:
@@ -38,6 +38,12 @@ def scene_scale(points: np.ndarray, params: OdometryParams) -> tuple[float, floa
     far = float(np.percentile(ranges, 99)) if len(ranges) else 100.0
     max_range = params.max_range or max(1.2 * far, 1.0)
     return max_range, params.voxel or max(typical / 70, 0.01)
+
+
+def kiss_voxel(params: OdometryParams) -> float:
+    """KISS-ICP's map voxel for ``params``: ``voxel``, else ``max_range / 100`` (its own
+    rule; 1 m at its default range of 100 m)."""
+    return params.voxel or (params.max_range or 100.0) / 100.0
 
 
 def kiss_config(points: np.ndarray, params: OdometryParams, timed: bool = False) -> Any:

@@ -24,10 +24,11 @@ from dataclasses import replace
 from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
 from alte.errors import ParameterError
-from alte.registration.backends import Kiss, Plane
+from alte.registration.backends import Kiss, Plane, kiss_voxel
 from alte.registration.lio import LioSettings, lio_frames
 from alte.registration.refine import refine_frames
 from alte.registration.settings import (
@@ -40,6 +41,7 @@ from alte.registration.settings import (
     pose_matrix,
     resolve_method,
 )
+from alte.registration.window import window_poses
 from alte.types import Frame, Mount
 
 if TYPE_CHECKING:
@@ -109,8 +111,20 @@ def odometry_frames(frames: Iterable[Frame], mount: Mount, *, counts: PoseCounts
     body_sensor = pose_matrix(mount.translation, mount.quaternion)
     sensor_body = np.linalg.inv(body_sensor)
     anchor = (pose_matrix(*start) if start is not None else np.eye(4)) @ body_sensor
-    odometry: Kiss | Plane | None = None
+    steps = _lidar_poses(frames, params, counts)
+    if params.method == "kiss" and params.window > 0:
+        steps = window_poses(steps, window=params.window, voxel=kiss_voxel(params),
+                             min_fitness=params.min_fitness, counts=counts)
     previous: Frame | None = None
+    for frame, pose in steps:
+        previous = _posed(frame, anchor @ pose @ sensor_body, previous)
+        yield previous
+
+
+def _lidar_poses(frames: Iterable[Frame], params: OdometryParams, counts: PoseCounts,
+                 ) -> Iterator[tuple[Frame, NDArray[np.float64]]]:
+    """Each frame with its sensor pose in the first scan's sensor frame (kiss or plane)."""
+    odometry: Kiss | Plane | None = None
     for frame in frames:
         points = np.asarray(frame.points, dtype=np.float64)
         began, cpu = time.perf_counter(), time.thread_time()
@@ -118,10 +132,9 @@ def odometry_frames(frames: Iterable[Frame], mount: Mount, *, counts: PoseCounts
             odometry = Kiss(points, params, frame.times is not None) \
                 if params.method == "kiss" \
                 else Plane(points, params, counts)
-        body = anchor @ odometry.step(points, frame.times) @ sensor_body
+        pose = odometry.step(points, frame.times)
         counts.seconds += time.perf_counter() - began
         counts.cpu_seconds += time.thread_time() - cpu
         counts.frames += 1
         counts.deskewed += int(isinstance(odometry, Kiss) and odometry.deskews(frame.times))
-        previous = _posed(frame, body, previous)
-        yield previous
+        yield frame, np.asarray(pose, dtype=np.float64)

@@ -61,6 +61,9 @@ class OdometryParams(Record):
                                  "m; kiss: least motion that updates the adaptive threshold")
     max_points_per_voxel: int = param(20, lambda v: v >= 1, ">= 1", "kiss: map points per voxel")
     deskew: bool = param(True, help="kiss: deskew scans that carry per-point time")
+    window: int = param(20, lambda v: v >= 0, ">= 0",
+                        "kiss: each pose re-aligned to this many scans before and after it "
+                        "once they have arrived (0: off; poses lag by as many scans)")
     threads: int = param(1, lambda v: v >= 0, ">= 0", "threads per scan (0: every core)")
     rebuild: int = param(5, lambda v: v >= 1, ">= 1",
                          "plane, refine: scans between local-map rebuilds")
@@ -90,7 +93,8 @@ class OdometryParams(Record):
 #: ranges are shared.
 KEYS: dict[str, tuple[str, ...]] = {
     "kiss": ("max_range", "min_range", "voxel", "single_downsample", "fixed_threshold",
-             "initial_threshold", "min_motion_th", "max_points_per_voxel", "deskew", "threads"),
+             "initial_threshold", "min_motion_th", "max_points_per_voxel", "deskew", "window",
+             "threads"),
     "plane": ("max_range", "voxel", "rebuild", "min_fitness"),
     "lio": ("max_range", "min_range", "voxel", "plane_sigma", "plane_reach", "plane_points",
             "imu_topic"),
@@ -141,6 +145,7 @@ class PoseCounts(Counts):
     frames: int = 0
     deskewed: int = 0
     corrected: int = 0
+    realigned: int = 0
     kept: dict[str, int] = field(default_factory=dict)
     weak_alignments: int = 0
     max_correction_m: float = 0.0

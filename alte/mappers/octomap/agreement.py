@@ -7,6 +7,7 @@ import time
 from collections.abc import Iterable
 
 import numpy as np
+from numpy.typing import NDArray
 
 from alte.mappers.octomap.mapper import Octomap, OctomapParams
 
@@ -14,7 +15,7 @@ __all__ = ["compare_backends"]
 
 
 def compare_backends(
-    scans: Iterable[tuple[np.ndarray, np.ndarray]], **params: float | str
+    scans: Iterable[tuple[NDArray[np.float64], NDArray[np.float64]]], **params: float | str
 ) -> dict[str, float]:
     """Insert the same scans into both backends; Jaccard of occupied voxels, leaves, times.
 

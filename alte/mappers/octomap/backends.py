@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
+from numpy.typing import NDArray
 
 from alte.mappers.octomap.cost import scan_cost
 from alte.mappers.octomap.scan import ScanWork, scan_blocks
@@ -94,18 +95,18 @@ class NativeTree:
         self.max_range = max_range
         self.model = model
         self.store = VoxelStore()
-        self._leaves: Leaves | None = None
+        self._leaves: Leaves[np.float32] | None = None
         self._work = ScanWork()
         self._hits = 0
 
-    def insert_scan(self, points: np.ndarray, origin: np.ndarray) -> None:
+    def insert_scan(self, points: NDArray[np.float64], origin: NDArray[np.float64]) -> None:
         """OctoMap ``insertPointCloud``: each voxel updated once, occupied beats free (one
         thread: the rays are walked four at a time in vector registers)."""
         blocks, bits = scan_blocks(points.astype(np.float32), origin.astype(np.float32),
                                    self.voxel, self.max_range, self._work)
         self._update(blocks, bits)
 
-    def insert_hits(self, points: np.ndarray) -> None:
+    def insert_hits(self, points: NDArray[np.float64]) -> None:
         """Mark the voxels holding ``points`` occupied once (no ray casting)."""
         keys = voxel_keys(points, self.voxel)
         self._hits += len(keys)
@@ -116,22 +117,22 @@ class NativeTree:
         """Ray steps of the scans (:func:`alte.mappers.octomap.cost.scan_cost`) and voxels hit."""
         return self._work.steps + self._hits
 
-    def _update(self, blocks: np.ndarray, bits: np.ndarray) -> None:
+    def _update(self, blocks: NDArray[np.uint64], bits: NDArray[np.uint64]) -> None:
         model = self.model
         self.store.update(blocks, bits, model.miss, model.hit, model.clamp)
         self._leaves = None
 
     @property
-    def keys(self) -> np.ndarray:
+    def keys(self) -> NDArray[np.uint64]:
         """Sorted Morton keys of every observed depth-16 voxel."""
         return self.store.fold()[0]
 
     @property
-    def log_odds(self) -> np.ndarray:
+    def log_odds(self) -> NDArray[np.float32]:
         """Float32 log-odds of the voxels in :attr:`keys`."""
         return self.store.fold()[1]
 
-    def leaves(self) -> Leaves:
+    def leaves(self) -> Leaves[np.float32]:
         """Pruned leaves (cached until the next update)."""
         if self._leaves is None:
             self._leaves = prune_voxels(*self.store.fold())
@@ -163,7 +164,7 @@ class ReferenceTree:
         _configure(self.tree, model)
         self.cost = 0
 
-    def insert_scan(self, points: np.ndarray, origin: np.ndarray) -> None:
+    def insert_scan(self, points: NDArray[np.float64], origin: NDArray[np.float64]) -> None:
         self.cost += scan_cost(points.astype(np.float32), origin.astype(np.float32),
                                self.voxel, self.max_range)
         self.tree.insertPointCloud(
@@ -172,13 +173,13 @@ class ReferenceTree:
             self.max_range, lazy_eval=False, discretize=False,
         )
 
-    def insert_hits(self, points: np.ndarray) -> None:
+    def insert_hits(self, points: NDArray[np.float64]) -> None:
         keys = voxel_keys(points, self.voxel)
         self.cost += len(keys)
         centers = (morton_decode(keys) - TREE_MAX_VAL + 0.5) * self.voxel
         self.tree.updateNodes(centers, True)
 
-    def leaves(self) -> Leaves:
+    def leaves(self) -> Leaves[np.float32]:
         return tree_leaves(self.tree)
 
     @property
@@ -207,7 +208,7 @@ def _configure(tree: pyoctomap.OcTree, model: SensorModel) -> None:
     tree.setOccupancyThres(model.occupancy_threshold)
 
 
-def voxel_keys(points: np.ndarray, voxel: float) -> np.ndarray:
+def voxel_keys(points: NDArray[np.float64], voxel: float) -> NDArray[np.uint64]:
     """Sorted unique Morton keys of the voxels holding float32-rounded ``points``."""
     keys = np.floor(points.astype(np.float32).astype(np.float64) * (1.0 / voxel))
     keys = keys.astype(np.int64) + TREE_MAX_VAL
@@ -215,7 +216,7 @@ def voxel_keys(points: np.ndarray, voxel: float) -> np.ndarray:
     return np.unique(morton_encode(keys[inside]))
 
 
-def tree_leaves(tree: OcTreeLike) -> Leaves:
+def tree_leaves(tree: OcTreeLike) -> Leaves[np.float32]:
     """Leaves of a ``pyoctomap.OcTree`` as Morton prefixes, depths and float32 log-odds.
 
     pyoctomap only offers a leaf iterator, so this is one Python step per leaf

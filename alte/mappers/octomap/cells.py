@@ -6,6 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import NDArray
 
 from alte.errors import MapperError
 from alte.mappers.base import Cells
@@ -16,12 +17,12 @@ from alte.mappers.octree.tree import Leaves, leaf_boxes
 __all__ = ["leaf_subset", "leaves_to_cells", "occupied_voxels", "read_bt"]
 
 
-def leaf_subset(leaves: Leaves, mask: np.ndarray) -> Leaves:
+def leaf_subset(leaves: Leaves[np.float32], mask: NDArray[np.bool_]) -> Leaves[np.float32]:
     """The leaves where ``mask`` is true."""
     return Leaves(leaves.prefix[mask], leaves.depth[mask], leaves.value[mask])
 
 
-def leaves_to_cells(leaves: Leaves, voxel: float,
+def leaves_to_cells(leaves: Leaves[np.float32], voxel: float,
                     occupied_log_odds: float | np.float32) -> Cells:
     """Cells of pruned leaves: centres, cubic sizes, probability, occupied flag, depth."""
     centers, sizes = leaf_boxes(leaves, voxel)
@@ -29,7 +30,8 @@ def leaves_to_cells(leaves: Leaves, voxel: float,
     return Cells(centers, sizes, value, leaves.value > occupied_log_odds, leaves.depth.copy())
 
 
-def occupied_voxels(leaves: Leaves, occupied_log_odds: float | np.float32) -> np.ndarray:
+def occupied_voxels(leaves: Leaves[np.float32], occupied_log_odds: float | np.float32
+                    ) -> NDArray[np.uint64]:
     """Depth-16 Morton keys covered by occupied leaves (a leaf is a contiguous Morton range)."""
     occ = leaf_subset(leaves, leaves.value > occupied_log_odds)
     span = np.uint64(1) << (np.uint64(3) * (TREE_DEPTH - occ.depth).astype(np.uint64))

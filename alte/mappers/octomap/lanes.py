@@ -16,13 +16,16 @@ it returns to numba only when a lane finishes, to load the next ray.
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Any
+from typing import Protocol
 
 import numba
 import numpy as np
 from llvmlite import ir  # type: ignore[import-untyped]  # numba's IR builder, untyped
 from numba import types
+from numba.core.typing.context import BaseContext
+from numba.core.typing.templates import Signature
 from numba.extending import intrinsic
+from numpy.typing import NDArray
 
 __all__ = ["FLOATS", "INTS", "LANES", "prefetch", "walk_lanes"]
 
@@ -37,7 +40,25 @@ INTS = 6
 _F64, _I64, _I32 = ir.DoubleType(), ir.IntType(64), ir.IntType(32)
 _VF, _VI = ir.VectorType(_F64, LANES), ir.VectorType(_I64, LANES)
 _VB = ir.VectorType(ir.IntType(1), LANES)
-Codegen = Callable[[Any, ir.IRBuilder, Any, list[ir.Value]], ir.Value]
+
+
+class _ArrayStruct(Protocol):
+    """numba's struct of an array argument, as the code generators read it."""
+
+    data: ir.Value
+
+
+class _Target(Protocol):
+    """What the code generators ask of numba's target context (``numba.core.base``, whose
+    methods carry no annotations)."""
+
+    def make_array(self, typ: types.Type
+                   ) -> Callable[[_Target, ir.IRBuilder, ir.Value], _ArrayStruct]: ...
+    def get_dummy_value(self) -> ir.Value: ...
+
+
+#: An intrinsic's code generator: (target context, IR builder, signature, argument values).
+Codegen = Callable[[_Target, ir.IRBuilder, Signature, list[ir.Value]], ir.Value]
 
 
 def _vectors(builder: ir.IRBuilder, base: ir.Value, kind: ir.VectorType,
@@ -78,7 +99,8 @@ def _set_bits(b: ir.IRBuilder, grid: ir.Value, where: ir.Value) -> None:
         b.store(b.or_(b.load(word), bit), word)
 
 
-def _advance_codegen(context: Any, b: ir.IRBuilder, sig: Any, args: list[ir.Value]) -> ir.Value:
+def _advance_codegen(context: _Target, b: ir.IRBuilder, sig: Signature,
+                     args: list[ir.Value]) -> ir.Value:
     fptr = _vectors(b, context.make_array(sig.args[0])(context, b, args[0]).data, _VF, FLOATS)
     iptr = _vectors(b, context.make_array(sig.args[1])(context, b, args[1]).data, _VI, INTS)
     grid = b.bitcast(context.make_array(sig.args[2])(context, b, args[2]).data,
@@ -108,8 +130,8 @@ def _advance_codegen(context: Any, b: ir.IRBuilder, sig: Any, args: list[ir.Valu
 
 
 @intrinsic
-def _advance(typingctx: Any, floats: Any, ints: Any, grid: Any,
-             dummy: Any) -> tuple[Any, Codegen]:
+def _advance(typingctx: BaseContext, floats: types.Type, ints: types.Type, grid: types.Type,
+             dummy: types.Type) -> tuple[Signature, Codegen]:
     """Step every lane until one stops; lane state lives in ``floats`` (FLOATS x LANES)
     and ``ints`` (INTS x LANES), stored back on return; returns the stopped lanes' mask.
     A lane's bit goes to ``dummy`` (a spare bit past the grid) when it stops before
@@ -117,7 +139,8 @@ def _advance(typingctx: Any, floats: Any, ints: Any, grid: Any,
     return types.int64(floats, ints, grid, dummy), _advance_codegen
 
 
-def _prefetch_codegen(context: Any, b: ir.IRBuilder, sig: Any, args: list[ir.Value]) -> ir.Value:
+def _prefetch_codegen(context: _Target, b: ir.IRBuilder, sig: Signature,
+                      args: list[ir.Value]) -> ir.Value:
     ptr = b.gep(context.make_array(sig.args[0])(context, b, args[0]).data, [args[1]])
     i8p = ir.IntType(8).as_pointer()
     fn = b.module.declare_intrinsic("llvm.prefetch", fnty=ir.FunctionType(
@@ -128,14 +151,15 @@ def _prefetch_codegen(context: Any, b: ir.IRBuilder, sig: Any, args: list[ir.Val
 
 
 @intrinsic
-def prefetch(typingctx: Any, array: Any, index: Any) -> tuple[Any, Codegen]:
+def prefetch(typingctx: BaseContext, array: types.Type, index: types.Type,
+             ) -> tuple[Signature, Codegen]:
     """Hint that element ``index`` of a C-contiguous ``array`` (flat) is written soon."""
     return types.void(array, index), _prefetch_codegen
 
 
 @numba.njit(cache=True, inline="always")
-def _load(lane: int, ray: int, state: tuple[np.ndarray, np.ndarray],
-          starts: tuple[np.ndarray, np.ndarray], dummy: int) -> int:
+def _load(lane: int, ray: int, state: tuple[NDArray[np.float64], NDArray[np.int64]],
+          starts: tuple[NDArray[np.float64], NDArray[np.int64]], dummy: int) -> int:
     """Start ``ray`` in ``lane`` (1), or park the lane (0) when no ray is left: a parked
     lane steps in place on the spare bit and never stops."""
     floats, ints = state
@@ -155,7 +179,8 @@ def _load(lane: int, ray: int, state: tuple[np.ndarray, np.ndarray],
 
 
 @numba.njit(cache=True)
-def walk_lanes(floats: np.ndarray, ints: np.ndarray, grid: np.ndarray, dummy: int) -> None:
+def walk_lanes(floats: NDArray[np.float64], ints: NDArray[np.int64], grid: NDArray[np.uint64],
+               dummy: int) -> None:
     """Set the bits of every ray's free voxels (start data: ``floats`` (R, FLOATS) and
     ``ints`` (R, INTS)) in ``grid``; ``dummy`` is a spare bit index past the grid's."""
     if floats.shape[0] == 0:
@@ -168,7 +193,7 @@ def walk_lanes(floats: np.ndarray, ints: np.ndarray, grid: np.ndarray, dummy: in
         live += _load(lane, ray, state, (floats, ints), dummy)
         ray += 1
     while live:
-        mask: int = _advance(state[0], state[1], grid, dummy)  # type: ignore[call-arg]  # numba intrinsic
+        mask: int = _advance(state[0], state[1], grid, dummy)  # type: ignore[call-arg, arg-type]  # numba intrinsic
         for lane in range(LANES):
             if (mask >> lane) & 1:
                 live -= 1 - _load(lane, ray, state, (floats, ints), dummy)

@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import ClassVar, Literal, Protocol
 
 import numpy as np
+from numpy.typing import NDArray
 
 from alte.errors import MapperError, ParameterError
 from alte.fsutil import atomic_path
@@ -56,9 +57,9 @@ class _Backend(Protocol):
 
     model: SensorModel
 
-    def insert_scan(self, points: np.ndarray, origin: np.ndarray) -> None: ...
-    def insert_hits(self, points: np.ndarray) -> None: ...
-    def leaves(self) -> Leaves: ...
+    def insert_scan(self, points: NDArray[np.float64], origin: NDArray[np.float64]) -> None: ...
+    def insert_hits(self, points: NDArray[np.float64]) -> None: ...
+    def leaves(self) -> Leaves[np.float32]: ...
     def write_bt(self, path: Path) -> None: ...
     @property
     def num_leaves(self) -> int: ...
@@ -149,7 +150,7 @@ class Octomap:
         self._record = parsed(OctomapParams, record, given)
         self._tree = self._new_tree()
         self.points_outside = 0
-        self._cells: tuple[Leaves, Cells] | None = None  # the cells of those leaves
+        self._cells: tuple[Leaves[np.float32], Cells] | None = None  # the cells of those leaves
 
     def reread(self, **changes: object) -> Octomap:
         """Octomap has no view parameters: the map itself (any change raises)."""
@@ -170,7 +171,7 @@ class Octomap:
         """None: Octomap's key space is fixed (2^16 voxels per axis centred on 0)."""
         return None
 
-    def _count_outside(self, pts: np.ndarray) -> np.ndarray:
+    def _count_outside(self, pts: NDArray[np.float64]) -> NDArray[np.bool_]:
         """Points inside the key space; the others are counted (their rays are skipped)."""
         half = TREE_MAX_VAL * self.voxel_size
         inside = rows_all((pts >= -half) & (pts < half))
@@ -182,14 +183,15 @@ class Octomap:
         """Edge of a finest voxel in metres (1 / resolution)."""
         return 1.0 / self._record.resolution
 
-    def insert(self, points: np.ndarray, origin: np.ndarray) -> None:
+    def insert(self, points: NDArray[np.float64], origin: NDArray[np.float64]) -> None:
         """Integrate one scan: free space along every ray, occupied end voxels."""
         pts = check_points(points, "octomap")
         start = check_origin(origin, "octomap")
         self._count_outside(pts)
         self._tree.insert_scan(pts, start)
 
-    def build(self, points: np.ndarray, origins: np.ndarray | None = None) -> None:
+    def build(self, points: NDArray[np.float64],
+              origins: NDArray[np.float64] | None = None) -> None:
         """Rebuild from a cloud; see the class docstring for the meaning of ``origins``."""
         pts = check_points(points, "octomap")
         self._tree = self._new_tree()
@@ -211,7 +213,7 @@ class Octomap:
             if part.size:
                 self._tree.insert_scan(part, orig[start])
 
-    def leaves(self) -> Leaves:
+    def leaves(self) -> Leaves[np.float32]:
         """Pruned leaves as Morton prefixes, depths and float32 log-odds."""
         return self._tree.leaves()
 
@@ -243,11 +245,11 @@ class Octomap:
         """Native: bytes of the key and log-odds arrays; reference: OctoMap's memoryUsage."""
         return self._tree.memory_bytes
 
-    def occupied_voxels(self) -> np.ndarray:
+    def occupied_voxels(self) -> NDArray[np.uint64]:
         """Sorted Morton keys of the occupied depth-16 voxels (pruned leaves expanded)."""
         return occupied_voxels(self.leaves(), self._tree.model.occupied)
 
-    def corners(self) -> np.ndarray:
+    def corners(self) -> NDArray[np.float64]:
         """The 8 corners of every occupied leaf, de-duplicated on the voxel grid."""
         leaves = self.leaves()
         occ = leaves.value > self._tree.model.occupied

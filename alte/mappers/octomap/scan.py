@@ -19,6 +19,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 from numba.cpython.unsafe.numbers import trailing_zeros
+from numpy.typing import NDArray
 
 from alte.mappers.octomap.cost import scan_cost, skip_ray, walk_limit, walk_steps
 from alte.mappers.octomap.lanes import walk_lanes
@@ -45,6 +46,13 @@ DENSE_MAX_WORDS = 1 << 24
 #: fast as hashed).
 DENSE_ANY_WORDS = 1 << 21
 WORDS_PER_STEP = 8
+#: A scan's block codes and their bit rows (8 free, then 8 occupied words).
+_Blocks = tuple[NDArray[np.uint64], NDArray[np.uint64]]
+#: :class:`ScanWork`'s arrays as the kernels take them: the bit grid, cell rows, flags.
+_Work = tuple[NDArray[np.uint64], NDArray[np.int64], NDArray[np.uint64]]
+#: A scan's blocks and bit rows, then the :data:`_Work` arrays (grown where it needed more).
+_Scanned = tuple[NDArray[np.uint64], NDArray[np.uint64], NDArray[np.uint64], NDArray[np.int64],
+                 NDArray[np.uint64]]
 
 
 class ScanWork:
@@ -62,7 +70,7 @@ class ScanWork:
 
 
 @numba.njit(cache=True)
-def _box(okey: np.ndarray, ekeys: np.ndarray) -> np.ndarray:
+def _box(okey: NDArray[np.int64], ekeys: NDArray[np.int64]) -> NDArray[np.int64]:
     """Block box of the origin and the valid ray ends, padded by one block: (x0, y0, z0,
     nbx, nby, nbz), nbx rounded up to whole grid words (8 blocks). A walk strays at most
     4 voxels from its own box, so it stays inside."""
@@ -78,15 +86,15 @@ def _box(okey: np.ndarray, ekeys: np.ndarray) -> np.ndarray:
 
 
 @numba.njit(cache=True, inline="always")
-def _cell(box: np.ndarray, k: np.ndarray) -> int:
+def _cell(box: NDArray[np.int64], k: NDArray[np.int64]) -> int:
     """Box cell (block index, x fastest) of voxel key ``k``."""
     return int((((k[2] >> 3) - box[2]) * box[4] + (k[1] >> 3) - box[1]) * box[3]
                + (k[0] >> 3) - box[0])
 
 
 @numba.njit(cache=True)
-def _mark(grid: np.ndarray, box: np.ndarray, flags: np.ndarray, ekeys: np.ndarray,
-          hit: np.ndarray) -> None:
+def _mark(grid: NDArray[np.uint64], box: NDArray[np.int64], flags: NDArray[np.uint64],
+          ekeys: NDArray[np.int64], hit: NDArray[np.bool_]) -> None:
     """Flag the box cells holding set bits or occupied ends: bit 8j of ``flags[c >> 3]``
     for cell ``c`` with ``c & 7 == j`` (a grid word spans the x rows of 8 cells)."""
     nwx, nby = box[3] // 8, box[4]
@@ -109,7 +117,8 @@ def _mark(grid: np.ndarray, box: np.ndarray, flags: np.ndarray, ekeys: np.ndarra
 
 
 @numba.njit(cache=True)
-def _rows(box: np.ndarray, flags: np.ndarray, cell: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _rows(box: NDArray[np.int64], flags: NDArray[np.uint64], cell: NDArray[np.int64],
+          ) -> tuple[NDArray[np.uint64], NDArray[np.int64]]:
     """A row per flagged cell (``cell[c]`` = its row): block codes and each row's cell."""
     nwx, nby = box[3] // 8, box[4]
     count = 0
@@ -134,7 +143,7 @@ def _rows(box: np.ndarray, flags: np.ndarray, cell: np.ndarray) -> tuple[np.ndar
 
 
 @numba.njit(cache=True, inline="always")
-def _swap(rows: np.ndarray, a: int, b: int, shift: int, mask: np.uint64) -> None:
+def _swap(rows: NDArray[np.uint64], a: int, b: int, shift: int, mask: np.uint64) -> None:
     """Swap the ``mask`` lanes of ``rows[b]`` with the lanes ``shift`` bits up in ``rows[a]``."""
     t = ((rows[a] >> np.uint64(shift)) ^ rows[b]) & mask
     rows[a] ^= t << np.uint64(shift)
@@ -142,7 +151,7 @@ def _swap(rows: np.ndarray, a: int, b: int, shift: int, mask: np.uint64) -> None
 
 
 @numba.njit(cache=True, inline="always")
-def _transpose(rows: np.ndarray) -> None:
+def _transpose(rows: NDArray[np.uint64]) -> None:
     """Transpose 8 words as an 8x8 byte matrix: byte j of word i <-> byte i of word j."""
     for i in range(4):
         _swap(rows, i, i + 4, 32, np.uint64(0x00000000FFFFFFFF))
@@ -153,8 +162,8 @@ def _transpose(rows: np.ndarray) -> None:
 
 
 @numba.njit(cache=True)
-def _gather(grid: np.ndarray, box: np.ndarray, cell: np.ndarray, flags: np.ndarray,
-            bits: np.ndarray) -> None:
+def _gather(grid: NDArray[np.uint64], box: NDArray[np.int64], cell: NDArray[np.int64],
+            flags: NDArray[np.uint64], bits: NDArray[np.uint64]) -> None:
     """Copy the grid's x rows (bytes) into the free words of their cells' rows (row
     ``bits.shape[0] - 1`` takes the unflagged cells' zeros), flagged groups of 8 cells at
     a time: the 8 y rows of a z slice are 8 words whose byte transpose gives each cell's
@@ -180,8 +189,8 @@ def _gather(grid: np.ndarray, box: np.ndarray, cell: np.ndarray, flags: np.ndarr
 
 
 @numba.njit(cache=True)
-def _hits(bits: np.ndarray, box: np.ndarray, cell: np.ndarray, ekeys: np.ndarray,
-          hit: np.ndarray) -> None:
+def _hits(bits: NDArray[np.uint64], box: NDArray[np.int64], cell: NDArray[np.int64],
+          ekeys: NDArray[np.int64], hit: NDArray[np.bool_]) -> None:
     """Set the occupied end voxels in their rows' occupied words (occupied beats free)."""
     for i in range(ekeys.shape[0]):
         k = ekeys[i]
@@ -194,9 +203,8 @@ def _hits(bits: np.ndarray, box: np.ndarray, cell: np.ndarray, ekeys: np.ndarray
 
 
 @numba.njit(cache=True)
-def _dense(rays: Ray, res: float, box: np.ndarray, work: tuple[np.ndarray, np.ndarray,
-                                                               np.ndarray],
-           hit: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def _dense(rays: Ray, res: float, box: NDArray[np.int64], work: _Work,
+           hit: NDArray[np.bool_]) -> _Scanned:
     """Blocks and bit rows of ``rays`` walked in the flat grid over ``box``, and the work
     buffers (grown when the box needs more)."""
     grid, cell, flags = work
@@ -221,7 +229,7 @@ def _dense(rays: Ray, res: float, box: np.ndarray, work: tuple[np.ndarray, np.nd
 
 
 @numba.njit(cache=True)
-def _rays_hashed(rays: Ray, res: float, capacity: int) -> tuple[np.ndarray, np.ndarray]:
+def _rays_hashed(rays: Ray, res: float, capacity: int) -> _Blocks:
     """Blocks and bit rows of ``rays`` (origin, its key, ends, their keys), walked into a
     hash table."""
     origin, okey, ends, ekeys = rays
@@ -239,8 +247,8 @@ def _rays_hashed(rays: Ray, res: float, capacity: int) -> tuple[np.ndarray, np.n
 
 
 @numba.njit(cache=True)
-def _finish(blocks: np.ndarray, bits: np.ndarray, ekeys: np.ndarray,
-            hit: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _finish(blocks: NDArray[np.uint64], bits: NDArray[np.uint64], ekeys: NDArray[np.int64],
+            hit: NDArray[np.bool_]) -> _Blocks:
     """Union of the rays' blocks plus the occupied end voxels; free bits lose occupied ones."""
     table, n_blocks = union(blocks, bits, blocks.size + 64)
     table = reserve(table, n_blocks, ekeys.shape[0])
@@ -257,10 +265,9 @@ def _finish(blocks: np.ndarray, bits: np.ndarray, ekeys: np.ndarray,
 
 
 @numba.njit(cache=True)
-def _scan(cloud: tuple[np.ndarray, np.ndarray], res: float, max_range: float,
-          work: tuple[np.ndarray, np.ndarray, np.ndarray],
-          sizes: tuple[int, int, int, int]) -> tuple[tuple[np.ndarray, np.ndarray, np.ndarray,
-                                                           np.ndarray, np.ndarray], int]:
+def _scan(cloud: tuple[NDArray[np.float32], NDArray[np.float32]], res: float, max_range: float,
+          work: _Work, sizes: tuple[int, int, int, int]
+          ) -> tuple[_Scanned, int]:
     """:func:`scan_blocks` of ``cloud`` (points, origin) in one compiled call; ``sizes``
     is the hashed set's first capacity and the flat grid's limits (DENSE_MAX_WORDS,
     DENSE_ANY_WORDS, WORDS_PER_STEP). Also returns the work buffers, and the ray steps."""
@@ -278,8 +285,8 @@ def _scan(cloud: tuple[np.ndarray, np.ndarray], res: float, max_range: float,
     return (blocks, bits, work[0], work[1], work[2]), cost
 
 
-def scan_blocks(points: np.ndarray, origin: np.ndarray, res: float, max_range: float,
-                work: ScanWork | None = None) -> tuple[np.ndarray, np.ndarray]:
+def scan_blocks(points: NDArray[np.float32], origin: NDArray[np.float32], res: float,
+                max_range: float, work: ScanWork | None = None) -> _Blocks:
     """One scan's update as (block codes, rows of 8 free + 8 occupied words).
 
     Free bits: every voxel a ray crosses before its end voxel; occupied bits: end

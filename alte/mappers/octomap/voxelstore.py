@@ -8,9 +8,12 @@ observed volume, never with the bounding box; pruning and the ``.bt`` file
 
 from __future__ import annotations
 
+from collections.abc import MutableSequence, Sequence
+
 import numba
 import numpy as np
 from numba.cpython.unsafe.numbers import trailing_zeros
+from numpy.typing import NDArray
 
 from alte.mappers.octomap.lanes import prefetch
 from alte.mappers.octree.blockset import EMPTY, MORTON_BIT, WORDS, find_slot, rehash
@@ -25,7 +28,7 @@ PAGE = 2048
 _PAGE_SHIFT = 11
 
 
-def _page() -> np.ndarray:
+def _page() -> NDArray[np.float32]:
     """Room for PAGE blocks, untouched: a block's row is set to NaN when the block is made,
     so the cost of fresh memory is spread over the scans that add blocks."""
     return np.empty((PAGE, 512), dtype=np.float32)
@@ -47,9 +50,10 @@ class VoxelStore:
         self._slots = np.full(1 << 10, EMPTY, dtype=np.uint64)
         self._rows = np.zeros(1 << 10, dtype=np.int64)
         self._blocks = np.zeros(PAGE, dtype=np.uint64)
-        self._pages = numba.typed.List([_page()])
+        #: A numba typed list, so that the kernels take the pages as they are.
+        self._pages: MutableSequence[NDArray[np.float32]] = numba.typed.List([_page()])
         self._n = 0
-        self._folded: tuple[np.ndarray, np.ndarray] | None = None
+        self._folded: tuple[NDArray[np.uint64], NDArray[np.float32]] | None = None
 
     def __len__(self) -> int:
         """Observed voxels."""
@@ -80,8 +84,8 @@ class VoxelStore:
                 size *= 2
             self._slots, self._rows = rehash(self._slots, self._blocks, self._n, size)
 
-    def update(self, blocks: np.ndarray, bits: np.ndarray, miss: np.float32, hit: np.float32,
-               clamp: tuple[np.float32, np.float32]) -> None:
+    def update(self, blocks: NDArray[np.uint64], bits: NDArray[np.uint64], miss: np.float32,
+               hit: np.float32, clamp: tuple[np.float32, np.float32]) -> None:
         """Add ``miss`` at the free bits and ``hit`` at the occupied bits of each block
         (rows as :func:`~alte.mappers.octomap.scan.scan_blocks` gives), clamped; a new voxel
         starts at log-odds 0 (OctoMap's new node)."""
@@ -93,7 +97,7 @@ class VoxelStore:
                          (blocks, bits), model)
         self._folded = None
 
-    def fold(self) -> tuple[np.ndarray, np.ndarray]:
+    def fold(self) -> tuple[NDArray[np.uint64], NDArray[np.float32]]:
         """Sorted Morton keys of the observed voxels and their log-odds (cached until the
         next update)."""
         if self._folded is None:
@@ -102,7 +106,7 @@ class VoxelStore:
 
 
 @numba.njit(cache=True)
-def _page_order(rows: np.ndarray, pages: int) -> np.ndarray:
+def _page_order(rows: NDArray[np.int64], pages: int) -> NDArray[np.int64]:
     """Indices of ``rows`` grouped by page (a counting sort; order kept within a page)."""
     start = np.zeros(pages + 1, dtype=np.int64)
     for row in rows:
@@ -117,7 +121,8 @@ def _page_order(rows: np.ndarray, pages: int) -> np.ndarray:
 
 
 @numba.njit(cache=True, inline="always")
-def _block(values: np.ndarray, bits: np.ndarray, model: np.ndarray) -> None:
+def _block(values: NDArray[np.float32], bits: NDArray[np.uint64],
+           model: NDArray[np.float32]) -> None:
     """Clamped add of miss at the free and hit at the occupied bits of one block (``model``
     is miss, hit, clamp low, clamp high)."""
     miss, hit, lo, hi = model[0], model[1], model[2], model[3]
@@ -135,8 +140,9 @@ def _block(values: np.ndarray, bits: np.ndarray, model: np.ndarray) -> None:
 
 
 @numba.njit(cache=True)
-def _apply(store: tuple[np.ndarray, np.ndarray, np.ndarray], pages: np.ndarray, n: int,
-           scan: tuple[np.ndarray, np.ndarray], model: np.ndarray) -> int:
+def _apply(store: tuple[NDArray[np.uint64], NDArray[np.int64], NDArray[np.uint64]],
+           pages: Sequence[NDArray[np.float32]], n: int,
+           scan: tuple[NDArray[np.uint64], NDArray[np.uint64]], model: NDArray[np.float32]) -> int:
     """Clamped float32 add of miss/hit at every set bit of the ``scan``'s blocks (codes,
     bit rows; new blocks get rows from ``n``); returns the new block count. ``store`` is
     the hash slots, their rows and the row blocks; ``model`` is miss, hit, clamp low,
@@ -161,13 +167,14 @@ def _apply(store: tuple[np.ndarray, np.ndarray, np.ndarray], pages: np.ndarray, 
         if q + 1 < order.size and at[order[q + 1]] >> _PAGE_SHIFT == current:
             ahead = (at[order[q + 1]] & (PAGE - 1)) * 512
             for line in range(0, 512, 16):
-                prefetch(page, ahead + line)  # type: ignore[call-arg]  # numba intrinsic
+                prefetch(page, ahead + line)  # type: ignore[call-arg, arg-type]  # numba intrinsic
         _block(page[row & (PAGE - 1)], scan_bits[order[q]], model)
     return n
 
 
 @numba.njit(cache=True)
-def _collect(blocks: np.ndarray, pages: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+def _collect(blocks: NDArray[np.uint64], pages: Sequence[NDArray[np.float32]], n: int,
+             ) -> tuple[NDArray[np.uint64], NDArray[np.float32]]:
     """Observed voxels in Morton order: blocks sorted, voxels by local Morton index within."""
     count = 0
     for row in range(n):

@@ -12,9 +12,10 @@ from __future__ import annotations
 
 import numba
 import numpy as np
+from numpy.typing import NDArray
 
 #: A block set: hash slots, their rows, bit rows (free, occupied) and block ids.
-Table = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+Table = tuple[NDArray[np.uint64], NDArray[np.int64], NDArray[np.uint64], NDArray[np.uint64]]
 
 __all__ = ["EMPTY", "MORTON_BIT", "WORDS", "find_slot", "keys_to_blocks", "local_index",
            "new_table", "rehash", "reserve", "row_of", "set_bit", "union"]
@@ -25,7 +26,7 @@ _GOLDEN = np.uint64(0x9E3779B97F4A7C15)
 WORDS = 8
 
 
-def _morton_bits() -> np.ndarray:
+def _morton_bits() -> NDArray[np.int64]:
     m = np.arange(512, dtype=np.int64)
     x = (m & 1) | (m >> 2 & 2) | (m >> 4 & 4)
     y = (m >> 1 & 1) | (m >> 3 & 2) | (m >> 5 & 4)
@@ -44,7 +45,7 @@ def local_index(kx: int, ky: int, kz: int) -> int:
 
 
 @numba.njit(cache=True, inline="always")
-def find_slot(slots: np.ndarray, block: np.uint64) -> int:
+def find_slot(slots: NDArray[np.uint64], block: np.uint64) -> int:
     """Slot of ``block`` in an open-addressing table, or of the empty slot where it belongs."""
     mask = np.uint64(slots.size - 1)
     j = ((block * _GOLDEN) >> np.uint64(32)) & mask
@@ -54,8 +55,8 @@ def find_slot(slots: np.ndarray, block: np.uint64) -> int:
 
 
 @numba.njit(cache=True)
-def rehash(slots: np.ndarray, blocks: np.ndarray, n_blocks: int,
-           size: int) -> tuple[np.ndarray, np.ndarray]:
+def rehash(slots: NDArray[np.uint64], blocks: NDArray[np.uint64], n_blocks: int,
+           size: int) -> tuple[NDArray[np.uint64], NDArray[np.int64]]:
     """Hash table of ``size`` slots (a power of two) holding the first ``n_blocks`` blocks."""
     new_slots = np.full(size, EMPTY, dtype=np.uint64)
     new_rows = np.zeros(size, dtype=np.int64)
@@ -108,14 +109,15 @@ def row_of(table: Table, block: np.uint64, n_blocks: int) -> tuple[int, int]:
 
 
 @numba.njit(cache=True, inline="always")
-def set_bit(bits: np.ndarray, row: int, word0: int, key: np.ndarray) -> None:
+def set_bit(bits: NDArray[np.uint64], row: int, word0: int, key: NDArray[np.int64]) -> None:
     """Set the bit of ``key`` (kx, ky, kz) in its block's row, in the words from ``word0``."""
     local = local_index(key[0], key[1], key[2])
     bits[row, word0 + (local >> 6)] |= np.uint64(1) << np.uint64(local & 63)
 
 
 @numba.njit(cache=True)
-def keys_to_blocks(keys: np.ndarray, word0: int) -> tuple[np.ndarray, np.ndarray]:
+def keys_to_blocks(keys: NDArray[np.uint64], word0: int,
+                   ) -> tuple[NDArray[np.uint64], NDArray[np.uint64]]:
     """Blocks and bit rows of Morton ``keys``, set in the words from ``word0``."""
     table = reserve(new_table(keys.size // 64), 0, keys.size)
     n_blocks = 0
@@ -127,7 +129,7 @@ def keys_to_blocks(keys: np.ndarray, word0: int) -> tuple[np.ndarray, np.ndarray
 
 
 @numba.njit(cache=True)
-def union(blocks: np.ndarray, bits: np.ndarray, capacity: int) -> tuple[Table, int]:
+def union(blocks: NDArray[np.uint64], bits: NDArray[np.uint64], capacity: int) -> tuple[Table, int]:
     """Table of the rows ``bits`` (block codes ``blocks``, repeats OR-ed); (table, n_blocks)."""
     table = reserve(new_table(capacity), 0, blocks.size)
     n_blocks = 0

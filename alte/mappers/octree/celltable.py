@@ -4,6 +4,7 @@ point counts over them: the state of 3D-ALTE, one sorted table per level."""
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import NDArray
 
 __all__ = ["BITS", "KEY_MASK", "Z_OFFSET", "child_keys", "merge_counts", "pack_keys",
            "unpack_keys"]
@@ -16,18 +17,20 @@ KEY_MASK = (1 << BITS) - 1
 Z_OFFSET = 1 << (BITS - 1)
 
 
-def pack_keys(ix: np.ndarray, iy: np.ndarray, iz: np.ndarray) -> np.ndarray:
+def pack_keys(ix: NDArray[np.int64], iy: NDArray[np.int64],
+              iz: NDArray[np.int64]) -> NDArray[np.int64]:
     """One int64 key per cell from its integer indices, BITS bits each."""
-    keys: np.ndarray = (ix << (2 * BITS)) | (iy << BITS) | iz
+    keys: NDArray[np.int64] = (ix << (2 * BITS)) | (iy << BITS) | iz
     return keys
 
 
-def unpack_keys(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def unpack_keys(keys: NDArray[np.int64],
+                ) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]]:
     """The integer indices of the cells ``keys``."""
     return keys >> (2 * BITS), (keys >> BITS) & KEY_MASK, keys & KEY_MASK
 
 
-def child_keys(keys: np.ndarray, variant: str) -> np.ndarray:
+def child_keys(keys: NDArray[np.int64], variant: str) -> NDArray[np.int64]:
     """The sorted keys of the cells' children: eight, or four in x/y (``fixed_altitude``)."""
     ix, iy, iz = unpack_keys(keys)
     if variant == "fixed_altitude":
@@ -39,8 +42,8 @@ def child_keys(keys: np.ndarray, variant: str) -> np.ndarray:
     return np.sort(np.concatenate(kids))
 
 
-def merge_counts(keys: np.ndarray, counts: np.ndarray, new_keys: np.ndarray,
-           new_counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def merge_counts(keys: NDArray[np.int64], counts: NDArray[np.int64], new_keys: NDArray[np.int64],
+           new_counts: NDArray[np.intp]) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
     """Add ``new_counts`` at sorted unique ``new_keys`` into the sorted table."""
     pos = np.searchsorted(keys, new_keys)
     found = pos < keys.size

@@ -21,25 +21,23 @@ from __future__ import annotations
 
 import numba
 import numpy as np
+from numpy.typing import NDArray
 
 from alte.mappers.octree.blockset import Table, local_index, row_of
 
-#: A ray (or rays): origin, origin key, end(s), end key(s).
-Ray = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+#: A ray (or rays): origin, origin key, end(s), end key(s) (float32 points, int64 keys).
+Ray = tuple[NDArray[np.float32], NDArray[np.int64], NDArray[np.float32], NDArray[np.int64]]
+#: A scan's rays as :func:`prepare` gives them: origin key, ends, their keys, hit flags.
+Prepared = tuple[NDArray[np.int64], NDArray[np.float32], NDArray[np.int64], NDArray[np.bool_]]
 #: Per-axis (step, tMax, tDelta) of a voxel walk.
 Axis = tuple[int, float, float]
 
-__all__ = ["TREE_DEPTH", "TREE_MAX_VAL", "flat_starts", "morton", "morton_decode",
-           "morton_encode", "prepare", "walk_hashed"]
+__all__ = ["TREE_DEPTH", "TREE_MAX_VAL", "Prepared", "Ray", "flat_starts", "morton",
+           "morton_decode", "morton_encode", "prepare", "walk_hashed"]
 
 TREE_DEPTH = 16
 TREE_MAX_VAL = 32768
 _KEY_LIMIT = 2 * TREE_MAX_VAL
-
-#: A ray's arrays: origin, origin key, end, end key, float and integer workspaces.
-_Ray = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]
-#: The block-bitmap key set: hash slots, slot rows, bit rows, row blocks.
-_Table = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
 
 
 @numba.njit(cache=True, inline="always")
@@ -72,7 +70,7 @@ def morton(kx: int, ky: int, kz: int) -> np.uint64:
 
 
 @numba.njit(cache=True)
-def morton_encode(keys: np.ndarray) -> np.ndarray:
+def morton_encode(keys: NDArray[np.int64]) -> NDArray[np.uint64]:
     """(N, 3) integer keys in [0, 65536) -> (N,) uint64 Morton codes."""
     out = np.empty(keys.shape[0], dtype=np.uint64)
     for i in range(keys.shape[0]):
@@ -81,7 +79,7 @@ def morton_encode(keys: np.ndarray) -> np.ndarray:
 
 
 @numba.njit(cache=True)
-def morton_decode(codes: np.ndarray) -> np.ndarray:
+def morton_decode(codes: NDArray[np.uint64]) -> NDArray[np.int64]:
     """(N,) uint64 Morton codes -> (N, 3) int64 keys."""
     out = np.empty((codes.shape[0], 3), dtype=np.int64)
     for i in range(codes.shape[0]):
@@ -109,8 +107,8 @@ def _norm(dx: np.float32, dy: np.float32, dz: np.float32) -> float:
 
 
 @numba.njit(cache=True)
-def _ends(points: np.ndarray, origin: np.ndarray, max_range: float, factor: float,
-          ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _ends(points: NDArray[np.float32], origin: NDArray[np.float32], max_range: float, factor: float,
+          ) -> tuple[NDArray[np.float32], NDArray[np.int64], NDArray[np.bool_]]:
     """Ray ends (truncated at ``max_range``), their keys and whether each end is a hit."""
     n = points.shape[0]
     ends = np.empty((n, 3), dtype=np.float32)
@@ -165,7 +163,8 @@ def _start(ray: Ray, res: float) -> tuple[Axis, Axis, Axis, float, int]:
 
 
 @numba.njit(cache=True)
-def flat_starts(rays: Ray, res: float, grid: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def flat_starts(rays: Ray, res: float, grid: NDArray[np.int64],
+                ) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
     """Start data of the walkable rays in a flat bit grid (for :func:`_lanes.walk_lanes`):
     per ray tMax, tDelta, length and bit index, bit steps, end bit, step limit - 1.
 
@@ -238,8 +237,8 @@ def walk_hashed(ray: Ray, res: float, limit: int, table: Table, n_blocks: int) -
 
 
 @numba.njit(cache=True)
-def prepare(points: np.ndarray, origin: np.ndarray, res: float,
-            max_range: float) -> Ray:
+def prepare(points: NDArray[np.float32], origin: NDArray[np.float32], res: float,
+            max_range: float) -> Prepared:
     """Origin key (-1 entries when off the key space), ray ends, their keys, hit flags."""
     factor = 1.0 / res
     okey = np.empty(3, dtype=np.int64)

@@ -12,9 +12,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Generic, TypeVar
 
 import numba
 import numpy as np
+from numpy.typing import NDArray
 
 from alte.errors import MapperError
 from alte.mappers.octree.raycast import TREE_DEPTH, TREE_MAX_VAL, _compact, morton_decode
@@ -23,21 +25,26 @@ __all__ = ["Leaves", "check_origin", "leaf_boxes", "leaf_geometry", "prune", "pr
            "write_bt"]
 
 _THREE = np.uint64(3)
+#: A leaf's value: float32 log-odds, or the occupied flag of a maximum-likelihood tree.
+_V = TypeVar("_V", np.float32, np.bool_)
+#: Either value of a leaf, where numba compiles one kernel for both (its dispatcher takes
+#: no type variables).
+_Values = NDArray[np.float32 | np.bool_]
 
 
 @dataclass(frozen=True)
-class Leaves:
+class Leaves(Generic[_V]):
     """Leaves of a pruned octree: Morton prefix at its ``depth``, and a value."""
 
-    prefix: np.ndarray
-    depth: np.ndarray
-    value: np.ndarray
+    prefix: NDArray[np.uint64]
+    depth: NDArray[np.int64]
+    value: NDArray[_V]
 
     def __len__(self) -> int:
         return int(self.prefix.size)
 
 
-def check_origin(origin: object, owner: str) -> np.ndarray:
+def check_origin(origin: object, owner: str) -> NDArray[np.float64]:
     """Return a finite float64 (3,) sensor origin or raise :class:`MapperError`."""
     arr = np.asarray(origin, dtype=np.float64)
     if arr.shape != (3,):
@@ -48,8 +55,8 @@ def check_origin(origin: object, owner: str) -> np.ndarray:
 
 
 @numba.njit(cache=True)
-def _collapse_sorted(keys: np.ndarray, values: np.ndarray
-                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def _collapse_sorted(keys: NDArray[np.uint64], values: _Values
+                     ) -> tuple[NDArray[np.uint64], _Values, NDArray[np.uint64], _Values]:
     """One pass over sorted keys: (kept keys, their values, parents whose 8 children all
     hold the same value, that value). Arrays allocated here, untouched beyond use."""
     n = keys.shape[0]
@@ -75,22 +82,24 @@ def _collapse_sorted(keys: np.ndarray, values: np.ndarray
     return kept_k[:kept], kept_v[:kept], par_k[:parents], par_v[:parents]
 
 
-def _collapse(keys: np.ndarray, values: np.ndarray, depth: int) -> tuple[Leaves, Leaves]:
+def _collapse(keys: NDArray[np.uint64], values: NDArray[_V], depth: int
+              ) -> tuple[Leaves[_V], Leaves[_V]]:
     """One depth of pruning over sorted ``keys``: the leaves kept at ``depth`` and the
     parents (at ``depth - 1``) whose 8 children all hold the same value."""
     kept, kept_values, parents, parent_values = _collapse_sorted(
         np.ascontiguousarray(keys, np.uint64), np.ascontiguousarray(values))
-    return (Leaves(kept, np.full(kept.size, depth, dtype=np.int64), kept_values),
-            Leaves(parents, np.empty(0, np.int64), parent_values))
+    return (Leaves(kept, np.full(kept.size, depth, dtype=np.int64),
+                   np.asarray(kept_values, dtype=values.dtype)),
+            Leaves(parents, np.empty(0, np.int64), np.asarray(parent_values, dtype=values.dtype)))
 
 
-def _joined(out: list[Leaves]) -> Leaves:
+def _joined(out: list[Leaves[_V]]) -> Leaves[_V]:
     return Leaves(np.concatenate([lv.prefix for lv in out]),
                   np.concatenate([lv.depth for lv in out]).astype(np.int64, copy=False),
                   np.concatenate([lv.value for lv in out]))
 
 
-def prune(leaves: Leaves) -> Leaves:
+def prune(leaves: Leaves[_V]) -> Leaves[_V]:
     """Collapse every node whose 8 children are leaves with equal values, bottom-up.
 
     Starting from depth-16 voxels this gives the canonical fully pruned tree that
@@ -114,7 +123,7 @@ def prune(leaves: Leaves) -> Leaves:
     return _joined(out)
 
 
-def prune_voxels(keys: np.ndarray, values: np.ndarray) -> Leaves:
+def prune_voxels(keys: NDArray[np.uint64], values: NDArray[np.float32]) -> Leaves[np.float32]:
     """:func:`prune` of sorted, unique depth-16 voxels (what the store folds to).
 
     With no leaves above depth 16 the nodes of each depth are exactly the collapsed
@@ -134,8 +143,8 @@ def prune_voxels(keys: np.ndarray, values: np.ndarray) -> Leaves:
 
 
 @numba.njit(cache=True)
-def _boxes(prefix: np.ndarray, depth: np.ndarray, voxel: float
-           ) -> tuple[np.ndarray, np.ndarray]:
+def _boxes(prefix: NDArray[np.uint64], depth: NDArray[np.int64], voxel: float
+           ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Centres and sizes (metres) of leaves, one pass: :func:`leaf_geometry`'s centres and
     ``side * voxel`` per axis, the same operations without its temporaries."""
     n = prefix.shape[0]
@@ -153,13 +162,14 @@ def _boxes(prefix: np.ndarray, depth: np.ndarray, voxel: float
     return centers, sizes
 
 
-def leaf_boxes(leaves: Leaves, voxel: float) -> tuple[np.ndarray, np.ndarray]:
+def leaf_boxes(leaves: Leaves[_V], voxel: float) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Centre (K, 3) and size (K, 3) of each leaf in metres."""
     return _boxes(np.ascontiguousarray(leaves.prefix, np.uint64),
                   np.ascontiguousarray(leaves.depth, np.int64), float(voxel))
 
 
-def leaf_geometry(leaves: Leaves, voxel: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def leaf_geometry(leaves: Leaves[_V], voxel: float,
+                  ) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.float64]]:
     """Minimum depth-16 key (K, 3), side in voxels (K,) and centre in metres (K, 3)."""
     shift = (TREE_DEPTH - leaves.depth).astype(np.uint64)
     min_keys = morton_decode(leaves.prefix << (_THREE * shift))
@@ -168,19 +178,19 @@ def leaf_geometry(leaves: Leaves, voxel: float) -> tuple[np.ndarray, np.ndarray,
     return min_keys, side, centers
 
 
-def _inner_nodes(leaves: Leaves) -> list[np.ndarray]:
+def _inner_nodes(leaves: Leaves[np.bool_]) -> list[NDArray[np.uint64]]:
     """Sorted Morton prefixes of the inner nodes at each depth (index = depth)."""
-    inner: list[np.ndarray] = [np.empty(0, np.uint64) for _ in range(TREE_DEPTH + 1)]
+    inner: list[NDArray[np.uint64]] = [np.empty(0, np.uint64) for _ in range(TREE_DEPTH + 1)]
     for depth in range(TREE_DEPTH, 0, -1):
         here = np.concatenate([leaves.prefix[leaves.depth == depth], inner[depth]])
         inner[depth - 1] = np.unique(here >> _THREE)
     return inner
 
 
-def _child_codes(leaves: Leaves, occupied: np.ndarray,
-                 inner: list[np.ndarray]) -> list[np.ndarray]:
+def _child_codes(leaves: Leaves[np.bool_], occupied: NDArray[np.bool_],
+                 inner: list[NDArray[np.uint64]]) -> list[NDArray[np.uint16]]:
     """16-bit child descriptor of each inner node: 2 bits per child (1 free, 2 occ, 3 inner)."""
-    codes: list[np.ndarray] = []
+    codes: list[NDArray[np.uint16]] = []
     for depth in range(TREE_DEPTH):
         parents = inner[depth]
         at = leaves.depth == depth + 1
@@ -193,7 +203,8 @@ def _child_codes(leaves: Leaves, occupied: np.ndarray,
     return codes
 
 
-def write_bt(path: Path, leaves: Leaves, occupied: np.ndarray, voxel: float) -> int:
+def write_bt(path: Path, leaves: Leaves[np.float32], occupied: NDArray[np.bool_],
+             voxel: float) -> int:
     """Write OctoMap's maximum-likelihood binary tree; return the number of nodes.
 
     Like ``OcTree::writeBinary``, values are first reduced to occupied/free and the

@@ -17,8 +17,12 @@ from __future__ import annotations
 
 import numba
 import numpy as np
+from numpy.typing import NDArray
 
-__all__ = ["aggregate_points", "combine", "fill_index", "merge_cells", "sort_keys"]
+__all__ = ["Index", "aggregate_points", "combine", "fill_index", "merge_cells", "sort_keys"]
+
+#: A level's row index: dense (int32 ``row + 1`` per key) or hashed (int64 ``key, row`` pairs).
+Index = NDArray[np.int32] | NDArray[np.int64]
 
 _GOLDEN = np.uint64(0x9E3779B97F4A7C15)
 #: Below this many keys numba's merge sort beats the radix passes' fixed cost.
@@ -26,7 +30,7 @@ _RADIX_MIN = 1 << 14
 
 
 @numba.njit(cache=True)
-def sort_keys(keys: np.ndarray, bits: int) -> tuple[np.ndarray, np.ndarray]:
+def sort_keys(keys: NDArray[np.int64], bits: int) -> tuple[NDArray[np.int64], NDArray[np.intp]]:
     """Stably sorted non-negative int64 ``keys`` below ``2**bits`` and their order (LSD
     radix sort of key and index together, digits of at most 12 bits counted in one
     pass; numba's merge sort for short arrays)."""
@@ -56,7 +60,7 @@ def sort_keys(keys: np.ndarray, bits: int) -> tuple[np.ndarray, np.ndarray]:
 
 
 @numba.njit(cache=True, inline="always")
-def _pairwise_block(x: np.ndarray, j: int, a: int, n: int) -> float:
+def _pairwise_block(x: NDArray[np.float64], j: int, a: int, n: int) -> float:
     """numpy's pairwise sum of ``x[a:a + n, j]`` for ``n <= 128``: a plain loop below 8,
     else 8 accumulators (scalars: no scratch array per call)."""
     res = -0.0
@@ -77,7 +81,7 @@ def _pairwise_block(x: np.ndarray, j: int, a: int, n: int) -> float:
 
 
 @numba.njit(cache=True)
-def _pairwise(x: np.ndarray, j: int, a: int, n: int) -> float:
+def _pairwise(x: NDArray[np.float64], j: int, a: int, n: int) -> float:
     """numpy's pairwise sum of ``x[a:a + n, j]`` (8 accumulators, blocks of 128)."""
     if n <= 128:
         return _pairwise_block(x, j, a, n)
@@ -87,7 +91,7 @@ def _pairwise(x: np.ndarray, j: int, a: int, n: int) -> float:
 
 
 @numba.njit(cache=True, inline="always")
-def _run_total(x: np.ndarray, j: int, a: int, b: int) -> float:
+def _run_total(x: NDArray[np.float64], j: int, a: int, b: int) -> float:
     """``np.add.reduceat`` of the run ``x[a:b, j]``."""
     if b - a <= 129:  # the usual short run: no call
         return float(x[a, j] + _pairwise_block(x, j, a + 1, b - a - 1) if b - a > 1 else x[a, j])
@@ -95,7 +99,7 @@ def _run_total(x: np.ndarray, j: int, a: int, b: int) -> float:
 
 
 @numba.njit(cache=True)
-def _run_starts(keys: np.ndarray, shift: int) -> np.ndarray:
+def _run_starts(keys: NDArray[np.int64], shift: int) -> NDArray[np.int64]:
     """Start index of every run of equal ``keys >> shift`` in sorted ``keys``, then ``n``."""
     n = keys.size
     runs = 0
@@ -112,7 +116,7 @@ def _run_starts(keys: np.ndarray, shift: int) -> np.ndarray:
 
 
 @numba.njit(cache=True)
-def _point_row(values: np.ndarray, a: int, out: np.ndarray, s: int) -> None:
+def _point_row(values: NDArray[np.float64], a: int, out: NDArray[np.float64], s: int) -> None:
     """Row ``s`` of ``out`` for the one point ``values[a]``: :func:`_cell_row`'s formulas
     with ``n = 1`` (``v / 1`` is ``v``, ``M2`` is ``0 * 0``), the usual finest cell."""
     nv = values.shape[1]
@@ -125,8 +129,8 @@ def _point_row(values: np.ndarray, a: int, out: np.ndarray, s: int) -> None:
 
 
 @numba.njit(cache=True)
-def _cell_row(values: np.ndarray, run: tuple[int, int], out: np.ndarray, s: int,
-              dev: np.ndarray) -> None:
+def _cell_row(values: NDArray[np.float64], run: tuple[int, int], out: NDArray[np.float64], s: int,
+              dev: NDArray[np.float64]) -> None:
     """Row ``s`` of ``out``: ``n, mean.., m2.., max..`` of the points ``values[a:b]``,
     ``run = (a, b)`` (``np.add.reduceat``'s sums; ``dev``: scratch of the values' shape).
     A plain function: numba's ``inline="always"`` adds reference counting of the arrays
@@ -150,7 +154,8 @@ def _cell_row(values: np.ndarray, run: tuple[int, int], out: np.ndarray, s: int,
 
 
 @numba.njit(cache=True)
-def aggregate_points(keys: np.ndarray, values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def aggregate_points(keys: NDArray[np.int64], values: NDArray[np.float64],
+                     ) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
     """Cells of sorted point ``keys`` and their rows ``n, mean.., m2.., max..``."""
     starts = _run_starts(keys, 0)
     out = np.empty((starts.size - 1, 1 + 3 * values.shape[1]))
@@ -166,7 +171,8 @@ def aggregate_points(keys: np.ndarray, values: np.ndarray) -> tuple[np.ndarray, 
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _parent_row(rows: np.ndarray, run: tuple[int, int], out: np.ndarray, s: int) -> None:
+def _parent_row(rows: NDArray[np.float64], run: tuple[int, int], out: NDArray[np.float64],
+                s: int) -> None:
     """Row ``s`` of ``out``: Chan's merge of the (at most 4) child rows ``rows[a:b]``,
     ``run = (a, b)``, each sum in ``np.add.reduceat``'s order on short runs (``x[0] +
     (x[1] + ... + x[m-1])``), in registers (no scratch; counts are >= 1, never 0)."""
@@ -202,7 +208,8 @@ def _parent_row(rows: np.ndarray, run: tuple[int, int], out: np.ndarray, s: int)
 
 
 @numba.njit(cache=True)
-def combine(keys: np.ndarray, rows: np.ndarray, nv: int) -> tuple[np.ndarray, np.ndarray]:
+def combine(keys: NDArray[np.int64], rows: NDArray[np.float64], nv: int,
+            ) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
     """Parent cells (key >> 2) of sorted child ``keys`` with Chan's merge of their rows."""
     starts = _run_starts(keys, 2)
     out = np.empty((starts.size - 1, rows.shape[1]))
@@ -214,7 +221,7 @@ def combine(keys: np.ndarray, rows: np.ndarray, nv: int) -> tuple[np.ndarray, np
 
 
 @numba.njit(cache=True, inline="always")
-def _locate(index: np.ndarray, key: int, dense: bool) -> int:
+def _locate(index: Index, key: int, dense: bool) -> int:
     """Position of ``key`` in ``index``: the key itself (dense), else the slot holding it
     or the empty slot where it belongs (hashed: pairs ``key, row``; key -1 = empty)."""
     if dense:
@@ -227,7 +234,7 @@ def _locate(index: np.ndarray, key: int, dense: bool) -> int:
 
 
 @numba.njit(cache=True, inline="always")
-def _row(index: np.ndarray, j: int, key: int, dense: bool) -> int:
+def _row(index: Index, j: int, key: int, dense: bool) -> int:
     """Row stored at position ``j`` for ``key``; -1 when the key is absent."""
     if dense:
         return int(index[j]) - 1
@@ -235,7 +242,7 @@ def _row(index: np.ndarray, j: int, key: int, dense: bool) -> int:
 
 
 @numba.njit(cache=True, inline="always")
-def _set(index: np.ndarray, j: int, key: int, row: int, dense: bool) -> None:
+def _set(index: Index, j: int, key: int, row: int, dense: bool) -> None:
     if dense:
         index[j] = row + 1
     else:
@@ -243,7 +250,7 @@ def _set(index: np.ndarray, j: int, key: int, row: int, dense: bool) -> None:
 
 
 @numba.njit(cache=True)
-def fill_index(index: np.ndarray, keys: np.ndarray, n: int, dense: bool) -> None:
+def fill_index(index: Index, keys: NDArray[np.int64], n: int, dense: bool) -> None:
     """Point ``index`` at the rows of the first ``n`` keys (an empty index, or one already
     holding exactly these keys at other rows: the rows are rewritten in place)."""
     for row in range(n):
@@ -251,9 +258,9 @@ def fill_index(index: np.ndarray, keys: np.ndarray, n: int, dense: bool) -> None
 
 
 @numba.njit(cache=True)
-def merge_cells(store: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray], n: int,
-                cells: tuple[np.ndarray, np.ndarray], nv: int,
-                dense: bool) -> tuple[np.ndarray, int]:
+def merge_cells(store: tuple[NDArray[np.int64], NDArray[np.float64], NDArray[np.bool_], Index],
+                n: int, cells: tuple[NDArray[np.int64], NDArray[np.float64]], nv: int,
+                dense: bool) -> tuple[NDArray[np.int64], int]:
     """Merge ``cells`` = (keys, rows) into a level's ``store`` = (keys, rows, split, index)
     holding ``n`` cells, capacity reserved; returns their rows and the new n.
 

@@ -24,9 +24,11 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 
 import numpy as np
+from numpy.typing import NDArray
 
 from alte.errors import MapperError
 from alte.mappers.quad.cellstats import (
+    Index,
     aggregate_points,
     combine,
     fill_index,
@@ -73,7 +75,7 @@ class LevelStats:
         self._s = [np.empty(0, bool) for _ in levels]
         self._n = [0 for _ in levels]  # cells held
         self._sorted = [0 for _ in levels]  # length of the sorted prefix
-        self._index: list[np.ndarray | None] = [None for _ in levels]  # None: to rebuild
+        self._index: list[Index | None] = [None for _ in levels]  # None: to rebuild
         self._defer = 0
         self._source: tuple[Sorted, float] | None = None  # see build_tree
         self._shared = False  # cells shared with a branch: no more points (see branch)
@@ -87,7 +89,7 @@ class LevelStats:
         """Number of cells at ``level``."""
         return self._n[level]
 
-    def column(self, level: int, what: str, j: int = 0) -> np.ndarray:
+    def column(self, level: int, what: str, j: int = 0) -> NDArray[np.float64]:
         """Column ``n``, ``mean``, ``m2`` or ``max`` (of value ``j``) at ``level``."""
         offset = {"n": 0, "mean": 1, "m2": 1 + self.nv, "max": 1 + 2 * self.nv}[what]
         self.fold(level)
@@ -102,7 +104,8 @@ class LevelStats:
         finally:
             self._defer -= 1
 
-    def add(self, fine_keys: np.ndarray, values: np.ndarray) -> list[np.ndarray] | None:
+    def add(self, fine_keys: NDArray[np.int64], values: NDArray[np.float64],
+            ) -> list[NDArray[np.int64]] | None:
         """Add points given by finest-level keys and (N, nv) values; the rows touched per
         level, or None when the map was empty (every row is new)."""
         self._check_own()
@@ -110,7 +113,7 @@ class LevelStats:
         was_empty = not any(self._n)
         keys, order = sort_keys(np.asarray(fine_keys, np.int64), 2 * self.depth)
         keys, agg = aggregate_points(keys, np.ascontiguousarray(values[order], float))
-        touched: list[np.ndarray] = [np.empty(0, np.int64)] * (self.depth + 1)
+        touched: list[NDArray[np.int64]] = [np.empty(0, np.int64)] * (self.depth + 1)
         for level in range(self.depth, -1, -1):
             if level < self.depth:
                 keys, agg = combine(keys, agg, self.nv)
@@ -118,7 +121,8 @@ class LevelStats:
             self.updates += len(keys)
         return None if was_empty else touched
 
-    def build_tree(self, fine_keys: np.ndarray, values: np.ndarray, split_above: float) -> None:
+    def build_tree(self, fine_keys: NDArray[np.int64], values: NDArray[np.float64],
+                   split_above: float) -> None:
         """Fill empty levels with the cells of a partition that splits a cell when its
         ``n > split_above``: the root and the children of split cells (``_treebuild``),
         with their split flags.
@@ -167,14 +171,15 @@ class LevelStats:
             raise MapperError("this map was re-read with other parameters and shares its cells "
                               "with the copy; build it afresh to add points")
 
-    def _set_level(self, level: int, keys: np.ndarray, rows: np.ndarray,
-                   split: np.ndarray) -> None:
+    def _set_level(self, level: int, keys: NDArray[np.int64], rows: NDArray[np.float64],
+                   split: NDArray[np.bool_]) -> None:
         """Replace ``level``'s cells by sorted ``keys`` with their rows and split flags."""
         self._k[level], self._r[level], self._s[level] = keys, rows, split
         self._n[level] = self._sorted[level] = len(keys)
         self._index[level] = None
 
-    def _merge(self, level: int, keys: np.ndarray, agg: np.ndarray) -> np.ndarray:
+    def _merge(self, level: int, keys: NDArray[np.int64],
+               agg: NDArray[np.float64]) -> NDArray[np.int64]:
         if not self._n[level]:  # empty level: take the arrays as they are
             self._set_level(level, keys, agg, np.zeros(len(keys), bool))
             return np.arange(len(keys))
@@ -187,7 +192,7 @@ class LevelStats:
     def _dense(self, level: int) -> bool:
         return bool(4**level <= _DENSE_CELLS)
 
-    def _reserve(self, level: int, k: int) -> np.ndarray:
+    def _reserve(self, level: int, k: int) -> Index:
         """Room for ``k`` more cells at ``level``; the index of its rows (a hashed one
         kept at most half full)."""
         n = self._n[level]
@@ -263,7 +268,7 @@ class LevelStats:
             kept = packed.nbytes + values.nbytes
         return sum(n * (8 + row + 1) for n in self._n) + kept
 
-    def leaves(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def leaves(self) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]]:
         """Partition by the split flags: (level, key, row or -1 for an empty cell) per leaf."""
         levels, keys, rows = [], [], []
         cand = np.zeros(1, np.int64)

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 
 import numba
 import numpy as np
+from numpy.typing import NDArray
 
 from alte._numba import CLOUD_MIN, threads_for
 from alte.types import rows_all
@@ -29,8 +30,8 @@ __all__ = ["Square", "morton_decode", "morton_encode"]
 
 
 
-def _part1by1(v: np.ndarray) -> np.ndarray:
-    v = v.astype(np.uint64) & np.uint64(0x00000000FFFFFFFF)
+def _part1by1(index: NDArray[np.int64]) -> NDArray[np.uint64]:
+    v = index.astype(np.uint64) & np.uint64(0x00000000FFFFFFFF)
     for shift, mask in ((16, 0x0000FFFF0000FFFF), (8, 0x00FF00FF00FF00FF),
                         (4, 0x0F0F0F0F0F0F0F0F), (2, 0x3333333333333333),
                         (1, 0x5555555555555555)):
@@ -38,7 +39,7 @@ def _part1by1(v: np.ndarray) -> np.ndarray:
     return v
 
 
-def _compact1by1(v: np.ndarray) -> np.ndarray:
+def _compact1by1(v: NDArray[np.uint64]) -> NDArray[np.uint64]:
     v = v.astype(np.uint64) & np.uint64(0x5555555555555555)
     for shift, mask in ((1, 0x3333333333333333), (2, 0x0F0F0F0F0F0F0F0F),
                         (4, 0x00FF00FF00FF00FF), (8, 0x0000FFFF0000FFFF),
@@ -59,8 +60,8 @@ def _spread(v: int) -> int:
 
 
 @numba.njit(cache=True, parallel=True)
-def _locate(xy: np.ndarray, corner: tuple[float, float], size: float,
-            cells: int) -> tuple[np.ndarray, np.ndarray]:
+def _locate(xy: NDArray[np.float64], corner: tuple[float, float], size: float,
+            cells: int) -> tuple[NDArray[np.int64], NDArray[np.bool_]]:
     """Morton keys of ``xy``'s cells (clipped to the grid) and whether each point lies in
     the closed square: :meth:`Square.keys` and :meth:`Square.contains` in one pass (on
     every thread for a whole cloud: ``alte._numba.CLOUD_MIN``)."""
@@ -75,20 +76,20 @@ def _locate(xy: np.ndarray, corner: tuple[float, float], size: float,
     return keys, inside
 
 
-def morton_encode(ix: np.ndarray, iy: np.ndarray) -> np.ndarray:
+def morton_encode(ix: NDArray[np.int64], iy: NDArray[np.int64]) -> NDArray[np.int64]:
     """Interleave cell indices (x in the even bits) into int64 keys."""
-    keys: np.ndarray = (_part1by1(ix) | (_part1by1(iy) << np.uint64(1))).astype(np.int64)
+    keys: NDArray[np.int64] = (_part1by1(ix) | (_part1by1(iy) << np.uint64(1))).astype(np.int64)
     return keys
 
 
-def morton_decode(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def morton_decode(keys: NDArray[np.int64]) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
     """Inverse of :func:`morton_encode`."""
     k = np.asarray(keys).astype(np.uint64)
     return (_compact1by1(k).astype(np.int64), _compact1by1(k >> np.uint64(1)).astype(np.int64))
 
 
 @numba.njit(cache=True)
-def _extent(xy: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _extent(xy: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Per-column minimum and maximum of (N >= 1, 2) finite points, in one pass (numpy
     reduces an (N, 2) array along axis 0 two values at a time, and a strided column
     at a time reads every row's cache line); the four bounds stay in registers."""
@@ -109,14 +110,14 @@ class Square:
     size: float
 
     @classmethod
-    def bounding(cls, xy: np.ndarray) -> Square:
+    def bounding(cls, xy: NDArray[np.float64]) -> Square:
         """Smallest square anchored at the minimum corner holding ``xy`` (size 1 if a point)."""
         lo, hi = _extent(xy)
         size = float((hi - lo).max())
         return cls(float(lo[0]), float(lo[1]), size if size > 0 else 1.0)
 
     @classmethod
-    def dyadic(cls, xy: np.ndarray) -> Square:
+    def dyadic(cls, xy: NDArray[np.float64]) -> Square:
         """Power-of-two square on a grid of its own size holding ``xy`` (root of a growing map)."""
         lo, hi = _extent(xy)
         extent = float((hi - lo).max())
@@ -124,35 +125,37 @@ class Square:
         xmin, ymin = np.floor(lo / size) * size
         return cls(float(xmin), float(ymin), size)
 
-    def contains(self, xy: np.ndarray, closed: bool = True) -> np.ndarray:
+    def contains(self, xy: NDArray[np.float64], closed: bool = True) -> NDArray[np.bool_]:
         """Mask of the points inside the square; ``closed=False`` excludes the upper edges."""
         rel = (xy - (self.xmin, self.ymin)) / self.size
         upper = (rel <= 1.0) if closed else (rel < 1.0)
-        inside: np.ndarray = rows_all((rel >= 0.0) & upper)
+        inside: NDArray[np.bool_] = rows_all((rel >= 0.0) & upper)
         return inside
 
-    def locate(self, xy: np.ndarray, level: int) -> tuple[np.ndarray, np.ndarray]:
+    def locate(self, xy: NDArray[np.float64], level: int,
+               ) -> tuple[NDArray[np.int64], NDArray[np.bool_]]:
         """:meth:`keys` and :meth:`contains` (closed) of ``xy`` (N, 2), computed together."""
         with threads_for(len(xy), CLOUD_MIN):
-            found: tuple[np.ndarray, np.ndarray] = _locate(
+            found: tuple[NDArray[np.int64], NDArray[np.bool_]] = _locate(
                 np.asarray(xy, dtype=np.float64), (self.xmin, self.ymin), self.size, 1 << level)
         return found
 
-    def keys(self, xy: np.ndarray, level: int) -> np.ndarray:
+    def keys(self, xy: NDArray[np.float64], level: int) -> NDArray[np.int64]:
         """Morton keys of the level-``level`` cells holding ``xy`` (upper edge -> last cell)."""
         cells = 1 << level
         rel = (xy - (self.xmin, self.ymin)) / self.size
         idx = np.clip(np.floor(rel * cells), 0, cells - 1).astype(np.int64)
         return morton_encode(idx[:, 0], idx[:, 1])
 
-    def doubled(self, xy: np.ndarray) -> tuple[Square, int]:
+    def doubled(self, xy: NDArray[np.float64]) -> tuple[Square, int]:
         """Twice as large a square towards the points outside; returns it and the old quadrant."""
         ox = int(bool((xy[:, 0] < self.xmin).any()))
         oy = int(bool((xy[:, 1] < self.ymin).any()))
         grown = Square(self.xmin - ox * self.size, self.ymin - oy * self.size, 2 * self.size)
         return grown, ox + 2 * oy
 
-    def cell_geometry(self, level: np.ndarray, keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def cell_geometry(self, level: NDArray[np.int64], keys: NDArray[np.int64],
+                      ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Centres (K, 2) and edge lengths (K,) of cells given by level and key."""
         ix, iy = morton_decode(keys)
         edge = self.size / np.exp2(level)

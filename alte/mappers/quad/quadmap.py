@@ -19,9 +19,10 @@ from __future__ import annotations
 
 import copy
 from pathlib import Path
-from typing import ClassVar, Self
+from typing import ClassVar, Self, TypeAlias
 
 import numpy as np
+from numpy.typing import NDArray
 
 from alte.errors import MapperError
 from alte.mappers._rows import unique_rows
@@ -39,10 +40,16 @@ from alte.mappers.quad.levelstats import LevelStats
 from alte.mappers.quad.quadgrid import Square
 from alte.params import Record
 
-__all__ = ["QuadMap", "plane_height", "rectangle_corners"]
+__all__ = ["LeafValues", "QuadMap", "Rows", "plane_height", "rectangle_corners"]
+
+#: Storage rows of a level's cells, or all of them (a slice: no gathered copy).
+Rows: TypeAlias = "NDArray[np.int64] | slice[None, None, None]"
+#: Per leaf: its height, its value and whether it is occupied.
+LeafValues = tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.bool_]]
 
 
-def plane_height(ground: float | np.ndarray, xy: np.ndarray) -> np.ndarray:
+def plane_height(ground: float | NDArray[np.float64], xy: NDArray[np.float64],
+                 ) -> NDArray[np.float64]:
     """Height of the ground at ``xy``: a float z, or a plane ``(a, b, c, d)``: ax+by+cz+d=0."""
     plane = np.asarray(ground, dtype=np.float64).reshape(-1)
     if plane.shape == (1,):
@@ -50,11 +57,11 @@ def plane_height(ground: float | np.ndarray, xy: np.ndarray) -> np.ndarray:
     if plane.shape != (4,) or not np.isfinite(plane).all() or abs(plane[2]) < 1e-9:
         raise ValueError(f"ground {plane.tolist()}: expected a z value or a non-vertical plane "
                          "a,b,c,d (a x + b y + c z + d = 0)")
-    height: np.ndarray = -(plane[0] * xy[:, 0] + plane[1] * xy[:, 1] + plane[3]) / plane[2]
+    height: NDArray[np.float64] = -(plane[0] * xy[:, 0] + plane[1] * xy[:, 1] + plane[3]) / plane[2]
     return height
 
 
-def rectangle_corners(cells: Cells, mask: np.ndarray) -> np.ndarray:
+def rectangle_corners(cells: Cells, mask: NDArray[np.bool_]) -> NDArray[np.float64]:
     """The 4 corners (at the cell's height) of the masked 2D cells, de-duplicated."""
     c = cells.centers[mask]
     half = cells.sizes[mask, :2] / 2
@@ -94,10 +101,10 @@ class QuadMap:
         """Deepest tree level allowed (root = 0)."""
         raise NotImplementedError
 
-    def _values(self, points: np.ndarray) -> np.ndarray:
+    def _values(self, points: NDArray[np.float64]) -> NDArray[np.float64]:
         raise NotImplementedError
 
-    def _split(self, level: int, rows: np.ndarray | slice) -> np.ndarray:
+    def _split(self, level: int, rows: Rows) -> NDArray[np.bool_]:
         raise NotImplementedError
 
     def _split_above(self) -> float | None:
@@ -106,7 +113,7 @@ class QuadMap:
         (:meth:`LevelStats.build_tree`). None: :meth:`_split` decides, on every cell."""
         return None
 
-    def _update_splits(self, touched: list[np.ndarray] | None) -> None:
+    def _update_splits(self, touched: list[NDArray[np.int64]] | None) -> None:
         """Recompute the split flags of the ``touched`` rows per level (None: all rows,
         as a slice: no gathering of whole columns).
 
@@ -117,8 +124,8 @@ class QuadMap:
                 rows = slice(None) if touched is None else touched[level]
                 self.stats.split[level][rows] = self._split(level, rows)
 
-    def _leaf_values(self, level: np.ndarray, rows: np.ndarray, centers: np.ndarray,
-                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def _leaf_values(self, level: NDArray[np.int64], rows: NDArray[np.int64],
+                     centers: NDArray[np.float64]) -> LeafValues:
         raise NotImplementedError
 
     # -- protocol ------------------------------------------------------------------------
@@ -150,7 +157,7 @@ class QuadMap:
         self.points_inserted = 0
         self._cells: Cells | None = None
 
-    def insert(self, points: np.ndarray, origin: np.ndarray) -> None:
+    def insert(self, points: NDArray[np.float64], origin: NDArray[np.float64]) -> None:
         """Add one registered frame; ``origin`` is checked but unused by a height map."""
         pts = check_points(points, self.name)
         check_points(np.reshape(origin, (1, -1)), self.name, "origin")
@@ -162,7 +169,8 @@ class QuadMap:
             self._grow(pts[:, :2])
         self._add(pts)
 
-    def build(self, points: np.ndarray, origins: np.ndarray | None = None) -> None:
+    def build(self, points: NDArray[np.float64],
+              origins: NDArray[np.float64] | None = None) -> None:
         """Replace the map by one built from a whole cloud (``origins`` unused)."""
         pts = check_points(points, self.name)
         square = self._fixed
@@ -185,7 +193,7 @@ class QuadMap:
         other._update_splits(None)
         return other
 
-    def _grow(self, xy: np.ndarray) -> None:
+    def _grow(self, xy: NDArray[np.float64]) -> None:
         assert self.square is not None  # callers set the root square first
         grown = False
         square = self._root()
@@ -201,7 +209,7 @@ class QuadMap:
         assert self.square is not None, "insert and build set the root before adding points"
         return self.square
 
-    def _add(self, pts: np.ndarray, batch: bool = False) -> None:
+    def _add(self, pts: NDArray[np.float64], batch: bool = False) -> None:
         keys, inside = self._root().locate(pts[:, :2], self.depth)
         kept = int(np.count_nonzero(inside))
         self.points_outside += len(pts) - kept
@@ -239,15 +247,16 @@ class QuadMap:
         sizes = np.column_stack([edge, edge, np.zeros(len(edge))])
         return Cells(centers, sizes, value, occupied, level)
 
-    def leaf_counts(self) -> np.ndarray:
+    def leaf_counts(self) -> NDArray[np.int64]:
         """Points in each leaf, in the order of :meth:`cells` (0 for unknown leaves)."""
         if self.square is None:
             return np.empty(0, np.int64)
         level, _keys, rows = self.stats.leaves()
-        counts: np.ndarray = np.nan_to_num(self.leaf_stat(level, rows, "n")).astype(np.int64)
+        counts: NDArray[np.int64] = np.nan_to_num(self.leaf_stat(level, rows, "n")).astype(np.int64)
         return counts
 
-    def leaf_stat(self, level: np.ndarray, rows: np.ndarray, what: str, j: int = 0) -> np.ndarray:
+    def leaf_stat(self, level: NDArray[np.int64], rows: NDArray[np.int64], what: str,
+                  j: int = 0) -> NDArray[np.float64]:
         """Statistic ``what`` of value ``j`` for leaves (NaN for unknown leaves)."""
         out = np.full(len(rows), np.nan)
         for lev in np.unique(level):
@@ -266,7 +275,7 @@ class QuadMap:
         a Quadtree build keeps)."""
         return self.stats.nbytes
 
-    def corners(self) -> np.ndarray:
+    def corners(self) -> NDArray[np.float64]:
         """Corners of every known leaf at its height (M, 3), de-duplicated: set B of fig. 5.1.
 
         A 2D map's basis functions are heights: a free leaf is ground at its mean

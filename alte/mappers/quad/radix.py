@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numba
 import numpy as np
+from numpy.typing import NDArray
 
 from alte._numba import CLOUD_MIN, threads_for
 from alte.mappers.quad.cellstats import sort_keys
@@ -19,10 +20,11 @@ __all__ = ["Sorted", "sort_points"]
 _RADIX_MIN = 1 << 14
 #: Points sorted by :func:`sort_points`: ``(packed, shift, values)``; ``shift`` 0 when
 #: the keys alone are sorted and ``values`` are in their order.
-Sorted = tuple[np.ndarray, int, np.ndarray]
+Sorted = tuple[NDArray[np.int64], int, NDArray[np.float64]]
 
 @numba.njit(cache=True, parallel=True)
-def _pack(keys: np.ndarray, shift: int, out: np.ndarray, scratch: np.ndarray) -> None:
+def _pack(keys: NDArray[np.int64], shift: int, out: NDArray[np.int64],
+          scratch: NDArray[np.int64]) -> None:
     """``out[i] = keys[i] << shift | i`` (``out`` may be ``keys``) and ``scratch`` touched,
     on every thread: a fresh array costs a page fault per 4 KiB at its first touch."""
     for i in numba.prange(keys.size):
@@ -31,7 +33,7 @@ def _pack(keys: np.ndarray, shift: int, out: np.ndarray, scratch: np.ndarray) ->
 
 
 @numba.njit(cache=True)
-def _radix(buffers: tuple[np.ndarray, np.ndarray], span: tuple[int, int],
+def _radix(buffers: tuple[NDArray[np.int64], NDArray[np.int64]], span: tuple[int, int],
            digits: tuple[int, int]) -> bool:
     """Stable LSD radix sort of ``src[lo:hi]`` (``buffers = (src, dst)``, ``span = (lo,
     hi)``) by ``bits`` bits of the values from bit ``low`` (``digits = (low, bits)``),
@@ -58,7 +60,7 @@ def _radix(buffers: tuple[np.ndarray, np.ndarray], span: tuple[int, int],
 
 
 @numba.njit(cache=True, parallel=True)
-def _radix_split(out: np.ndarray, scratch: np.ndarray, shift: int, bits: int) -> None:
+def _radix_split(out: NDArray[np.int64], scratch: NDArray[np.int64], shift: int, bits: int) -> None:
     """:func:`_radix` of all of ``out`` by the key's top 6 bits into ``scratch`` (the 64
     runs of the walk's split level), then of each run by the other bits on every thread
     (``out`` the other buffer)."""
@@ -70,7 +72,8 @@ def _radix_split(out: np.ndarray, scratch: np.ndarray, shift: int, bits: int) ->
         _radix((scratch, out), (starts[b], starts[b + 1]), (shift, bits - 6))
 
 
-def _sort_packed(out: np.ndarray, bits: int, shift: int, scratch: np.ndarray) -> np.ndarray:
+def _sort_packed(out: NDArray[np.int64], bits: int, shift: int,
+                 scratch: NDArray[np.int64]) -> NDArray[np.int64]:
     """Packed keys ``out`` (:func:`_pack`) sorted; the sorted array is ``out`` or
     ``scratch``. Small inputs: numpy's sort; a cloud: the top 6 bits first, then their
     runs side by side; else one radix sort."""
@@ -83,7 +86,7 @@ def _sort_packed(out: np.ndarray, bits: int, shift: int, scratch: np.ndarray) ->
     return scratch if _radix((out, scratch), (0, out.size), (shift, bits)) else out
 
 
-def sort_points(keys: np.ndarray, values: np.ndarray, bits: int, *,
+def sort_points(keys: NDArray[np.int64], values: NDArray[np.float64], bits: int, *,
                 reuse_keys: bool = False) -> Sorted:
     """Points with finest ``keys`` (below ``2**bits``) and (N, nv) ``values``, stably
     sorted by key: packed with their index when both fit in 63 bits, else by

@@ -31,6 +31,7 @@ import itertools
 import numba
 import numpy as np
 from numba.cpython.unsafe.numbers import leading_zeros
+from numpy.typing import NDArray
 
 from alte._numba import CLOUD_MIN
 from alte.mappers.quad.cellstats import _cell_row, _parent_row, _run_starts
@@ -43,7 +44,7 @@ __all__ = ["Sorted", "sort_points", "tree_cells"]
 _SPLIT_LEVEL = 3
 #: The walk's output: rows, keys and split flags of every level's cells, level ``l``
 #: from ``offsets[l]``, and the next place per level.
-Out = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+Out = tuple[NDArray[np.float64], NDArray[np.int64], NDArray[np.bool_], NDArray[np.int64]]
 
 
 @numba.njit(cache=True, inline="always")
@@ -54,8 +55,8 @@ def _coarsest_change(a: int, b: int, depth: int) -> int:
 
 
 @numba.njit(cache=True)
-def _run_row(points: Sorted, span: tuple[int, int], rows: np.ndarray, s: int,
-             scratch: tuple[np.ndarray, np.ndarray]) -> None:
+def _run_row(points: Sorted, span: tuple[int, int], rows: NDArray[np.float64], s: int,
+             scratch: tuple[NDArray[np.float64], NDArray[np.float64]]) -> None:
     """Row ``s``: the finest cell of the sorted points ``span = (i, j)``, two or more
     (``scratch``: two arrays of at least ``j - i`` rows)."""
     packed, shift, values = points
@@ -69,7 +70,7 @@ def _run_row(points: Sorted, span: tuple[int, int], rows: np.ndarray, s: int,
 
 
 @numba.njit(cache=True)
-def _emit(stack: tuple[np.ndarray, np.ndarray], kids: tuple[int, int], level: int,
+def _emit(stack: tuple[NDArray[np.float64], NDArray[np.int64]], kids: tuple[int, int], level: int,
           flags: tuple[int, float], out: Out) -> None:
     """Write the stack's rows ``kids = (a, b)`` at ``level``'s next places in ``out``,
     each flagged to split when ``level < depth`` and ``n > split_above`` (``flags =
@@ -85,8 +86,8 @@ def _emit(stack: tuple[np.ndarray, np.ndarray], kids: tuple[int, int], level: in
 
 
 @numba.njit(cache=True)
-def _tree_counts(packed: np.ndarray, shift: int, depth: int,
-                 split_above: float) -> tuple[np.ndarray, np.ndarray]:
+def _tree_counts(packed: NDArray[np.int64], shift: int, depth: int,
+                 split_above: float) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
     """Cells per level of the tree (the root, the non-empty children of cells with ``n >
     split_above``) and each cell's first sorted point, levels one after the other, top
     down: a cell is a range of the sorted keys, its children the runs of their next two
@@ -119,7 +120,7 @@ def _tree_counts(packed: np.ndarray, shift: int, depth: int,
 
 @numba.njit(cache=True, error_model="numpy")
 def _walk(points: Sorted, span: tuple[int, int, int], flags: tuple[int, float], out: Out,
-          root: tuple[np.ndarray, np.ndarray, int]) -> None:
+          root: tuple[NDArray[np.float64], NDArray[np.int64], int]) -> None:
     """Write the cells below level ``floor`` of the points ``i..end`` (``span = (i, end,
     floor)``: those of one cell at ``floor``; all of them for floor 0) to ``out``, each
     level's in key order (the children of a split cell together, as it closes), and put
@@ -162,8 +163,8 @@ def _walk(points: Sorted, span: tuple[int, int, int], flags: tuple[int, float], 
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _walk_top(cells: tuple[np.ndarray, np.ndarray], floor: int, flags: tuple[int, float],
-              out: Out) -> None:
+def _walk_top(cells: tuple[NDArray[np.float64], NDArray[np.int64]], floor: int,
+              flags: tuple[int, float], out: Out) -> None:
     """The levels ``0..floor`` from the rows and keys of the non-empty cells at
     ``floor`` in key order, merged, split and written as :func:`_walk` does (a cell of
     one point enters where its neighbours differ, as that point would have)."""
@@ -189,9 +190,9 @@ def _walk_top(cells: tuple[np.ndarray, np.ndarray], floor: int, flags: tuple[int
 
 
 @numba.njit(cache=True, parallel=True)
-def _walk_groups(points: Sorted, cuts: tuple[np.ndarray, np.ndarray, int],
+def _walk_groups(points: Sorted, cuts: tuple[NDArray[np.int64], NDArray[np.int64], int],
                  flags: tuple[int, float], out: Out,
-                 cells: tuple[np.ndarray, np.ndarray]) -> None:
+                 cells: tuple[NDArray[np.float64], NDArray[np.int64]]) -> None:
     """:func:`_walk` of every cell at level ``floor`` (``cuts = (spans, groups, floor)``;
     ``spans``: the cells' first points, then ``n``), group ``g`` of them (``groups[g]..
     groups[g + 1]``) on a thread of its own; ``out[3]`` holds each cell's next places per
@@ -205,14 +206,15 @@ def _walk_groups(points: Sorted, cuts: tuple[np.ndarray, np.ndarray, int],
 
 
 @numba.njit(cache=True)
-def _output(cells: int, width: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _output(cells: int, width: int,
+            ) -> tuple[NDArray[np.float64], NDArray[np.int64], NDArray[np.bool_]]:
     """The walk's rows, keys and flags, allocated by numba: numpy asks the kernel for huge
     pages from 4 MiB on, whose first touch (zeroing, compaction) costs more than a walk."""
     return np.empty((cells, width)), np.empty(cells, np.int64), np.empty(cells, np.bool_)
 
 
-def _places(spans: np.ndarray, firsts: np.ndarray, offsets: np.ndarray,
-            floor: int) -> np.ndarray:
+def _places(spans: NDArray[np.int64], firsts: NDArray[np.int64], offsets: NDArray[np.int64],
+            floor: int) -> NDArray[np.int64]:
     """Each floor cell's first place per level below ``floor`` in the output: the
     level's offset plus the tree cells of the floor cells before it (by first point)."""
     places = np.zeros((spans.size - 1, offsets.size - 1), np.int64)
@@ -224,7 +226,7 @@ def _places(spans: np.ndarray, firsts: np.ndarray, offsets: np.ndarray,
 
 
 def tree_cells(points: Sorted, depth: int, split_above: float, threads: int | None = None,
-               ) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+               ) -> list[tuple[NDArray[np.int64], NDArray[np.float64], NDArray[np.bool_]]]:
     """Per level ``0..depth``: sorted keys, rows ``n, mean.., m2.., max..`` and split
     flags (``n > split_above`` above the finest level) of the root and the children of
     split cells of :func:`sort_points`' points (views of one buffer per array).
