@@ -29,6 +29,11 @@ lint: bootstrap
 
 # mypy and the compilation of the mappers' numba kernels (`alte warmup`, cached for every
 # later process) run side by side on the two cores, then the tests.
+# The tests start a hundred or so Python processes (workers, notebook kernels, CLI runs);
+# with PYTHONDONTWRITEBYTECODE set in the caller's environment each of them compiled
+# numpy, pandas, alte ... from source again (about 4 of its 6 CPU seconds of imports),
+# so make test writes the bytecode caches (__pycache__, git-ignored) whatever the caller says.
+test: export PYTHONDONTWRITEBYTECODE :=
 test: bootstrap
 	$(PY) -m ruff check alte tests bench
 	@$(PY) -m alte warmup & warm=$$!; $(PY) -m mypy; typed=$$?; wait $$warm && exit $$typed

@@ -40,6 +40,14 @@ def spec(tmp_path_factory):
     return parse_spec(_raw(data_dir=str(data), output=str(data.parent / "unused")), "test")
 
 
+@pytest.fixture(scope="module")
+def serial(spec, tmp_path_factory):
+    """``spec`` run serially into a fresh folder, once: the rows every scheduler must give
+    (and the first run of the resume test, which goes on in ``serial[1]``)."""
+    out = tmp_path_factory.mktemp("serial") / "runs"
+    return run_sweep(spec, scheduler="serial", output=out, progress=False), out
+
+
 # -- spec --------------------------------------------------------------------------------------
 def test_grid_is_a_cartesian_product_plus_rows_in_order():
     runs = plan_runs(parse_spec(_raw(), "s.yaml"))
@@ -208,9 +216,8 @@ def test_store_errors(tmp_path):
 
 
 # -- running -----------------------------------------------------------------------------------
-def test_serial_sweep_writes_rows_and_resumes(spec, tmp_path):
-    out = tmp_path / "runs"
-    first = run_sweep(spec, scheduler="serial", output=out, progress=False)
+def test_serial_sweep_writes_rows_and_resumes(spec, serial):
+    first, out = serial
     assert (first.ran, first.skipped, first.failed) == (6, 0, [])
     table = first.table
     assert list(table["run_id"]) == [r.run_id for r in plan_runs(spec)]
@@ -273,26 +280,26 @@ def test_unknown_terrain_simulation_failure_is_named(spec, tmp_path, monkeypatch
 
 
 @pytest.mark.slow
-def test_local_cluster_gives_the_serial_rows(spec, tmp_path):
+def test_local_cluster_gives_the_serial_rows(spec, serial, tmp_path):
     """The issue's acceptance test: same grid, serial vs LocalCluster(2 workers)."""
-    serial = run_sweep(spec, scheduler="serial", output=tmp_path / "a", progress=False)
+    table = serial[0].table
     dask = run_sweep(spec, scheduler="local", workers=2, output=tmp_path / "b", progress=False)
     assert dask.ran == 6 and not dask.failed
-    keep = [c for c in serial.table.columns if c not in TIMING_COLUMNS]
-    pd.testing.assert_frame_equal(dask.table[keep], serial.table[keep], check_exact=True)
+    keep = [c for c in table.columns if c not in TIMING_COLUMNS]
+    pd.testing.assert_frame_equal(dask.table[keep], table[keep], check_exact=True)
 
 
 @pytest.mark.slow
-def test_existing_scheduler_address(spec, tmp_path):
+def test_existing_scheduler_address(spec, serial, tmp_path):
     from distributed import LocalCluster
 
     with LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
                       dashboard_address=None) as cluster:
         result = run_sweep(spec, scheduler=cluster.scheduler_address, output=tmp_path,
                            progress=False)
-    serial = run_sweep(spec, scheduler="serial", output=tmp_path / "s", progress=False)
-    keep = [c for c in serial.table.columns if c not in TIMING_COLUMNS]
-    pd.testing.assert_frame_equal(result.table[keep], serial.table[keep], check_exact=True)
+    table = serial[0].table
+    keep = [c for c in table.columns if c not in TIMING_COLUMNS]
+    pd.testing.assert_frame_equal(result.table[keep], table[keep], check_exact=True)
 
 
 # -- analysis ----------------------------------------------------------------------------------
