@@ -40,26 +40,22 @@ __all__ = ["DENSE_ANY_WORDS", "DENSE_MAX_WORDS", "WORDS_PER_STEP", "ScanWork", "
 #: Largest flat bit grid (uint64 words; 2^24 = 128 MiB, of which only the pages the rays
 #: cross are ever written) before the hashed set is used.
 DENSE_MAX_WORDS = 1 << 24
-#: A flat grid above this size (2^21 words = 16 MiB) is used only while it has at most
-#: WORDS_PER_STEP words per ray step: the passes over the grid after the walk cost about
-#: a step's hashing per few words (sim_nav_1's full-range scans at 0.1 m: flat twice as
-#: fast as hashed).
+#: A flat grid above 2^21 words (16 MiB) is used only with at most WORDS_PER_STEP words per
+#: ray step: the passes over the grid after the walk cost a step's hashing per few words
+#: (sim_nav_1's full-range scans at 0.1 m: flat twice as fast as hashed).
 DENSE_ANY_WORDS = 1 << 21
 WORDS_PER_STEP = 8
-#: A scan's block codes and their bit rows (8 free, then 8 occupied words).
+#: What the kernels pass: a scan's block codes and bit rows (8 free, then 8 occupied words);
+#: :class:`ScanWork`'s bit grid, cell rows and flags; both (the work grown where needed).
 _Blocks = tuple[NDArray[np.uint64], NDArray[np.uint64]]
-#: :class:`ScanWork`'s arrays as the kernels take them: the bit grid, cell rows, flags.
 _Work = tuple[NDArray[np.uint64], NDArray[np.int64], NDArray[np.uint64]]
-#: A scan's blocks and bit rows, then the :data:`_Work` arrays (grown where it needed more).
-_Scanned = tuple[NDArray[np.uint64], NDArray[np.uint64], NDArray[np.uint64], NDArray[np.int64],
-                 NDArray[np.uint64]]
+_Scanned = tuple[NDArray[np.uint64], NDArray[np.uint64], *_Work]
 
 
 class ScanWork:
-    """Buffers reused by the scans of one map: the flat bit grid and the cell flags (all
-    zero between scans), the box cell -> row table (all -1) and the last scan's block
-    count (the hashed set's first size); and ``steps``, the ray steps of its scans so far
-    (:func:`scan_cost`)."""
+    """Buffers reused by the scans of one map: the flat bit grid and cell flags (zero
+    between scans), the box cell -> row table (-1), the last scan's block count (the
+    hashed set's first size) and ``steps``, its scans' ray steps (:func:`scan_cost`)."""
 
     def __init__(self) -> None:
         self.grid = np.zeros(1, dtype=np.uint64)
