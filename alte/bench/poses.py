@@ -1,13 +1,15 @@
 """Row 12: odometry and refinement per real scan, beside KISS-ICP's own pipeline.
 
 On the real ``balm_seq`` scans (about 73,000 points each, ``../shared/realdata``) on one
-core: alte's default odometry (``odometry_frames``, KISS-ICP behind alte's frame stream)
-and refinement (``refine_frames`` from the recorded poses) against ``kiss_icp``'s own
-``KissICP`` with its default configuration, fed the same scans in the same run. The
-figure is the median per-scan time of the pose step (the thread's CPU time, steadier than
-wall time on a shared machine; wall medians are in the detail). Targets: ours within 1.2x
-of the peer, and under 100 ms per scan (a 10 Hz sensor) for odometry and refinement each.
-"""
+core: alte's default odometry (``odometry_frames``: KISS-ICP behind alte's frame stream,
+then each pose re-aligned to the scans around it), its KISS-ICP stage alone
+(``window=0``) and refinement (``refine_frames`` from the recorded poses) against
+``kiss_icp``'s own ``KissICP`` with its default configuration, fed the same scans in the
+same run. The figure is the mean per-scan time of the pose step (the thread's CPU time
+over the whole stream divided by its scans: the window yields a pose 20 scans late, so
+per-yield times are bursty; medians and wall times are in the detail). Targets: the
+KISS-ICP stage within 1.2x of the peer, and under 100 ms per scan (a 10 Hz sensor) for
+odometry and refinement each."""
 
 from __future__ import annotations
 
@@ -83,7 +85,7 @@ class _Poser(Protocol):
                  params: OdometryParams) -> Iterator[Frame]: ...
 
 
-def _ours(frames: list[Frame], refine: bool, clock: _Clock) -> None:
+def _ours(frames: list[Frame], refine: bool, clock: _Clock, window: int | None = None) -> None:
     from alte.registration.odometry import (
         OdometryParams,
         PoseCounts,
@@ -92,7 +94,8 @@ def _ours(frames: list[Frame], refine: bool, clock: _Clock) -> None:
     )
     stream: _Poser = refine_frames if refine else odometry_frames
     bare = [replace(f, times=None) for f in frames]
-    for _ in clock.timed(stream(bare, Mount(), counts=PoseCounts(), params=OdometryParams())):
+    params = OdometryParams() if window is None else OdometryParams(window=window)
+    for _ in clock.timed(stream(bare, Mount(), counts=PoseCounts(), params=params)):
         pass
 
 
@@ -101,24 +104,28 @@ def pose_speed(ctx: Context) -> list[Result]:
     if not (realdata_dir() / "balm_seq" / "bag").exists():
         return []
     frames = _scans(ctx)
-    clocks = {name: _Clock() for name in ("kiss-icp", "odometry", "refine")}
+    clocks = {name: _Clock() for name in ("kiss-icp", "odometry", "kiss-stage", "refine")}
     with one_core():
         for _ in range(max(1, ctx.config.repeats // 5)):
             _peer(frames, clocks["kiss-icp"])
             _ours(frames, False, clocks["odometry"])
+            _ours(frames, False, clocks["kiss-stage"], window=0)
             _ours(frames, True, clocks["refine"])
-    med = {k: float(np.median(c.cpu)) for k, c in clocks.items()}
+    mean = {k: float(np.mean(c.cpu)) for k, c in clocks.items()}
     detail: JSONDict = {
         "scans": len(frames), "points_per_scan": int(np.median([len(f.points) for f in frames])),
-        "cpu_ms_median": med,
+        "cpu_ms_mean": mean,
+        "cpu_ms_median": {k: float(np.median(c.cpu)) for k, c in clocks.items()},
         "wall_ms_median": {k: float(np.median(c.wall)) for k, c in clocks.items()},
         "cpu_ms_p90": {k: float(np.percentile(c.cpu, 90)) for k, c in clocks.items()}}
-    peer = med["kiss-icp"]
+    peer, scans = mean["kiss-icp"], f"balm_seq ({len(frames)} scans)"
     return [
-        Result(12, f"odometry per real scan vs kiss-icp pipeline, balm_seq ({len(frames)} scans)",
-               med["odometry"], peer, "ms", f"ratio <= {LIMITS[12]:g}, < {BUDGET_MS:g} ms",
-               bool(med["odometry"] <= LIMITS[12] * peer and med["odometry"] < BUDGET_MS),
+        Result(12, f"odometry (KISS-ICP + window) per real scan vs kiss-icp pipeline, {scans}",
+               mean["odometry"], peer, "ms", f"< {BUDGET_MS:g} ms",
+               bool(mean["odometry"] < BUDGET_MS), detail),
+        Result(12, f"odometry's KISS-ICP stage per real scan vs kiss-icp pipeline, {scans}",
+               mean["kiss-stage"], peer, "ms", f"ratio <= {LIMITS[12]:g}, < {BUDGET_MS:g} ms",
+               bool(mean["kiss-stage"] <= LIMITS[12] * peer and mean["kiss-stage"] < BUDGET_MS),
                detail),
-        Result(12, f"refinement per real scan vs kiss-icp pipeline, balm_seq ({len(frames)} "
-                   "scans)", med["refine"], peer, "ms", f"< {BUDGET_MS:g} ms",
-               bool(med["refine"] < BUDGET_MS), detail)]
+        Result(12, f"refinement per real scan vs kiss-icp pipeline, {scans}", mean["refine"],
+               peer, "ms", f"< {BUDGET_MS:g} ms", bool(mean["refine"] < BUDGET_MS), detail)]
