@@ -57,6 +57,9 @@ def miss_note(result: Result) -> str:
         return (f"row {result.row} {result.case}: the grid's estimated wall time "
                 f"{result.detail['grid_wall_h']:.2f} h on {result.detail['workers']} cores, "
                 f"{result.target}")
+    if "ratio" not in result.target:  # an absolute target, e.g. "< 100 ms"
+        return f"row {result.row} {result.case}: {result.ours:.3g} {result.unit}, " \
+               f"target {result.target}"
     limit = result.detail.get("limit", LIMITS[result.row])
     bound = float(limit) if isinstance(limit, int | float) else LIMITS[result.row]
     return (f"row {result.row} {result.case}: ratio {result.ratio:.3g}, target <= {bound:.3g} "

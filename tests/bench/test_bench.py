@@ -164,6 +164,8 @@ def test_formatting_and_miss_notes():
     slow = Result(3, "quadtree build", 30.0, 2.0, "s", "ratio <= 10", False)
     assert "missed by 1.50x" in miss_note(slow)
     assert miss_note(Result(3, "ok", 1.0, 1.0, "s", "ratio <= 10", True)) == ""
+    late = Result(12, "odometry per scan", 156.0, 91.4, "ms", "< 100 ms", False)
+    assert miss_note(late) == "row 12 odometry per scan: 156 ms, target < 100 ms"
     assert machine_info()["cores"] >= 1
 
 
