@@ -126,6 +126,13 @@ def _kernel_config() -> Config:
                   else {})
 
 
+#: The kernel logs only what is critical: jupyter_client interrupts every kernel before it
+#: shuts it down, and ipykernel then logs "KeyboardInterrupt caught in kernel", noise a
+#: report's reader cannot act on (a cell's error is in the notebook, a dead kernel in the
+#: run's status).
+KERNEL_ARGUMENTS = ["--IPKernelApp.log_level=CRITICAL"]
+
+
 def execute_run(run: Run, run_dir: Path, data_dir: Path, cwd: Path = REPO_ROOT,
                 kernel_name: str = "python3") -> RunResult:
     """Execute one notebook into ``run_dir``; failures are returned, never raised."""
@@ -138,7 +145,7 @@ def execute_run(run: Run, run_dir: Path, data_dir: Path, cwd: Path = REPO_ROOT,
     try:
         papermill.execute_notebook(str(run.notebook), str(tmp), parameters=params,
                                    kernel_name=kernel_name, cwd=str(cwd), progress_bar=False,
-                                   config=_kernel_config())
+                                   config=_kernel_config(), extra_arguments=KERNEL_ARGUMENTS)
     except papermill.PapermillExecutionError as err:
         status, error = "failed", f"cell {err.exec_count}: {err.ename}: {err.evalue}"
     except Exception as err:  # dead kernel, timeout, unreadable notebook: isolate it too
