@@ -130,6 +130,12 @@ def test_odometry_settings_errors_name_the_flag() -> None:
     with pytest.raises(ParameterError, match=r"--odometry-set: odometry: voxel=-1.0 out of "
                                              r"range \(> 0\)"):
         odometry_params(None, {"voxel": "-1"})
+    with pytest.raises(ParameterError, match=r"--odometry-set: odometry: window=-2 out of "
+                                             r"range \(>= 0\)"):
+        odometry_params("kiss", {"window": "-2"})
+    with pytest.raises(ParameterError, match=r"--odometry-set window: not a setting "
+                                             r"of --odometry plane"):
+        odometry_params("plane", {"window": "5"})
     chosen = odometry_params("kiss", {"single_downsample": "true", "voxel": "0.5"})
     assert chosen.single_downsample and chosen.voxel == 0.5 and chosen.method == "kiss"
 
