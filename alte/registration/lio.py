@@ -6,13 +6,15 @@ each sweep; every scan is then
 1. deskewed to its stamp with the IMU's motion over the sweep (each point moved from its
    own instant, the per-point time, with the mean rate and acceleration of the sweep);
 2. down-sampled on ``voxel`` and registered point-to-plane against a local map of the
-   scans before it (planes fitted to the ``neighbours`` nearest map points within
-   ``max_distance``: five, FAST-LIO's choice; twenty halves the drift on sim_lan_1 and
-   sim_nav_2, where a five-point normal tilted by range noise reads as a false constraint
-   along the ground, but breaks sim_nav_1's first seconds (README)), as the measurement of
-   an iterated Kalman update (FAST-LIO's scheme: correspondences found again at every
-   iteration). Directions the scan cannot see (x, y and yaw over flat ground) keep the
-   IMU's prediction instead of sliding, which is what LiDAR-only odometry cannot do;
+   scans before it, as the measurement of an iterated Kalman update (FAST-LIO's scheme:
+   correspondences found again at every iteration). Planes are fitted to the
+   ``wide_points`` nearest map points within ``wide_reach`` where they are flat, else to
+   the ``neighbours`` nearest within ``max_distance`` (five, FAST-LIO's choice): a ground
+   point's five nearest lie along one scan ring (a line, refused), twenty span rings.
+   Directions of the pose a scan informs less than ``least`` keep the IMU's prediction
+   (:func:`~alte.registration.inertial.strong_directions`): over flat ground x, y and yaw
+   get only the false information of normals tilted by noise, which the filter would
+   fold into velocity and accelerometer bias; LiDAR-only odometry slides there;
 3. added to the map (``voxel / 2`` grid, points beyond ``max_range`` of the vehicle dropped).
 
 The world frame is the first scan's body pose (the recorded one when the bag has poses,
@@ -32,7 +34,7 @@ from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation
 
 from alte.errors import RegistrationError
-from alte.registration.inertial import ImuNoise, InertialFilter, NavState
+from alte.registration.inertial import ImuNoise, InertialFilter, NavState, Residuals
 from alte.types import Frame, Mount
 
 if TYPE_CHECKING:
@@ -43,7 +45,8 @@ __all__ = ["LioOdometry", "LioSettings", "LocalMap", "check_overlap", "lio_frame
 
 @dataclass(frozen=True)
 class LioSettings:
-    """What the LIO reads from :class:`~alte.registration.odometry.OdometryParams`."""
+    """What the LIO reads from :class:`~alte.registration.odometry.OdometryParams` (the
+    fields from ``wide_points`` on are not settings of ``--odometry-set``)."""
 
     voxel: float = 0.5
     max_range: float = 100.0
@@ -51,6 +54,9 @@ class LioSettings:
     plane_sigma: float = 0.15
     max_distance: float = 2.0
     neighbours: int = 5
+    wide_points: int = 20
+    wide_reach: float = 3.0
+    least: float = 30.0
     iterations: int = 5
     noise: ImuNoise = field(default_factory=ImuNoise)
 
@@ -100,24 +106,47 @@ class LocalMap:
         self.tree = cKDTree(self.points, balanced_tree=False, compact_nodes=False) \
             if len(self.points) >= 5 else None
 
-    def planes(self, query: NDArray[np.float64], max_distance: float, k: int = 5
+    def planes(self, query: NDArray[np.float64], max_distance: float, k: int = 5,
+               wide: tuple[int, float] = (0, 0.0),
                ) -> tuple[NDArray[np.intp], NDArray[np.float64], NDArray[np.float64]]:
-        """For each query point with five map neighbours within ``max_distance`` lying on
-        a plane (thinner than ``thickness``, and not a line as a ring's points are): its
-        index, the plane's unit normal and a point of the plane."""
+        """For each query point whose ``wide = (points, reach)`` map neighbours lie on a
+        plane (thinner than ``thickness``, and not a line as a ring's points are), or
+        else its ``k`` nearest within ``max_distance``: its index, the plane's unit normal
+        and a point of the plane. A normal fitted to twenty points over metres tilts far
+        less than one fitted to five, and a tilted normal reads as a constraint along the
+        ground; the five keep small objects and edges."""
         if self.tree is None or len(query) == 0:
             return np.empty(0, np.int64), np.empty((0, 3)), np.empty((0, 3))
-        dist, found = self.tree.query(query, k=k, distance_upper_bound=max_distance)
-        idx = np.asarray(found, dtype=np.int64).reshape(-1, k)
-        ok = np.isfinite(np.asarray(dist)).reshape(-1, k).all(axis=1)
+        count = max(k, wide[0])
+        dist, found = self.tree.query(query, k=count,
+                                      distance_upper_bound=max(max_distance, wide[1]))
+        dist = np.asarray(dist).reshape(-1, count)
+        idx = np.asarray(found, dtype=np.int64).reshape(-1, count)
+        flat, normal, centre = self._fit(idx[:, :k], dist[:, :k] <= max_distance)
+        if wide[0] > k:
+            broad, wide_normal, wide_centre = self._fit(idx, dist <= wide[1])
+            normal[broad], centre[broad] = wide_normal[broad], wide_centre[broad]
+            flat |= broad
+        index = np.flatnonzero(flat)
+        return index, normal[index], centre[index]
+
+    def _fit(self, idx: NDArray[np.int64], inside: NDArray[np.bool_],
+             ) -> tuple[NDArray[np.bool_], NDArray[np.float64], NDArray[np.float64]]:
+        """Per row of neighbour indices: whether all are ``inside`` and on a plane, the
+        plane's unit normal and the neighbours' centroid."""
+        ok: NDArray[np.bool_] = np.asarray(inside.all(axis=1), dtype=np.bool_)
+        normal, centre = np.zeros((len(idx), 3)), np.zeros((len(idx), 3))
         nbrs = self.points[idx[ok]]
-        centre = nbrs.mean(axis=1)
-        centred = nbrs - centre[:, None, :]
-        values, vectors = np.linalg.eigh(np.einsum("nki,nkj->nij", centred, centred) / k)
+        centre[ok] = nbrs.mean(axis=1)
+        centred = nbrs - centre[ok][:, None, :]
+        values, vectors = np.linalg.eigh(np.einsum("nki,nkj->nij", centred, centred)
+                                         / idx.shape[1])
         spread = np.sqrt(np.maximum(values, 0.0))
-        flat = (spread[:, 0] < self.thickness) & (spread[:, 1] > 3.0 * self.thickness)
-        index = np.flatnonzero(ok)[flat]
-        return index, vectors[flat, :, 0], centre[flat]
+        good = (spread[:, 0] < self.thickness) & (spread[:, 1] > 3.0 * self.thickness)
+        normal[ok] = vectors[:, :, 0]
+        flat = ok.copy()
+        flat[ok] = good
+        return flat, normal, centre
 
 
 def check_overlap(imu: ImuSamples, stamp: int) -> None:
@@ -181,14 +210,15 @@ class LioOdometry:
         return moved
 
     def _residuals(self, scan: NDArray[np.float64],
-                   ) -> Callable[[NavState], tuple[NDArray[np.float64], NDArray[np.float64]]]:
+                   ) -> Callable[[NavState], Residuals]:
         settings = self.settings
 
-        def residuals(state: NavState) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        def residuals(state: NavState) -> Residuals:
             rot = state.rotation.as_matrix()
             world = scan @ rot.T + state.position
-            index, normal, centre = self.map.planes(world, settings.max_distance,
-                                                    settings.neighbours)
+            index, normal, centre = self.map.planes(
+                world, settings.max_distance, settings.neighbours,
+                (settings.wide_points, settings.wide_reach))
             r = np.einsum("ij,ij->i", normal, world[index] - centre)
             keep = np.abs(r) < settings.max_distance / 2
             index, normal, r = index[keep], normal[keep], r[keep]
@@ -213,7 +243,8 @@ class LioOdometry:
         scan = self.deskew(points[keep], times)
         if self.map.tree is not None:
             self.filter.update(self._residuals(_voxel_first(scan, self.settings.voxel)),
-                               self.settings.plane_sigma, self.settings.iterations)
+                               self.settings.plane_sigma, self.settings.iterations,
+                               least=self.settings.least)
         state = self.filter.state
         self.map.add(scan @ state.rotation.as_matrix().T + state.position, state.position)
         return state.matrix() @ np.linalg.inv(self.body_imu)

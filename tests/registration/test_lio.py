@@ -11,7 +11,14 @@ from alte.errors import ParameterError, RegistrationError
 from alte.io.bag import FrameStream
 from alte.io.imu import ImuSamples, read_imu
 from alte.metrics.trajectory import trajectory_errors
-from alte.registration.inertial import GRAVITY, ImuNoise, InertialFilter, NavState, integrate
+from alte.registration.inertial import (
+    GRAVITY,
+    ImuNoise,
+    InertialFilter,
+    NavState,
+    integrate,
+    strong_directions,
+)
 from alte.registration.lio import LioOdometry, LioSettings, LocalMap, check_overlap
 from alte.registration.odometry import (
     OdometryParams,
@@ -138,8 +145,11 @@ def uav_mission(tmp_path_factory):
 
 
 def test_lio_flies_the_first_five_seconds_of_the_uav_mission(uav_mission):
-    """50 scans (5 s, 24 m): LiDAR-inertial ATE 0.23 m and 4 cm at the last scan against the
-    simulator's truth (KISS-ICP over the whole mission: 34 m; README)."""
+    """50 scans (5 s, 24 m): LiDAR-inertial ATE 0.95 m, 0.97 m off at the last scan, against
+    the simulator's truth (KISS-ICP over the whole mission: 34 m; README). The first
+    updates, with the velocity still unknown (1 m/s), fold their fix's error into it
+    (-0.58 m/s at 0.4 s); the buildings then hold the error at a metre (whole mission:
+    0.51 m ATE; with five-point planes and no projection, 0.23 m here and 1.67 m there)."""
     bag = uav_mission / "bag"
     stream = FrameStream(bag, pose_topic="", allow_no_pose=True)
     imu = read_imu(bag)
@@ -154,9 +164,9 @@ def test_lio_flies_the_first_five_seconds_of_the_uav_mission(uav_mission):
     errors = trajectory_errors(stamps, np.array([f.position for f in frames]),
                                np.array([f.quaternion for f in frames]),
                                truth.positions[j], truth.quaternions[j])
-    assert errors.ate_m < 0.3
+    assert errors.ate_m < 1.2
     final = np.linalg.norm(frames[-1].position - truth.positions[j[-1]])
-    assert final < 0.3
+    assert final < 1.2
 
 
 def test_the_pipeline_picks_lio_for_a_bag_with_an_imu_and_says_so(tmp_path, capsys):
@@ -176,3 +186,55 @@ def test_the_pipeline_picks_lio_for_a_bag_with_an_imu_and_says_so(tmp_path, caps
     assert main(["register", str(uav), "--poses", "odometry", "--out",
                  str(tmp_path / "cloud.ply")]) == 0
     assert "odometry (lidar-inertial" in capsys.readouterr().out
+
+
+def _rings(rng: np.random.Generator, spacing: float, angle: float) -> np.ndarray:
+    """Ground as a scan sees it: lines (rings) ``spacing`` apart, 3 cm of range noise."""
+    t, k = rng.uniform(-12, 12, 30000), rng.integers(-15, 16, 30000) * spacing
+    c, s = np.cos(angle), np.sin(angle)
+    return np.c_[t * c - k * s, t * s + k * c, rng.normal(0.0, 0.03, len(t))]
+
+
+def test_a_wide_plane_fit_spans_scan_rings_and_keeps_the_five_point_planes():
+    """Two scans' rings 0.7 m apart: a point's five nearest map points lie along one ring
+    (a line, refused), so almost no ground point gets a plane; twenty within 3 m span
+    rings and fit one, tilted by about a degree. Near a building's corner every plane the
+    five points found is kept."""
+    rng = np.random.default_rng(5)
+    local = LocalMap(0.25, 100.0)
+    local.add(np.vstack([_rings(rng, 0.7, 0.0), _rings(rng, 0.7, 0.5)]), np.zeros(3))
+    query = np.c_[rng.uniform(-8, 8, (500, 2)), np.zeros(500)]
+    assert len(local.planes(query, 2.0, 5)[0]) < 25
+    index, normal, _ = local.planes(query, 2.0, 5, (20, 3.0))
+    assert len(index) > 450
+    assert np.degrees(np.arcsin(np.linalg.norm(normal[:, :2], axis=1))).mean() < 2.0
+    rng, local = np.random.default_rng(5), LocalMap(0.25, 100.0)
+    corner = np.vstack([  # two walls of a building meeting at (3, 1)
+        np.c_[np.full(3000, 3.0), rng.uniform(-1, 1, 3000), rng.uniform(0.5, 2.5, 3000)],
+        np.c_[rng.uniform(3, 5, 3000), np.full(3000, 1.0), rng.uniform(0.5, 2.5, 3000)]])
+    local.add(corner, np.zeros(3))
+    probe = np.c_[np.full(20, 3.0), rng.uniform(0.3, 0.6, 20), rng.uniform(1.2, 1.8, 20)]
+    five = local.planes(probe, 2.0, 5)[0]
+    index, normal, _ = local.planes(probe, 2.0, 5, (20, 3.0))
+    assert len(five) > 0 and set(five) <= set(index) and np.abs(normal[:, 0]).min() > 0.99
+
+
+def test_weak_directions_of_flat_ground_are_projected_out_and_walls_keep_all_six():
+    """Residuals of noisy flat ground inform z, roll and pitch; x, y and yaw only through
+    tilted normals, below the threshold: the projector drops them. Three planes keep all."""
+    rng = np.random.default_rng(7)
+    for walls, kept in ((False, 3), (True, 6)):
+        world = _planes(rng, walls)
+        normal = np.zeros_like(world)
+        normal[:, 2] = 1.0
+        if walls:
+            normal[6000:12000], normal[12000:] = [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]
+        normal[:, :2] += rng.normal(0.0, 0.02, (len(world), 2)) * (normal[:, 2:] > 0)
+        normal /= np.linalg.norm(normal, axis=1, keepdims=True)
+        scan = world[::6] - [0.0, 0.0, 10.0]
+        jac = np.hstack([np.cross(scan, normal[::6]), normal[::6]])
+        projector = strong_directions(jac, np.full(len(jac), 1 / 0.15**2), 30.0)
+        assert round(np.trace(projector)) == kept
+        if not walls:
+            for axis in (2, 3, 4):  # yaw, x, y
+                assert np.linalg.norm(projector @ np.eye(6)[axis]) < 0.01
