@@ -1,13 +1,14 @@
 """The LiDAR odometry backends behind :func:`alte.registration.odometry.odometry_frames`.
 
 * :class:`Kiss`: KISS-ICP (Vizzo et al., RA-L 2023) as its own pipeline runs it: range
-  filter, deskew with per-point time, double down-sampling, adaptive threshold. Its map is
-  coarser than its own defaults (voxel ``1.5 x max_range / 100``, 10 points a voxel
-  instead of ``max_range / 100`` and 20): the window (:mod:`~alte.registration.window`)
-  re-aligns every pose after it, and on the real ``balm_seq`` the pair lands as close to
-  the reference as with KISS-ICP's own map at a third of its CPU (README, "Poses"); the
-  registration's nearest-neighbour search over 27 voxels of up to that many points is
-  what KISS-ICP spends its time on. Two switches follow its maintainers' advice for
+  filter, deskew with per-point time, double down-sampling, adaptive threshold, its map
+  voxel ``max_range / 100`` with 20 points a voxel. When the window
+  (:mod:`~alte.registration.window`) follows it, which re-aligns every pose, its map is
+  coarser (voxel ``1.5 x max_range / 100``, 10 points a voxel): on the real ``balm_seq``
+  the pair lands as close to the reference as with KISS-ICP's own map at a third of its
+  CPU (README, "Poses"); the registration's nearest-neighbour search over 27 voxels of up
+  to that many points is what KISS-ICP spends its time on. Two switches follow its
+  maintainers' advice for
   sparse (16-beam, Livox) sensors: ``single_downsample`` registers the 0.5-voxel cloud
   instead of the 1.5-voxel one (PRBonn/kiss-icp#128) and ``fixed_threshold`` replaces
   the adaptive one (PRBonn/kiss-icp#146).
@@ -30,8 +31,8 @@ if TYPE_CHECKING:
 
     from alte.registration.settings import OdometryParams, PoseCounts
 
-__all__ = ["KISS_VOXEL_SCALE", "Kiss", "Plane", "PlaneMap", "kiss_config", "kiss_voxel",
-           "scene_scale", "window_voxel"]
+__all__ = ["KISS_POINTS", "KISS_VOXEL_SCALE", "Kiss", "Plane", "PlaneMap", "kiss_config",
+           "kiss_points", "kiss_voxel", "scene_scale", "window_voxel"]
 
 
 class _KissData(Protocol):
@@ -69,14 +70,22 @@ def scene_scale(points: NDArray[np.float64], params: OdometryParams) -> tuple[fl
     return max_range, params.voxel or max(typical / 70, 0.01)
 
 
-#: KISS-ICP's map voxel by default, in units of its own rule (``max_range / 100``).
-KISS_VOXEL_SCALE = 1.5
+#: KISS-ICP's map voxel with the window after it, in units of its own rule
+#: (``max_range / 100``), and its points a voxel then (module docstring).
+KISS_VOXEL_SCALE, KISS_POINTS = 1.5, 10
 
 
 def kiss_voxel(params: OdometryParams) -> float:
-    """KISS-ICP's map voxel for ``params``: ``voxel``, else ``1.5 x max_range / 100``
-    (1.5 m at KISS-ICP's default range of 100 m; module docstring)."""
-    return params.voxel or KISS_VOXEL_SCALE * window_voxel(params)
+    """KISS-ICP's map voxel for ``params``: ``voxel``, else ``max_range / 100`` (1 m at its
+    default range of 100 m), 1.5 times that when the window follows (module docstring)."""
+    scale = KISS_VOXEL_SCALE if params.window > 0 else 1.0
+    return params.voxel or scale * (params.max_range or 100.0) / 100.0
+
+
+def kiss_points(params: OdometryParams) -> int:
+    """KISS-ICP's map points per voxel: ``max_points_per_voxel``, else its own 20, 10 when
+    the window follows (module docstring)."""
+    return params.max_points_per_voxel or (KISS_POINTS if params.window > 0 else 20)
 
 
 def window_voxel(params: OdometryParams) -> float:
@@ -97,7 +106,7 @@ def kiss_config(points: NDArray[np.float64], params: OdometryParams,
     config.data.max_range = max_range
     config.data.min_range = params.min_range
     config.mapping.voxel_size = voxel
-    config.mapping.max_points_per_voxel = params.max_points_per_voxel
+    config.mapping.max_points_per_voxel = kiss_points(params)
     config.adaptive_threshold.initial_threshold = params.initial_threshold
     config.adaptive_threshold.min_motion_th = params.min_motion_th
     config.adaptive_threshold.fixed_threshold = params.fixed_threshold

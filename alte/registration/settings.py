@@ -49,8 +49,9 @@ class OdometryParams(Record):
     min_range: float = param(0.0, lambda v: v >= 0, ">= 0", "m; nearer points are not used "
                                                             "(kiss)")
     voxel: float | None = param(None, _positive, "> 0",
-                                "m; map voxel (kiss: 1.5 x max_range / 100; plane and refine: "
-                                "the median range of the first scan / 70; lio: 0.5)")
+                                "m; map voxel (kiss: 1.5 x max_range / 100 with the window, "
+                                "KISS-ICP's max_range / 100 without; plane and refine: the "
+                                "median range of the first scan / 70; lio: 0.5)")
     single_downsample: bool = param(False, help="kiss: register the 0.5-voxel cloud (sparse "
                                                 "sensors' advice)")
     fixed_threshold: float | None = param(None, _positive, "> 0",
@@ -60,7 +61,9 @@ class OdometryParams(Record):
                                      "m; kiss: adaptive threshold before any motion")
     min_motion_th: float = param(0.1, _positive, "> 0",
                                  "m; kiss: least motion that updates the adaptive threshold")
-    max_points_per_voxel: int = param(10, lambda v: v >= 1, ">= 1", "kiss: map points per voxel")
+    max_points_per_voxel: int | None = param(None, lambda v: v >= 1, ">= 1",
+                                             "kiss: map points per voxel (10 with the "
+                                             "window, KISS-ICP's 20 without)")
     deskew: bool = param(True, help="kiss: deskew scans that carry per-point time")
     window: int = param(20, lambda v: v >= 0, ">= 0",
                         "kiss: each pose re-aligned to this many scans before and after it "

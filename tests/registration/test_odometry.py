@@ -148,13 +148,17 @@ def test_odometry_settings_errors_name_the_flag() -> None:
 
 
 def test_kiss_map_and_window_voxels() -> None:
-    """By default KISS-ICP maps on 1.5 x its own voxel rule (max_range / 100) with 10 points
-    a voxel and the window on the rule itself; ``voxel`` sets KISS-ICP's alone,
-    ``window_voxel`` the window's alone, ``max_range`` scales both."""
+    """With the window after it KISS-ICP maps on 1.5 x its own voxel rule (max_range / 100)
+    with 10 points a voxel, without it on its own defaults (the rule, 20 points); the window
+    on the rule itself. ``voxel`` sets KISS-ICP's alone, ``window_voxel`` the window's
+    alone, ``max_range`` scales both."""
     scan = np.random.default_rng(0).uniform(-20, 20, (500, 3))
     default = kiss_config(scan, OdometryParams(method="kiss"))
     assert default.mapping.voxel_size == pytest.approx(1.5)
     assert default.mapping.max_points_per_voxel == 10
+    alone = kiss_config(scan, OdometryParams(method="kiss", window=0))
+    assert alone.mapping.voxel_size == pytest.approx(1.0)
+    assert alone.mapping.max_points_per_voxel == 20
     assert window_voxel(OdometryParams()) == pytest.approx(1.0)
     near = OdometryParams(method="kiss", max_range=20.0)
     assert kiss_voxel(near) == pytest.approx(0.3) and window_voxel(near) == pytest.approx(0.2)
@@ -220,10 +224,10 @@ def test_real_recordings_odometry(method: str) -> None:
 
 
 def test_the_kiss_stage_is_kiss_icps_own_pipeline_on_a_real_sequence() -> None:
-    """On balm_seq alte's KISS-ICP stage (the odometry without its window), given kiss-icp's
-    own map (voxel max_range / 100, 20 points a voxel), follows kiss-icp's own ``KissICP``
-    (its default configuration, fed the same scans) to the millimetre: the stage is the
-    peer, not a wrapper."""
+    """On balm_seq alte's KISS-ICP stage without the window (on kiss-icp's own map, voxel
+    max_range / 100, 20 points a voxel) follows kiss-icp's own ``KissICP`` (its default
+    configuration, fed the same scans) to the millimetre: the stage is the peer, not a
+    wrapper."""
     bag = REALDATA / "balm_seq" / "bag"
     if not bag.exists():
         pytest.skip("../shared/realdata/balm_seq absent")
@@ -233,9 +237,9 @@ def test_the_kiss_stage_is_kiss_icps_own_pipeline_on_a_real_sequence() -> None:
     from alte.io.bag import read_frames
 
     scans = read_frames(bag, frames=None).frames[:12]
-    own = OdometryParams(window=0, voxel=1.0, max_points_per_voxel=20)  # kiss-icp's map
     ours = [pose_matrix(f.position, f.quaternion) for f in
-            odometry_frames(scans, Mount(), counts=PoseCounts(), params=own)]
+            odometry_frames(scans, Mount(), counts=PoseCounts(),
+                            params=OdometryParams(window=0))]
     config = KISSConfig()
     config.data.deskew = False
     config.mapping.voxel_size = config.data.max_range / 100.0
