@@ -88,9 +88,10 @@ class OdometryParams(Record):
     plane_sigma: float = param(0.15, _positive, "> 0",
                                "m; lio: point-to-plane noise (Cauchy kernel width)")
     plane_reach: float = param(2.0, _positive, "> 0",
-                               "m; lio: farthest map neighbour of a plane fit")
+                               "m; lio: farthest map neighbour of a small plane fit")
     plane_points: int = param(5, lambda v: v >= 3, ">= 3",
-                              "lio: map points a plane is fitted to")
+                              "lio: map points of a small plane fit (used where the 20 "
+                              "within 3 m are not flat)")
     imu_topic: str | None = param(None, bool, "a topic name",
                                   "lio: the IMU topic (default: the bag's only "
                                   "sensor_msgs/msg/Imu)")
