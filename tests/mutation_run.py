@@ -44,6 +44,8 @@ MODULES: dict[str, tuple[str, tuple[str, ...]]] = {
         "tests/metrics/test_metrics.py", "tests/metrics/test_truth.py",
         "tests/metrics/test_truth_cases.py", "-k",
         "not hausdorff and not directed and not to_the_last_bit")),
+    "freespace": ("alte/metrics/freespace.py", (
+        "tests/metrics/test_metrics.py", "tests/metrics/test_truth.py", "-k", "free")),
     "trajectory": ("alte/metrics/trajectory.py", ("tests/metrics/test_trajectory.py",)),
     "checks": ("alte/studies/analysis/checks.py", (
         "tests/studies/analysis/test_checks.py", "tests/studies/analysis/test_verdicts.py",
@@ -60,6 +62,9 @@ MODULES: dict[str, tuple[str, tuple[str, ...]]] = {
         "tests/studies/analysis/test_verdicts.py", "tests/studies/analysis/test_evidence.py",
         "tests/studies/analysis/test_evidence_tables.py",
         "tests/studies/analysis/test_conditions.py")),
+    "wording": ("alte/studies/analysis/wording.py", (
+        "tests/studies/analysis/test_verdicts.py", "tests/studies/analysis/test_evidence.py",
+        "tests/studies/analysis/test_evidence_tables.py")),
     "tradeoff": ("alte/studies/analysis/tradeoff.py", (
         "tests/studies/analysis/test_tradeoff.py", "tests/studies/analysis/test_verdicts.py",
         "tests/studies/analysis/test_measures.py",

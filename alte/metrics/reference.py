@@ -222,7 +222,7 @@ class Reference:
                 surface: TrueSurface) -> TruthValues:
         """The 3D metrics beyond accuracy: completeness (all, seen, per object and
         class) and the free-space truth."""
-        from alte.metrics.truth import free_space_share
+        from alte.metrics.freespace import free_space_share
 
         samples, seen, opts = self.samples, self.seen, self.options
         covered = leaves.covered(occ, samples.points, self.sample_tree, opts.tolerance)

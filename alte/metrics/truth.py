@@ -28,22 +28,20 @@ Definitions (``tol`` = ``tolerance`` in metres; "occupied" = ``Cells.occupied``)
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from typing import TYPE_CHECKING, TypedDict
 
-import numba
 import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 
 from alte.errors import MetricsError
+from alte.metrics.freespace import free_space_truth
 from alte.metrics.surface import SurfaceSamples, TrueSurface
 
 if TYPE_CHECKING:
     from alte.mappers.base import Cells
 
 __all__ = [
-    "FREE_SPACE_CELLS",
     "TruthValues",
     "accuracy",
     "accuracy_of",
@@ -53,8 +51,6 @@ __all__ = [
     "completeness_by_class",
     "completeness_by_object",
     "distance_to_boxes",
-    "free_space_share",
-    "free_space_truth",
     "ground_truth_metrics",
     "height_metrics_2d",
     "height_summary",
@@ -64,8 +60,6 @@ __all__ = [
 ]
 
 
-#: Free leaves :func:`free_space_truth` tests at most (drawn by volume when there are more).
-FREE_SPACE_CELLS = 200_000
 
 
 class TruthValues(TypedDict, total=False):
@@ -257,50 +251,6 @@ def height_summary(idx: NDArray[np.int64], map_h: NDArray[np.float64],
         "completeness": float(np.mean(np.abs(map_h[has_truth] - true_h[has_truth]) <= tolerance))
         if has_truth.any() else np.nan,
     }
-
-
-def free_space_truth(cells: Cells, surface: TrueSurface, max_cells: int | None = None,
-                     seed: int = 0) -> float:
-    """Volume share of free leaves whose centres are outside every solid; NaN if none.
-
-    With more than ``max_cells`` (default :data:`FREE_SPACE_CELLS`) free leaves, that many
-    are drawn (seeded, with
-    probability proportional to volume) and the share of truly free ones among them is
-    an unbiased estimate of the volume share (standard error <= 0.5 / sqrt(max_cells)).
-    """
-    return free_space_share(cells, lambda rows: surface.inside(cells.centers[rows]),
-                            max_cells, seed)
-
-
-@numba.njit(cache=True)
-def _free_volumes(occupied: NDArray[np.bool_], sizes: NDArray[np.float64],
-                  ) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
-    """Indices of the free cells and their volumes (edges multiplied left to right, as
-    ``np.prod(axis=1)``), one pass: an Octomap flight at 0.1 m has tens of millions."""
-    free, volume = np.empty(occupied.shape[0], np.int64), np.empty(occupied.shape[0])
-    m = 0
-    for i in range(occupied.shape[0]):
-        if not occupied[i]:
-            free[m], volume[m] = i, sizes[i, 0] * sizes[i, 1] * sizes[i, 2]
-            m += 1
-    return free[:m], volume[:m]
-
-
-def free_space_share(cells: Cells,
-                     inside: Callable[[NDArray[np.int64]], NDArray[np.bool_]],
-                     max_cells: int | None = None, seed: int = 0) -> float:
-    """:func:`free_space_truth` with ``inside(rows)``: whether the centres of the cells
-    ``rows`` lie inside a solid."""
-    max_cells = FREE_SPACE_CELLS if max_cells is None else max_cells
-    free, volume = _free_volumes(np.ascontiguousarray(cells.occupied, np.bool_),
-                                 np.ascontiguousarray(cells.sizes, np.float64))
-    if free.size == 0:
-        return float("nan")
-    if free.size <= max_cells:
-        truly = ~inside(free)
-        return float(volume[truly].sum() / volume.sum())
-    pick = np.random.default_rng(seed).choice(free, size=max_cells, p=volume / volume.sum())
-    return float(np.mean(~inside(pick)))
 
 
 def check_truth_args(dims: int, tolerance: float) -> None:

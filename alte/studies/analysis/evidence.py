@@ -35,13 +35,16 @@ import numpy as np
 import pandas as pd
 
 from alte.studies.analysis.measures import CheckValues, NoDataError, measure_check
-from alte.studies.analysis.tradeoff import MAPPER_NAMES, METRICS, prepare
+from alte.studies.analysis.tradeoff import MAPPER_NAMES, prepare
 from alte.studies.analysis.uncertainty import (
     CONFIDENCE,
-    TIME_SPREAD_FLOOR,
     Interval,
     bootstrap_bounds,
     bootstrap_ci,
+)
+from alte.studies.analysis.wording import (
+    check_text,
+    time_check_text,
 )
 from alte.studies.thesis.claims.types import (
     AllOf,
@@ -96,24 +99,6 @@ class Finding:
     time_check: str = ""
 
 
-def _number(value: float, ratio: bool) -> str:
-    """A statistic as text: log ratios as factors (x1.8), others signed (+0.12); an
-    unbounded end of an interval (a censored read) as such."""
-    if np.isinf(value):
-        return "unbounded"
-    if not np.isfinite(value):
-        return "n/a"
-    return f"x{np.exp(value):.3g}" if ratio else f"{value:+.3g}"
-
-
-def _level_text(level: float, column: str) -> str:
-    if not np.isfinite(level):
-        return ""
-    value = f"{level:,.0f}" if abs(level) >= 100 else f"{level:.3g}"
-    name, unit = METRICS.get(column, (column, ""))
-    return f" at {value} {unit or name}"
-
-
 def _outcome(low: float, high: float, seeds: int, m: CheckValues, min_seeds: int) -> str:
     if seeds < min_seeds or np.isnan(low) or np.isnan(high):  # inf: an unbounded side
         return "inconclusive"
@@ -163,32 +148,6 @@ def _cell_verdict(cells: pd.DataFrame, level_kind: str) -> tuple[str, str]:
     return _DEPENDS, ", ".join(dims) or "terrain"
 
 
-def _criterion(m: CheckValues) -> str:
-    unit = f" {m.unit}" if m.unit and not m.ratio else ""
-    if m.relation == "undecided":
-        return "the interval contains 0"
-    if m.relation == "similar":
-        return (f"the interval lies within {_number(-m.band, m.ratio)} .. "
-                f"{_number(m.band, m.ratio)}{unit}")
-    return f"the interval lies above {_number(m.threshold, m.ratio)}{unit}"
-
-
-def _check_text(m: CheckValues, cells: pd.DataFrame) -> str:
-    seeds = int(cells["seeds"].max())
-    unit = f" {m.unit}" if m.unit and not m.ratio else ""
-    parts = []
-    columns = ("terrain", "level", "seeds", "estimate", "low", "high")
-    for terrain, level, n, est, low, high in zip(*(cells[c].tolist() for c in columns),
-                                                 strict=True):
-        span = (f" [{_number(low, m.ratio)}, {_number(high, m.ratio)}]"
-                if n > 1 else " (one seed, no interval)")
-        fewer = f" ({n} seeds)" if 1 < n < seeds else ""
-        parts.append(f"{terrain}{_level_text(level, m.level_name)}: "
-                     f"{_number(est, m.ratio)}{span}{unit}{fewer}")
-    return (f"{m.what} ({seeds} seed{'s' if seeds != 1 else ''}; supports the claim where "
-            f"{_criterion(m)}): " + "; ".join(parts))
-
-
 def _property(p: Property) -> tuple[str, str]:
     from alte.mappers import MAPPERS
 
@@ -199,13 +158,6 @@ def _property(p: Property) -> tuple[str, str]:
 
 
 Result = tuple[str, str, str, pd.DataFrame, str]
-
-
-def _time_check(m: CheckValues) -> str:
-    """How the check's time was judged: on the cost, or on the CPU time within its spread."""
-    if m.time == "cpu":
-        return f"CPU time, within its spread (>= x{np.exp(TIME_SPREAD_FLOOR):.2f})"
-    return "cost" if m.time == "cost" else ""
 
 
 def _crosscheck_text(m: CheckValues, cells: pd.DataFrame, options: EvidenceOptions) -> str:
@@ -225,7 +177,7 @@ def _crosscheck_text(m: CheckValues, cells: pd.DataFrame, options: EvidenceOptio
     where = ", ".join(dict.fromkeys(against["terrain"].astype(str)))
     verdict += f" ({depends})" if depends else ""
     contra = f"it contradicts the cost on {where}" if where else "no cell contradicts the cost"
-    text = _check_text(m.crosscheck, time)
+    text = check_text(m.crosscheck, time)
     return f" Cross-check on the CPU time: {text} -> {verdict}; {contra}."
 
 
@@ -255,8 +207,8 @@ def _one(check: Check, table: pd.DataFrame, options: EvidenceOptions,
     shown = cells.assign(what=m.what, unit=m.unit, estimate=scale(cells["estimate"]),
                          low=scale(cells["low"]), high=scale(cells["high"]),
                          from_times=m.read_from_times)
-    text = _check_text(m, cells) + _crosscheck_text(m, cells, options)
-    return verdict, depends, text, shown, _time_check(m)
+    text = check_text(m, cells) + _crosscheck_text(m, cells, options)
+    return verdict, depends, text, shown, time_check_text(m)
 
 
 def _part_dims(good: Sequence[Check], bad: Sequence[Check]) -> list[str]:

@@ -15,12 +15,12 @@ from alte.studies.analysis.evidence import (
     Finding,
     _cell_verdict,
     _combine,
-    _level_text,
     cells_table,
     claims_table,
     evaluate,
     evaluate_all,
 )
+from alte.studies.analysis.wording import level_text
 from alte.studies.thesis.claims import (
     CLAIMS,
     AllOf,
@@ -282,9 +282,9 @@ def test_what_parts_depend_on_is_merged_once_each():
 
 
 def test_a_level_of_a_column_without_a_display_name_is_shown_with_its_name():
-    assert _level_text(1500.0, "p_kappa") == " at 1,500 p_kappa"
-    assert _level_text(0.25, "mhd_m") == " at 0.25 m"
-    assert _level_text(float("nan"), "mhd_m") == ""
+    assert level_text(1500.0, "p_kappa") == " at 1,500 p_kappa"
+    assert level_text(0.25, "mhd_m") == " at 0.25 m"
+    assert level_text(float("nan"), "mhd_m") == ""
 
 
 @pytest.mark.parametrize(("check", "criterion"), [
