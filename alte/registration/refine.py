@@ -71,8 +71,8 @@ class ScanDecision:
 
 
 def _constraint(hessian: NDArray[np.float64], length: float) -> float:
-    """Smallest over largest eigenvalue of the Hessian (rotation first, as small_gicp
-    orders it) with rotation scaled to metres at ``length``."""
+    """Smallest over largest eigenvalue of the Hessian (rotation first) with rotation
+    scaled to metres at ``length``."""
     scale = np.diag([1.0 / length] * 3 + [1.0] * 3)
     values = np.linalg.eigvalsh(scale @ np.asarray(hessian) @ scale)
     return float(max(values[0], 0.0) / values[-1]) if values[-1] > 0 else 0.0
