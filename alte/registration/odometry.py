@@ -28,7 +28,7 @@ from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
 from alte.errors import ParameterError
-from alte.registration.backends import Kiss, Plane, kiss_voxel
+from alte.registration.backends import Kiss, Plane, window_voxel
 from alte.registration.lio import LioSettings, lio_frames
 from alte.registration.refine import refine_frames
 from alte.registration.settings import (
@@ -113,7 +113,7 @@ def odometry_frames(frames: Iterable[Frame], mount: Mount, *, counts: PoseCounts
     anchor = (pose_matrix(*start) if start is not None else np.eye(4)) @ body_sensor
     steps = _lidar_poses(frames, params, counts)
     if params.method == "kiss" and params.window > 0:
-        steps = window_poses(steps, window=params.window, voxel=kiss_voxel(params),
+        steps = window_poses(steps, window=params.window, voxel=window_voxel(params),
                              min_fitness=params.min_fitness, counts=counts)
     previous: Frame | None = None
     for frame, pose in steps:

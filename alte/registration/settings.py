@@ -49,7 +49,8 @@ class OdometryParams(Record):
     min_range: float = param(0.0, lambda v: v >= 0, ">= 0", "m; nearer points are not used "
                                                             "(kiss)")
     voxel: float | None = param(None, _positive, "> 0",
-                                "m; map voxel (kiss: max_range / 100; plane and refine: the "
+                                "m; map voxel (kiss: 1.5 x max_range / 100 with the window, "
+                                "KISS-ICP's max_range / 100 without; plane and refine: the "
                                 "median range of the first scan / 70; lio: 0.5)")
     single_downsample: bool = param(False, help="kiss: register the 0.5-voxel cloud (sparse "
                                                 "sensors' advice)")
@@ -60,11 +61,16 @@ class OdometryParams(Record):
                                      "m; kiss: adaptive threshold before any motion")
     min_motion_th: float = param(0.1, _positive, "> 0",
                                  "m; kiss: least motion that updates the adaptive threshold")
-    max_points_per_voxel: int = param(20, lambda v: v >= 1, ">= 1", "kiss: map points per voxel")
+    max_points_per_voxel: int | None = param(None, lambda v: v >= 1, ">= 1",
+                                             "kiss: map points per voxel (10 with the "
+                                             "window, KISS-ICP's 20 without)")
     deskew: bool = param(True, help="kiss: deskew scans that carry per-point time")
     window: int = param(20, lambda v: v >= 0, ">= 0",
                         "kiss: each pose re-aligned to this many scans before and after it "
                         "once they have arrived (0: off; poses lag by as many scans)")
+    window_voxel: float | None = param(None, _positive, "> 0",
+                                       "m; kiss: the window's Gaussian voxel map (max_range / "
+                                       "100), scans down-sampled at a quarter of it")
     threads: int = param(1, lambda v: v >= 0, ">= 0", "threads per scan (0: every core)")
     rebuild: int = param(5, lambda v: v >= 1, ">= 1",
                          "plane, refine: scans between local-map rebuilds")
@@ -95,7 +101,7 @@ class OdometryParams(Record):
 KEYS: dict[str, tuple[str, ...]] = {
     "kiss": ("max_range", "min_range", "voxel", "single_downsample", "fixed_threshold",
              "initial_threshold", "min_motion_th", "max_points_per_voxel", "deskew", "window",
-             "threads"),
+             "window_voxel", "threads"),
     "plane": ("max_range", "voxel", "rebuild", "min_fitness"),
     "lio": ("max_range", "min_range", "voxel", "plane_sigma", "plane_reach", "plane_points",
             "imu_topic"),

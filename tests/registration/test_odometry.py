@@ -14,6 +14,7 @@ from alte.cli import main
 from alte.errors import ParameterError, TopicError
 from alte.paths import realdata_dir
 from alte.pipeline import FrameSpec, PoseSource, merged_cloud, open_input, prepare
+from alte.registration.backends import kiss_config, kiss_voxel, window_voxel
 from alte.registration.odometry import (
     OdometryParams,
     PoseCounts,
@@ -136,8 +137,34 @@ def test_odometry_settings_errors_name_the_flag() -> None:
     with pytest.raises(ParameterError, match=r"--odometry-set window: not a setting "
                                              r"of --odometry plane"):
         odometry_params("plane", {"window": "5"})
+    with pytest.raises(ParameterError, match=r"--odometry-set: odometry: window_voxel=0.0 out "
+                                             r"of range \(> 0\)"):
+        odometry_params("kiss", {"window_voxel": "0"})
+    with pytest.raises(ParameterError, match=r"--odometry-set window_voxel: not a setting "
+                                             r"of --odometry plane"):
+        odometry_params("plane", {"window_voxel": "0.5"})
     chosen = odometry_params("kiss", {"single_downsample": "true", "voxel": "0.5"})
     assert chosen.single_downsample and chosen.voxel == 0.5 and chosen.method == "kiss"
+
+
+def test_kiss_map_and_window_voxels() -> None:
+    """With the window after it KISS-ICP maps on 1.5 x its own voxel rule (max_range / 100)
+    with 10 points a voxel, without it on its own defaults (the rule, 20 points); the window
+    on the rule itself. ``voxel`` sets KISS-ICP's alone, ``window_voxel`` the window's
+    alone, ``max_range`` scales both."""
+    scan = np.random.default_rng(0).uniform(-20, 20, (500, 3))
+    default = kiss_config(scan, OdometryParams(method="kiss"))
+    assert default.mapping.voxel_size == pytest.approx(1.5)
+    assert default.mapping.max_points_per_voxel == 10
+    alone = kiss_config(scan, OdometryParams(method="kiss", window=0))
+    assert alone.mapping.voxel_size == pytest.approx(1.0)
+    assert alone.mapping.max_points_per_voxel == 20
+    assert window_voxel(OdometryParams()) == pytest.approx(1.0)
+    near = OdometryParams(method="kiss", max_range=20.0)
+    assert kiss_voxel(near) == pytest.approx(0.3) and window_voxel(near) == pytest.approx(0.2)
+    chosen = odometry_params("kiss", {"voxel": "1.0", "window_voxel": "0.5"})
+    assert kiss_voxel(chosen) == 1.0 and window_voxel(chosen) == 0.5
+    assert kiss_config(scan, chosen).mapping.voxel_size == 1.0
 
 
 def test_cli_odometry_flags(unposed, tmp_path: Path, capsys) -> None:
@@ -175,30 +202,32 @@ def test_kiss_deskews_scans_with_per_point_time() -> None:
 @pytest.mark.realdata
 @pytest.mark.parametrize("method", ["plane", "kiss"])
 def test_real_recordings_odometry(method: str) -> None:
-    """A stationary VLP-16 (raw packets, no pose topic) stays put within 1 cm; the ROS 1
-    Luminar bag (its Odometry is on another clock) moves ~2.3 m per scan, both backends
-    agreeing within 0.3 m over 9.4 m (measured: 0.23 m, mostly sideways)."""
+    """A stationary VLP-16 (raw packets, no pose topic) stays put within 1.5 cm (measured:
+    plane 1 mm; kiss 12.8 mm with its 1.5 m map, 8.2 mm with KISS-ICP's own 1 m map); the
+    ROS 1 Luminar bag (its Odometry is on another clock) moves ~2.3 m per scan, both
+    backends agreeing within 0.35 m over 9.4 m (measured: 0.30 m, 0.24 m with KISS-ICP's
+    own map, mostly sideways)."""
     still, moving = REALDATA / "vlp16_packets" / "bag", REALDATA / "ros1_bag" / "test.bag"
     if not still.exists() or not moving.exists():
         pytest.skip("../shared/realdata (vlp16_packets, ros1_bag) absent")
     spec = FrameSpec(poses=PoseSource.ODOMETRY, odometry=OdometryParams(method=method))
     parked = prepare(open_input(still), spec).trajectory.positions
     assert len(parked) == 4
-    assert np.linalg.norm(parked - parked[0], axis=1).max() < 0.01
+    assert np.linalg.norm(parked - parked[0], axis=1).max() < 0.015
     driven = prepare(open_input(moving), spec).trajectory.positions
     steps = np.linalg.norm(np.diff(driven, axis=0), axis=1)
     assert len(driven) == 5 and np.all((steps > 2.0) & (steps < 2.6))
     other = "kiss" if method == "plane" else "plane"
     again = prepare(open_input(moving), FrameSpec(poses=PoseSource.ODOMETRY,
                                                   odometry=OdometryParams(method=other)))
-    assert np.linalg.norm(again.trajectory.positions - driven, axis=1).max() < 0.3
+    assert np.linalg.norm(again.trajectory.positions - driven, axis=1).max() < 0.35
 
 
 def test_the_kiss_stage_is_kiss_icps_own_pipeline_on_a_real_sequence() -> None:
-    """On balm_seq alte's KISS-ICP stage (the default odometry without its window) follows
-    kiss-icp's own ``KissICP`` (its default configuration, voxel max_range / 100, fed the
-    same scans) to the millimetre: the benchmark's ``window=0`` row is the peer's accuracy,
-    not a wrapper's."""
+    """On balm_seq alte's KISS-ICP stage without the window (on kiss-icp's own map, voxel
+    max_range / 100, 20 points a voxel) follows kiss-icp's own ``KissICP`` (its default
+    configuration, fed the same scans) to the millimetre: the stage is the peer, not a
+    wrapper."""
     bag = REALDATA / "balm_seq" / "bag"
     if not bag.exists():
         pytest.skip("../shared/realdata/balm_seq absent")

@@ -11,7 +11,7 @@ import random
 import pandas as pd
 import pytest
 
-from alte.metrics import truth as truth_module
+from alte.metrics import freespace as freespace_module
 from alte.pipeline import DomainPolicy, MapSpec
 from alte.sim import ensure_terrain, terrain_folder
 from alte.studies.experiments import measure
@@ -75,7 +75,7 @@ def test_groups_share_a_map_only_where_view_parameters_or_set_b_differ(spec):
 def test_grouped_rows_equal_fresh_maps_measured_from_scratch(spec, monkeypatch):
     # few free leaves drawn, so Octomap's and 3D-ALTE's free-space truth takes the
     # drawing path on these short missions too
-    monkeypatch.setattr(truth_module, "FREE_SPACE_CELLS", 300)
+    monkeypatch.setattr(freespace_module, "FREE_SPACE_CELLS", 300)
     data_dir = spec.data_dir
     runs = plan_runs(spec)
     for terrain in spec.terrains:
