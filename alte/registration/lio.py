@@ -45,8 +45,8 @@ __all__ = ["LioOdometry", "LioSettings", "LocalMap", "check_overlap", "lio_frame
 
 @dataclass(frozen=True)
 class LioSettings:
-    """What the LIO reads from :class:`~alte.registration.odometry.OdometryParams` (the
-    fields from ``wide_points`` on are not settings of ``--odometry-set``)."""
+    """What the LIO reads from :class:`~alte.registration.odometry.OdometryParams`
+    (``iterations`` and ``noise`` are not settings of ``--odometry-set``)."""
 
     voxel: float = 0.5
     max_range: float = 100.0

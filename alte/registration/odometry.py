@@ -56,7 +56,9 @@ def lio_settings(params: OdometryParams) -> LioSettings:
     return LioSettings(voxel=params.voxel or base.voxel,
                        max_range=params.max_range or base.max_range,
                        min_range=params.min_range, plane_sigma=params.plane_sigma,
-                       max_distance=params.plane_reach, neighbours=params.plane_points)
+                       max_distance=params.plane_reach, neighbours=params.plane_points,
+                       wide_points=params.wide_points, wide_reach=params.wide_reach,
+                       least=params.least)
 
 
 def _rate(previous: Frame | None, quaternion: NDArray[np.float64], stamp: int) -> float:

@@ -92,6 +92,14 @@ class OdometryParams(Record):
     plane_points: int = param(5, lambda v: v >= 3, ">= 3",
                               "lio: map points of a small plane fit (used where the 20 "
                               "within 3 m are not flat)")
+    wide_points: int = param(20, lambda v: v == 0 or v >= 3, "0 or >= 3",
+                             "lio: map points of the plane fit across scan rings (0: small "
+                             "fits only)")
+    wide_reach: float = param(3.0, _positive, "> 0",
+                              "m; lio: farthest map neighbour of the plane fit across rings")
+    least: float = param(30.0, lambda v: v >= 0, ">= 0",
+                         "1/m^2; lio: least information a scan gives a pose direction for "
+                         "the update to move it (0: every direction)")
     imu_topic: str | None = param(None, bool, "a topic name",
                                   "lio: the IMU topic (default: the bag's only "
                                   "sensor_msgs/msg/Imu)")
@@ -105,7 +113,7 @@ KEYS: dict[str, tuple[str, ...]] = {
              "window_voxel", "threads"),
     "plane": ("max_range", "voxel", "rebuild", "min_fitness"),
     "lio": ("max_range", "min_range", "voxel", "plane_sigma", "plane_reach", "plane_points",
-            "imu_topic"),
+            "wide_points", "wide_reach", "least", "imu_topic"),
     "refine": ("max_range", "voxel", "rebuild", "min_fitness", "min_constraint", "min_gain",
                "max_correction", "max_correction_deg", "threads"),
 }

@@ -23,6 +23,7 @@ from alte.registration.lio import LioOdometry, LioSettings, LocalMap, check_over
 from alte.registration.odometry import (
     OdometryParams,
     PoseCounts,
+    lio_settings,
     odometry_frames,
     odometry_params,
     resolve_method,
@@ -238,3 +239,23 @@ def test_weak_directions_of_flat_ground_are_projected_out_and_walls_keep_all_six
         if not walls:
             for axis in (2, 3, 4):  # yaw, x, y
                 assert np.linalg.norm(projector @ np.eye(6)[axis]) < 0.01
+
+
+def test_the_plane_fit_across_rings_and_the_projection_are_odometry_settings():
+    """``--odometry-set wide_points=0 least=0`` is the filter before both (small plane fits,
+    every direction updated); a wide fit of fewer than three points, a negative floor, or
+    either with ``--odometry kiss`` are refused naming the flag."""
+    before = lio_settings(odometry_params("lio", {"wide_points": "0", "least": "0"}))
+    assert (before.wide_points, before.least) == (0, 0.0)
+    default = lio_settings(odometry_params("lio", {}))
+    assert (default.wide_points, default.wide_reach, default.least) == (20, 3.0, 30.0)
+    assert lio_settings(odometry_params("lio", {"wide_reach": "4"})).wide_reach == 4.0
+    with pytest.raises(ParameterError, match=r"--odometry-set: odometry: wide_points=2 out "
+                                             r"of range \(0 or >= 3\)"):
+        odometry_params("lio", {"wide_points": "2"})
+    with pytest.raises(ParameterError, match=r"--odometry-set: odometry: least=-1.0 out of "
+                                             r"range \(>= 0\)"):
+        odometry_params("lio", {"least": "-1"})
+    with pytest.raises(ParameterError, match=r"--odometry-set least: not a setting of "
+                                             r"--odometry kiss"):
+        odometry_params("kiss", {"least": "5"})
