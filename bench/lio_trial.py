@@ -20,6 +20,7 @@ error over 1 s per metre) of the body trajectory against the simulator's truth.
 
 from __future__ import annotations
 
+import json
 import sys
 import time
 from dataclasses import replace
@@ -110,7 +111,8 @@ def main(folder: str, name: str, package: str, *settings: str) -> None:
     bag = Path(folder) / "bag"
     stream = FrameStream(bag, pose_topic="", allow_no_pose=True)
     imu = read_imu(bag)
-    truth = true_poses(get_terrain(name))
+    seed = int(json.loads((Path(folder) / "scenario.json").read_text()).get("seed", 0))
+    truth = true_poses(get_terrain(name), seed)
     start = time.perf_counter()
     if package == "alte":
         poses = _alte(stream, imu, truth, dict(s.split("=", 1) for s in settings))

@@ -26,7 +26,7 @@ from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
 __all__ = ["GRAVITY", "ImuNoise", "InertialFilter", "NavState", "Residuals", "hat",
-           "integrate", "strong_directions"]
+           "integrate", "still", "strong_directions"]
 
 GRAVITY = np.array([0.0, 0.0, -9.81])
 
@@ -133,6 +133,25 @@ def strong_directions(jac: NDArray[np.float64], weight: NDArray[np.float64], lea
     return out
 
 
+def still(gyro: NDArray[np.float64], accel: NDArray[np.float64], noise: ImuNoise,
+          rate_hz: float) -> int:
+    """How many of the first IMU samples were taken at rest (0 when under 0.5 s of them):
+    those before the first sample off the median by more than four white-noise sigmas
+    (plus 0.005 rad/s, 0.05 m/s^2 of vibration), with a mean rate within three turn-on
+    bias sigmas (a steady turn is not a bias)."""
+    root = np.sqrt(rate_hz)
+    if len(gyro) < 0.5 * rate_hz:
+        return 0
+    off = np.any(np.abs(gyro - np.median(gyro, axis=0)) > 4 * noise.gyro * root + 0.005,
+                 axis=1) | np.any(np.abs(accel - np.median(accel, axis=0))
+                                  > 4 * noise.accel * root + 0.05, axis=1)
+    count = int(np.argmax(off)) if off.any() else len(off)
+    if count < 0.5 * rate_hz or np.linalg.norm(gyro[:count].mean(axis=0)) \
+            >= 3 * noise.gyro_bias:
+        return 0
+    return count
+
+
 class InertialFilter:
     """Error-state Kalman filter of :class:`NavState` (module docstring)."""
 
@@ -143,6 +162,27 @@ class InertialFilter:
                      np.full(3, velocity_sigma**2), np.full(3, noise.gyro_bias**2),
                      np.full(3, noise.accel_bias**2)]
         self.cov = np.diag(diag)
+
+    def settle(self, gyro: NDArray[np.float64], accel: NDArray[np.float64]) -> None:
+        """Start from rest (static initialisation): the velocity is zero, the gyroscope
+        bias the mean rate and the accelerometer bias the mean force less gravity seen
+        in the current attitude. That bias is only as good as the attitude: its error is
+        ``-[u]x`` times the attitude error (``u`` gravity in the IMU frame), so the LiDAR's
+        ground, which fixes roll and pitch, fixes the bias with them."""
+        count = len(gyro)
+        u = self.state.rotation.inv().apply(-GRAVITY)
+        self.state.velocity = np.zeros(3)
+        self.state.gyro_bias = gyro.mean(axis=0)
+        self.state.accel_bias = accel.mean(axis=0) - u
+        cov, coupling = self.cov, -hat(u)
+        cov[6:15, :] = 0.0
+        cov[:, 6:15] = 0.0
+        cov[6:9, 6:9] = np.eye(3) * 0.01**2
+        cov[9:12, 9:12] = np.diag(gyro.var(axis=0) / count + 1e-10)
+        cov[12:15, 0:3] = coupling @ cov[0:3, 0:3]
+        cov[0:3, 12:15] = cov[12:15, 0:3].T
+        cov[12:15, 12:15] = coupling @ cov[0:3, 0:3] @ coupling.T \
+            + np.diag(accel.var(axis=0) / count + 1e-8)
 
     def _covariance_step(self, state: NavState, w: NDArray[np.float64], f: NDArray[np.float64],
                          dt: float) -> None:

@@ -1,7 +1,12 @@
 """LiDAR-inertial odometry: scans registered point-to-plane inside an IMU error-state filter.
 
 The IMU (:mod:`alte.registration.inertial`) carries the state from scan to scan and through
-each sweep; every scan is then
+each sweep. It starts at rest when the IMU log holds at least 0.5 s of stillness in the 2 s
+before the first scan (a flight log begun before departure): velocity zero, gyroscope bias
+the mean rate, accelerometer bias the mean force less gravity in the start attitude, turned
+back to the rest by the gyroscope (:meth:`~alte.registration.inertial.InertialFilter.settle`).
+Without it the accelerometer's turn-on bias (0.2 m/s^2 on a MEMS IMU) is learned only when a
+scan constrains x and y, and the velocity drifts with it meanwhile. Every scan is then
 
 1. deskewed to its stamp with the IMU's motion over the sweep (each point moved from its
    own instant, the per-point time, with the mean rate and acceleration of the sweep);
@@ -30,17 +35,24 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation
 
 from alte.errors import RegistrationError
-from alte.registration.inertial import ImuNoise, InertialFilter, NavState, Residuals
+from alte.registration.inertial import (
+    ImuNoise,
+    InertialFilter,
+    NavState,
+    Residuals,
+    integrate,
+    still,
+)
+from alte.registration.localmap import LocalMap, voxel_first
 from alte.types import Frame, Mount
 
 if TYPE_CHECKING:
     from alte.io.imu import ImuSamples
 
-__all__ = ["LioOdometry", "LioSettings", "LocalMap", "check_overlap", "lio_frames"]
+__all__ = ["LioOdometry", "LioSettings", "check_overlap", "lio_frames"]
 
 
 @dataclass(frozen=True)
@@ -67,88 +79,6 @@ def _matrix(position: NDArray[np.float64], rotation: Rotation[tuple[()]]) -> NDA
     return out
 
 
-def _cells(points: NDArray[np.float64], voxel: float) -> NDArray[np.int64]:
-    """One int64 key per ``voxel`` cell (21 bits an axis: +-500 km at 0.25 m)."""
-    index = np.floor(points / voxel).astype(np.int64) + (1 << 20)
-    keys: NDArray[np.int64] = (index[:, 0] << 42) | (index[:, 1] << 21) | index[:, 2]
-    return keys
-
-
-def _voxel_first(points: NDArray[np.float64], voxel: float) -> NDArray[np.float64]:
-    """One point per ``voxel`` cell (the first): a cheap, deterministic down-sampling."""
-    if len(points) == 0:
-        return points
-    _, first = np.unique(_cells(points, voxel), return_index=True)
-    return points[np.sort(first)]
-
-
-class LocalMap:
-    """World points near the vehicle on a grid, with a k-d tree for plane fits."""
-
-    def __init__(self, voxel: float, radius: float, thickness: float = 0.05) -> None:
-        self.voxel, self.radius, self.thickness = voxel, radius, thickness
-        self.points = np.empty((0, 3))
-        self.keys = np.empty(0, np.int64)
-        self.tree: cKDTree | None = None
-
-    def add(self, points: NDArray[np.float64], centre: NDArray[np.float64]) -> None:
-        """Add ``points`` (world) in cells not yet filled; drop what lies beyond ``radius``
-        of ``centre``."""
-        new = _voxel_first(points, self.voxel)
-        keys = _cells(new, self.voxel)
-        at = np.clip(np.searchsorted(self.keys, keys), 0, max(len(self.keys) - 1, 0))
-        fresh = ~(self.keys[at] == keys) if len(self.keys) else np.ones(len(keys), bool)
-        merged = np.vstack([self.points, new[fresh]])
-        cells = np.r_[self.keys, keys[fresh]]
-        near = np.linalg.norm(merged - centre, axis=1) <= self.radius
-        order = np.argsort(cells[near], kind="stable")
-        self.points, self.keys = merged[near][order], cells[near][order]
-        self.tree = cKDTree(self.points, balanced_tree=False, compact_nodes=False) \
-            if len(self.points) >= 5 else None
-
-    def planes(self, query: NDArray[np.float64], max_distance: float, k: int = 5,
-               wide: tuple[int, float] = (0, 0.0),
-               ) -> tuple[NDArray[np.intp], NDArray[np.float64], NDArray[np.float64]]:
-        """For each query point whose ``wide = (points, reach)`` map neighbours lie on a
-        plane (thinner than ``thickness``, and not a line as a ring's points are), or
-        else its ``k`` nearest within ``max_distance``: its index, the plane's unit normal
-        and a point of the plane. A normal fitted to twenty points over metres tilts far
-        less than one fitted to five, and a tilted normal reads as a constraint along the
-        ground; the five keep small objects and edges."""
-        if self.tree is None or len(query) == 0:
-            return np.empty(0, np.int64), np.empty((0, 3)), np.empty((0, 3))
-        count = max(k, wide[0])
-        dist, found = self.tree.query(query, k=count,
-                                      distance_upper_bound=max(max_distance, wide[1]))
-        dist = np.asarray(dist).reshape(-1, count)
-        idx = np.asarray(found, dtype=np.int64).reshape(-1, count)
-        flat, normal, centre = self._fit(idx[:, :k], dist[:, :k] <= max_distance)
-        if wide[0] > k:
-            broad, wide_normal, wide_centre = self._fit(idx, dist <= wide[1])
-            normal[broad], centre[broad] = wide_normal[broad], wide_centre[broad]
-            flat |= broad
-        index = np.flatnonzero(flat)
-        return index, normal[index], centre[index]
-
-    def _fit(self, idx: NDArray[np.int64], inside: NDArray[np.bool_],
-             ) -> tuple[NDArray[np.bool_], NDArray[np.float64], NDArray[np.float64]]:
-        """Per row of neighbour indices: whether all are ``inside`` and on a plane, the
-        plane's unit normal and the neighbours' centroid."""
-        ok: NDArray[np.bool_] = np.asarray(inside.all(axis=1), dtype=np.bool_)
-        normal, centre = np.zeros((len(idx), 3)), np.zeros((len(idx), 3))
-        nbrs = self.points[idx[ok]]
-        centre[ok] = nbrs.mean(axis=1)
-        centred = nbrs - centre[ok][:, None, :]
-        values, vectors = np.linalg.eigh(np.einsum("nki,nkj->nij", centred, centred)
-                                         / idx.shape[1])
-        spread = np.sqrt(np.maximum(values, 0.0))
-        good = (spread[:, 0] < self.thickness) & (spread[:, 1] > 3.0 * self.thickness)
-        normal[ok] = vectors[:, :, 0]
-        flat = ok.copy()
-        flat[ok] = good
-        return flat, normal, centre
-
-
 def check_overlap(imu: ImuSamples, stamp: int) -> None:
     """Raise when the IMU does not cover a scan stamp (another clock or unit)."""
     lo, hi = int(imu.stamps[0]), int(imu.stamps[-1])
@@ -168,19 +98,55 @@ class LioOdometry:
         self.body_imu = _matrix(imu_mount.translation, imu_mount.rotation)
         self.imu_lidar = np.linalg.inv(self.body_imu) @ _matrix(lidar.translation,
                                                                 lidar.rotation)
-        body = self._level(first) if start is None \
+        rest = self._rest(first)
+        body = self._level(first, rest) if start is None \
             else _matrix(start[0], Rotation.from_quat(start[1]))
         world_imu = body @ self.body_imu
         state = NavState(first, Rotation.from_matrix(world_imu[:3, :3]), world_imu[:3, 3],
                          np.zeros(3), np.zeros(3), np.zeros(3))
-        self.filter = InertialFilter(state, settings.noise)
+        self.settled = rest is not None
+        self.filter = InertialFilter(state if rest is None else
+                                     self._at_rest(state, rest, turn=start is not None),
+                                     settings.noise)
+        if rest is not None:  # static initialisation, then on to the first scan
+            self.filter.settle(self.imu.angular_velocity[rest],
+                               self.imu.linear_acceleration[rest])
+            self._predict(first)
         self.map = LocalMap(settings.voxel / 2, settings.max_range)
 
-    def _level(self, stamp: int) -> NDArray[np.float64]:
-        """A body pose at the origin, level by the mean specific force of the first 0.1 s."""
+    def _rest(self, stamp: int) -> slice[int, int] | None:
+        """The IMU samples of the 2 s before the first scan while the vehicle was still
+        (:func:`~alte.registration.inertial.still`), else None."""
+        end = int(np.searchsorted(self.imu.stamps, stamp))
+        begin = int(np.searchsorted(self.imu.stamps, stamp - 2_000_000_000))
+        window = slice(begin, end)
+        count = still(self.imu.angular_velocity[window], self.imu.linear_acceleration[window],
+                      self.settings.noise, self.imu.rate_hz) if end - begin > 1 else 0
+        return slice(begin, begin + count) if count else None
+
+    def _at_rest(self, state: NavState, rest: slice[int, int], *, turn: bool) -> NavState:
+        """``state`` (at the first scan) moved back to the end of the rest: with ``turn``
+        (a recorded attitude), turned back by what the gyroscope saw since."""
+        end = int(self.imu.stamps[rest.stop - 1])
+        out = state.copy()
+        out.stamp = end
+        if turn:
+            bias = self.imu.angular_velocity[rest].mean(axis=0)
+            since = NavState(end, Rotation.identity(), np.zeros(3), np.zeros(3), bias,
+                             np.zeros(3))
+            span = self._window(end, state.stamp)
+            moved = integrate(since, state.stamp, self.imu.stamps[span],
+                              self.imu.angular_velocity[span],
+                              self.imu.linear_acceleration[span])
+            out.rotation = state.rotation * moved.rotation.inv()
+        return out
+
+    def _level(self, stamp: int, rest: slice[int, int] | None) -> NDArray[np.float64]:
+        """A body pose at the origin, level by the mean specific force at rest before the
+        first scan, else over the first 0.1 s."""
         near = np.abs(self.imu.stamps - stamp) <= 50_000_000
-        force = self.imu.linear_acceleration[near].mean(axis=0) if near.any() \
-            else self.imu.linear_acceleration[0]
+        force = self.imu.linear_acceleration[rest if rest is not None else near
+                                             if near.any() else slice(0, 1)].mean(axis=0)
         up = self.body_imu[:3, :3] @ force
         tilt, _ = Rotation.align_vectors([[0.0, 0.0, 1.0]], [up])
         return _matrix(np.zeros(3), tilt)
@@ -190,6 +156,12 @@ class LioOdometry:
         lo = max(int(np.searchsorted(self.imu.stamps, start)) - 1, 0)
         hi = int(np.searchsorted(self.imu.stamps, end)) + 1
         return slice(lo, hi)
+
+    def _predict(self, stamp: int) -> None:
+        """The filter carried to ``stamp`` (ns) by the IMU."""
+        span = self._window(self.filter.state.stamp, stamp)
+        self.filter.predict(stamp, self.imu.stamps[span], self.imu.angular_velocity[span],
+                            self.imu.linear_acceleration[span])
 
     def deskew(self, points: NDArray[np.float64], times: NDArray[np.float64] | None,
                ) -> NDArray[np.float64]:
@@ -232,9 +204,7 @@ class LioOdometry:
     def step(self, frame: Frame) -> NDArray[np.float64]:
         """The body pose (4x4, world) at the frame's stamp."""
         check_overlap(self.imu, frame.stamp)
-        span = self._window(self.filter.state.stamp, frame.stamp)
-        self.filter.predict(frame.stamp, self.imu.stamps[span],
-                            self.imu.angular_velocity[span], self.imu.linear_acceleration[span])
+        self._predict(frame.stamp)
         points = np.asarray(frame.points, dtype=np.float64)
         ranges = np.linalg.norm(points, axis=1)
         keep = np.isfinite(ranges) & (ranges >= self.settings.min_range) \
@@ -242,7 +212,7 @@ class LioOdometry:
         times = None if frame.times is None else np.asarray(frame.times)[keep]
         scan = self.deskew(points[keep], times)
         if self.map.tree is not None:
-            self.filter.update(self._residuals(_voxel_first(scan, self.settings.voxel)),
+            self.filter.update(self._residuals(voxel_first(scan, self.settings.voxel)),
                                self.settings.plane_sigma, self.settings.iterations,
                                least=self.settings.least)
         state = self.filter.state

@@ -83,11 +83,13 @@ def _noise(n: int, rate: float, figures: tuple[float, float, float],
 
 def imu_stream(trajectory: Trajectory, start_ns: int, profile: SensorProfile,
                rng: np.random.Generator, mount: Mount = IMU_MOUNT) -> ImuStream:
-    """Samples at ``profile.imu_hz`` over the whole trajectory (stamps from ``start_ns``)."""
+    """Samples at ``profile.imu_hz`` over the whole trajectory (stamps from ``start_ns``),
+    and ``profile.imu_lead`` seconds before it with the vehicle still at its start."""
     rate = profile.imu_hz
     step_ns = round(1e9 / rate)
-    count = int(trajectory.duration * 1e9) // step_ns + 1
-    stamps = start_ns + step_ns * np.arange(count, dtype=np.int64)
+    lead = round(profile.imu_lead * 1e9) // step_ns
+    count = int(trajectory.duration * 1e9) // step_ns + 1 + lead
+    stamps = start_ns + step_ns * (np.arange(count, dtype=np.int64) - lead)
     gyro, accel = true_imu(trajectory, (stamps - start_ns) / 1e9, rate, mount)
     g_white, g_bias = _noise(count, rate, (profile.gyro_noise, profile.gyro_walk,
                                            profile.gyro_bias), rng)

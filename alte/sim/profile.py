@@ -16,6 +16,10 @@ from one pose, no per-point time, no IMU; the chapter tables are its reproductio
   3.39e-4 rad/s/sqrt(Hz), bias random walk 3.88e-5 rad/s^2/sqrt(Hz), turn-on bias sigma
   0.5 deg/s; accelerometer 4.0e-3 m/s^2/sqrt(Hz), 6.0e-3 m/s^3/sqrt(Hz), 0.196 m/s^2
   (Kalibr's continuous-time noise model; discrete sigma = density * sqrt(rate)).
+* ``imu_lead``: the IMU log begins this long before the first scan with the vehicle still
+  at its start pose, as a flight log does that starts before departure (a flight
+  controller logs from boot; the mission here starts with the first scan). A LiDAR-inertial
+  odometry initialises its IMU biases there, as every static initialisation does.
 * ``dropout``: returns lost on dark or grazing surfaces. Received power goes as
   reflectivity x cos(incidence) / range^2 (per-class reflectivity, :data:`REFLECTIVITY`);
   a return is detected with probability ``1 / (1 + (P50 / P)^4)``, ``P50`` the power of a
@@ -71,6 +75,8 @@ class SensorProfile(Record):
     accel_noise: float = param(4.0e-3, _non_negative, ">= 0", "m/s^2/sqrt(Hz)")
     accel_walk: float = param(6.0e-3, _non_negative, ">= 0", "m/s^3/sqrt(Hz)")
     accel_bias: float = param(0.196, _non_negative, ">= 0", "turn-on bias sigma, m/s^2")
+    imu_lead: float = param(0.0, _non_negative, ">= 0",
+                            "s of IMU before the first scan, the vehicle still")
     dropout: bool = param(False, help="lose returns on dark or grazing surfaces")
     dropout_range: float = param(60.0, _positive, "> 0",
                                  "m; a 10 % target head-on is detected half the time here")
@@ -87,7 +93,8 @@ class SensorProfile(Record):
 #: Named profiles of ``alte simulate --profile``.
 PROFILES: dict[str, SensorProfile] = {
     "thesis": SensorProfile(),
-    "uav": SensorProfile(sweep=True, pose_hz=50.0, imu_hz=200.0, dropout=True),
+    "uav": SensorProfile(sweep=True, pose_hz=50.0, imu_hz=200.0, imu_lead=2.0,
+                         dropout=True),
 }
 
 

@@ -129,6 +129,21 @@ def test_imu_noise_has_the_stated_figures(nav):
     assert np.std(steps) == pytest.approx(UAV.gyro_walk / np.sqrt(200.0), rel=0.05)
 
 
+def test_the_uav_imu_log_begins_before_the_first_scan_with_the_vehicle_still(nav):
+    quiet = UAV.replace(gyro_noise=0.0, gyro_walk=0.0, gyro_bias=0.0, accel_noise=0.0,
+                        accel_walk=0.0, accel_bias=0.0, dropout=False)
+    sim = simulate(nav, frames=1, profile=quiet)
+    imu = sim.imu
+    assert imu.stamps[0] == START_NS - 2_000_000_000 and UAV.imu_lead == 2.0
+    assert (imu.stamps < START_NS).sum() == 400
+    before = imu.stamps < START_NS - 50_000_000  # the vehicle tilts as it sets off at 0 s
+    assert np.abs(imu.angular_velocity[before]).max() < 1e-9
+    force = imu.linear_acceleration[before]
+    assert np.abs(force - force[0]).max() < 1e-9
+    assert np.linalg.norm(force[0]) == pytest.approx(GRAVITY)
+    assert sim.stamps[0] >= START_NS
+
+
 def test_uav_terrain_folder_bag_and_scenario(tmp_path):
     folder = ensure_terrain("sim_lan_1", tmp_path, frames=3, profile=UAV)
     assert folder == terrain_folder(tmp_path, "sim_lan_1", 3, 0, UAV)
