@@ -65,8 +65,9 @@ def pose_line(counts: StreamCounts) -> str:
         from alte.registration.odometry import OdometryParams, odometry_label
 
         label = odometry_label(OdometryParams.parse(poses.settings))
+        rest = f", IMU biases from {poses.rest_s:.1f} s at rest" if poses.rest_s > 0 else ""
         return f"{poses.source} ({label}, {1e3 * poses.seconds / max(poses.frames, 1):.0f} " \
-               "ms per scan)"
+               f"ms per scan{rest})"
     return poses.source
 
 

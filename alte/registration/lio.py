@@ -51,6 +51,7 @@ from alte.types import Frame, Mount
 
 if TYPE_CHECKING:
     from alte.io.imu import ImuSamples
+    from alte.registration.settings import PoseCounts
 
 __all__ = ["LioOdometry", "LioSettings", "check_overlap", "lio_frames"]
 
@@ -104,7 +105,8 @@ class LioOdometry:
         world_imu = body @ self.body_imu
         state = NavState(first, Rotation.from_matrix(world_imu[:3, :3]), world_imu[:3, 3],
                          np.zeros(3), np.zeros(3), np.zeros(3))
-        self.settled = rest is not None
+        self.rest_s = 0.0 if rest is None else \
+            (int(imu.stamps[rest.stop - 1]) - int(imu.stamps[rest.start])) / 1e9
         self.filter = InertialFilter(state if rest is None else
                                      self._at_rest(state, rest, turn=start is not None),
                                      settings.noise)
@@ -221,12 +223,16 @@ class LioOdometry:
 
 
 def lio_frames(frames: Iterable[Frame], lidar: Mount, imu: ImuSamples, settings: LioSettings,
-               start: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None) -> Iterator[
-                   tuple[Frame, NDArray[np.float64]]]:
-    """Each frame with its body pose (4x4) from LIO, anchored at ``start``."""
+               start: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None,
+               *, counts: PoseCounts | None = None,
+               ) -> Iterator[tuple[Frame, NDArray[np.float64]]]:
+    """Each frame with its body pose (4x4) from LIO, anchored at ``start``; ``counts``
+    gets how long the IMU was still before the first scan."""
     odometry: LioOdometry | None = None
     for frame in frames:
         if odometry is None:
             check_overlap(imu, frame.stamp)
             odometry = LioOdometry(imu, lidar, settings, start, frame.stamp)
+            if counts is not None:
+                counts.rest_s = odometry.rest_s
         yield frame, odometry.step(frame)

@@ -84,7 +84,7 @@ def _lio_frames(frames: Iterable[Frame], mount: Mount, imu: ImuSamples | None, *
         raise ParameterError("--odometry lio needs an IMU topic (sensor_msgs/msg/Imu) in the "
                              "bag; use --odometry kiss")
     previous: Frame | None = None
-    steps = lio_frames(frames, mount, imu, lio_settings(params), start)
+    steps = lio_frames(frames, mount, imu, lio_settings(params), start, counts=counts)
     while True:
         began, cpu = time.perf_counter(), time.thread_time()
         item = next(steps, None)

@@ -153,13 +153,15 @@ def odometry_label(params: OdometryParams) -> str:
 class PoseCounts(Counts):
     """Where the poses came from, what odometry / refinement did and how long it took
     (``seconds``: the pose step alone, wall; ``cpu_seconds``: its thread's CPU time);
-    ``scans``: refinement's decision per scan."""
+    ``scans``: refinement's decision per scan; ``rest_s``: the still IMU the LiDAR-inertial
+    odometry started from, s (0: none, it started in motion)."""
 
     source: str = "recorded"
     method: str = ""
     settings: dict[str, object] = field(default_factory=dict)
     frames: int = 0
     deskewed: int = 0
+    rest_s: float = 0.0
     corrected: int = 0
     realigned: int = 0
     kept: dict[str, int] = field(default_factory=dict)

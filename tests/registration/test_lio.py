@@ -2,6 +2,7 @@
 known planes, the time checks, and the backend on the simulated UAV mission's first scans."""
 
 import itertools
+import re
 
 import numpy as np
 import pytest
@@ -162,6 +163,7 @@ def test_lio_flies_the_first_five_seconds_of_the_uav_mission(uav_mission):
         stream, stream.mount, counts=counts, imu=imu,
         start=(truth.positions[0], truth.quaternions[0])), 50))
     assert counts.method == "lio" and counts.deskewed == 50
+    assert 1.9 < counts.rest_s <= 2.0  # the IMU's 2 s before the first scan, less the set-off
     stamps = np.array([f.stamp for f in frames])
     j = np.searchsorted(truth.stamps, stamps)
     errors = trajectory_errors(stamps, np.array([f.position for f in frames]),
@@ -188,7 +190,10 @@ def test_the_pipeline_picks_lio_for_a_bag_with_an_imu_and_says_so(tmp_path, caps
     assert kiss.poses.method == "kiss" and not any("inertial" in n for n in kiss.notes)
     assert main(["register", str(uav), "--poses", "odometry", "--out",
                  str(tmp_path / "cloud.ply")]) == 0
-    assert "odometry (lidar-inertial" in capsys.readouterr().out
+    out = capsys.readouterr().out
+    assert re.search(r"odometry \(lidar-inertial, \d+ ms per scan, IMU biases from 1\.9 s at "
+                     r"rest\)", out)
+    assert kiss.poses.rest_s == 0.0
 
 
 def _rings(rng: np.random.Generator, spacing: float, angle: float) -> np.ndarray:
@@ -319,9 +324,9 @@ def test_the_uav_mission_starts_the_filter_at_rest(uav_mission):
     imu = read_imu(bag)
     first = next(iter(stream))
     odometry = LioOdometry(imu, stream.mount, LioSettings(), None, first.stamp)
-    assert odometry.settled
+    assert odometry.rest_s > 1.9
     assert np.abs(odometry.filter.state.velocity).max() < 0.05
     settled = imu.angular_velocity[imu.stamps < first.stamp - 100_000_000].mean(axis=0)
     assert np.abs(odometry.filter.state.gyro_bias - settled).max() < 1e-3
     late = LioOdometry(imu, stream.mount, LioSettings(), None, first.stamp + 3_000_000_000)
-    assert not late.settled  # the 2 s before are flight: no rest, the old start
+    assert late.rest_s == 0.0  # the 2 s before are flight: no rest, the old start
