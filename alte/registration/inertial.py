@@ -156,12 +156,20 @@ class InertialFilter:
     """Error-state Kalman filter of :class:`NavState` (module docstring)."""
 
     def __init__(self, state: NavState, noise: ImuNoise, *, velocity_sigma: float = 1.0,
-                 attitude_sigma: float = 0.02) -> None:
+                 attitude_sigma: float = 0.02, heading_sigma: float = 1e-3) -> None:
+        """``attitude_sigma`` (rad): roll and pitch against gravity; ``heading_sigma``:
+        yaw, which the first pose defines (the world frame is its heading), so it is
+        known (to 1 mrad: tighter, and the tilt-bias coupling of :meth:`settle` leaves the
+        information matrix too ill-conditioned to invert); a yaw as uncertain as the tilt
+        lets the first scans' biased plane fits turn the map by tenths of a degree."""
         self.state, self.noise = state, noise
-        diag = np.r_[np.full(3, attitude_sigma**2), np.full(3, 1e-6),
+        diag = np.r_[np.zeros(3), np.full(3, 1e-6),
                      np.full(3, velocity_sigma**2), np.full(3, noise.gyro_bias**2),
                      np.full(3, noise.accel_bias**2)]
         self.cov = np.diag(diag)
+        rot = state.rotation.as_matrix()  # world from IMU: the error lives in the IMU frame
+        world = np.diag([attitude_sigma**2, attitude_sigma**2, heading_sigma**2])
+        self.cov[0:3, 0:3] = rot.T @ world @ rot
 
     def settle(self, gyro: NDArray[np.float64], accel: NDArray[np.float64]) -> None:
         """Start from rest (static initialisation): the velocity is zero, the gyroscope

@@ -12,7 +12,8 @@ scan constrains x and y, and the velocity drifts with it meanwhile. Every scan i
    own instant, the per-point time, with the mean rate and acceleration of the sweep);
 2. down-sampled on ``voxel`` and registered point-to-plane against a local map of the
    scans before it, as the measurement of an iterated Kalman update (FAST-LIO's scheme:
-   correspondences found again at every iteration). Planes are fitted to the
+   correspondences found again at every iteration, each kept within ``gate`` sigmas of
+   what the prior pose covariance allows). Planes are fitted to the
    ``wide_points`` nearest map points within ``wide_reach`` where they are flat, else to
    the ``neighbours`` nearest within ``max_distance`` (five, FAST-LIO's choice): a ground
    point's five nearest lie along one scan ring (a line, refused), twenty span rings.
@@ -23,7 +24,9 @@ scan constrains x and y, and the velocity drifts with it meanwhile. Every scan i
 3. added to the map (``voxel / 2`` grid, points beyond ``max_range`` of the vehicle dropped).
 
 The world frame is the first scan's body pose (the recorded one when the bag has poses,
-else level from the accelerometer), gravity along -z. Two PyPI packages were tried first
+else level from the accelerometer), gravity along -z; its heading is therefore known, and
+the filter starts with a yaw uncertainty of 1 mrad
+(:class:`~alte.registration.inertial.InertialFilter`). Two PyPI packages were tried first
 (environment.md); both diverged on the simulated UAV missions.
 """
 
@@ -70,6 +73,8 @@ class LioSettings:
     wide_points: int = 20
     wide_reach: float = 3.0
     least: float = 30.0
+    gate: float = 3.0
+    gate_sigma: float = 0.05
     iterations: int = 5
     noise: ImuNoise = field(default_factory=ImuNoise)
 
@@ -185,7 +190,12 @@ class LioOdometry:
 
     def _residuals(self, scan: NDArray[np.float64],
                    ) -> Callable[[NavState], Residuals]:
+        """Point-to-plane residuals of ``scan`` at a state, gated: a residual is kept
+        within ``gate`` sigmas of what the prior pose covariance and ``gate_sigma`` of
+        point and plane noise allow (a plane fitted across a wall's foot and the ground,
+        or a parallel face 0.5 m off, reads as a rotation of tenths of a degree)."""
         settings = self.settings
+        prior = self.filter.cov[:6, :6].copy()
 
         def residuals(state: NavState) -> Residuals:
             rot = state.rotation.as_matrix()
@@ -194,12 +204,12 @@ class LioOdometry:
                 world, settings.max_distance, settings.neighbours,
                 (settings.wide_points, settings.wide_reach))
             r = np.einsum("ij,ij->i", normal, world[index] - centre)
-            keep = np.abs(r) < settings.max_distance / 2
-            index, normal, r = index[keep], normal[keep], r[keep]
             # d r / d theta = -n^T R [q]x ; d r / d p = n^T
-            nr = normal @ rot
-            jac = np.hstack([np.cross(scan[index], nr), normal])
-            return r, jac
+            jac = np.hstack([np.cross(scan[index], normal @ rot), normal])
+            spread = settings.gate_sigma**2 + np.einsum("ij,jk,ik->i", jac, prior, jac)
+            keep = (np.abs(r) < settings.max_distance / 2) \
+                & (r**2 < settings.gate**2 * spread)
+            return r[keep], jac[keep]
 
         return residuals
 

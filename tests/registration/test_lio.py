@@ -112,6 +112,7 @@ def _update(walls: bool, offset: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     lio.map, lio.settings = local, LioSettings(max_distance=2.0)
     filt = InertialFilter(start, ImuNoise())
     filt.cov = np.diag(np.r_[np.full(3, 0.05**2), np.full(3, 0.5**2), np.ones(9)])
+    lio.filter = filt
     assert filt.update(lio._residuals(scan), 0.05, 10) > 100
     return (filt.state.position - truth.position,
             (filt.state.rotation.inv() * truth.rotation).as_rotvec())
@@ -120,6 +121,39 @@ def _update(walls: bool, offset: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 def test_update_on_three_planes_recovers_the_pose():
     dp, dr = _update(True, np.array([0.01, -0.01, 0.02, 0.3, -0.2, 0.25]))
     assert np.abs(dp).max() < 0.01 and np.degrees(np.abs(dr).max()) < 0.05
+
+
+def _gated(position_sigma: float) -> int:
+    """Residuals kept of a scan 0.5 m in front of a mapped wall (a parallel face the
+    scan's own wall is not mapped yet), the state at the truth with that prior."""
+    rng = np.random.default_rng(5)
+    local = LocalMap(0.25, 100.0)
+    local.add(np.c_[np.full(4000, 15.0), rng.uniform(-10, 10, (4000, 2))], np.zeros(3))
+    truth = NavState(T0, Rotation.identity(), np.zeros(3), np.zeros(3), np.zeros(3),
+                     np.zeros(3))
+    scan = np.c_[np.full(500, 14.5), rng.uniform(-8, 8, (500, 2))]
+    lio = object.__new__(LioOdometry)
+    lio.map, lio.settings = local, LioSettings(max_distance=2.0)
+    lio.filter = InertialFilter(truth, ImuNoise())
+    lio.filter.cov[:6, :6] = np.diag(np.r_[np.full(3, 1e-3**2), np.full(3, position_sigma**2)])
+    r, _ = lio._residuals(scan)(truth)
+    return len(r)
+
+
+def test_residuals_beyond_what_the_prior_allows_are_gated():
+    assert _gated(0.01) == 0  # 0.5 m off with a pose known to 1 cm: another surface
+    assert _gated(0.5) == 500  # with a pose known to 0.5 m it may be this wall
+
+
+def test_the_filter_starts_knowing_its_heading_not_its_tilt():
+    """The world frame is the first pose's heading: yaw has no uncertainty at the start;
+    roll and pitch against gravity do (0.02 rad)."""
+    rotation = Rotation.from_euler("ZYX", [40.0, 10.0, -5.0], degrees=True)
+    state = NavState(T0, rotation, np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3))
+    world = rotation.as_matrix() @ InertialFilter(state, ImuNoise()).cov[0:3, 0:3] \
+        @ rotation.as_matrix().T
+    assert np.sqrt(world[2, 2]) == pytest.approx(1e-3)
+    assert np.sqrt(np.diag(world)[:2]) == pytest.approx([0.02, 0.02])
 
 
 def test_update_on_flat_ground_keeps_what_the_ground_cannot_see():
