@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import itertools
 from collections.abc import Iterator
+from dataclasses import replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -59,6 +60,8 @@ def odometry_poses(stream: FrameStream, probe: FrameStream, spec: FrameSpec,
     first scan when ``probe`` (the stream with the pose topic) has one."""
     chosen: set[int] = set()
     frames = _tagged(stream, chosen)
+    if not spec.deskew:  # --no-deskew: the odometry aligns, and the map keeps, scans as taken
+        frames = (replace(frame, times=None) for frame in frames)
     first = next(frames, None)
     if first is None:
         return

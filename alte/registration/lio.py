@@ -214,31 +214,34 @@ class LioOdometry:
 
         return residuals
 
-    def step(self, frame: Frame) -> NDArray[np.float64]:
-        """The body pose (4x4, world) at the frame's stamp."""
+    def step(self, frame: Frame) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """The body pose (4x4, world) at the frame's stamp, and the scan deskewed to the
+        stamp (LiDAR frame, every point in its order: the cloud the map is built from)."""
         check_overlap(self.imu, frame.stamp)
         self._predict(frame.stamp)
         points = np.asarray(frame.points, dtype=np.float64)
         ranges = np.linalg.norm(points, axis=1)
         keep = np.isfinite(ranges) & (ranges >= self.settings.min_range) \
             & (ranges <= self.settings.max_range)
-        times = None if frame.times is None else np.asarray(frame.times)[keep]
-        scan = self.deskew(points[keep], times)
+        moved = self.deskew(points, None if frame.times is None else np.asarray(frame.times))
+        scan = moved[keep]
         if self.map.tree is not None:
             self.filter.update(self._residuals(voxel_first(scan, self.settings.voxel)),
                                self.settings.plane_sigma, self.settings.iterations,
                                least=self.settings.least)
         state = self.filter.state
         self.map.add(scan @ state.rotation.as_matrix().T + state.position, state.position)
-        return state.matrix() @ np.linalg.inv(self.body_imu)
+        lidar = (moved - self.imu_lidar[:3, 3]) @ self.imu_lidar[:3, :3]
+        return state.matrix() @ np.linalg.inv(self.body_imu), lidar
 
 
 def lio_frames(frames: Iterable[Frame], lidar: Mount, imu: ImuSamples, settings: LioSettings,
                start: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None,
                *, counts: PoseCounts | None = None,
-               ) -> Iterator[tuple[Frame, NDArray[np.float64]]]:
-    """Each frame with its body pose (4x4) from LIO, anchored at ``start``; ``counts``
-    gets how long the IMU was still before the first scan."""
+               ) -> Iterator[tuple[Frame, NDArray[np.float64], NDArray[np.float64]]]:
+    """Each frame with its body pose (4x4) from LIO, anchored at ``start``, and its points
+    deskewed to the stamp by the IMU (:meth:`LioOdometry.step`); ``counts`` gets how long
+    the IMU was still before the first scan."""
     odometry: LioOdometry | None = None
     for frame in frames:
         if odometry is None:
@@ -246,4 +249,4 @@ def lio_frames(frames: Iterable[Frame], lidar: Mount, imu: ImuSamples, settings:
             odometry = LioOdometry(imu, lidar, settings, start, frame.stamp)
             if counts is not None:
                 counts.rest_s = odometry.rest_s
-        yield frame, odometry.step(frame)
+        yield frame, *odometry.step(frame)

@@ -6,8 +6,11 @@
   with its own defaults; ``plane``: point-to-plane scan-to-map ICP) or LiDAR-inertial
   odometry (``lio``, :mod:`alte.registration.lio`) with the bag's IMU. ``auto``, the
   default, is ``lio`` when the bag has an IMU topic and ``kiss`` otherwise
-  (:func:`resolve_method`). Scans that carry per-point time are deskewed (KISS-ICP's
-  own deskew, or the IMU's motion over the sweep).
+  (:func:`resolve_method`). Scans that carry per-point time are deskewed: for the
+  alignment (KISS-ICP's own deskew, or the IMU's motion over the sweep) and for the map
+  (the frames carry the scan moved to its stamp: LIO's deskewed scan, else the constant
+  motion between the backend's last two poses; the first scan of a LiDAR-only run as
+  taken).
 * :func:`~alte.registration.refine.refine_frames`: recorded poses aligned scan-to-map,
   a correction applied only when it is well constrained and clearly better.
 
@@ -29,6 +32,7 @@ from scipy.spatial.transform import Rotation
 
 from alte.errors import ParameterError
 from alte.registration.backends import Kiss, Plane, window_voxel
+from alte.registration.deskew import deskew_constant_velocity
 from alte.registration.lio import LioSettings, lio_frames
 from alte.registration.refine import refine_frames
 from alte.registration.settings import (
@@ -93,8 +97,11 @@ def _lio_frames(frames: Iterable[Frame], mount: Mount, imu: ImuSamples | None, *
         counts.seconds += time.perf_counter() - began
         counts.cpu_seconds += time.thread_time() - cpu
         counts.frames += 1
-        frame, body = item
-        counts.deskewed += int(frame.times is not None and len(frame.times) > 0)
+        frame, body, points = item
+        if frame.times is not None and len(frame.times) > 0:  # the cloud as the map saw it
+            counts.deskewed += 1
+            frame = replace(frame, points=points.astype(frame.points.dtype, copy=False),
+                            times=None)
         previous = _posed(frame, body, previous)
         yield previous
 
@@ -118,9 +125,25 @@ def odometry_frames(frames: Iterable[Frame], mount: Mount, *, counts: PoseCounts
         steps = window_poses(steps, window=params.window, voxel=window_voxel(params),
                              min_fitness=params.min_fitness, counts=counts)
     previous: Frame | None = None
+    before: tuple[int, NDArray[np.float64]] | None = None
     for frame, pose in steps:
-        previous = _posed(frame, anchor @ pose @ sensor_body, previous)
+        previous = _posed(_carried(frame, pose, before), anchor @ pose @ sensor_body, previous)
+        before = (frame.stamp, pose)
         yield previous
+
+
+def _carried(frame: Frame, pose: NDArray[np.float64],
+             before: tuple[int, NDArray[np.float64]] | None) -> Frame:
+    """``frame`` as the map gets it: with per-point time, its points moved to the stamp
+    under the constant sensor motion since the scan ``before`` (its stamp and sensor pose;
+    the backends deskew a copy for their own alignment only), else as taken."""
+    if frame.times is None or before is None or frame.stamp == before[0]:
+        return replace(frame, times=None)
+    motion = np.linalg.inv(before[1]) @ pose
+    points = deskew_constant_velocity(np.asarray(frame.points, dtype=np.float64),
+                                      np.asarray(frame.times, dtype=np.float64), motion,
+                                      (frame.stamp - before[0]) / 1e9)
+    return replace(frame, points=points.astype(frame.points.dtype, copy=False), times=None)
 
 
 def _lidar_poses(frames: Iterable[Frame], params: OdometryParams, counts: PoseCounts,

@@ -28,3 +28,24 @@ def test_odometry_reads_every_scan_and_registers_the_selected_ones(terrain: Path
         np.testing.assert_allclose(mine.points, whole.points, atol=1e-9)
     assert "odometry over all 4 scans; 2 of them (evenly spaced) registered" in picked.notes
     assert not any("odometry over all" in n for n in every.notes)
+
+
+def test_odometry_keeps_scans_as_taken_with_no_deskew(tmp_path_factory) -> None:
+    """LIO deskews every timed scan and the frames carry it so; ``deskew=False``
+    (``--no-deskew``) keeps the scans as taken for the odometry and the map alike."""
+    from alte.sim.profile import PROFILES
+    from alte.sim.scenario import ensure_terrain
+
+    uav = ensure_terrain("sim_lan_1", tmp_path_factory.mktemp("uav"), 0, 4,
+                         profile=PROFILES["uav"])
+    source = open_input(uav / "bag")
+    first = {}
+    for deskew, deskewed in ((True, 4), (False, 0)):
+        counts = StreamCounts()
+        spec = FrameSpec(poses=PoseSource.ODOMETRY, deskew=deskew)
+        frames = list(stream_frames(source, source.resolve(spec), counts))
+        assert (counts.poses.method, counts.poses.deskewed, len(frames)) == ("lio", deskewed, 4)
+        first[deskew] = frames[0]
+    np.testing.assert_allclose(first[True].position, first[False].position)  # the anchor
+    assert first[True].points.shape == first[False].points.shape
+    assert np.abs(first[True].points - first[False].points).max() > 0.05
