@@ -66,8 +66,9 @@ def pose_line(counts: StreamCounts) -> str:
 
         label = odometry_label(OdometryParams.parse(poses.settings))
         rest = f", IMU biases from {poses.rest_s:.1f} s at rest" if poses.rest_s > 0 else ""
+        swept = f", {poses.deskewed} scans deskewed" if poses.deskewed else ""
         return f"{poses.source} ({label}, {1e3 * poses.seconds / max(poses.frames, 1):.0f} " \
-               f"ms per scan{rest})"
+               f"ms per scan{rest}{swept})"
     return poses.source
 
 

@@ -256,7 +256,7 @@ def test_the_pipeline_picks_lio_for_a_bag_with_an_imu_and_says_so(tmp_path, caps
                  str(tmp_path / "cloud.ply")]) == 0
     out = capsys.readouterr().out
     assert re.search(r"odometry \(lidar-inertial, \d+ ms per scan, IMU biases from 1\.9 s at "
-                     r"rest\)", out)
+                     r"rest, 3 scans deskewed\)", out)
     assert kiss.poses.rest_s == 0.0
 
 
