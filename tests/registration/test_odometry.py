@@ -183,12 +183,16 @@ def test_cli_odometry_flags(unposed, tmp_path: Path, capsys) -> None:
     assert summary["odometry"]["settings"]["rebuild"] == 2
 
 
-def test_kiss_deskews_scans_with_per_point_time() -> None:
-    rng = np.random.default_rng(3)
+def _room(rng: np.random.Generator) -> np.ndarray:
+    """A 16 x 16 x 3 m room (floor, four walls, ceiling) around the sensor, 1 m up."""
     xy = rng.uniform(-8, 8, (6000, 2))
     walls = np.column_stack([np.full(3000, 8.0), rng.uniform(-8, 8, 3000), rng.uniform(0, 3, 3000)])
-    room = np.vstack([np.column_stack([xy, np.zeros(6000)]), walls, walls[:, [1, 0, 2]],
+    return np.vstack([np.column_stack([xy, np.zeros(6000)]), walls, walls[:, [1, 0, 2]],
                       -walls, -walls[:, [1, 0, 2]] + [0.0, 0.0, 3.0]]) - [0.0, 0.0, 1.0]
+
+
+def test_kiss_deskews_scans_with_per_point_time() -> None:
+    room = _room(np.random.default_rng(3))
     times = np.linspace(0.0, 0.1, len(room))
     frames = [Frame(k * 100_000_000, room - [0.1 * k, 0.0, 0.0], np.zeros(3),
                     np.array([0.0, 0.0, 0.0, 1.0]), times=times) for k in range(6)]
@@ -288,11 +292,7 @@ def test_lidar_odometry_frames_carry_their_scans_deskewed() -> None:
     ``-t`` m; the frames odometry yields carry it moved to the stamp (the constant motion
     between the last two poses), per-point time dropped: the room as at the stamp within
     a centimetre, where the swept scan is off by up to 0.1 m. The first scan stays as taken."""
-    rng = np.random.default_rng(4)
-    xy = rng.uniform(-8, 8, (6000, 2))
-    walls = np.column_stack([np.full(3000, 8.0), rng.uniform(-8, 8, 3000), rng.uniform(0, 3, 3000)])
-    room = np.vstack([np.column_stack([xy, np.zeros(6000)]), walls, walls[:, [1, 0, 2]],
-                      -walls, -walls[:, [1, 0, 2]] + [0.0, 0.0, 3.0]]) - [0.0, 0.0, 1.0]
+    room = _room(np.random.default_rng(4))
     times = np.linspace(0.0, 0.1, len(room))
     swept = [room - np.column_stack([0.1 * k + times, np.zeros((len(room), 2))])
              for k in range(8)]
