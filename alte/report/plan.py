@@ -93,7 +93,7 @@ PLAN: tuple[Entry, ...] = (
     Entry("ch5_analysis", "ch5_analysis.ipynb", {"FRAMES": QUICK_FRAMES},
           {"FRAMES": None, "ROWS": None, "GRID_SPEC": "notebooks/sweeps/tradeoff.yaml",
            "SCHEDULER": "local", "WORKERS": 2, "SENSOR_TERRAINS": list(UAV_MISSIONS),
-           "SENSOR_RUNS": None, "SENSOR_FRAMES": None},
+           "SENSOR_RUNS": None, "SENSOR_FRAMES": None, "SENSOR_SEEDS": [0, 1, 2]},
           terrains=("sim_nav_1", "sim_lan_2", "sim_nav_2")),
     Entry("ch7_sensitivity", "ch7_sensitivity.ipynb", {"FRAMES": QUICK_FRAMES},
           {"FRAMES": None, "SPEC": "notebooks/sweeps/report.yaml", "SCHEDULER": "local"},

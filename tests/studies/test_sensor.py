@@ -28,12 +28,33 @@ def test_the_table_has_a_row_per_terrain(tmp_path):
     table = sensor_table(["sim_lan_2"], tmp_path, runs=("recorded",), frames=3)
     assert list(table["terrain"]) == ["sim_lan_2"]
     assert not math.isnan(table["mesh_recorded_m"].iloc[0])
+    assert list(table["seed"]) == [0]
     made = table.assign(ate_recorded_m=0.50004, path_m=200.0, rpe_recorded_pct=1.5,
                         mesh_recorded_m=0.04, ms_per_scan_recorded=30.04)
     assert sensor_view(made).to_dict("records") == [{
-        "terrain": "sim_lan_2", "run": RUN_TEXT["recorded"], "ATE (m)": 0.5,
-        "ATE (% of path)": 0.25, "RPE (% per m)": 1.5, "cloud to true mesh, mean (m)": 0.04,
+        "terrain": "sim_lan_2", "run": RUN_TEXT["recorded"], "seeds": 1, "ATE (m)": 0.5,
+        "ATE (% of path)": 0.25, "ATE, worst seed (% of path)": 0.25, "RPE (% per m)": 1.5,
+        "cloud to true mesh, mean (m)": 0.04, "cloud to true mesh, worst seed (m)": 0.04,
         "time per scan (ms)": 30.0}]  # rounded to mm and 0.1 ms
+
+
+def test_seeds_give_a_row_each_and_the_view_their_mean_and_worst(tmp_path):
+    table = sensor_table(["sim_lan_2"], tmp_path, seeds=[0, 1], runs=("recorded",), frames=3)
+    assert list(zip(table["terrain"], table["seed"], strict=True)) == [("sim_lan_2", 0),
+                                                                         ("sim_lan_2", 1)]
+    made = table.assign(ate_recorded_m=[1.0, 3.0], path_m=200.0, rpe_recorded_pct=[1.0, 2.0],
+                        mesh_recorded_m=[0.04, 0.08], ms_per_scan_recorded=[30.0, 50.0])
+    row = sensor_view(made).iloc[0]
+    assert (row["seeds"], row["ATE (m)"], row["ATE (% of path)"]) == (2, 2.0, 1.0)
+    assert row["ATE, worst seed (% of path)"] == 1.5 and row["RPE (% per m)"] == 1.5
+    assert row["cloud to true mesh, mean (m)"] == 0.06
+    assert row["cloud to true mesh, worst seed (m)"] == 0.08
+    assert row["time per scan (ms)"] == 40.0
+
+
+def test_an_empty_seed_list_is_refused(tmp_path):
+    with pytest.raises(ParameterError, match="sensor study: seeds is empty"):
+        sensor_table(["sim_lan_2"], tmp_path, seeds=[])
 
 
 def test_an_unknown_run_is_named_with_the_valid_ones(tmp_path):
