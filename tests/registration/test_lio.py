@@ -352,6 +352,9 @@ def test_rest_is_the_still_samples_before_motion_and_never_a_steady_turn():
     assert still(moving, accel, noise, RATE) == 300
     assert still(gyro[:80], accel[:80], noise, RATE) == 0  # 0.4 s is too short
     assert still(gyro + np.array([0.0, 0.0, 0.1]), accel, noise, RATE) == 0  # a steady turn
+    # a 3.2-sigma yaw bias (1.6 deg/s) is a bias, one of 4.7 sigmas (2.3 deg/s) a turn
+    assert still(gyro + np.array([0.0, 0.0, 0.0276]), accel, noise, RATE) == 400
+    assert still(gyro + np.array([0.0, 0.0, 0.041]), accel, noise, RATE) == 0
     shaken = accel + rng.normal(0.0, 0.5, accel.shape)
     assert still(gyro, shaken, noise, RATE) == 0
 
