@@ -94,21 +94,42 @@ def sensor_row(name: str, data_dir: str | os.PathLike[str] = "data", seed: int =
     return row
 
 
+def _row(item: tuple[str, int, tuple[str, ...] | None, int | None],
+         data_dir: str) -> dict[str, object]:
+    """:func:`sensor_row` of one (terrain, seed, runs, frames) item, on a worker."""
+    name, seed, runs, frames = item
+    return sensor_row(name, data_dir, seed, runs=runs, frames=frames)
+
+
 def sensor_table(names: Sequence[str], data_dir: str | os.PathLike[str] = "data",
                  seed: int = 0, *, seeds: Sequence[int] | None = None,
                  runs: Sequence[str] | None = None, frames: int | None = None,
-                 progress: bool = False) -> pd.DataFrame:
+                 progress: bool = False, scheduler: str = "serial",
+                 workers: int = 2) -> pd.DataFrame:
     """Rows of :func:`sensor_row` for ``names``, one per simulation seed of ``seeds``
-    (None: ``seed`` alone), with a progress bar over terrains and seeds."""
+    (None: ``seed`` alone), in that order, with a progress bar over terrains and seeds.
+    ``scheduler`` and ``workers`` as for a sweep
+    (:func:`~alte.studies.sweep.runner.executor`): each terrain and seed is one task and
+    touches its own folders; the first failure is raised."""
     from tqdm.auto import tqdm
+
+    from alte.studies.sweep.runner import executor
 
     if seeds is not None and len(seeds) == 0:
         raise ParameterError("sensor study: seeds is empty; give at least one seed "
                              "(None: the seed argument alone)")
-    pairs = [(n, s) for n in names for s in ((seed,) if seeds is None else seeds)]
-    return pd.DataFrame([sensor_row(n, data_dir, s, runs=runs, frames=frames)
-                         for n, s in tqdm(pairs, desc="sensor", unit="mission",
-                                          disable=not progress)])
+    chosen = None if runs is None else tuple(runs)
+    items = [(n, s, chosen, frames) for n in names
+             for s in ((seed,) if seeds is None else seeds)]
+    rows: list[dict[str, object]] = [{} for _ in items]
+    with executor(scheduler, workers) as pool, \
+            tqdm(total=len(items), desc="sensor", unit="mission", disable=not progress) as bar:
+        for i, row, err in pool(_row, items, str(data_dir)):
+            if err is not None:
+                raise err
+            rows[i] = row or {}
+            bar.update()
+    return pd.DataFrame(rows)
 
 
 #: What each run of :data:`RUNS` is, in words (the report's table).

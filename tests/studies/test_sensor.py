@@ -39,9 +39,14 @@ def test_the_table_has_a_row_per_terrain(tmp_path):
 
 
 def test_seeds_give_a_row_each_and_the_view_their_mean_and_worst(tmp_path):
-    table = sensor_table(["sim_lan_2"], tmp_path, seeds=[0, 1], runs=("recorded",), frames=3)
-    assert list(zip(table["terrain"], table["seed"], strict=True)) == [("sim_lan_2", 0),
-                                                                         ("sim_lan_2", 1)]
+    """Two workers give the serial rows, in the order asked (each seed its own task)."""
+    table = sensor_table(["sim_lan_2"], tmp_path, seeds=[1, 0], runs=("recorded",), frames=3,
+                         scheduler="local", workers=2)
+    assert list(zip(table["terrain"], table["seed"], strict=True)) == [("sim_lan_2", 1),
+                                                                         ("sim_lan_2", 0)]
+    serial = sensor_table(["sim_lan_2"], tmp_path, seeds=[1, 0], runs=("recorded",), frames=3)
+    assert list(table["mesh_recorded_m"]) == list(serial["mesh_recorded_m"])
+    assert table["mesh_recorded_m"].nunique() == 2
     made = table.assign(ate_recorded_m=[1.0, 3.0], path_m=200.0, rpe_recorded_pct=[1.0, 2.0],
                         mesh_recorded_m=[0.04, 0.08], ms_per_scan_recorded=[30.0, 50.0])
     row = sensor_view(made).iloc[0]
@@ -61,3 +66,5 @@ def test_an_unknown_run_is_named_with_the_valid_ones(tmp_path):
     with pytest.raises(ParameterError, match="sensor runs imu: valid: thesis, recorded, "
                                              "deskew, lidar, lio"):
         sensor_row("sim_nav_1", tmp_path, runs=("imu",))
+    with pytest.raises(ParameterError, match="sensor runs imu: valid: thesis"):
+        sensor_table(["sim_nav_1"], tmp_path, runs=("imu",))

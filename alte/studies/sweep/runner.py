@@ -29,7 +29,8 @@ from alte.studies.sweep.spec import SweepSettings, SweepSpec
 from alte.studies.sweep.store import finished_ids, load_results, write_row
 from alte.studies.sweep.work import MapGroup, group_runs, input_data, run_group, run_one
 
-__all__ = ["SERIAL", "SweepResult", "override", "run_one", "run_sweep", "variant_table"]
+__all__ = ["SERIAL", "MapUnordered", "SweepResult", "executor", "override", "run_one", "run_sweep",
+           "variant_table"]
 
 #: How long to wait for a scheduler given by address.
 CONNECT_TIMEOUT = "10s"
@@ -104,8 +105,9 @@ def _dask_map(client: Client) -> MapUnordered:
 
 
 @contextlib.contextmanager
-def _executor(scheduler: str, workers: int) -> Iterator[MapUnordered]:
-    """``serial``/``none``: in-process; ``local``: a LocalCluster; else a scheduler address."""
+def executor(scheduler: str, workers: int) -> Iterator[MapUnordered]:
+    """A :class:`MapUnordered` on ``scheduler``: ``serial``/``none`` in-process; ``local`` a
+    LocalCluster of ``workers`` single-threaded processes; else a scheduler address."""
     if scheduler in SERIAL:
         yield _serial_map
         return
@@ -189,7 +191,7 @@ def run_sweep(spec: SweepSpec, *, scheduler: str = "local", workers: int = 2,
     todo = [r for r in runs if r.run_id not in done]
     failed: list[tuple[SweepRun, str]] = []
     if todo:
-        with _executor(scheduler, workers) as pool:
+        with executor(scheduler, workers) as pool:
             _ensure_all(pool, todo, data_dir, progress)
             failed = _map_all(pool, todo, data_dir, out, progress)
     table = load_results(out, [r.run_id for r in runs])
