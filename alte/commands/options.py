@@ -72,7 +72,9 @@ def add_odometry_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--odometry-set", action="append", default=[], metavar="KEY=VALUE",
                    dest="odometry_sets",
                    help="odometry / refinement setting (repeatable), e.g. --odometry-set "
-                        "voxel=0.5; valid keys: " + ", ".join(OdometryParams.names()[1:]))
+                        "voxel=0.5; the keys: " + "; ".join(
+                            f"{k}: {v}" for k, v in OdometryParams.help().items()
+                            if k != "method"))
 
 
 def parse_key_values(items: list[str], flag: str) -> dict[str, str]:

@@ -62,8 +62,8 @@ __all__ = ["LioOdometry", "LioSettings", "check_overlap", "lio_frames"]
 @dataclass(frozen=True)
 class LioSettings:
     """What the LIO reads from :class:`~alte.registration.odometry.OdometryParams`
-    (``gate``, ``gate_sigma`` (m), ``iterations`` and ``noise`` are not settings of
-    ``--odometry-set``)."""
+    (``noise`` from its six IMU figures; ``gate``, ``gate_sigma`` (m) and ``iterations``
+    are not settings of ``--odometry-set``)."""
 
     voxel: float = 0.5
     max_range: float = 100.0

@@ -33,6 +33,7 @@ from scipy.spatial.transform import Rotation
 from alte.errors import ParameterError
 from alte.registration.backends import Kiss, Plane, window_voxel
 from alte.registration.deskew import deskew_constant_velocity
+from alte.registration.inertial import ImuNoise
 from alte.registration.lio import LioSettings, lio_frames
 from alte.registration.refine import refine_frames
 from alte.registration.settings import (
@@ -62,7 +63,10 @@ def lio_settings(params: OdometryParams) -> LioSettings:
                        min_range=params.min_range, plane_sigma=params.plane_sigma,
                        max_distance=params.plane_reach, neighbours=params.plane_points,
                        wide_points=params.wide_points, wide_reach=params.wide_reach,
-                       least=params.least)
+                       least=params.least,
+                       noise=ImuNoise(gyro=params.gyro_noise, accel=params.accel_noise,
+                                      gyro_walk=params.gyro_walk, accel_walk=params.accel_walk,
+                                      gyro_bias=params.gyro_bias, accel_bias=params.accel_bias))
 
 
 def _rate(previous: Frame | None, quaternion: NDArray[np.float64], stamp: int) -> float:

@@ -17,6 +17,7 @@ from scipy.spatial.transform import Rotation
 
 from alte.errors import ParameterError
 from alte.params import Record, param
+from alte.registration.inertial import ImuNoise
 from alte.types import Counts
 
 __all__ = ["KEYS", "METHODS", "OdometryParams", "PoseCounts", "odometry_label",
@@ -25,6 +26,8 @@ __all__ = ["KEYS", "METHODS", "OdometryParams", "PoseCounts", "odometry_label",
 #: Odometry backends (module docstring).
 OdometryMethod = Literal["auto", "kiss", "plane", "lio"]
 METHODS: tuple[str, ...] = get_args(OdometryMethod)
+#: The LIO's IMU figures unless set (the ADIS16448's, as the simulator's ``uav`` profile).
+_IMU = ImuNoise()
 
 
 def _positive(value: float) -> bool:
@@ -100,6 +103,23 @@ class OdometryParams(Record):
     least: float = param(30.0, lambda v: v >= 0, ">= 0",
                          "1/m^2; lio: least information a scan gives a pose direction for "
                          "the update to move it (0: every direction)")
+    gyro_noise: float = param(_IMU.gyro, _positive, "> 0",
+                              "rad/s/sqrt(Hz); lio: the IMU's gyroscope white noise (Kalibr's "
+                              "gyroscope_noise_density; default: the ADIS16448's)")
+    accel_noise: float = param(_IMU.accel, _positive, "> 0",
+                               "m/s^2/sqrt(Hz); lio: accelerometer white noise (Kalibr's "
+                               "accelerometer_noise_density)")
+    gyro_walk: float = param(_IMU.gyro_walk, _positive, "> 0",
+                             "rad/s^2/sqrt(Hz); lio: gyroscope bias random walk (Kalibr's "
+                             "gyroscope_random_walk)")
+    accel_walk: float = param(_IMU.accel_walk, _positive, "> 0",
+                              "m/s^3/sqrt(Hz); lio: accelerometer bias random walk (Kalibr's "
+                              "accelerometer_random_walk)")
+    gyro_bias: float = param(_IMU.gyro_bias, _positive, "> 0",
+                             "rad/s; lio: gyroscope turn-on bias sigma (what a still start "
+                             "may read as bias)")
+    accel_bias: float = param(_IMU.accel_bias, _positive, "> 0",
+                              "m/s^2; lio: accelerometer turn-on bias sigma")
     imu_topic: str | None = param(None, bool, "a topic name",
                                   "lio: the IMU topic (default: the bag's only "
                                   "sensor_msgs/msg/Imu)")
@@ -113,7 +133,8 @@ KEYS: dict[str, tuple[str, ...]] = {
              "window_voxel", "threads"),
     "plane": ("max_range", "voxel", "rebuild", "min_fitness"),
     "lio": ("max_range", "min_range", "voxel", "plane_sigma", "plane_reach", "plane_points",
-            "wide_points", "wide_reach", "least", "imu_topic"),
+            "wide_points", "wide_reach", "least", "gyro_noise", "accel_noise", "gyro_walk",
+            "accel_walk", "gyro_bias", "accel_bias", "imu_topic"),
     "refine": ("max_range", "voxel", "rebuild", "min_fitness", "min_constraint", "min_gain",
                "max_correction", "max_correction_deg", "threads"),
 }

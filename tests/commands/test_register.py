@@ -185,3 +185,13 @@ def test_register_a_point_file_speaks_of_its_rows_and_keeps_its_fields(tmp_path,
     assert "fields: not kept intensity (plain text holds x y z only)" in capsys.readouterr().out
     assert main(["register", str(source), "--out", str(tmp_path / "v.npz"), "--voxel", "1"]) == 0
     assert "note: fields intensity, label not kept: --voxel averages" in capsys.readouterr().out
+
+
+def test_register_help_gives_each_odometry_setting_with_its_unit(capsys):
+    """A user setting their own IMU's figures reads the units in ``--help``."""
+    with pytest.raises(SystemExit):
+        main(["register", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert "accel_walk: m/s^3/sqrt(Hz); lio: accelerometer bias random walk" in text
+    assert "gyro_bias: rad/s; lio: gyroscope turn-on bias sigma" in text
+    assert "voxel: m; map voxel" in text

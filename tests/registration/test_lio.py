@@ -29,6 +29,7 @@ from alte.registration.odometry import (
     PoseCounts,
     lio_settings,
     odometry_frames,
+    odometry_label,
     odometry_params,
     resolve_method,
 )
@@ -357,6 +358,31 @@ def test_rest_is_the_still_samples_before_motion_and_never_a_steady_turn():
     assert still(gyro + np.array([0.0, 0.0, 0.041]), accel, noise, RATE) == 0
     shaken = accel + rng.normal(0.0, 0.5, accel.shape)
     assert still(gyro, shaken, noise, RATE) == 0
+
+
+def test_the_imus_figures_are_odometry_settings_and_decide_what_a_rest_is():
+    """A flight controller's IMU is not the ADIS16448: ``--odometry-set gyro_bias=...`` (and
+    the five other Kalibr figures) reach the filter, so a still IMU whose turn-on bias is
+    2.9 deg/s (5.8 of the ADIS's sigmas: a turn) is a rest when its own sigma is 1 deg/s."""
+    default = lio_settings(odometry_params("lio", {}))
+    assert default.noise == ImuNoise()
+    mine = lio_settings(odometry_params("lio", {
+        "gyro_noise": "5e-4", "accel_noise": "6e-3", "gyro_walk": "1e-4", "accel_walk": "3e-3",
+        "gyro_bias": "0.0175", "accel_bias": "0.5"}))
+    assert mine.noise == ImuNoise(5e-4, 6e-3, 1e-4, 3e-3, 0.0175, 0.5)
+    assert odometry_label(odometry_params("lio", {"accel_walk": "3e-3"})) \
+        == "lidar-inertial accel_walk=0.003"
+    rng = np.random.default_rng(5)
+    gyro, accel = _at_rest(rng, 2.0, Rotation.identity(), np.array([0.0, 0.0, 0.0506]),
+                           np.zeros(3))
+    assert still(gyro, accel, default.noise, RATE) == 0
+    assert still(gyro, accel, mine.noise, RATE) == 400
+    with pytest.raises(ParameterError, match=r"--odometry-set: odometry: gyro_bias=0.0 out "
+                                             r"of range \(> 0\)"):
+        odometry_params("lio", {"gyro_bias": "0"})
+    with pytest.raises(ParameterError, match=r"--odometry-set accel_walk: not a setting of "
+                                             r"--odometry kiss"):
+        odometry_params("kiss", {"accel_walk": "1e-3"})
 
 
 def test_settling_at_rest_finds_the_biases_and_the_ground_corrects_the_accelerometer():
