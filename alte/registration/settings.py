@@ -38,6 +38,11 @@ def _fraction(value: float) -> bool:
     return 0 <= value <= 1
 
 
+def _imu(default: float, unit: str, what: str) -> float:
+    """One of the LIO's IMU figures (:class:`~alte.registration.inertial.ImuNoise`)."""
+    return param(default, _positive, "> 0", f"{unit}; lio: the IMU's {what}")
+
+
 @dataclass(frozen=True)
 class OdometryParams(Record):
     """How scans are aligned by odometry (``method``) and refinement; unset values come
@@ -103,23 +108,14 @@ class OdometryParams(Record):
     least: float = param(30.0, lambda v: v >= 0, ">= 0",
                          "1/m^2; lio: least information a scan gives a pose direction for "
                          "the update to move it (0: every direction)")
-    gyro_noise: float = param(_IMU.gyro, _positive, "> 0",
-                              "rad/s/sqrt(Hz); lio: the IMU's gyroscope white noise (Kalibr's "
-                              "gyroscope_noise_density; default: the ADIS16448's)")
-    accel_noise: float = param(_IMU.accel, _positive, "> 0",
-                               "m/s^2/sqrt(Hz); lio: accelerometer white noise (Kalibr's "
-                               "accelerometer_noise_density)")
-    gyro_walk: float = param(_IMU.gyro_walk, _positive, "> 0",
-                             "rad/s^2/sqrt(Hz); lio: gyroscope bias random walk (Kalibr's "
-                             "gyroscope_random_walk)")
-    accel_walk: float = param(_IMU.accel_walk, _positive, "> 0",
-                              "m/s^3/sqrt(Hz); lio: accelerometer bias random walk (Kalibr's "
-                              "accelerometer_random_walk)")
-    gyro_bias: float = param(_IMU.gyro_bias, _positive, "> 0",
-                             "rad/s; lio: gyroscope turn-on bias sigma (what a still start "
-                             "may read as bias)")
-    accel_bias: float = param(_IMU.accel_bias, _positive, "> 0",
-                              "m/s^2; lio: accelerometer turn-on bias sigma")
+    gyro_noise: float = _imu(_IMU.gyro, "rad/s/sqrt(Hz)", "gyroscope white noise "
+                             "(Kalibr's gyroscope_noise_density; unset: the ADIS16448's)")
+    accel_noise: float = _imu(_IMU.accel, "m/s^2/sqrt(Hz)", "accelerometer white noise")
+    gyro_walk: float = _imu(_IMU.gyro_walk, "rad/s^2/sqrt(Hz)", "gyroscope bias random walk")
+    accel_walk: float = _imu(_IMU.accel_walk, "m/s^3/sqrt(Hz)", "accelerometer bias random walk")
+    gyro_bias: float = _imu(_IMU.gyro_bias, "rad/s", "gyroscope turn-on bias sigma (what a "
+                                                      "still start may read as bias)")
+    accel_bias: float = _imu(_IMU.accel_bias, "m/s^2", "accelerometer turn-on bias sigma")
     imu_topic: str | None = param(None, bool, "a topic name",
                                   "lio: the IMU topic (default: the bag's only "
                                   "sensor_msgs/msg/Imu)")

@@ -192,6 +192,6 @@ def test_register_help_gives_each_odometry_setting_with_its_unit(capsys):
     with pytest.raises(SystemExit):
         main(["register", "--help"])
     text = " ".join(capsys.readouterr().out.split())
-    assert "accel_walk: m/s^3/sqrt(Hz); lio: accelerometer bias random walk" in text
-    assert "gyro_bias: rad/s; lio: gyroscope turn-on bias sigma" in text
+    assert "accel_walk: m/s^3/sqrt(Hz); lio: the IMU's accelerometer bias random walk" in text
+    assert "gyro_bias: rad/s; lio: the IMU's gyroscope turn-on bias sigma" in text
     assert "voxel: m; map voxel" in text

@@ -315,22 +315,32 @@ def test_weak_directions_of_flat_ground_are_projected_out_and_walls_keep_all_six
 
 def test_the_plane_fit_across_rings_and_the_projection_are_odometry_settings():
     """``--odometry-set wide_points=0 least=0`` is the filter before both (small plane fits,
-    every direction updated); a wide fit of fewer than three points, a negative floor, or
-    either with ``--odometry kiss`` are refused naming the flag."""
+    every direction updated)."""
     before = lio_settings(odometry_params("lio", {"wide_points": "0", "least": "0"}))
     assert (before.wide_points, before.least) == (0, 0.0)
     default = lio_settings(odometry_params("lio", {}))
     assert (default.wide_points, default.wide_reach, default.least) == (20, 3.0, 30.0)
     assert lio_settings(odometry_params("lio", {"wide_reach": "4"})).wide_reach == 4.0
-    with pytest.raises(ParameterError, match=r"--odometry-set: odometry: wide_points=2 out "
-                                             r"of range \(0 or >= 3\)"):
-        odometry_params("lio", {"wide_points": "2"})
-    with pytest.raises(ParameterError, match=r"--odometry-set: odometry: least=-1.0 out of "
-                                             r"range \(>= 0\)"):
-        odometry_params("lio", {"least": "-1"})
-    with pytest.raises(ParameterError, match=r"--odometry-set least: not a setting of "
-                                             r"--odometry kiss"):
-        odometry_params("kiss", {"least": "5"})
+
+
+#: LIO settings refused, as ``--odometry METHOD --odometry-set KEY=VALUE``, and the message.
+REFUSED = [
+    ("lio", "wide_points", "2", r"--odometry-set: odometry: wide_points=2 out of range "
+                                r"\(0 or >= 3\)"),
+    ("lio", "least", "-1", r"--odometry-set: odometry: least=-1.0 out of range \(>= 0\)"),
+    ("kiss", "least", "5", r"--odometry-set least: not a setting of --odometry kiss"),
+    ("lio", "gyro_bias", "0", r"--odometry-set: odometry: gyro_bias=0.0 out of range "
+                              r"\(> 0\)"),
+    ("kiss", "accel_walk", "1e-3", r"--odometry-set accel_walk: not a setting of "
+                                   r"--odometry kiss"),
+]
+
+
+@pytest.mark.parametrize(("method", "key", "value", "message"), REFUSED)
+def test_lio_settings_out_of_range_or_of_another_backend_are_refused_naming_the_flag(
+        method, key, value, message):
+    with pytest.raises(ParameterError, match=message):
+        odometry_params(method, {key: value})
 
 
 def _at_rest(rng: np.random.Generator, seconds: float, attitude: Rotation, gyro_bias: np.ndarray,
@@ -377,12 +387,6 @@ def test_the_imus_figures_are_odometry_settings_and_decide_what_a_rest_is():
                            np.zeros(3))
     assert still(gyro, accel, default.noise, RATE) == 0
     assert still(gyro, accel, mine.noise, RATE) == 400
-    with pytest.raises(ParameterError, match=r"--odometry-set: odometry: gyro_bias=0.0 out "
-                                             r"of range \(> 0\)"):
-        odometry_params("lio", {"gyro_bias": "0"})
-    with pytest.raises(ParameterError, match=r"--odometry-set accel_walk: not a setting of "
-                                             r"--odometry kiss"):
-        odometry_params("kiss", {"accel_walk": "1e-3"})
 
 
 def test_settling_at_rest_finds_the_biases_and_the_ground_corrects_the_accelerometer():
