@@ -21,7 +21,11 @@ scan constrains x and y, and the velocity drifts with it meanwhile. Every scan i
    (:func:`~alte.registration.inertial.strong_directions`): over flat ground x, y and yaw
    get only the false information of normals tilted by noise, which the filter would
    fold into velocity and accelerometer bias; LiDAR-only odometry slides there;
-3. added to the map (``voxel / 2`` grid, points beyond ``max_range`` of the vehicle dropped).
+3. added to the map (``voxel / 2`` grid, points beyond ``max_range`` of the vehicle dropped)
+   with the filter's position variance at that moment: a residual against a map point
+   weighs as its plane noise plus where that point was placed
+   (:mod:`~alte.registration.localmap`), so a wall the drift itself mapped does not
+   shrink the along-track uncertainty it was mapped with.
 
 The world frame is the first scan's body pose (the recorded one when the bag has poses,
 else level from the accelerometer), gravity along -z; its heading is therefore known, and
@@ -191,26 +195,29 @@ class LioOdometry:
 
     def _residuals(self, scan: NDArray[np.float64],
                    ) -> Callable[[NavState], Residuals]:
-        """Point-to-plane residuals of ``scan`` at a state, gated: a residual is kept
-        within ``gate`` sigmas of what the prior pose covariance and ``gate_sigma`` of
-        point and plane noise allow (a plane fitted across a wall's foot and the ground,
-        or a parallel face 0.5 m off, reads as a rotation of tenths of a degree)."""
+        """Point-to-plane residuals of ``scan`` at a state, gated and whitened. A residual
+        is kept within ``gate`` sigmas of what the prior pose covariance, ``gate_sigma``
+        of point and plane noise and the map's own uncertainty allow (a plane fitted
+        across a wall's foot and the ground, or a parallel face 0.5 m off, reads as a
+        rotation of tenths of a degree); it weighs as ``plane_sigma`` against that noise
+        plus where the map point was placed (:mod:`~alte.registration.localmap`)."""
         settings = self.settings
         prior = self.filter.cov[:6, :6].copy()
 
         def residuals(state: NavState) -> Residuals:
             rot = state.rotation.as_matrix()
             world = scan @ rot.T + state.position
-            index, normal, centre = self.map.planes(
-                world, settings.max_distance, settings.neighbours,
-                (settings.wide_points, settings.wide_reach))
-            r = np.einsum("ij,ij->i", normal, world[index] - centre)
+            fit = self.map.planes(world, settings.max_distance, settings.neighbours,
+                                  (settings.wide_points, settings.wide_reach))
+            r = np.einsum("ij,ij->i", fit.normal, world[fit.index] - fit.centre)
             # d r / d theta = -n^T R [q]x ; d r / d p = n^T
-            jac = np.hstack([np.cross(scan[index], normal @ rot), normal])
-            spread = settings.gate_sigma**2 + np.einsum("ij,jk,ik->i", jac, prior, jac)
+            jac = np.hstack([np.cross(scan[fit.index], fit.normal @ rot), fit.normal])
+            spread = settings.gate_sigma**2 + fit.variance \
+                + np.einsum("ij,jk,ik->i", jac, prior, jac)
             keep = (np.abs(r) < settings.max_distance / 2) \
                 & (r**2 < settings.gate**2 * spread)
-            return r[keep], jac[keep]
+            scale = settings.plane_sigma / np.sqrt(settings.plane_sigma**2 + fit.variance[keep])
+            return r[keep] * scale, jac[keep] * scale[:, None]
 
         return residuals
 
@@ -230,7 +237,8 @@ class LioOdometry:
                                self.settings.plane_sigma, self.settings.iterations,
                                least=self.settings.least)
         state = self.filter.state
-        self.map.add(scan @ state.rotation.as_matrix().T + state.position, state.position)
+        self.map.add(scan @ state.rotation.as_matrix().T + state.position, state.position,
+                     np.diag(self.filter.cov[3:6, 3:6]))
         lidar = (moved - self.imu_lidar[:3, 3]) @ self.imu_lidar[:3, :3]
         return state.matrix() @ np.linalg.inv(self.body_imu), lidar
 

@@ -125,6 +125,41 @@ def test_update_on_three_planes_recovers_the_pose():
     assert np.abs(dp).max() < 0.01 and np.degrees(np.abs(dr).max()) < 0.05
 
 
+def _along_track_sigma(placed: float) -> tuple[float, float]:
+    """Posterior x sigma and x error after one update over exact flat ground and a wall
+    across the track (normal x, six map points) placed with x variance ``placed``, from a
+    state 0.3 m behind the truth with 0.5 m of prior sigma."""
+    rng = np.random.default_rng(8)
+    g = rng.uniform(-15, 15, (6000, 2))
+    ground = np.c_[g, np.zeros(len(g))]
+    wall = np.c_[np.full(6, 15.0), rng.uniform(-1.0, 1.0, 6), rng.uniform(4.0, 6.0, 6)]
+    local = LocalMap(0.25, 100.0)
+    local.add(ground, np.zeros(3))
+    local.add(np.vstack([wall, wall + np.array([0.0, 0.0, 0.3])]), np.zeros(3),
+              np.array([placed, 0.0, 0.0]))
+    truth = NavState(T0, Rotation.identity(), np.array([0.0, 0.0, 6.0]), np.zeros(3),
+                     np.zeros(3), np.zeros(3))
+    scan = np.vstack([ground[rng.choice(len(ground), 1500)], wall]) - truth.position
+    lio = object.__new__(LioOdometry)
+    lio.map, lio.settings = local, LioSettings(plane_sigma=0.05, max_distance=2.0, gate=10.0)
+    filt = InertialFilter(replace(truth, position=truth.position - [0.3, 0.0, 0.0]),
+                          ImuNoise())
+    filt.cov = np.diag(np.r_[np.full(3, 0.01**2), np.full(3, 0.5**2), np.ones(9)])
+    lio.filter = filt
+    filt.update(lio._residuals(scan), lio.settings.plane_sigma, 10)
+    return float(np.sqrt(filt.cov[3, 3])), float(filt.state.position[0] - truth.position[0])
+
+
+def test_a_wall_mapped_while_uncertain_places_the_vehicle_no_better_than_that():
+    """Six points of a wall placed exactly fix the along-track position to centimetres; the
+    same points placed while x was uncertain by 0.5 m leave it uncertain by 0.2 m (a wall
+    the drift itself mapped is no absolute fix)."""
+    sigma, error = _along_track_sigma(0.0)
+    assert sigma < 0.03 and abs(error) < 0.01
+    sigma, _ = _along_track_sigma(0.25)
+    assert 0.15 < sigma < 0.3
+
+
 def _gated(position_sigma: float) -> int:
     """Residuals kept of a scan 0.5 m in front of a mapped wall (a parallel face the
     scan's own wall is not mapped yet), the state at the truth with that prior."""
@@ -277,19 +312,20 @@ def test_a_wide_plane_fit_spans_scan_rings_and_keeps_the_five_point_planes():
     local = LocalMap(0.25, 100.0)
     local.add(np.vstack([_rings(rng, 0.7, 0.0), _rings(rng, 0.7, 0.5)]), np.zeros(3))
     query = np.c_[rng.uniform(-8, 8, (500, 2)), np.zeros(500)]
-    assert len(local.planes(query, 2.0, 5)[0]) < 25
-    index, normal, _ = local.planes(query, 2.0, 5, (20, 3.0))
-    assert len(index) > 450
-    assert np.degrees(np.arcsin(np.linalg.norm(normal[:, :2], axis=1))).mean() < 2.0
+    assert len(local.planes(query, 2.0, 5).index) < 25
+    wide = local.planes(query, 2.0, 5, (20, 3.0))
+    assert len(wide.index) > 450
+    assert np.degrees(np.arcsin(np.linalg.norm(wide.normal[:, :2], axis=1))).mean() < 2.0
     rng, local = np.random.default_rng(5), LocalMap(0.25, 100.0)
     corner = np.vstack([  # two walls of a building meeting at (3, 1)
         np.c_[np.full(3000, 3.0), rng.uniform(-1, 1, 3000), rng.uniform(0.5, 2.5, 3000)],
         np.c_[rng.uniform(3, 5, 3000), np.full(3000, 1.0), rng.uniform(0.5, 2.5, 3000)]])
     local.add(corner, np.zeros(3))
     probe = np.c_[np.full(20, 3.0), rng.uniform(0.3, 0.6, 20), rng.uniform(1.2, 1.8, 20)]
-    five = local.planes(probe, 2.0, 5)[0]
-    index, normal, _ = local.planes(probe, 2.0, 5, (20, 3.0))
-    assert len(five) > 0 and set(five) <= set(index) and np.abs(normal[:, 0]).min() > 0.99
+    five = local.planes(probe, 2.0, 5).index
+    wide = local.planes(probe, 2.0, 5, (20, 3.0))
+    assert len(five) > 0 and set(five) <= set(wide.index)
+    assert np.abs(wide.normal[:, 0]).min() > 0.99
 
 
 def test_weak_directions_of_flat_ground_are_projected_out_and_walls_keep_all_six():
