@@ -12,9 +12,9 @@ from pathlib import Path
 from tqdm.auto import tqdm
 
 from alte.errors import ParameterError
+from alte.sim.profile import PROFILES, SensorProfile, get_profile
 from alte.sim.real import GROUND_CLASS, MISSIONS, Flight, import_terrain, write_imported
 from alte.sim.real.tiles import POINT_SUFFIXES, RASTER_SUFFIXES
-from alte.sim.profile import PROFILES, SensorProfile, get_profile
 from alte.sim.scenario import SCENARIO_FILE, update_terrain
 from alte.sim.terrains import TERRAINS
 

@@ -113,6 +113,7 @@ def import_terrain(paths: Sequence[str | os.PathLike[str]], flight: Flight | Non
         "grid": {"step_m": surfaces.step, "x0_m": surfaces.x0, "y0_m": surfaces.y0,
                  "shape": list(surfaces.shape),
                  "measured_ground_share": float(surfaces.measured.mean()),
+                 "covered_share": float(surfaces.covered.mean()),
                  "min_object_m": MIN_OBJECT},
         "ground_class": ground_class if ground is None else None,
         "ground_file": str(ground) if ground is not None else None,

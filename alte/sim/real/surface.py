@@ -1,7 +1,7 @@
 """A real terrain's surfaces on one grid, and the labelled mesh the simulated sensor scans.
 
-The grid's cells are ``step`` metres square, its first cell centred on the lowest
-coordinate of the tiles (so a DEM's cell centres are its nodes). Per cell:
+The grid's cells are ``step`` metres square, on multiples of the step (of a DEM: its
+own cells, their centres the grid's nodes). Per cell:
 
 * **bare earth** (``ground``): the mean height of the ground points in the cell (a DEM's
   own value); cells without one are filled by linear interpolation between the cells
@@ -11,6 +11,10 @@ coordinate of the tiles (so a DEM's cell centres are its nodes). Per cell:
   height and class (a building, a tree, low vegetation, another object); elsewhere the
   bare earth. A canopy with gaps stays porous at the grid's resolution: a cell whose
   first returns mostly reach the ground is ground;
+* **coverage** (``covered``): cells within :data:`FILL` metres of a cell holding any
+  point. Gaps narrower than twice that are bridged (the ground under a roof, a patch
+  without returns); beyond it (outside a survey's footprint, a lake without returns)
+  there is no surface: the mesh has a hole there, as the tile has;
 * **objects**: the connected cells of one class (8-neighbours) are one object, so the
   obstacle and landing studies have truth. ASPRS 6 is ``building``, 5 ``tree``, 3 and 4
   ``vegetation``, any other class above the ground ``object`` (e.g. vegetation a survey
@@ -33,10 +37,13 @@ from alte.errors import ParameterError
 from alte.sim.real.tiles import Tile
 from alte.sim.scene import Scene, SceneObject
 
-__all__ = ["CLASS_OF", "MIN_OBJECT", "Surfaces", "grid_step", "grid_surfaces", "surface_mesh"]
+__all__ = ["CLASS_OF", "FILL", "MIN_OBJECT", "Surfaces", "grid_step", "grid_surfaces",
+           "surface_mesh"]
 
 #: ASPRS class -> object class of the ground truth (others above the ground: ``object``).
 CLASS_OF = {3: "vegetation", 4: "vegetation", 5: "tree", 6: "building"}
+#: Distance (m) from the nearest point within which a cell has a surface.
+FILL = 5.0
 #: Least height (m) of an object cell above the bare earth: lower ones (grass, kerbs) are
 #: ground a vehicle may land on.
 MIN_OBJECT = 0.2
@@ -56,6 +63,7 @@ class Surfaces:
     label: NDArray[np.int32]
     objects: tuple[SceneObject, ...]
     measured: NDArray[np.bool_]
+    covered: NDArray[np.bool_]
 
     @property
     def shape(self) -> tuple[int, int]:
@@ -84,7 +92,10 @@ def grid_step(tiles: list[Tile]) -> float:
 
 
 def _index(tiles: list[Tile], step: float) -> tuple[float, float, tuple[int, int]]:
-    lo = np.min([t.points[:, :2].min(axis=0) for t in tiles], axis=0) - 0.5 * step
+    low = np.min([t.points[:, :2].min(axis=0) for t in tiles], axis=0)
+    # A DEM's cell centres are the grid's; points fall in cells on multiples of the step.
+    raster = any(t.cell is not None for t in tiles)
+    lo = low - 0.5 * step if raster else np.floor(low / step) * step
     hi = np.max([t.points[:, :2].max(axis=0) for t in tiles], axis=0)
     nx, ny = (np.floor((hi - lo) / step).astype(int) + 1).tolist()
     if nx * ny > 25_000_000:
@@ -175,12 +186,16 @@ def grid_surfaces(tiles: list[Tile], step: float | None = None,
     names[~is_object] = "ground"
     label, objects = _objects(names.reshape(shape))
     top = np.where(is_object, high, bare.ravel()).reshape(shape)
-    return Surfaces(x0, y0, step, bare, top, label, tuple(objects), measured)
+    held = (np.bincount(cell, minlength=size) > 0).reshape(shape)
+    reach = int(np.ceil(FILL / step))
+    covered = ndimage.binary_dilation(held, np.ones((3, 3), bool), iterations=reach)
+    return Surfaces(x0, y0, step, bare, top, label, tuple(objects), measured, covered)
 
 
 def surface_mesh(surfaces: Surfaces, origin: NDArray[np.float64]) -> Scene:
     """The object surface as a labelled triangle mesh in local coordinates (``origin``
-    subtracted); objects without a triangle of their own are left out."""
+    subtracted), over the covered cells; objects without a triangle of their own are
+    left out."""
     ny, nx = surfaces.shape
     xs, ys = surfaces.axes()
     gx, gy = np.meshgrid(xs - origin[0], ys - origin[1])
@@ -189,6 +204,7 @@ def surface_mesh(surfaces: Surfaces, origin: NDArray[np.float64]) -> Scene:
     a, b = idx[:-1, :-1].ravel(), idx[:-1, 1:].ravel()
     c, d = idx[1:, :-1].ravel(), idx[1:, 1:].ravel()
     triangles = np.vstack([np.column_stack([a, b, d]), np.column_stack([a, d, c])])
+    triangles = triangles[surfaces.covered.ravel()[triangles].all(axis=1)]
     corner = np.argmax(vertices[triangles, 2], axis=1)
     owner = surfaces.label.ravel()[triangles[np.arange(len(triangles)), corner]]
     used, ids = np.unique(owner, return_inverse=True)
