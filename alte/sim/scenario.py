@@ -61,9 +61,9 @@ def get_terrain(name: str, data_dir: str | os.PathLike[str] | None = None) -> Te
         from alte.sim.real.importer import imported_terrain
 
         return imported_terrain(folder)
-    where = f" nor a terrain imported into {data_dir}" if data_dir is not None else ""
-    raise SimulationError(f"unknown terrain {name!r}{where}; valid: {', '.join(TERRAINS)}, or "
-                          "import one with `alte simulate TILE.laz --out DIR`")
+    where = f" in {data_dir}" if data_dir is not None else ""
+    raise SimulationError(f"unknown terrain {name!r}; valid: {', '.join(TERRAINS)}, or a "
+                          f"terrain imported{where} (`alte simulate TILE.laz --out DIR`)")
 
 
 def profile_label(profile: SensorProfile) -> str:
