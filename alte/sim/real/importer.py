@@ -98,7 +98,10 @@ def import_terrain(paths: Sequence[str | os.PathLike[str]], flight: Flight | Non
     xs, ys = surfaces.axes()
     corners = np.array([[xs[0], ys[0], surfaces.ground.min()],
                         [xs[-1], ys[-1], surfaces.top.max()]])
-    origin = local_origin(corners) * np.array([1.0, 1.0, 0.0])  # heights stay heights
+    # x, y: the centre to 1 km as every georeferenced cloud in alte; heights above a
+    # round datum (100 m below the lowest ground), so the pipeline's own local frame
+    # (its 1 km origin) leaves them where they are.
+    origin = np.r_[local_origin(corners)[:2], np.floor(corners[0, 2] / 100.0) * 100.0]
     scene = surface_mesh(surfaces, origin)
     platform, frames, flight = flight_plan(surfaces, origin, flight)
     stem = name or f"{Path(paths[0]).stem.replace('-', '_')}_{flight.case}"

@@ -29,7 +29,9 @@ def flat_flight(tmp_path_factory):
 
 def test_dem_round_trip_measures_the_error_known_by_construction(flat_flight):
     data, imported = flat_flight
-    assert np.allclose(data.cloud[:, 2], PLANE, atol=1e-4)  # the sensor saw the DEM
+    datum = imported.origin[2]
+    assert datum == 200.0 and imported.source["origin_m"][2] == 200.0
+    assert np.allclose(data.cloud[:, 2] + datum, PLANE, atol=1e-4)  # the sensor saw the DEM
     # A 2D map's cells hold the mean height of noise-free points on a plane: no error.
     heights = measure(data, "alte2d", {"max_res": 5, "min_pts": 10}, truth=TruthOptions())
     assert heights.metrics.truth.height_rmse_m == pytest.approx(0.0, abs=1e-4)
@@ -41,7 +43,7 @@ def test_dem_round_trip_measures_the_error_known_by_construction(flat_flight):
     cells = voxels.mapper.cells()
     centres = cells.centers[cells.occupied.astype(bool)]
     assert voxels.metrics.truth.accuracy_mean_m == pytest.approx(
-        np.mean(np.abs(centres[:, 2] - PLANE)), abs=1e-4)
+        np.mean(np.abs(centres[:, 2] + datum - PLANE)), abs=1e-4)
     assert imported.source["altitude_m"] == 10.0  # the thesis' landing altitude
 
 
@@ -53,7 +55,7 @@ def test_imported_folder_is_a_terrain_every_entry_point_reads(tmp_path):
     assert folder.name == "field-5f"
     meta = json.loads((folder / "scenario.json").read_text())
     assert meta["kind"] == "real" and meta["case"] == "nav"
-    assert meta["source"]["origin_m"] == [X0, Y0, 0.0]
+    assert meta["source"]["origin_m"] == [X0, Y0, 200.0]
     assert meta["source"]["units"]["crs"] == "EPSG:32632"
     assert {o["class"] for o in meta["objects"]} == {"ground", "building"}
     assert set(meta["files"]) >= {"bare_earth.npz", "ground_truth.ply"}
@@ -71,7 +73,7 @@ def test_flight_climbs_over_objects_and_follows_the_ground(tmp_path):
     pts, cls = field()
     tile = write_las(tmp_path / "field.las", pts, cls)
     imported = import_terrain([tile], Flight(altitude=6.0, clearance=4.0), cell=1.0)
-    heights = np.asarray(imported.terrain.spec.platform.heights)
+    heights = np.asarray(imported.terrain.spec.platform.heights) + imported.origin[2]
     # 6 m above the ground, 4 m above the 8 m roof wherever the roof is within reach.
     assert heights.min() == pytest.approx(250.0 + 6.0, abs=0.3)
     assert heights.max() == pytest.approx(250.0 + 8.0 + 4.0, abs=0.3)

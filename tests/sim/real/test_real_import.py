@@ -37,7 +37,7 @@ def test_las_and_laz_give_bare_earth_object_surface_and_objects(tmp_path, suffix
     tile = write_las(tmp_path / f"field{suffix}", pts, cls)
     imported = import_terrain([tile], Flight(), cell=1.0)
     s = imported.surfaces
-    assert np.allclose(s.ground + imported.origin[2], GROUND_Z, atol=1e-3)  # under the roof too
+    assert np.allclose(s.ground, GROUND_Z, atol=1e-3)  # under the roof too
     height, cells = _building(imported)
     assert height == pytest.approx(ROOF, abs=1e-3)
     assert cells == 36  # 6 m x 6 m at 1 m
@@ -47,7 +47,8 @@ def test_las_and_laz_give_bare_earth_object_surface_and_objects(tmp_path, suffix
     assert len(meta["tiles"][0]["sha256"]) == 64
     truth = imported.terrain.scene
     assert {o.cls for o in truth.objects} == {"ground", "building"}
-    assert truth.vertices[:, 2].max() == pytest.approx(GROUND_Z + ROOF, abs=1e-3)
+    top = truth.vertices[:, 2].max() + imported.origin[2]
+    assert top == pytest.approx(GROUND_Z + ROOF, abs=1e-3)
 
 
 def test_isprs_style_pair_takes_its_ground_from_the_second_file(tmp_path):
@@ -70,7 +71,7 @@ def test_dem_rasters_are_the_bare_earth_at_their_own_cells(tmp_path, suffix):
     s = imported.surfaces
     assert s.step == 2.0 and s.shape == (30, 40)
     expected = height[::-1]  # rasters run north to south, the grid south to north
-    got = s.ground + imported.origin[2]
+    got = s.ground
     known = np.isfinite(expected)
     assert np.allclose(got[known], expected[known], atol=1e-9)
     assert got[-1, 0] == pytest.approx(GROUND_Z + 2.9, abs=0.15)  # the nodata cell, filled
@@ -87,7 +88,7 @@ def test_a_tile_in_us_feet_comes_out_in_metres(tmp_path):
     assert imported.source["units"]["horizontal_m_per_unit"] == pytest.approx(US_FOOT)
     xs, _ = s.axes()
     assert xs[-1] - xs[0] == pytest.approx((SIDE - 0.5) * US_FOOT, abs=1.0)
-    assert np.median(s.ground) + imported.origin[2] == pytest.approx(GROUND_Z * US_FOOT, abs=1e-3)
+    assert np.median(s.ground) == pytest.approx(GROUND_Z * US_FOOT, abs=1e-3)
     height, _ = _building(imported)
     assert height == pytest.approx(ROOF * US_FOOT, abs=1e-3)
 
