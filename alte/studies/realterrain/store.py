@@ -1,0 +1,80 @@
+"""The committed real-terrain evidence: made once by one command, read by the report.
+
+``python -m alte.studies.realterrain [FOLDER]`` runs :func:`~alte.studies.realterrain.
+evidence.evidence_rows` on every shared site (``../shared/realdata``) and writes
+``FOLDER/realterrain_fronts.csv`` with ``provenance.json`` (the command, commit, sites
+and their tiles, seeds, scans, CPU and wall seconds, the machine). The default folder is
+:data:`EVIDENCE` (committed); ``make report`` reads it (:func:`load_evidence`) and
+copies the table into the run's tables, never recomputing it.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import sys
+import time
+from datetime import UTC, datetime
+from pathlib import Path
+
+import pandas as pd
+
+from alte.paths import realdata_dir, resolve
+from alte.studies.analysis.tables import write_csv
+from alte.studies.missions import git_commit
+from alte.studies.realterrain.evidence import GRID, evidence_rows
+from alte.studies.realterrain.sites import SITES
+
+__all__ = ["EVIDENCE", "TABLE", "load_evidence", "main", "write_evidence"]
+
+#: Where the evidence is committed (relative to the repository root).
+EVIDENCE = Path("notebooks/realterrain")
+#: The table's name (CSV stem), in the evidence folder and in a report's tables.
+TABLE = "realterrain_fronts"
+
+
+def write_evidence(folder: str | os.PathLike[str] = EVIDENCE, *, seeds: tuple[int, ...] = (0, 1, 2),
+                   frames: int = 20, data_dir: str | os.PathLike[str] = "data/real",
+                   command: str = "") -> Path:
+    """Run the evidence on every site present and write the folder (module docstring)."""
+    where = resolve(folder)
+    root = realdata_dir()
+    start, cpu, began = time.perf_counter(), time.process_time(), datetime.now(UTC)
+    table = evidence_rows(root, resolve(data_dir), seeds=seeds, frames=frames)
+    path = write_csv(table, where, TABLE, overwrite=True)
+    provenance = {
+        "command": command or "python -m alte.studies.realterrain", "commit": git_commit(),
+        "sites": [{"name": s.name, "tiles": list(s.tiles), "region": s.region,
+                   "crs": s.crs, "ground": s.ground, "note": s.note} for s in SITES],
+        "seeds": list(seeds), "frames": frames, "grid": GRID, "rows": len(table),
+        "cpu_s": round(time.process_time() - cpu, 1),
+        "wall_s": round(time.perf_counter() - start, 1), "started": began.isoformat(),
+        "finished": datetime.now(UTC).isoformat(),
+        "machine": {"platform": platform.platform(), "cpus": os.cpu_count()}}
+    (where / "provenance.json").write_text(json.dumps(provenance, indent=2) + "\n")
+    return path
+
+
+def load_evidence(folder: str | os.PathLike[str] = EVIDENCE) -> pd.DataFrame | None:
+    """The committed table (None when absent)."""
+    path = resolve(folder) / f"{TABLE}.csv"
+    return pd.read_csv(path) if path.is_file() else None
+
+
+def main(argv: list[str] | None = None) -> int:
+    """``python -m alte.studies.realterrain [FOLDER] [--seeds 0,1,2] [--frames 20]``."""
+    p = argparse.ArgumentParser(prog="python -m alte.studies.realterrain",
+                                description=__doc__)
+    p.add_argument("folder", nargs="?", default=str(EVIDENCE))
+    p.add_argument("--seeds", default="0,1,2")
+    p.add_argument("--frames", type=int, default=20)
+    p.add_argument("--data", default="data/real", help="where the flown terrains go")
+    args = p.parse_args(argv)
+    seeds = tuple(int(s) for s in args.seeds.split(","))
+    path = write_evidence(args.folder, seeds=seeds, frames=args.frames, data_dir=args.data,
+                          command=" ".join(["python -m alte.studies.realterrain",
+                                            *(argv if argv is not None else sys.argv[1:])]))
+    print(f"wrote {path}")
+    return 0
