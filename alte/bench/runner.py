@@ -21,6 +21,7 @@ from alte.bench.core import BenchConfig, Context, Result
 from alte.bench.maps import batch_builds, insert_latency, octomap_memory, octomap_speed
 from alte.bench.memory import map_memory
 from alte.bench.poses import pose_speed
+from alte.bench.realterrain import real_terrain
 from alte.bench.scaling import scaling
 from alte.bench.stream import scan_peer, streaming_chain
 from alte.bench.sweep import sweep_throughput
@@ -49,6 +50,7 @@ ROWS: dict[int, tuple[str, Row]] = {
     12: ("odometry / refinement per real scan vs kiss-icp's pipeline", pose_speed),
     13: ("sweep runs per core-second (20 scans, whole missions) and the grid's time",
          sweep_throughput),
+    14: ("a real LiDAR tile imported and flown vs a built-in mission simulated", real_terrain),
 }
 
 

@@ -15,8 +15,14 @@ from alte.studies.realterrain.sites import (
     surface_figures,
     terrain_class,
 )
-from alte.studies.realterrain.store import EVIDENCE, TABLE, load_evidence, write_evidence
+from alte.studies.realterrain.store import (
+    EVIDENCE,
+    TABLE,
+    load_evidence,
+    summary,
+    write_evidence,
+)
 
 __all__ = ["CLASSES", "COLUMNS", "EVIDENCE", "GRID", "HOLD_BACK", "SITES", "TABLE", "Site",
-           "evidence_rows", "load_evidence", "site_rows", "surface_figures", "terrain_class",
-           "write_evidence"]
+           "evidence_rows", "load_evidence", "site_rows", "summary", "surface_figures",
+           "terrain_class", "write_evidence"]

@@ -24,10 +24,10 @@ import pandas as pd
 from alte.paths import realdata_dir, resolve
 from alte.studies.analysis.tables import write_csv
 from alte.studies.missions import git_commit
-from alte.studies.realterrain.evidence import GRID, evidence_rows
+from alte.studies.realterrain.evidence import COLUMNS, GRID, evidence_rows
 from alte.studies.realterrain.sites import SITES
 
-__all__ = ["EVIDENCE", "TABLE", "load_evidence", "main", "write_evidence"]
+__all__ = ["EVIDENCE", "TABLE", "load_evidence", "main", "summary", "write_evidence"]
 
 #: Where the evidence is committed (relative to the repository root).
 EVIDENCE = Path("notebooks/realterrain")
@@ -57,10 +57,33 @@ def write_evidence(folder: str | os.PathLike[str] = EVIDENCE, *, seeds: tuple[in
     return path
 
 
-def load_evidence(folder: str | os.PathLike[str] = EVIDENCE) -> pd.DataFrame | None:
-    """The committed table (None when absent)."""
+def load_evidence(folder: str | os.PathLike[str] = EVIDENCE) -> pd.DataFrame:
+    """The committed table (empty when absent)."""
     path = resolve(folder) / f"{TABLE}.csv"
-    return pd.read_csv(path) if path.is_file() else None
+    return pd.read_csv(path) if path.is_file() else pd.DataFrame(columns=list(COLUMNS))
+
+
+def summary(table: pd.DataFrame) -> pd.DataFrame:
+    """Per terrain, evidence and mapper: its class, the mapper's best truth (mean over
+    seeds of a setting; landing: height RMSE, navigation: mean accuracy among settings
+    covering at least half the surface) and that setting's size and completeness."""
+    if table.empty:
+        return pd.DataFrame()
+    rows = []
+    keys = ["terrain", "terrain_class", "evidence", "case", "mapper"]
+    for key, part in table.groupby(keys, sort=True):
+        metric = "height_rmse_m" if key[3] == "lan" else "accuracy_mean_m"
+        means = part.groupby("params")[[metric, "completeness", "basis_functions"]].mean()
+        fit = means if key[3] == "lan" else means[means["completeness"] >= 0.5]
+        fit = fit.dropna(subset=[metric])
+        if fit.empty:
+            continue
+        best = fit.sort_values(metric).iloc[0]
+        rows.append({**dict(zip(keys, key, strict=True)), "metric": metric,
+                     "best": best[metric], "completeness": best["completeness"],
+                     "basis_functions": best["basis_functions"],
+                     "seeds": int(part["seed"].nunique())})
+    return pd.DataFrame(rows)
 
 
 def main(argv: list[str] | None = None) -> int:
