@@ -66,11 +66,10 @@ def class_checks(grid: pd.DataFrame, real: pd.DataFrame | None, use: Use) -> lis
     terrains of ``grid`` (module docstring); [] without real-terrain rows."""
     if real is None or real.empty or "terrain_class" not in real:
         return []
-    cases = grid["case"] if "case" in grid else pd.Series("", index=grid.index)
-    simulated = grid[(cases == use.case)
+    simulated = grid[grid["mapper"].isin(use.mappers)
                      & grid["terrain"].astype(str).str.startswith(GROUPS["simulated"])]
     builtin = order(simulated, use, use.truth)
-    mine = real[real["case"] == use.case]
+    mine = real[real["mapper"].isin(use.mappers)]  # the use's maps are of its case
     known = [c for c in CLASS_ORDER if c in set(mine["terrain_class"])]
     out = []
     for cls in [*known, *sorted(set(mine["terrain_class"]) - set(CLASS_ORDER))]:
