@@ -11,8 +11,8 @@ For each :class:`~alte.studies.realterrain.sites.Site` the tiles are imported on
   terrains, with the landing maps' obstacle identification against its objects;
 * **(b) points** (``evidence = points``): the tile's own points are mapped, with a seeded
   random 20 % of them (every class) held back: the maps are made of the other 80 %
-  (seen from 300 m above the tile's centre, an airborne sensor: Octomap's rays then
-  unlimited in range) and scored against the
+  (seen from 100 m above the tile's highest point over its centre, an airborne sensor:
+  Octomap's rays then unlimited in range, its finest voxel 0.5 m) and scored against the
   held-back points as the real sequence's fronts are (:func:`~alte.studies.realdata.
   reference_metrics`: distance of the cells to the nearest held-back point, 3D
   completeness, 2D height RMSE against the highest held-back point per 1 m pixel), and
@@ -159,10 +159,12 @@ def _points(site: Site, root: Path, case: str, seed: int,
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         path = write_points(Path(tmp) / "kept.npz", kept)
-        above = (*np.mean(kept[:, :2], axis=0).tolist(), float(kept[:, 2].max()) + 300.0)
+        above = (*np.mean(kept[:, :2], axis=0).tolist(), float(kept[:, 2].max()) + 100.0)
         data = prepare(open_input(path), FrameSpec(origin=above))
         for mapper, setting in _grid(case, grid):
             # An airborne sensor: Octomap's rays longer than a VLP-16's.
+            if mapper == "octomap" and float(setting["resolution"]) > 2.0:
+                continue  # 0.25 m voxels along 100 m rays: millions of free leaves
             params = {**setting, "max_range": -1.0} if mapper == "octomap" else setting
             found = measure(data, mapper, spec=MapSpec(mapper, params,
                                                        domain=DomainPolicy.DATA))

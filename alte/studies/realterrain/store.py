@@ -35,14 +35,25 @@ EVIDENCE = Path("notebooks/realterrain")
 TABLE = "realterrain_fronts"
 
 
-def write_evidence(folder: str | os.PathLike[str] = EVIDENCE, *, seeds: tuple[int, ...] = (0, 1, 2),
-                   frames: int = 20, data_dir: str | os.PathLike[str] = "data/real",
-                   command: str = "") -> Path:
-    """Run the evidence on every site present and write the folder (module docstring)."""
+def write_evidence(folder: str | os.PathLike[str] = EVIDENCE, *,
+                   seeds: tuple[int, ...] = (0, 1), frames: int = 20,
+                   data_dir: str | os.PathLike[str] = "data/real", command: str = "",
+                   only: list[str] | None = None) -> Path:
+    """Run the evidence on every site present (or those named ``only``) and write the
+    folder (module docstring); each site's rows are kept in ``FOLDER/sites/`` as it
+    finishes, so a rerun does only the sites missing (delete them to redo)."""
     where = resolve(folder)
     root = realdata_dir()
     start, cpu, began = time.perf_counter(), time.process_time(), datetime.now(UTC)
-    table = evidence_rows(root, resolve(data_dir), seeds=seeds, frames=frames)
+    parts = where / "sites"
+    for site in [s for s in SITES if s.name in (only or [s.name for s in SITES])]:
+        done = parts / f"{site.name}.csv"  # each site kept as it finishes: a rerun resumes
+        if not done.is_file():
+            rows = evidence_rows(root, resolve(data_dir), sites=(site,), seeds=seeds,
+                                 frames=frames, progress=False)
+            write_csv(rows, parts, site.name, overwrite=True)
+    table = pd.concat([pd.read_csv(p) for p in sorted(parts.glob("*.csv"))],
+                      ignore_index=True)
     path = write_csv(table, where, TABLE, overwrite=True)
     provenance = {
         "command": command or "python -m alte.studies.realterrain", "commit": git_commit(),
@@ -87,16 +98,19 @@ def summary(table: pd.DataFrame) -> pd.DataFrame:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """``python -m alte.studies.realterrain [FOLDER] [--seeds 0,1,2] [--frames 20]``."""
+    """``python -m alte.studies.realterrain [FOLDER] [--seeds 0,1] [--frames 20] [--sites A,B]``."""
     p = argparse.ArgumentParser(prog="python -m alte.studies.realterrain",
                                 description=__doc__)
     p.add_argument("folder", nargs="?", default=str(EVIDENCE))
-    p.add_argument("--seeds", default="0,1,2")
+    p.add_argument("--seeds", default="0,1")
+    p.add_argument("--sites", default=None, help="comma-separated site names (default: all)")
     p.add_argument("--frames", type=int, default=20)
     p.add_argument("--data", default="data/real", help="where the flown terrains go")
     args = p.parse_args(argv)
     seeds = tuple(int(s) for s in args.seeds.split(","))
+    only = args.sites.split(",") if args.sites else None
     path = write_evidence(args.folder, seeds=seeds, frames=args.frames, data_dir=args.data,
+                          only=only,
                           command=" ".join(["python -m alte.studies.realterrain",
                                             *(argv if argv is not None else sys.argv[1:])]))
     print(f"wrote {path}")

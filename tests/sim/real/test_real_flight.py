@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 from support.tiles import X0, Y0, field, write_dem, write_las
 
+from alte.errors import ParameterError, SimulationError
 from alte.metrics.options import TruthOptions
 from alte.pipeline import open_input, prepare
 from alte.sim import VLP16, load_scenario, simulate, write_scenario
@@ -65,7 +66,7 @@ def test_imported_folder_is_a_terrain_every_entry_point_reads(tmp_path):
                   truth=TruthOptions())
     assert run.metrics.truth.completeness_by_class["building"] > 0.3
     assert run.metrics.truth.completeness_seen > 0.9
-    with pytest.raises(Exception, match="exists"):
+    with pytest.raises(SimulationError, match=r"exists .*--force"):
         write_imported(imported, tmp_path / "data", frames=5)
 
 
@@ -77,3 +78,26 @@ def test_flight_climbs_over_objects_and_follows_the_ground(tmp_path):
     # 6 m above the ground, 4 m above the 8 m roof wherever the roof is within reach.
     assert heights.min() == pytest.approx(250.0 + 6.0, abs=0.3)
     assert heights.max() == pytest.approx(250.0 + 8.0 + 4.0, abs=0.3)
+
+
+def test_the_trade_off_grid_runs_on_an_imported_terrain(tmp_path):
+    """A sweep names the imported terrain like a built-in one: other seeds and scan
+    counts of its mission are flown from the folder, every map is measured on its truth."""
+    from alte.studies.grid import tradeoff_table
+    from alte.studies.sweep import parse_spec, run_sweep
+
+    pts, cls = field()
+    tile = write_las(tmp_path / "field.laz", pts, cls)
+    data = tmp_path / "data"
+    write_imported(import_terrain([tile], Flight(), name="field_lan"), data)
+    spec = parse_spec({"terrains": ["field_lan"], "frames": 4, "seeds": [0, 1],
+                       "data_dir": str(data), "obstacles": True,
+                       "mappers": {"quadtree": {"grid": {"max_points": [25, 200]}}}}, "test")
+    result = run_sweep(spec, scheduler="serial", output=tmp_path / "out", progress=False)
+    table = tradeoff_table(result.table)
+    assert len(table) == 4 and set(table["case"]) == {"lan"}
+    assert table["height_rmse_m"].notna().all() and (table["height_rmse_m"] < 1.0).all()
+    assert (data / "field_lan-4f-s1" / "scenario.json").is_file()
+    with pytest.raises(ParameterError, match=r"unknown terrain.*imported into"):
+        parse_spec({"terrains": ["moon"], "data_dir": str(data),
+                    "mappers": {"quadtree": {"grid": {"max_points": [25]}}}}, "test")
