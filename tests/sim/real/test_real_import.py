@@ -144,7 +144,10 @@ def test_cli_errors_are_one_line_naming_the_flag(tmp_path, capsys):
     nocrs = write_las(tmp_path / "nocrs.las", pts, cls, crs=None)
     raw = write_las(tmp_path / "raw.las", pts, np.ones(len(pts), np.uint8))
     dem = write_dem(tmp_path / "empty.asc", np.full((5, 5), np.nan))
+    degrees = write_las(tmp_path / "degrees.las", pts, cls, crs="EPSG:4326")
+    pcd = write_points(tmp_path / "all.pcd", pts)
     cases = [([str(nocrs)], "--crs"), ([str(raw)], "--ground-class"), ([str(dem)], "nodata"),
+             ([str(degrees)], "geographic (degrees)"), ([str(pcd)], "--ground FILE"),
              ([str(raw), "--ground-class", "1", "--altitude", "-2"], "--altitude -2.0"),
              ([str(raw), "--ground-class", "1", "--region", "1,2,3"], "--region")]
     for args, flag in cases:
