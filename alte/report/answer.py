@@ -122,7 +122,8 @@ _CSS = {"holds": "holds", "does not hold": "fails", "cannot tell": "depends"}
 def _class_row(check: ClassCheck) -> ClassRow:
     return ClassRow(check.terrain_class, ", ".join(check.real.terrains),
                     _EVIDENCE.get(check.evidence, check.evidence),
-                    check.real.text(where=False), check.verdict, _CSS[check.verdict])
+                    f"{metric_words(check.metric)}: {check.real.text(where=False)} (built-in: "
+                    f"{check.builtin.text(where=False)})", check.verdict, _CSS[check.verdict])
 
 
 def _use(found: UseAnswer, sequence: str) -> UseView:
@@ -130,7 +131,8 @@ def _use(found: UseAnswer, sequence: str) -> UseView:
     title = (f"{found.use.name.capitalize()}: {names}, ranked by "
              f"{metric_words(found.use.truth)}")
     orders = [f"{metric_words(o.metric)}: {o.text()}" for o in found.orders]
-    builtin = found.classes[0].builtin.text(where=False) if found.classes else ""
+    builtin = "; ".join(dict.fromkeys(
+        f"{metric_words(c.metric)}: {c.builtin.text(where=False)}" for c in found.classes))
     return UseView(title, found.summary, found.disagreement, [_row(c) for c in found.choices],
                    orders, [check.text(sequence) for check in found.real], found.real_why,
                    [_class_row(c) for c in found.classes], builtin)

@@ -5,9 +5,10 @@ has the trade-off table's schema with a ``terrain_class`` (flat open, flat under
 slope, steep, built-up) and an ``evidence`` (``flown``: the thesis' missions flown over
 the real surface, exact truth; ``points``: the tile's own points mapped, scored on a
 held-back 20 %). For each use, class and evidence, :func:`class_checks` reads the order
-of the use's two mappers at equal size by the use's truth metric on that class's
-terrains (:func:`~alte.studies.answer.orders.order`) and sets it beside the order on
-the simulated built-in terrains: the built-in answer *holds* there when both name the
+of the use's two mappers at equal size by the use's truth metric (navigation: also by
+completeness, which mean accuracy alone does not see) on that class's terrains
+(:func:`~alte.studies.answer.orders.order`) and sets it beside the order on the
+simulated built-in terrains: the built-in answer *holds* there when both name the
 same leader, *does not hold* when they name different ones, and cannot be told when
 either names none.
 
@@ -25,6 +26,7 @@ import pandas as pd
 
 from alte.studies.answer.choose import GROUPS, Use
 from alte.studies.answer.orders import Order, agreement, metric_words, order
+from alte.studies.thesis.numbers import TERRAIN_CASE
 
 __all__ = ["CLASS_ORDER", "RANKS_WITHIN", "ClassCheck", "class_checks", "sequence_ranks"]
 
@@ -49,6 +51,11 @@ class ClassCheck:
     holds: bool | None
 
     @property
+    def metric(self) -> str:
+        """The metric both orders read."""
+        return self.real.metric
+
+    @property
     def verdict(self) -> str:
         """``holds``, ``does not hold`` or ``cannot tell``."""
         return {True: "holds", False: "does not hold", None: "cannot tell"}[self.holds]
@@ -57,7 +64,7 @@ class ClassCheck:
         """The check in one sentence."""
         where = ", ".join(self.real.terrains) or "no terrain"
         return (f"{self.terrain_class} ({where}; {_EVIDENCE.get(self.evidence, self.evidence)})"
-                f": {metric_words(self.use.truth)} at equal size {self.real.text(where=False)}"
+                f": {metric_words(self.metric)} at equal size {self.real.text(where=False)}"
                 f"; built-in: {self.builtin.text(where=False)}: {self.verdict}.")
 
 
@@ -66,20 +73,22 @@ def class_checks(grid: pd.DataFrame, real: pd.DataFrame | None, use: Use) -> lis
     terrains of ``grid`` (module docstring); [] without real-terrain rows."""
     if real is None or real.empty or "terrain_class" not in real:
         return []
-    simulated = grid[grid["mapper"].isin(use.mappers)
+    cases = grid["case"] if "case" in grid else grid["terrain"].map(TERRAIN_CASE)
+    simulated = grid[(cases == use.case) & grid["mapper"].isin(use.mappers)
                      & grid["terrain"].astype(str).str.startswith(GROUPS["simulated"])]
-    builtin = order(simulated, use, use.truth)
+    # Navigation is also read by completeness: accuracy alone favours maps covering little.
+    metrics = [use.truth, *(["completeness"] if use.second == "completeness" else [])]
+    builtin = {m: order(simulated, use, m) for m in metrics}
     mine = real[real["mapper"].isin(use.mappers)]  # the use's maps are of its case
     known = [c for c in CLASS_ORDER if c in set(mine["terrain_class"])]
     out = []
     for cls in [*known, *sorted(set(mine["terrain_class"]) - set(CLASS_ORDER))]:
         for evidence in ("flown", "points"):
             rows = mine[(mine["terrain_class"] == cls) & (mine["evidence"] == evidence)]
-            if rows.empty:
-                continue
-            there = order(rows, use, use.truth)
-            out.append(ClassCheck(use, str(cls), evidence, there, builtin,
-                                  agreement(builtin, there)))
+            for metric in metrics if not rows.empty else []:
+                there = order(rows, use, metric)
+                out.append(ClassCheck(use, str(cls), evidence, there, builtin[metric],
+                                      agreement(builtin[metric], there)))
     return out
 
 
