@@ -18,6 +18,7 @@ from tqdm.auto import tqdm
 
 from alte.bench.clouds import cloud_stages, hausdorff_speed
 from alte.bench.core import BenchConfig, Context, Result
+from alte.bench.ground import ground_speed
 from alte.bench.maps import batch_builds, insert_latency, octomap_memory, octomap_speed
 from alte.bench.memory import map_memory
 from alte.bench.poses import pose_speed
@@ -49,6 +50,7 @@ ROWS: dict[int, tuple[str, Row]] = {
     12: ("odometry / refinement per real scan vs kiss-icp's pipeline", pose_speed),
     13: ("sweep runs per core-second (20 scans, whole missions) and the grid's time",
          sweep_throughput),
+    14: ("ground stage per real tile vs pysmrf and CSF (CPU s)", ground_speed),
 }
 
 

@@ -19,7 +19,14 @@ from alte.commands.options import parse_key_values
 from alte.errors import ParameterError
 from alte.fsutil import refuse_overwrite
 from alte.ground.filters import filter_ground
-from alte.ground.settings import DEFAULT_METHOD, METHODS, SOURCES, ground_settings
+from alte.ground.settings import (
+    DEFAULT_METHOD,
+    DEFAULT_SETTINGS,
+    METHODS,
+    SOURCES,
+    GroundSettings,
+    ground_settings,
+)
 from alte.io.tiles import read_tile, tile_crs, write_classified
 
 __all__ = ["add_parser", "run"]
@@ -42,9 +49,10 @@ def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) 
     p.add_argument("input", type=Path, help="terrain tile: LAS/LAZ, PCD, PLY, npz or xyz")
     p.add_argument("--out", type=Path, required=True, metavar="OUTPUT",
                    help="the classified tile to write (.las or .laz)")
-    p.add_argument("--method", choices=list(METHODS), default=DEFAULT_METHOD,
-                   help=f"ground filter (default {DEFAULT_METHOD}, chosen on real data): "
-                        + "; ".join(f"{k}: {v}" for k, v in SOURCES.items()))
+    p.add_argument("--method", choices=list(METHODS), default=None,
+                   help="ground filter with its published defaults; default: "
+                        f"{DEFAULT_METHOD} with {DEFAULT_SETTINGS.as_dict()}, chosen on real "
+                        "data. " + "; ".join(f"{k}: {v}" for k, v in SOURCES.items()))
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", dest="sets",
                    help="the method's setting (repeatable), e.g. --set window=24; defaults: "
                         + _settings_help())
@@ -56,7 +64,8 @@ def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) 
     p.set_defaults(func=run)
 
 
-def _settings(args: argparse.Namespace) -> object:
+def _settings(args: argparse.Namespace) -> GroundSettings:
+    """The settings of ``--method`` / ``--set`` (errors name ``--set``)."""
     try:
         return ground_settings(args.method, parse_key_values(args.sets, "--set"))
     except ParameterError as err:
@@ -67,7 +76,8 @@ def _settings(args: argparse.Namespace) -> object:
 
 def run(args: argparse.Namespace) -> int:
     """Read, filter, write, print the summary."""
-    settings = ground_settings(args.method) if not args.sets else _settings(args)
+    settings = _settings(args)
+    method = args.method or DEFAULT_METHOD
     if args.out.suffix.lower() not in (".las", ".laz"):
         raise ParameterError(f"--out {args.out}: the output is LAS or LAZ (.las, .laz)")
     refuse_overwrite(args.out, args.force)
@@ -76,11 +86,11 @@ def run(args: argparse.Namespace) -> int:
     crs = tile_crs(tile, args.crs)
     read_s = time.perf_counter() - start
     start = time.perf_counter()
-    result = filter_ground(tile.points, args.method, settings)  # type: ignore[arg-type]
+    result = filter_ground(tile.points, method, settings)
     filter_s = time.perf_counter() - start
     provenance: dict[str, object] = {
-        "software": f"alte {__version__}", "method": args.method,
-        "settings": result.settings.as_dict(), "source": SOURCES[args.method],
+        "software": f"alte {__version__}", "method": method,
+        "settings": result.settings.as_dict(), "source": SOURCES[method],
         "input": str(args.input), "points": len(tile.points),
         "ground_points": int(result.ground.sum())}
     start = time.perf_counter()

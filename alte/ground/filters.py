@@ -227,11 +227,13 @@ def _plane(pts: NDArray[np.float64], s: PlaneSettings) -> _Run:
     return np.abs(pts[:, 2] - height) <= s.tolerance, height, tolerance
 
 
-def filter_ground(points: object, method: str = DEFAULT_METHOD,
+def filter_ground(points: object, method: str | None = None,
                   settings: GroundSettings | None = None) -> GroundResult:
-    """Run ``method`` with ``settings`` (None: :func:`ground_settings`'s defaults) on
-    (N, 3) points in metres; the cloud is shifted near the origin first (UTM-safe)."""
+    """Run ``method`` with ``settings`` on (N, 3) points in metres; no method: the ground
+    stage's default method and settings, no settings: the method's published defaults.
+    The cloud is shifted near the origin first (UTM-safe)."""
     chosen = settings if settings is not None else ground_settings(method)
+    method = method or DEFAULT_METHOD
     if not isinstance(chosen, type(ground_settings(method))):
         raise ParameterError(f"ground {method}: settings are {type(chosen).__name__}, not "
                              f"{type(ground_settings(method)).__name__}")

@@ -57,7 +57,7 @@ def test_a_point_file_becomes_classified_laz(scene: tuple[Path, np.ndarray], tmp
     assert las.header.parse_crs().to_epsg() == 32632
     provenance = read_provenance(out)
     assert provenance is not None and provenance["method"] == "smrf"
-    assert provenance["settings"] == {"cell": 1.0, "window": 18.0, "slope": 0.15,
+    assert provenance["settings"] == {"cell": 1.0, "window": 18.0, "slope": 0.10,
                                       "threshold": 0.5, "scalar": 1.25}
     assert "Pingel" in str(provenance["source"])
     # an existing output is kept unless --force

@@ -102,7 +102,9 @@ def test_published_defaults_are_pinned() -> None:
             package.class_threshold, package.interations) == (1.0, 3, True, 0.5, 500)
     assert package.time_step == pytest.approx(0.65)
     assert DEFAULT_METHOD in METHODS and isinstance(DEFAULT_SETTINGS, METHODS[DEFAULT_METHOD])
-    assert ground_settings(DEFAULT_METHOD) == DEFAULT_SETTINGS
+    assert ground_settings() == DEFAULT_SETTINGS  # the stage's choice on real data
+    assert ground_settings("smrf") == SmrfSettings()  # a named method: its publication's
+    assert SmrfSettings(slope=0.10) == DEFAULT_SETTINGS
 
 
 @pytest.mark.parametrize(("method", "given", "match"), [

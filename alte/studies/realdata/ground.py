@@ -1,20 +1,15 @@
-"""Map-based ground filter of airborne clouds and its scores (Sithole & Vosselman 2004).
+"""Map-based ground and its scores (Sithole & Vosselman 2004).
 
 A 2D map (2D-ALTE or Quadtree) gives every point the height of the leaf holding it
-(:func:`map_heights`); a raster of ``step`` metres keeps the lowest such height per
-pixel, and a grey-scale morphological opening with a ``window`` metre square
-(erosion then dilation, NaN-aware) turns it into the map's local minimum-height
-surface (:func:`opened_surface`): objects narrower than the window (buildings,
-trees) are cut off, planar slopes are kept exactly, except within half a window of
-the cloud's edge, where an uphill slope sags by up to slope x window / 2 (the
-window is truncated there). A point is ground when it lies
-within ``tolerance`` of that surface, above or below (:func:`classify_ground`).
-Fed raw point heights instead of leaf heights, the same steps are the classic
-morphological filter (Kilian et al. 1996), the baseline a map is judged against.
+(:func:`map_heights`); the ground filter (:mod:`alte.ground.filters`) run on those
+heights gives the map's bare earth, against which the raw points are judged with the
+filter's own tolerance, the same filter as on the raw points (the baseline a map is
+judged against). :func:`opened_surface` and :func:`classify_ground`, the morphological
+baseline's two steps, live in :mod:`alte.ground.filters` and are re-exported here.
 
 Scores (:func:`ground_errors`): type I = reference ground rejected / reference
 ground, type II = objects accepted as ground / objects, total = misclassified / all,
-all in per cent. Everything here takes and returns arrays.
+all in per cent, and Cohen's kappa. Everything here takes and returns arrays.
 """
 
 from __future__ import annotations
