@@ -8,6 +8,7 @@ import pytest
 
 from alte.errors import GroundError, ParameterError
 from alte.ground.filters import filter_ground, looks_gridded
+from alte.ground.obstacles import find_obstacles
 from alte.ground.settings import (
     DEFAULT_METHOD,
     DEFAULT_SETTINGS,
@@ -142,3 +143,24 @@ def test_a_dem_given_as_points_is_named() -> None:
     points, _ = slope_with_objects(size=20.0)
     assert looks_gridded(points) is None
     assert looks_gridded(np.round(points, 1)) is None  # quantised LiDAR is not a DEM
+
+
+def test_obstacles_stand_on_the_bare_earth(scene: tuple[np.ndarray, np.ndarray]) -> None:
+    """The boxes are obstacles of their own height above the slope; the hump is not one,
+    though it rises 1.5 m above a plane through the site."""
+    points, truth = scene
+    found = find_obstacles(points, tolerance=1.5, min_size=20)  # ~2 points/m^2
+    table = found.table
+    boxes = [(15.0, 40.0, 6.0), (45.0, 45.0, 4.0)]
+    for x, y, height in boxes:
+        near = np.hypot(table["x"] - x, table["y"] - y) < 3
+        assert near.sum() == 1, table
+        assert table.loc[near, "height"].iloc[0] == pytest.approx(height, abs=0.5)
+    obstacle = found.labels >= 0
+    hump = np.hypot(points[:, 0] - 40, points[:, 1] - 15) < 5
+    assert not (obstacle & hump & truth).any()
+    assert not (obstacle & truth).mean() > 0.01
+    with pytest.raises(ParameterError, match="ground csf gives no bare earth"):
+        find_obstacles(points, filter_ground(points, "csf"))
+    with pytest.raises(ParameterError, match="min_height=-1"):
+        find_obstacles(points, min_height=-1)
