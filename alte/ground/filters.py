@@ -38,6 +38,7 @@ from alte.errors import GroundError, ParameterError
 from alte.ground.plane import fit_plane_msac, height_above
 from alte.ground.settings import (
     DEFAULT_METHOD,
+    DEFAULT_SETTINGS,
     CsfSettings,
     GroundSettings,
     MorphSettings,
@@ -47,8 +48,8 @@ from alte.ground.settings import (
 )
 from alte.types import as_points
 
-__all__ = ["GroundResult", "check_cloud", "classify_ground", "filter_ground", "looks_gridded",
-           "opened_surface"]
+__all__ = ["GroundResult", "bare_earth_raster", "check_cloud", "classify_ground",
+           "filter_ground", "looks_gridded", "opened_surface"]
 
 #: Fewest points a filter accepts (a plane needs 3; a raster filter a few cells).
 MIN_POINTS = 3
@@ -253,3 +254,25 @@ def filter_ground(points: object, method: str | None = None,
     if height is not None:
         height = height + origin[2]
     return GroundResult(mask, height, tol, method, chosen, cpu)
+
+
+def bare_earth_raster(height: NDArray[np.float64], step: float, window: float,
+                      ) -> NDArray[np.float64]:
+    """The ground stage's filter (SMRF, :data:`DEFAULT_SETTINGS`) on a height raster: its
+    bare earth under every known pixel (NaN elsewhere). The pixel centres are the points
+    (a raster is a grid, so the DEM check does not apply); SMRF's cell is the pixel (at
+    least its 1 m) and its largest window radius half of ``window``, the side of the
+    widest object to remove."""
+    known = np.isfinite(height)
+    out = np.full(height.shape, np.nan)
+    if known.sum() < MIN_POINTS:
+        return out
+    rows, cols = np.nonzero(known)
+    pts = np.column_stack([cols * step, rows * step, height[known]])
+    base = DEFAULT_SETTINGS if isinstance(DEFAULT_SETTINGS, SmrfSettings) else SmrfSettings()
+    chosen = base.replace(cell=max(step, base.cell), window=max(window / 2, step))
+    origin = np.array([0.0, 0.0, float(np.floor(pts[:, 2].min()))])
+    _, bare, _ = _smrf(pts - origin, chosen)
+    assert bare is not None  # SMRF always gives its bare earth
+    out[known] = bare + origin[2]
+    return out
