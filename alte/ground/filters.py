@@ -257,22 +257,23 @@ def filter_ground(points: object, method: str | None = None,
 
 
 def bare_earth_raster(height: NDArray[np.float64], step: float, window: float,
-                      ) -> NDArray[np.float64]:
+                      ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """The ground stage's filter (SMRF, :data:`DEFAULT_SETTINGS`) on a height raster: its
-    bare earth under every known pixel (NaN elsewhere). The pixel centres are the points
-    (a raster is a grid, so the DEM check does not apply); SMRF's cell is the pixel (at
-    least its 1 m) and its largest window radius half of ``window``, the side of the
-    widest object to remove."""
+    bare earth under every known pixel and the rise its slope allows there (SMRF's
+    ``scalar x slope``; NaN elsewhere). The pixel centres are the points (a raster is a
+    grid, so the DEM check does not apply); SMRF's cell is the pixel (at least its 1 m)
+    and its largest window radius half of ``window``, the side of the widest object."""
     known = np.isfinite(height)
-    out = np.full(height.shape, np.nan)
+    out, rise = np.full(height.shape, np.nan), np.full(height.shape, np.nan)
     if known.sum() < MIN_POINTS:
-        return out
+        return out, rise
     rows, cols = np.nonzero(known)
     pts = np.column_stack([cols * step, rows * step, height[known]])
     base = DEFAULT_SETTINGS if isinstance(DEFAULT_SETTINGS, SmrfSettings) else SmrfSettings()
     chosen = base.replace(cell=max(step, base.cell), window=max(window / 2, step))
     origin = np.array([0.0, 0.0, float(np.floor(pts[:, 2].min()))])
-    _, bare, _ = _smrf(pts - origin, chosen)
-    assert bare is not None  # SMRF always gives its bare earth
+    _, bare, tolerance = _smrf(pts - origin, chosen)
+    assert bare is not None and tolerance is not None  # SMRF always gives both
     out[known] = bare + origin[2]
-    return out
+    rise[known] = tolerance - chosen.threshold
+    return out, rise

@@ -18,8 +18,8 @@ A known pixel of a height raster (NaN = unknown) is **landable** when
   morphological filter (Zhang et al. 2003), measured around each pixel. On flat ground
   a roof or a box keeps nearly the bare ``obstacle_height``; only the ring its own
   edges tilt adds to it. ``ground=filter`` takes the bare earth of the ground stage's
-  filter run on the raster (SMRF, :func:`alte.ground.filters.bare_earth_raster`), with
-  no allowance: SMRF's surface follows the slope.
+  filter run on the raster (SMRF, :func:`alte.ground.filters.bare_earth_raster`), the
+  allowance SMRF's own: its scaling factor times the bare earth's slope.
 
 :func:`classify_surface` applies it to every pixel at once (image filters, one
 vectorised pass); the landing study (:mod:`alte.studies.landing`) tests site centres
@@ -207,10 +207,10 @@ def _obstacles(height: NDArray[np.float64], origin: tuple[float, float] | NDArra
     if rule.ground == "filter":
         from alte.ground.filters import bare_earth_raster
 
-        bare = bare_earth_raster(height, step, rule.ground_window)
+        bare, rise = bare_earth_raster(height, step, rule.ground_window)
         with np.errstate(invalid="ignore"):
             above: NDArray[np.bool_] = np.isfinite(height) & (
-                np.nan_to_num(height - bare) > rule.obstacle_height)
+                np.nan_to_num(height - bare) > rule.obstacle_height + np.nan_to_num(rise))
         return above
     ground = local_ground(height, step, rule.ground_window)
     known = np.isfinite(height) & np.isfinite(slope_deg)
