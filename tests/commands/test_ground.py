@@ -140,4 +140,5 @@ def test_every_shared_tile_is_classified(tile: Path, tmp_path: Path) -> None:
     out = tmp_path / "out.laz"
     assert main(["ground", str(source), "--out", str(out)]) == 0
     classes = np.asarray(laspy.read(out).classification)
-    assert 0.05 < np.mean(classes == 2) < 1.0
+    assert set(np.unique(classes)) <= {1, 2}
+    assert np.mean(classes == 2) > 0.05  # (the farmland's centre is a bare field: all 2)
