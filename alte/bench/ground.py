@@ -15,6 +15,7 @@ dense forest 2) and no slower than pysmrf called directly (ratio ``LIMITS[14]``)
 from __future__ import annotations
 
 import time
+import warnings
 from collections.abc import Callable
 from functools import partial
 
@@ -35,9 +36,11 @@ def peer_smrf(points: NDArray[np.float64]) -> NDArray[np.bool_]:
     """pysmrf as its README shows it, with SMRF's published parameters."""
     import pysmrf
 
-    found = pysmrf.classify(points[:, 0], points[:, 1], points[:, 2], cellsize=1.0,
-                            windows=18, slope_threshold=0.15, elevation_threshold=0.5,
-                            elevation_scaler=1.25)
+    with warnings.catch_warnings():  # rasterio's own deprecation inside pysmrf: not ours
+        warnings.simplefilter("ignore", PendingDeprecationWarning)
+        found = pysmrf.classify(points[:, 0], points[:, 1], points[:, 2], cellsize=1.0,
+                                windows=18, slope_threshold=0.15, elevation_threshold=0.5,
+                                elevation_scaler=1.25)
     return np.asarray(found.is_ground, bool)
 
 

@@ -118,7 +118,7 @@ def test_config_and_row_selection_errors():
         BenchConfig(budget_s=0)
     with pytest.raises(ParameterError, match=r"unknown row\(s\) \[99\]"):
         select_rows([1, 99])
-    assert select_rows(None) == sorted(ROWS) == list(range(1, 14))
+    assert select_rows(None) == sorted(ROWS) == list(range(1, 15))
     assert BenchConfig(quick=True).scaling_sizes == (3000, 6000, 12000)
     assert BenchConfig().scaling_sizes[-1] == 10**7
 
