@@ -22,6 +22,7 @@ COMMANDS: dict[str, str] = {
     "map": "alte.commands.map",
     "info": "alte.commands.info",
     "export": "alte.commands.export",
+    "ground": "alte.commands.ground",
     "odometry": "alte.commands.odometry",
     "report": "alte.commands.report",
     "register": "alte.commands.register",

@@ -181,8 +181,10 @@ def quick_bench(tmp_path_factory):
 @pytest.mark.slow
 def test_quick_bench_runs_every_row_and_writes_its_outputs(quick_bench):
     assert quick_bench.errors == {}
-    rows = set(range(1, 14)) if (REALDATA / "balm_seq").exists() else set(range(1, 12)) | {13}
+    rows = set(range(1, 12)) | {13}
+    rows |= {12} if (REALDATA / "balm_seq").exists() else set()
     rows |= {14} if (REALDATA / "als").exists() else set()
+    rows |= {15} if (REALDATA / "isprs_terrain").exists() else set()
     assert {r.row for r in quick_bench.results} == rows
     for r in quick_bench.results:
         if r.row != 8:
