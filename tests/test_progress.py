@@ -7,11 +7,11 @@ import os
 from pathlib import Path
 
 import pytest
+from report.conftest import make_notebook
 
 from alte import progress
 from alte.report.plan import Entry, build_plan
 from alte.report.runner import run_report
-from report.conftest import make_notebook
 
 
 @pytest.fixture
