@@ -95,3 +95,25 @@ def pytest_terminal_summary(terminalreporter: pytest.TerminalReporter,
                                     f"CPU s over {len(_CPU_SEEN)} tests)")
     for nodeid, seconds in ranked[:count]:
         terminalreporter.write_line(f"{seconds:8.2f}s  {nodeid}")
+
+
+#: Scans of a terrain :func:`small_terrain` simulates unless told otherwise.
+SMALL = 40
+
+
+@pytest.fixture(scope="session")
+def small_data(tmp_path_factory: pytest.TempPathFactory):
+    """Folder holding the terrains :func:`small_terrain` simulates (one per test process)."""
+    return tmp_path_factory.mktemp("simdata")
+
+
+@pytest.fixture(scope="session")
+def small_terrain(small_data):
+    """``make(name, frames=SMALL)`` -> the folder of that terrain simulated with ``frames``
+    evenly spaced scans, seed 0: made on first use, then shared by every test of the
+    process (any package's tests: one simulation for many tests)."""
+    from alte.sim import ensure_terrain
+
+    def make(name: str, frames: int = SMALL):
+        return ensure_terrain(name, small_data / f"f{frames}", seed=0, frames=frames)
+    return make

@@ -92,3 +92,11 @@ def test_an_unknown_command_lists_the_commands(capsys) -> None:
     assert stop.value.code == 2
     err = capsys.readouterr().err
     assert "invalid choice: 'mapp'" in err and "info" in err
+
+
+def test_the_bench_row_of_the_light_commands(bags) -> None:
+    from alte.bench.memory import LIGHT_CEILINGS_MB, light_memory
+
+    rows = light_memory(bags[0])
+    assert [r.case.split(" peak")[0] for r in rows] == ["alte --version", "alte info BAG"]
+    assert all(r.met and r.peer < r.ours < max(LIGHT_CEILINGS_MB.values()) for r in rows)
