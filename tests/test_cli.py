@@ -32,7 +32,7 @@ def _loaded(argv: list[str], before: str = "") -> tuple[list[str], str]:
             f"try:\n    main({argv!r})\nexcept SystemExit:\n    pass\n"
             f"print(json.dumps([h for h in {HEAVY!r} if h in sys.modules]))")
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                         check=True, timeout=120)
+                         check=True, timeout=600)
     *out, last = run.stdout.splitlines()
     loaded: list[str] = json.loads(last)
     return loaded, "\n".join(out)

@@ -19,8 +19,11 @@ from scipy.sparse import csr_array
 from scipy.sparse.csgraph import connected_components
 
 #: Modules ``alte map BAG`` imports before it reads a scan.
-MAP_PATH = ["alte.cli", "alte.commands.map", "alte.pipeline", "alte.io", "alte.registration",
-            "alte.mappers", "alte.metrics"]
+#: (Modules, not only packages: ``alte.pipeline``, ``alte.io`` and ``alte.mappers`` load
+#: their modules on first use.)
+MAP_PATH = ["alte.cli", "alte.commands.map", "alte.pipeline.run", "alte.pipeline.prepare",
+            "alte.io.bag", "alte.io.pointfiles", "alte.registration", "alte.mappers.registry",
+            "alte.export.run", "alte.metrics"]
 HEAVY = ["open3d", "pyvista", "vtk", "kiss_icp", "small_gicp", "matplotlib", "dask"]
 
 
@@ -32,7 +35,7 @@ def _loaded(*stages: list[str]) -> list[list[str]]:
             f"    seen.append([h for h in {HEAVY!r} if h in sys.modules])\n"
             "print(json.dumps(seen))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                         check=True, timeout=120).stdout
+                         check=True, timeout=600).stdout
     loaded: list[list[str]] = json.loads(out)
     return loaded
 
