@@ -8,8 +8,9 @@ summarises each cluster by centroid and radius, the circles a path planner avoid
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
-import pandas as pd
 from numpy.typing import ArrayLike, NDArray
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
@@ -18,6 +19,9 @@ from scipy.spatial import cKDTree
 from alte.errors import ParameterError
 from alte.ground.plane import PlaneFit, height_above
 from alte.types import as_points
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 __all__ = ["OBSTACLE_COLUMNS", "euclidean_clusters", "obstacle_map"]
 
@@ -96,6 +100,8 @@ def obstacle_map(
     height under every point as a ground filter gives it, or a ground level z), or from
     the cluster's lowest point when no ground is given. Points labelled -1 are ignored.
     """
+    import pandas as pd  # on first use: the ground package is on ``alte map``'s path
+
     pts = _check(points, "obstacle_map")
     lab = np.asarray(labels).reshape(-1)
     if lab.shape[0] != len(pts) or not np.issubdtype(lab.dtype, np.integer):

@@ -14,17 +14,19 @@ import enum
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import ClassVar
+from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
 
 from alte.errors import ParameterError
-from alte.mappers import MapperClass, mapper_class
 from alte.mappers.base import Feed
 from alte.mappers.domain import Domain
 from alte.params import Record, param
 from alte.registration.odometry import OdometryParams
 from alte.types import Box, Mount
+
+if TYPE_CHECKING:
+    from alte.mappers import MapperClass
 
 __all__ = ["DomainChoice", "DomainPolicy", "FrameSpec", "MapSpec", "PoseSource"]
 
@@ -156,16 +158,22 @@ class MapSpec(Record):
     feed: Feed | None = None
     snapshots: int = param(0, lambda v: v >= 0, "snapshots >= 0",
                            "cell snapshots kept over the run (time-lapse figures)")
-    cls: MapperClass = field(init=False, repr=False, compare=False)
     record: Record = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        cls = mapper_class(self.mapper)
+        cls = self.cls
         given = self.params
         record = given if isinstance(given, cls.Params) else cls.Params.parse(
             given.as_dict() if isinstance(given, Record) else given)
-        object.__setattr__(self, "cls", cls)
         object.__setattr__(self, "record", record)
         object.__setattr__(self, "params", given.as_dict() if isinstance(given, Record)
                            else dict(given))
+
+    @property
+    def cls(self) -> MapperClass:
+        """The mapper's class (the registry, and with it the mappers' kernels, loads on
+        first use: a spec is light to import)."""
+        from alte.mappers import mapper_class
+
+        return mapper_class(self.mapper)

@@ -178,6 +178,7 @@ def quick_bench(tmp_path_factory):
     return run_bench(config)
 
 
+@pytest.mark.full
 @pytest.mark.slow
 def test_quick_bench_runs_every_row_and_writes_its_outputs(quick_bench):
     assert quick_bench.errors == {}

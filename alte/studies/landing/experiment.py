@@ -17,10 +17,10 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import pandas as pd
-from tqdm.auto import tqdm
 
 from alte.errors import MetricsError, ParameterError
 from alte.pipeline import MapRun, MapSpec, Registered, run
+from alte.progress import bar as progress_bar
 from alte.studies.analysis.tables import write_csv
 from alte.studies.experiments import ground_truth, terrain
 from alte.studies.landing.detect import Centres, Detection, detect_sites
@@ -130,7 +130,7 @@ def landing_table(datasets: Sequence[Registered],
     """
     jobs = [(d, *s) for d in datasets for s in landing_param_sets(d.source.name)]
     rows, runs, truths = [], [], {}
-    for data, label, mapper, params in tqdm(jobs, desc="landing", unit="map",
+    for data, label, mapper, params in progress_bar(jobs, desc="landing", unit="map",
                                             disable=not progress):
         name = data.source.name
         chosen = (landing or {}).get(name) or landing_params(name)
@@ -149,7 +149,7 @@ def load_terrains(names: Sequence[str], data_dir: str | os.PathLike[str] = "data
     """Simulate (when missing or stale) and register the named terrains, ``frames`` scans
     each."""
     return [terrain(name, data_dir, seed, frames)
-            for name in tqdm(names, desc="terrains", unit="terrain", disable=not progress)]
+            for name in progress_bar(names, desc="terrains", unit="terrain", disable=not progress)]
 
 
 def landing_summary(table: pd.DataFrame) -> pd.DataFrame:

@@ -21,7 +21,6 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
-from tqdm.auto import tqdm
 
 from alte.errors import ParameterError
 from alte.ground.filters import MIN_POINTS, filter_ground
@@ -38,6 +37,7 @@ from alte.pipeline import (
     open_input,
     prepare,
 )
+from alte.progress import bar as progress_bar
 from alte.studies.analysis.tables import write_csv as write_tables_csv
 from alte.studies.experiments import Measured, measure
 from alte.studies.realdata.ground import ground_errors, map_heights, reference_labels
@@ -201,7 +201,7 @@ def ground_runs(data: RealData, samples: Sequence[str] | None,
                              f"{data.file(ISPRS_FOLDER)}: {list(present)}")
     sources = {**({BASELINE: {}} if baseline else {}), **mappers}
     runs = []
-    for name in tqdm(samples, desc="ISPRS samples", disable=not progress):
+    for name in progress_bar(samples, desc="ISPRS samples", disable=not progress):
         sample = isprs_sample(data, name)
         runs += [_ground_run(sample, m, p, method, chosen) for m, p in sources.items()]
     return runs
@@ -240,7 +240,7 @@ def map_runs(dataset: Registered | None, mappers: Mapping[str, Mapping[str, obje
         return []
     name = dataset.source.name
     return [measure(dataset, m, spec=MapSpec(m, dict(p), domain=DomainPolicy.DATA))
-            for m, p in tqdm(mappers.items(), desc=name, disable=not progress)]
+            for m, p in progress_bar(mappers.items(), desc=name, disable=not progress)]
 
 
 def map_table(runs: Sequence[Measured]) -> pd.DataFrame:
