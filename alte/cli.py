@@ -1,4 +1,4 @@
-"""Command-line entry point: ``alte COMMAND ...``.
+"""Command-line entry point: ``alte COMMAND ...`` (:data:`DESCRIPTION` is what it says).
 
 Each command lives in its own module under ``alte.commands`` exposing
 ``add_parser(subparsers)`` and ``run(args) -> int``; :data:`COMMANDS` lists them
@@ -15,7 +15,12 @@ from collections.abc import Sequence
 from alte import __version__
 from alte.errors import AlteError
 
-__all__ = ["COMMANDS", "main"]
+__all__ = ["COMMANDS", "DESCRIPTION", "build_parser", "main"]
+
+#: What ``alte --help`` says first: plain text, as a terminal shows it.
+DESCRIPTION = ("alte: UAV terrain mapping from LiDAR. Map a ROS bag, a point file or a "
+               "terrain tile with Quadtree, Octomap, 2D-ALTE or 3D-ALTE; run the thesis' "
+               "experiments into a report. 'alte COMMAND --help' explains each command.")
 
 #: Command name -> module implementing it.
 COMMANDS: dict[str, str] = {
@@ -34,7 +39,7 @@ COMMANDS: dict[str, str] = {
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser with every registered command."""
-    parser = argparse.ArgumentParser(prog="alte", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="alte", description=DESCRIPTION)
     parser.add_argument("--version", action="version", version=f"alte {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for name, module in COMMANDS.items():

@@ -22,7 +22,7 @@ def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) 
     """Register ``alte export``."""
     p = subparsers.add_parser(
         "export", help="map an input and write the result as a ROS 2 MCAP (Foxglove, RViz)",
-        description="Map INPUT like `alte map` and write one ROS 2 MCAP file: registered "
+        description="Map INPUT as 'alte map' does and write one ROS 2 MCAP file: registered "
                     "cloud and scans (PointCloud2), trajectory (Path), pose (PoseStamped, "
                     "/tf), map cells (MarkerArray), occupancy for landing (OccupancyGrid: 0 "
                     "free, 100 occupied, -1 unseen; see --occupancy-set), height and "

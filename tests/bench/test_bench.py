@@ -8,8 +8,9 @@ import threading
 import numpy as np
 import pytest
 
-from alte.bench import ROWS, BenchConfig, Context, Result, run_bench, select_rows, write_outputs
-from alte.bench.output import format_value, miss_note, render_markdown
+from alte.bench.core import BenchConfig, Context, Result
+from alte.bench.output import format_value, miss_note, render_markdown, write_outputs
+from alte.bench.runner import ROWS, run_bench, select_rows
 from alte.bench.scaling import predicted_seconds, whole_scans
 from alte.bench.timing import (
     fit_exponent,
