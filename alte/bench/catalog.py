@@ -28,5 +28,5 @@ TITLES: dict[int, str] = {
 
 
 def describe() -> str:
-    """One line per row, ``N  title``, for help texts."""
-    return "\n".join(f"{number:>3}  {title}" for number, title in sorted(TITLES.items()))
+    """One line per row, ``- row N: title``, for help texts (a list in the docs too)."""
+    return "\n".join(f"- row {number}: {title}" for number, title in sorted(TITLES.items()))

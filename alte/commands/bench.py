@@ -34,7 +34,7 @@ def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) 
         description=textwrap.fill(
             "Time our stages beside their peers (pyoctomap, open3d, numpy.argsort, "
             "kiss-icp, ...) and write reports/bench.md, bench.json and bench_scaling.png.")
-        + "\n\nrows:\n" + describe())
+        + "\n\nThe rows:\n\n" + describe())
     parser.add_argument("--quick", action="store_true",
                         help="tiny inputs (a few simulated scans): a smoke run in seconds")
     parser.add_argument("--only", type=_rows, default=None, metavar="ROWS",

@@ -47,5 +47,5 @@ def test_bench_help_lists_the_rows_that_exist(helps: dict[str, str]) -> None:
     assert set(TITLES) == set(ROWS)  # one registry of rows, titles and functions alike
     text = helps["bench"]
     for number, title in TITLES.items():
-        assert f"{number:>3}  {title}" in text
+        assert f"- row {number}: {title}" in text
     assert f"all, {min(TITLES)}-{max(TITLES)}" in " ".join(text.split())
