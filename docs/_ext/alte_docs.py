@@ -32,7 +32,8 @@ from docutils.statemachine import StringList
 from sphinx.application import Sphinx
 from sphinx.util.docutils import SphinxDirective
 
-API_DIR = Path(__file__).resolve().parents[1] / "reference" / "api"
+REPO = Path(__file__).resolve().parents[2]
+API_DIR = REPO / "docs" / "reference" / "api"
 
 
 def public_modules(package: str = "alte") -> list[str]:
@@ -263,11 +264,69 @@ class MappersDirective(RecordDirective):
         return self._parse(lines)
 
 
+class CsvDirective(RecordDirective):
+    """``{alte-csv} path.csv`` (from the repository root) with ``:columns: a, b`` and an
+    optional ``:where: column=value``: a committed table, as a list-table, with the row
+    count and the file named under it, so a page quotes the numbers from their file."""
+
+    option_spec = {"columns": lambda text: [c.strip() for c in text.split(",")],
+                   "where": str, "caption": str}
+
+    def run(self) -> list[nodes.Node]:
+        import csv
+
+        path = REPO / self.arguments[0]
+        self.env.note_dependency(str(path))
+        with path.open(newline="") as handle:
+            rows = list(csv.DictReader(handle))
+        if "where" in self.options:
+            key, _, value = self.options["where"].partition("=")
+            rows = [r for r in rows if r.get(key.strip()) == value.strip()]
+        columns = self.options.get("columns") or (list(rows[0]) if rows else [])
+        missing = [c for c in columns if rows and c not in rows[0]]
+        if missing:
+            raise self.error(f"{path.name} has no column(s) {missing}")
+        lines = [".. list-table:: " + self.options.get("caption", ""), "   :header-rows: 1", "",
+                 "   * - " + columns[0], *(f"     - {c}" for c in columns[1:])]
+        for row in rows:
+            cells = [_escape(row[c]) for c in columns]
+            lines += [f"   * - {cells[0]}", *(f"     - {c}" for c in cells[1:])]
+        lines += ["", f"{len(rows)} rows, read from ``{self.arguments[0]}``."]
+        return self._parse(lines)
+
+
+class ProvenanceDirective(RecordDirective):
+    """``{alte-provenance} path.json``: the command, commit, dates and cost a committed
+    result was written with (a sweep's ``provenance.json``)."""
+
+    def run(self) -> list[nodes.Node]:
+        import json
+
+        path = REPO / self.arguments[0]
+        self.env.note_dependency(str(path))
+        said = json.loads(path.read_text())
+        machine = said.get("machine", {})
+        lines = [".. list-table::", "   :stub-columns: 1", ""]
+        items = [("command", f"``{said.get('command', '-')}``"),
+                 ("commit", f"``{str(said.get('commit', '-'))[:10]}``"),
+                 ("started", said.get("started", "-")), ("finished", said.get("finished", "-")),
+                 ("runs", f"{said.get('runs', '-'):,}" if isinstance(said.get("runs"), int)
+                  else "-"),
+                 ("CPU", f"{said['cpu_s'] / 3600:.2f} h" if "cpu_s" in said else "-"),
+                 ("machine", f"{machine.get('cpu', '-')}, {machine.get('cores', '-')} cores"),
+                 ("file", f"``{self.arguments[0]}``")]
+        for key, value in items:
+            lines += [f"   * - {key}", f"     - {value}"]
+        return self._parse(lines)
+
+
 def setup(app: Sphinx) -> dict[str, object]:
     """Register the page generator and the two directives."""
     app.connect("builder-inited", write_api_pages)
     app.add_directive("alte-record", RecordDirective)
     app.add_directive("alte-mappers", MappersDirective)
+    app.add_directive("alte-csv", CsvDirective)
+    app.add_directive("alte-provenance", ProvenanceDirective)
     return {"parallel_read_safe": True, "parallel_write_safe": True}
 
 
