@@ -1,10 +1,10 @@
 """``alte export INPUT --mcap FILE --mapper M``: a map run as one ROS 2 MCAP file.
 
 Open the file in Foxglove Studio, or play it into RViz (``ros2 bag play FILE``); the
-topics and their types are listed in :mod:`alte.export.mcap` and the README. The final
-map is there from the file's first instant; with ``--timeline N`` it is also written
-every N mapped scans, stamped with the scan's time, so scrubbing the timeline replays
-the mapping.
+topics and their types are listed in :mod:`alte.export.mcap` and in the documentation's
+Foxglove / RViz guide (docs/how-to/foxglove-rviz.md). The final map is there from the
+file's first instant; with ``--timeline N`` it is also written every N mapped scans,
+stamped with the scan's time, so scrubbing the timeline replays the mapping.
 """
 
 from __future__ import annotations

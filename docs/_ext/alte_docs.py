@@ -24,8 +24,9 @@ import importlib.util
 import os
 import pkgutil
 import tempfile
+from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar
 
 from docutils import nodes
 from docutils.statemachine import StringList
@@ -269,8 +270,9 @@ class CsvDirective(RecordDirective):
     optional ``:where: column=value``: a committed table, as a list-table, with the row
     count and the file named under it, so a page quotes the numbers from their file."""
 
-    option_spec = {"columns": lambda text: [c.strip() for c in text.split(",")],
-                   "where": str, "caption": str}
+    option_spec: ClassVar[dict[str, Callable[[str], object]]] = {
+        "columns": lambda text: [c.strip() for c in text.split(",")],
+        "where": str, "caption": str}
 
     def run(self) -> list[nodes.Node]:
         import csv
