@@ -76,3 +76,5 @@ html_theme_options = {
 }
 html_sidebars = {"index": [], "getting-started": []}
 html_show_sourcelink = False
+# The theme's light/dark switch starts from "auto" (an empty mode is refused by its script).
+html_context = {"default_mode": "auto"}
