@@ -243,6 +243,10 @@ class RecordDirective(SphinxDirective):
         return self._parse(record_table(record))
 
     def _parse(self, lines: list[str]) -> list[nodes.Node]:
+        """The reST ``lines`` as nodes. In a MyST page a nested parse reads Markdown, so
+        the lines go through MyST's ``eval-rst`` block there (reST pages parse them as is)."""
+        if "myst" in type(self.state).__module__.lower():
+            lines = ["````{eval-rst}", *lines, "````"]
         node = nodes.section()
         node.document = self.state.document
         self.state.nested_parse(StringList(lines, source="alte-record"), 0, node)
@@ -260,7 +264,7 @@ class MappersDirective(RecordDirective):
         lines: list[str] = []
         for name, cls in MAPPERS.items():
             said = (cls.__doc__ or "").strip().splitlines()[0]
-            lines += [f"**{name}** (:class:`{cls.__module__}.{cls.__name__}`): {_escape(said)}",
+            lines += [f"**{name}** (:class:`{cls.__module__}.{cls.__name__}`): {said}",
                       "", *record_table(cls.Params), ""]
         return self._parse(lines)
 

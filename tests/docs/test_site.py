@@ -140,10 +140,13 @@ def test_every_public_module_is_in_the_api_reference(site: Path) -> None:
 def test_settings_tables_list_every_mapper_setting(site: Path) -> None:
     from alte.mappers import MAPPERS
 
+    page = (site / "reference" / "settings.html").read_text()
     text = _text(site / "reference" / "settings.html")
     missing = [f"{name}.{field}" for name, cls in MAPPERS.items()
                for field in cls.Params.names() if field not in text]
     assert missing == [] and "gyro_noise" in text and "imu_hz" in text
+    assert page.count("<table") >= len(MAPPERS) + 9  # rendered tables, not reST as text
+    assert "list-table" not in text and ":class:" not in text
 
 
 @pytest.mark.parametrize("notebook", [p.stem for p in TUTORIALS])
@@ -165,6 +168,7 @@ def test_results_pages_date_every_figure_and_name_their_command(site: Path) -> N
         text = _text(page)
         assert re.search(r"20\d\d-\d\d-\d\d", text), f"{page.name}: no date"
         assert re.search(r"\b(alte|make|python) [a-z-]+", text), f"{page.name}: no command"
+        assert "list-table" not in text  # the generated tables rendered
 
 
 def test_the_readme_is_short_and_points_at_the_site() -> None:
