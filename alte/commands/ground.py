@@ -14,27 +14,14 @@ import json
 import time
 from pathlib import Path
 
-from alte import __version__
-from alte.commands.options import parse_key_values
+from alte.commands.options import add_ground_options, ground_spec
 from alte.errors import ParameterError
 from alte.fsutil import refuse_overwrite
 from alte.ground.filters import filter_ground
-from alte.ground.settings import (
-    DEFAULT_METHOD,
-    DEFAULT_SETTINGS,
-    METHODS,
-    SOURCES,
-    GroundSettings,
-    ground_settings,
-)
+from alte.ground.settings import DEFAULT_METHOD
 from alte.io.tiles import read_tile, tile_crs, write_classified
 
 __all__ = ["add_parser", "run"]
-
-
-def _settings_help() -> str:
-    return "; ".join(f"{name}: " + ", ".join(f"{k}={v}" for k, v in cls().as_dict().items())
-                     for name, cls in METHODS.items())
 
 
 def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -49,15 +36,7 @@ def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) 
     p.add_argument("input", type=Path, help="terrain tile: LAS/LAZ, PCD, PLY, npz or xyz")
     p.add_argument("--out", type=Path, required=True, metavar="OUTPUT",
                    help="the classified tile to write (.las or .laz)")
-    p.add_argument("--method", choices=list(METHODS), default=None,
-                   help="ground filter with its published defaults; default: "
-                        f"{DEFAULT_METHOD} with "
-                        + ", ".join(f"{k}={v}" for k, v in DEFAULT_SETTINGS.as_dict().items())
-                        + ", chosen on real "
-                        "data. " + "; ".join(f"{k}: {v}" for k, v in SOURCES.items()))
-    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", dest="sets",
-                   help="the method's setting (repeatable), e.g. --set window=24; defaults: "
-                        + _settings_help())
+    add_ground_options(p)
     p.add_argument("--crs", default=None, metavar="CRS",
                    help="coordinate reference system of a tile whose header names none "
                         "(e.g. EPSG:32632; projected, in metres); written into OUTPUT")
@@ -66,20 +45,10 @@ def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) 
     p.set_defaults(func=run)
 
 
-def _settings(args: argparse.Namespace) -> GroundSettings:
-    """The settings of ``--method`` / ``--set`` (errors name ``--set``)."""
-    try:
-        return ground_settings(args.method, parse_key_values(args.sets, "--set"))
-    except ParameterError as err:
-        if str(err).startswith("--set"):
-            raise
-        raise ParameterError(f"--set: {err}") from err
-
-
 def run(args: argparse.Namespace) -> int:
     """Read, filter, write, print the summary."""
-    settings = _settings(args)
-    method = args.method or DEFAULT_METHOD
+    named, settings = ground_spec(args)
+    method = named or DEFAULT_METHOD
     if args.out.suffix.lower() not in (".las", ".laz"):
         raise ParameterError(f"--out {args.out}: the output is LAS or LAZ (.las, .laz)")
     refuse_overwrite(args.out, args.force)
@@ -90,11 +59,7 @@ def run(args: argparse.Namespace) -> int:
     start = time.perf_counter()
     result = filter_ground(tile.points, method, settings)
     filter_s = time.perf_counter() - start
-    provenance: dict[str, object] = {
-        "software": f"alte {__version__}", "method": method,
-        "settings": result.settings.as_dict(), "source": SOURCES[method],
-        "input": str(args.input), "points": len(tile.points),
-        "ground_points": int(result.ground.sum())}
+    provenance: dict[str, object] = {**result.provenance(), "input": str(args.input)}
     start = time.perf_counter()
     write_classified(args.out, tile, result.ground, provenance, crs=crs,
                      overwrite=args.force)

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from alte.commands.options import add_frame_options, frame_spec
+from alte.commands.options import add_frame_options, frame_spec, parse_key_values
 from alte.errors import ParameterError
 from alte.export import ExportOptions
 from alte.export import export_map as export_mcap
@@ -82,13 +82,7 @@ def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) 
 
 def parse_sets(items: list[str], flag: str = "--set") -> dict[str, str]:
     """``["k=v", ...]`` -> ``{"k": "v"}``; an item without '=' raises (naming ``flag``)."""
-    out: dict[str, str] = {}
-    for item in items:
-        key, sep, value = item.partition("=")
-        if not sep or not key.strip():
-            raise ParameterError(f"{flag} {item!r}: expected KEY=VALUE")
-        out[key.strip()] = value.strip()
-    return out
+    return parse_key_values(items, flag)
 
 
 def parse_domain(text: str) -> Domain | DomainPolicy:

@@ -1,6 +1,9 @@
 """``alte simulate``: write the benchmark terrains (bag + ground truth + scenario.json), or
-import real terrain tiles (LAS/LAZ with a ground class, an ISPRS-style pair, a DEM) and fly
-the thesis' landing or navigation mission over them into the same kind of folder."""
+import real terrain tiles (LAS/LAZ, with or without a ground class; an ISPRS-style pair; a
+DEM) and fly the thesis' landing or navigation mission over them into the same kind of
+folder. A tile's ground is its producer's class; a tile without one, or every tile when
+``--ground-method`` is named, is classified with the ground stage's filter
+(:mod:`alte.sim.real.ground`)."""
 
 from __future__ import annotations
 
@@ -11,9 +14,17 @@ from pathlib import Path
 
 from tqdm.auto import tqdm
 
+from alte.commands.options import add_ground_options, ground_spec, parse_key_values
 from alte.errors import ParameterError
 from alte.sim.profile import PROFILES, SensorProfile, get_profile
-from alte.sim.real import GROUND_CLASS, MISSIONS, Flight, import_terrain, write_imported
+from alte.sim.real import (
+    GROUND_CLASS,
+    MISSIONS,
+    Flight,
+    GroundChoice,
+    import_terrain,
+    write_imported,
+)
 from alte.sim.real.tiles import POINT_SUFFIXES, RASTER_SUFFIXES
 from alte.sim.scenario import SCENARIO_FILE, update_terrain
 from alte.sim.terrains import TERRAINS
@@ -29,12 +40,14 @@ def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) 
         description="Fly the simulated VLP-16 over a thesis terrain (or all eight) and write "
                     "DIR/NAME/: a ROS 2 bag, ground_truth.ply (object id per triangle) and "
                     "scenario.json. A folder whose spec and seed match is reused. "
-                    f"Terrains: {', '.join(TERRAINS)}. Given terrain tiles instead (LAS/LAZ "
-                    "with ground class 2, a PCD with --ground, a DEM as GeoTIFF or ESRI "
-                    "ASCII grid; several adjacent or overlapping tiles of one CRS make one "
-                    "terrain), import them as a terrain (bare earth, object surface and "
-                    "objects from the classes, CRS and units in scenario.json, "
-                    "bare_earth.npz) and fly --mission over it into DIR/NAME/.")
+                    f"Terrains: {', '.join(TERRAINS)}. Given terrain tiles instead (LAS/LAZ, "
+                    "a PCD with --ground, a DEM as GeoTIFF or ESRI ASCII grid; several "
+                    "adjacent or overlapping tiles of one CRS make one terrain), import them "
+                    "as a terrain (bare earth, object surface and objects from the classes, "
+                    "CRS and units in scenario.json, bare_earth.npz) and fly --mission over "
+                    "it into DIR/NAME/. A LAS/LAZ tile's ground is its ground class (2); one "
+                    "without any is classified with the ground filter (--ground-method), "
+                    "and how ground was told is recorded in scenario.json.")
     p.add_argument("name", nargs="+", metavar="NAME|all|TILE",
                    help="terrain name, 'all', or one or more terrain tiles to import")
     p.add_argument("--out", type=Path, default=Path("data"), metavar="DIR",
@@ -75,8 +88,14 @@ def _add_import_options(p: argparse.ArgumentParser) -> None:
     g.add_argument("--ground", type=Path, default=None, metavar="FILE",
                    help="the tile's bare-earth points (an ISPRS-style pair: the tile holds "
                         "every point, FILE the reference ground among them)")
-    g.add_argument("--ground-class", type=int, default=GROUND_CLASS, metavar="N",
-                   help=f"class of the ground points in LAS/LAZ (default: {GROUND_CLASS})")
+    g.add_argument("--ground-class", type=int, default=None, metavar="N",
+                   help=f"class of the ground points in LAS/LAZ (default: {GROUND_CLASS}, "
+                        "and the ground filter for a tile with no point of it; a class "
+                        "named here that a tile lacks is an error)")
+    add_ground_options(g, "ground-",
+                       "classify every LAS/LAZ tile with this ground filter, replacing the "
+                       "producer's ground class (without it a tile keeps its class, and one "
+                       "with no point of it is classified with the default filter)")
     g.add_argument("--cell", type=float, default=None, metavar="M",
                    help="cell of the surfaces in metres (default: a DEM's own, else about two "
                         "first returns a cell, at least 1 m)")
@@ -89,16 +108,18 @@ def _add_import_options(p: argparse.ArgumentParser) -> None:
 
 def _profile(args: argparse.Namespace) -> SensorProfile:
     """The profile of ``--profile`` with ``--sensor-set`` applied (errors name the flags)."""
-    changes: dict[str, str] = {}
-    for item in args.sensor_sets:
-        key, sep, value = item.partition("=")
-        if not sep or not key.strip():
-            raise ParameterError(f"--sensor-set {item!r}: expected KEY=VALUE")
-        changes[key.strip()] = value.strip()
+    changes = parse_key_values(args.sensor_sets, "--sensor-set")
     try:
         return get_profile(args.profile, changes)
     except ParameterError as err:
         raise ParameterError(f"--sensor-set: {err}") from err
+
+
+def _ground_by(args: argparse.Namespace) -> GroundChoice:
+    """``--ground-class``, ``--ground-method`` and ``--ground-set`` as one choice."""
+    method, settings = ground_spec(args, "ground-")
+    named = method is not None or bool(args.ground_sets)
+    return GroundChoice(args.ground_class, method, settings if named else None)
 
 
 def _is_tile(text: str) -> bool:
@@ -132,7 +153,7 @@ def _import(args: argparse.Namespace, profile: SensorProfile) -> int:
     """Import the tiles as a terrain and fly its mission; one summary line."""
     start = time.perf_counter()
     imported = import_terrain(args.name, _flight(args), name=args.name_, crs=args.crs,
-                              ground=args.ground, ground_class=args.ground_class,
+                              ground=args.ground, ground_by=_ground_by(args),
                               cell=args.cell, region=_region(args.region))
     spec = imported.terrain.spec
     tqdm.write(f"{spec.name}: {imported.surfaces.shape[1]} x {imported.surfaces.shape[0]} "

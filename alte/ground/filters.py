@@ -34,11 +34,13 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy import ndimage
 
+from alte import __version__
 from alte.errors import GroundError, ParameterError
 from alte.ground.plane import fit_plane_msac, height_above
 from alte.ground.settings import (
     DEFAULT_METHOD,
     DEFAULT_SETTINGS,
+    SOURCES,
     CsfSettings,
     GroundSettings,
     MorphSettings,
@@ -46,7 +48,7 @@ from alte.ground.settings import (
     SmrfSettings,
     ground_settings,
 )
-from alte.types import as_points
+from alte.types import JSONDict, as_points
 
 __all__ = ["GroundResult", "bare_earth_raster", "check_cloud", "classify_ground",
            "filter_ground", "looks_gridded", "opened_surface"]
@@ -84,6 +86,13 @@ class GroundResult:
         with np.errstate(invalid="ignore"):
             out: NDArray[np.bool_] = np.abs(np.asarray(z) - self.height) <= self.tolerance
         return out
+
+    def provenance(self) -> JSONDict:
+        """Which points were called ground and how: software, method, settings and their
+        source, point counts (a classified tile's header record, scenario.json's source)."""
+        return {"software": f"alte {__version__}", "method": self.method,
+                "settings": self.settings.as_dict(), "source": SOURCES[self.method],
+                "points": len(self.ground), "ground_points": int(self.ground.sum())}
 
 
 def looks_gridded(points: NDArray[np.float64]) -> float | None:

@@ -8,10 +8,12 @@ and plans the thesis' mission over them (:mod:`~alte.sim.real.flight`): a
 :func:`write_imported` flies it and writes ``DIR/NAME/`` with the built-in terrains'
 files (``bag/``, ``ground_truth.ply``, ``scenario.json``) plus ``bare_earth.npz`` (the
 bare-earth grid in local metres); ``scenario.json`` adds ``kind: real`` and
-``source``: every tile with its SHA-256, the CRS and units, the local origin, the grid
-and the flight. :func:`imported_terrain` reads such a folder back as a
-:class:`~alte.sim.terrains.Terrain`, so other seeds, scan counts and sensor profiles of
-it are flown like any terrain's (:func:`alte.sim.scenario.ensure_terrain`).
+``source``: every tile with its SHA-256, the CRS and units, the local origin, the grid,
+which points were called ground and how (the class, the pair's file, or the ground
+filter with its method, settings, source and alte's version) and the flight.
+:func:`imported_terrain` reads such a folder back as a
+:class:`~alte.sim.terrains.Terrain`, so other seeds, scan counts and sensor profiles of it
+are flown like any terrain's (:func:`alte.sim.scenario.ensure_terrain`).
 """
 
 from __future__ import annotations
@@ -25,12 +27,12 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from alte.errors import ParameterError, SimulationError
+from alte.errors import SimulationError
 from alte.io.pointformats import local_origin
 from alte.sim.platform import Quadrotor
 from alte.sim.real.flight import Flight, flight_plan
+from alte.sim.real.ground import GroundChoice, terrain_tiles
 from alte.sim.real.surface import MIN_OBJECT, Surfaces, grid_surfaces, surface_mesh
-from alte.sim.real.tiles import GROUND_CLASS, Tile, read_tiles
 from alte.sim.terrains import Terrain, TerrainSpec
 from alte.types import JSONDict
 
@@ -52,30 +54,6 @@ class Imported:
     source: JSONDict
 
 
-def _crop(tiles: list[Tile], region: Sequence[float] | None) -> list[Tile]:
-    """Each tile's points inside ``region`` (x0, y0, x1, y1 in the tiles' CRS units)."""
-    if region is None:
-        return tiles
-    x0, y0, x1, y1 = (float(region[i]) for i in range(4))
-    if not (x1 > x0 and y1 > y0):
-        raise ParameterError(f"--region {list(region)}: expected XMIN,YMIN,XMAX,YMAX with "
-                             "XMIN < XMAX and YMIN < YMAX")
-    out = []
-    for t in tiles:
-        f = t.units.horizontal_m
-        xy = t.points[:, :2]
-        keep = (xy[:, 0] >= x0 * f) & (xy[:, 0] <= x1 * f) & (xy[:, 1] >= y0 * f) & (
-            xy[:, 1] <= y1 * f)
-        if keep.any() and t.ground[keep].any():
-            out.append(Tile(t.path, t.kind, t.units, t.points[keep], t.classes[keep],
-                            t.first[keep], t.ground[keep], t.sha256, t.cell,
-                            [*t.notes, f"cropped to --region {x0:g},{y0:g},{x1:g},{y1:g}"]))
-    if not out:
-        raise ParameterError(f"--region {list(region)}: no tile has ground points inside it "
-                             "(the region is in the tiles' CRS units)")
-    return out
-
-
 def _crop_box(surfaces: Surfaces, origin: NDArray[np.float64]) -> tuple[float, ...]:
     xs, ys = surfaces.axes()
     lo = np.array([xs[0], ys[0], float(surfaces.ground.min()) - 1.0]) - origin
@@ -87,13 +65,14 @@ def _crop_box(surfaces: Surfaces, origin: NDArray[np.float64]) -> tuple[float, .
 def import_terrain(paths: Sequence[str | os.PathLike[str]], flight: Flight | None = None, *,
                    name: str | None = None, crs: str | None = None,
                    ground: str | os.PathLike[str] | None = None,
-                   ground_class: int = GROUND_CLASS, cell: float | None = None,
+                   ground_by: GroundChoice | None = None, cell: float | None = None,
                    region: Sequence[float] | None = None) -> Imported:
-    """Read ``paths`` (one or several adjacent or overlapping tiles of one CRS) and plan
-    ``flight`` over them (module docstring)."""
+    """Read ``paths`` (one or several adjacent or overlapping tiles of one CRS), tell their
+    ground (``ground``: a pair's ground file; ``ground_by``: class or filter,
+    :mod:`~alte.sim.real.ground`) and plan ``flight`` over them (module docstring)."""
     flight = flight or Flight()
-    tiles = _crop(read_tiles(list(paths), crs=crs, ground=ground, ground_class=ground_class),
-                  region)
+    tiles, told = terrain_tiles(paths, crs=crs, ground=ground, choice=ground_by,
+                                region=region)
     surfaces = grid_surfaces(tiles, cell)
     xs, ys = surfaces.axes()
     corners = np.array([[xs[0], ys[0], surfaces.ground.min()],
@@ -118,8 +97,7 @@ def import_terrain(paths: Sequence[str | os.PathLike[str]], flight: Flight | Non
                  "measured_ground_share": float(surfaces.measured.mean()),
                  "covered_share": float(surfaces.covered.mean()),
                  "min_object_m": MIN_OBJECT},
-        "ground_class": ground_class if ground is None else None,
-        "ground_file": str(ground) if ground is not None else None,
+        "ground": told,
         "region": list(region) if region is not None else None,
         "flight": flight.as_dict(), "altitude_m": flight.height, "lane_spacing_m": flight.lanes,
         "objects": {c: sum(o.cls == c for o in scene.objects)

@@ -1,9 +1,11 @@
 """Real terrain tiles read into metres: LAS/LAZ with a ground class, an ISPRS-style pair, a DEM.
 
 Every input becomes a :class:`Tile`: points in the tile's projected CRS scaled to metres
-(not shifted), each with its ASPRS class, whether it is a first return and whether it
-is ground (:func:`ground_mask`, the one place that decides it). A DEM raster (GeoTIFF,
-ESRI ASCII grid; read with rasterio) becomes the ground points at its cell centres. CRS
+(not shifted), each with its ASPRS class, whether it is a first return and whether the
+file calls it ground (its ground class, an ISPRS-style pair's ground file); a tile that
+calls none ground is classified by :mod:`~alte.sim.real.ground`, the one place that
+decides the import's ground. A DEM raster (GeoTIFF, ESRI ASCII grid; read with rasterio)
+becomes the ground points at its cell centres. CRS
 and units come from the file (LAS VLRs through laspy, the raster's own CRS or ``.prj``)
 or from ``--crs``; pyproj says what one unit of each axis is in metres, so a tile in US
 survey feet comes out in metres. Noise (ASPRS 7 and 18) and IGN LiDAR HD's artefact and
@@ -28,7 +30,7 @@ if TYPE_CHECKING:
     import pyproj
 
 __all__ = ["DROPPED_CLASSES", "GROUND_CLASS", "POINT_SUFFIXES", "RASTER_SUFFIXES", "Tile",
-           "Units", "ground_mask", "read_tiles", "units_of"]
+           "Units", "read_tiles", "units_of"]
 
 #: ASPRS class of bare-earth points.
 GROUND_CLASS = 2
@@ -37,8 +39,6 @@ GROUND_CLASS = 2
 DROPPED_CLASSES = (7, 18, 65, 66)
 POINT_SUFFIXES = (".las", ".laz", ".pcd")
 RASTER_SUFFIXES = (".tif", ".tiff", ".asc")
-_CLASSIFY = ("classify its ground first with a ground filter (SMRF or CSF, e.g. PDAL's "
-             "filters.smrf)")
 
 
 @dataclass(frozen=True)
@@ -61,7 +61,9 @@ class Units:
 
 @dataclass(eq=False)
 class Tile:
-    """One input in metres (module docstring); ``notes`` say what was dropped or assumed."""
+    """One input in metres (module docstring); ``notes`` say what was dropped or assumed,
+    ``ground_by`` how its ground was told (``class 2``, ``file NAME``, ``DEM``, ``filter
+    smrf``)."""
 
     path: Path
     kind: str
@@ -73,12 +75,13 @@ class Tile:
     sha256: str
     cell: float | None = None
     notes: list[str] = field(default_factory=list)
+    ground_by: str = ""
 
     def about(self) -> JSONDict:
         """Provenance of the tile for scenario.json."""
         return {"file": str(self.path), "kind": self.kind, "sha256": self.sha256,
                 "points": len(self.points), "ground_points": int(self.ground.sum()),
-                "crs": self.units.crs, "notes": list(self.notes)}
+                "ground_by": self.ground_by, "crs": self.units.crs, "notes": list(self.notes)}
 
 
 def units_of(crs: pyproj.CRS, where: str) -> Units:
@@ -118,21 +121,6 @@ def _crs(found: pyproj.CRS | None, given: str | None, where: str) -> Units:
     return units_of(found, where)
 
 
-def ground_mask(classes: NDArray[np.uint8], where: str,
-                ground_class: int = GROUND_CLASS) -> NDArray[np.bool_]:
-    """Which points are bare earth: class ``ground_class`` (ASPRS 2). A tile without
-    any is refused with what it holds and how to classify it."""
-    mask: NDArray[np.bool_] = np.asarray(classes) == ground_class
-    if not mask.any():
-        held = np.unique(np.asarray(classes), return_counts=True)
-        present = ", ".join(f"{c} ({n:,} points)" for c, n in zip(*held, strict=True))
-        raise PointFileError(
-            f"{where}: no point of ground class {ground_class} (classes present: "
-            f"{present or 'none'}); pass --ground-class N if its ground is another class, "
-            f"--ground FILE with its bare-earth points, or {_CLASSIFY}")
-    return mask
-
-
 def _digest(path: Path) -> str:
     return hashlib.sha256(path.read_bytes()).hexdigest()
 
@@ -170,9 +158,9 @@ def _read_las(path: Path, crs: str | None, ground_class: int) -> Tile:
         first = np.ones(len(pts), dtype=bool)
         notes.append("no point is flagged a first return: every point counts as one")
     pts, classes, first = _keep(pts, classes, first, notes)
-    ground = ground_mask(classes, str(path), ground_class)
-    return Tile(path, "las", units, _scaled(pts, units), classes, first, ground,
-                _digest(path), notes=notes)
+    return Tile(path, "las", units, _scaled(pts, units), classes, first,
+                classes == ground_class, _digest(path), notes=notes,
+                ground_by=f"class {ground_class}")
 
 
 def _read_pair(path: Path, ground_file: Path, crs: str | None) -> Tile:
@@ -191,7 +179,7 @@ def _read_pair(path: Path, ground_file: Path, crs: str | None) -> Tile:
     classes = np.where(ground, GROUND_CLASS, 1).astype(np.uint8)
     notes = [f"ground: the {int(ground.sum()):,} points also in {ground_file.name}"]
     return Tile(path, "pair", units, _scaled(pts, units), classes, np.ones(len(pts), bool),
-                ground, _digest(path), notes=notes)
+                ground, _digest(path), notes=notes, ground_by=f"file {ground_file}")
 
 
 def _read_raster(path: Path, crs: str | None) -> Tile:
@@ -219,14 +207,15 @@ def _read_raster(path: Path, crs: str | None) -> Tile:
     notes = [f"{int((~valid).sum()):,} nodata cells"] if (~valid).any() else []
     return Tile(path, "raster", units, _scaled(pts, units),
                 np.full(n, GROUND_CLASS, np.uint8), np.ones(n, bool), np.ones(n, bool),
-                _digest(path), cell, notes)
+                _digest(path), cell, notes, "DEM")
 
 
 def read_tiles(paths: list[str | os.PathLike[str]], *, crs: str | None = None,
                ground: str | os.PathLike[str] | None = None,
                ground_class: int = GROUND_CLASS) -> list[Tile]:
     """Read every tile (module docstring); all must share one CRS. ``ground`` is the
-    bare-earth file of a single point tile (an ISPRS-style pair)."""
+    bare-earth file of a single point tile (an ISPRS-style pair); a LAS/LAZ tile's ground
+    is class ``ground_class`` (none may be: :mod:`~alte.sim.real.ground` decides)."""
     if not paths:
         raise ParameterError("no tile given: name one or more LAS/LAZ, PCD or DEM files")
     if ground is not None and len(paths) != 1:

@@ -42,7 +42,7 @@ from alte.io.pointfiles import write_points
 from alte.mappers.base import Cells
 from alte.metrics.options import TruthOptions
 from alte.pipeline import DomainPolicy, FrameSpec, MapSpec, open_input, prepare
-from alte.sim.real import Flight, Imported, import_terrain, write_imported
+from alte.sim.real import Flight, Imported, import_terrain, terrain_tiles, write_imported
 from alte.studies.experiments import Measured, measure
 from alte.studies.obstacles import obstacle_columns, obstacle_options, obstacle_scores
 from alte.studies.realdata.fronts import reference_metrics
@@ -181,12 +181,9 @@ def _points(site: Site, root: Path, case: str, seed: int,
 def _tile_points(imported: Imported, site: Site, root: Path
                  ) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
     """The site's points in local metres with their ground flags (read again, cropped)."""
-    from alte.sim.real.importer import _crop
-    from alte.sim.real.tiles import read_tiles
-
-    tiles = _crop(read_tiles([root / t for t in site.tiles], crs=site.crs,
-                             ground=root / site.ground if site.ground else None),
-                  site.region)
+    tiles, _ = terrain_tiles([root / t for t in site.tiles], crs=site.crs,
+                             ground=root / site.ground if site.ground else None,
+                             region=site.region)
     pts = np.vstack([t.points for t in tiles]) - imported.origin
     return pts, np.concatenate([t.ground for t in tiles])
 

@@ -114,15 +114,6 @@ def test_tiles_in_different_crss_are_refused(tmp_path):
         read_tiles(tiles)
 
 
-def test_no_ground_class_names_the_flags_and_how_to_classify(tmp_path):
-    pts, _ = field()
-    tile = write_las(tmp_path / "raw.las", pts, np.ones(len(pts), np.uint8))
-    with pytest.raises(PointFileError, match=r"no point of ground class 2 .*classes present: "
-                                             r"1 .*--ground-class N.*--ground FILE.*SMRF"):
-        read_tiles([tile])
-    assert read_tiles([tile], ground_class=1)[0].ground.all()
-
-
 def test_dem_of_only_nodata_is_refused(tmp_path):
     dem = write_dem(tmp_path / "empty.tif", np.full((5, 5), np.nan))
     with pytest.raises(PointFileError, match="every cell is nodata"):
@@ -146,7 +137,8 @@ def test_cli_errors_are_one_line_naming_the_flag(tmp_path, capsys):
     dem = write_dem(tmp_path / "empty.asc", np.full((5, 5), np.nan))
     degrees = write_las(tmp_path / "degrees.las", pts, cls, crs="EPSG:4326")
     pcd = write_points(tmp_path / "all.pcd", pts)
-    cases = [([str(nocrs)], "--crs"), ([str(raw)], "--ground-class"), ([str(dem)], "nodata"),
+    cases = [([str(nocrs)], "--crs"), ([str(raw), "--ground-class", "9"], "--ground-class N"),
+             ([str(dem)], "nodata"),
              ([str(degrees)], "geographic (degrees)"), ([str(pcd)], "--ground FILE"),
              ([str(raw), "--ground-class", "1", "--altitude", "-2"], "--altitude -2.0"),
              ([str(raw), "--ground-class", "1", "--region", "1,2,3"], "--region")]
