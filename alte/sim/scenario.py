@@ -24,7 +24,7 @@ import numpy as np
 from alte.errors import AlteError, SimulationError
 from alte.fsutil import atomic_dir
 from alte.sim.groundtruth import GROUND_TRUTH_FILE, load_ground_truth, write_ground_truth
-from alte.sim.meta import MountMeta, ScenarioMeta
+from alte.sim.meta import SCENARIO_FILE, MountMeta, ScenarioMeta
 from alte.sim.mission import Simulation, simulate
 from alte.sim.profile import PROFILES, SensorProfile
 from alte.sim.scene import Scene
@@ -43,7 +43,6 @@ __all__ = ["BAG_DIR", "IMU_TOPIC", "SCENARIO_FILE", "SIM_VERSION", "MountMeta", 
 
 #: Bump when the simulator's output changes for the same spec (invalidates caches).
 SIM_VERSION = 1
-SCENARIO_FILE = "scenario.json"
 BAG_DIR = "bag"
 CLOUD_TOPIC = "/velodyne_points"
 POSE_TOPIC = "/pose"
@@ -58,7 +57,7 @@ def get_terrain(name: str, data_dir: str | os.PathLike[str] | None = None) -> Te
         return builder()
     folder = Path(data_dir) / name if data_dir is not None else None
     if folder is not None and (folder / SCENARIO_FILE).is_file():
-        from alte.sim.real.importer import imported_terrain
+        from alte.sim.real.folder import imported_terrain
 
         return imported_terrain(folder)
     where = f" in {data_dir}" if data_dir is not None else ""

@@ -4,19 +4,14 @@
 grids the bare earth, the object surface and the objects and triangulates them,
 :mod:`~alte.sim.real.ground` tells their ground (the producer's class, else the ground
 stage's filter), :mod:`~alte.sim.real.flight` sizes the thesis' missions to the tile and
-:mod:`~alte.sim.real.importer` writes the terrain folder (``alte simulate TILE ...``).
+:mod:`~alte.sim.real.importer` writes the terrain folder (``alte simulate TILE ...``) and
+:mod:`~alte.sim.real.folder` reads it back.
 """
 
 from alte.sim.real.flight import MISSIONS, Flight, flight_plan
+from alte.sim.real.folder import BARE_EARTH_FILE, bare_earth, imported_terrain
 from alte.sim.real.ground import GroundChoice, crop_tiles, terrain_tiles
-from alte.sim.real.importer import (
-    BARE_EARTH_FILE,
-    Imported,
-    bare_earth,
-    import_terrain,
-    imported_terrain,
-    write_imported,
-)
+from alte.sim.real.importer import Imported, import_terrain, write_imported
 from alte.sim.real.surface import CLASS_OF, Surfaces, grid_surfaces, surface_mesh
 from alte.sim.real.tiles import GROUND_CLASS, Tile, Units, read_tiles
 

@@ -11,14 +11,11 @@ bare-earth grid in local metres); ``scenario.json`` adds ``kind: real`` and
 ``source``: every tile with its SHA-256, the CRS and units, the local origin, the grid,
 which points were called ground and how (the class, the pair's file, or the ground
 filter with its method, settings, source and alte's version) and the flight.
-:func:`imported_terrain` reads such a folder back as a
-:class:`~alte.sim.terrains.Terrain`, so other seeds, scan counts and sensor profiles of it
-are flown like any terrain's (:func:`alte.sim.scenario.ensure_terrain`).
+:mod:`~alte.sim.real.folder` reads such a folder back.
 """
 
 from __future__ import annotations
 
-import json
 import os
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -29,17 +26,16 @@ from numpy.typing import NDArray
 
 from alte.errors import SimulationError
 from alte.io.pointformats import local_origin
-from alte.sim.platform import Quadrotor
+from alte.sim.meta import SCENARIO_FILE
 from alte.sim.real.flight import Flight, flight_plan
+from alte.sim.real.folder import BARE_EARTH_FILE
 from alte.sim.real.ground import GroundChoice, terrain_tiles
 from alte.sim.real.surface import MIN_OBJECT, Surfaces, grid_surfaces, surface_mesh
 from alte.sim.terrains import Terrain, TerrainSpec
 from alte.types import JSONDict
 
-__all__ = ["BARE_EARTH_FILE", "Imported", "bare_earth", "import_terrain", "imported_terrain",
-           "write_imported"]
+__all__ = ["Imported", "import_terrain", "write_imported"]
 
-BARE_EARTH_FILE = "bare_earth.npz"
 #: Registration voxel (m) of imported terrains: the built-in ones' (0.12-0.185 m).
 _VOXEL = {"lan": 0.15, "nav": 0.2}
 
@@ -121,7 +117,7 @@ def write_imported(imported: Imported, out_dir: str | os.PathLike[str] = "data",
     ``NAME-Nf``... as :func:`~alte.sim.scenario.terrain_folder` names it)."""
     from alte.sim.mission import simulate
     from alte.sim.profile import SensorProfile
-    from alte.sim.scenario import SCENARIO_FILE, terrain_folder, write_scenario
+    from alte.sim.scenario import terrain_folder, write_scenario
 
     chosen = profile if isinstance(profile, SensorProfile) else None
     name = imported.terrain.spec.name
@@ -135,48 +131,3 @@ def write_imported(imported: Imported, out_dir: str | os.PathLike[str] = "data",
     extra: JSONDict = {"source": imported.source, "bare_earth": BARE_EARTH_FILE}
     return write_scenario(target, imported.terrain, sim, seed=seed, frames=frames,
                           progress=progress, extra=extra, more=_write_bare_earth(imported))
-
-
-def _platform(found: dict[str, list[list[float]] | list[float] | float | None]
-              ) -> Quadrotor:
-    heights, points = found.get("heights"), found["waypoints"]
-    altitude, ramp = found["altitude"], found["ramp_s"]
-    if not (isinstance(points, list) and isinstance(altitude, float | int)
-            and isinstance(ramp, float | int) and (heights is None or isinstance(heights, list))):
-        raise TypeError("platform: waypoints, altitude, ramp_s or heights malformed")
-    return Quadrotor(tuple((float(p[0]), float(p[1])) for p in points  # type: ignore[index]
-                           ), float(altitude), float(ramp),
-                     tuple(float(h) for h in heights) if heights else None)  # type: ignore[arg-type]
-
-
-def imported_terrain(folder: str | os.PathLike[str]) -> Terrain:
-    """The :class:`Terrain` of an imported terrain folder (its mesh and mission)."""
-    from alte.sim.groundtruth import load_ground_truth
-    from alte.sim.scenario import SCENARIO_FILE
-
-    where = Path(folder)
-    try:
-        meta = json.loads((where / SCENARIO_FILE).read_text())
-        spec = meta["spec"]
-        if meta.get("kind") != "real":
-            raise SimulationError(f"{where}: not an imported terrain (kind {meta.get('kind')!r})")
-        terrain_spec = TerrainSpec(
-            spec["name"], spec["section"], spec["title"], spec["case"], spec["kind"],
-            int(spec["frames"]), _platform(spec["platform"]),
-            tuple(float(v) for v in spec["crop_box"]), float(spec["registration_voxel"]))
-    except (OSError, ValueError, KeyError, TypeError) as err:
-        raise SimulationError(f"{where}: not a readable imported terrain ({err})") from err
-    return Terrain(terrain_spec, load_ground_truth(where))
-
-
-def bare_earth(folder: str | os.PathLike[str]) -> tuple[NDArray[np.float64], float, float,
-                                                         float]:
-    """The bare-earth grid of an imported terrain: heights (rows along y), x0, y0 (its
-    south-west corner, local metres) and the cell (m)."""
-    try:
-        with np.load(Path(folder) / BARE_EARTH_FILE) as data:
-            return (np.asarray(data["height"], np.float64), float(data["x0"]),
-                    float(data["y0"]), float(data["step"]))
-    except OSError as err:
-        raise SimulationError(f"{folder}: no {BARE_EARTH_FILE} (not an imported terrain)") \
-            from err
