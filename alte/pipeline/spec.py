@@ -19,8 +19,8 @@ from typing import ClassVar
 import numpy as np
 
 from alte.errors import ParameterError
-from alte.mappers import MapperClass, mapper_class
-from alte.mappers.base import Feed
+from alte.mappers import registry
+from alte.mappers.base import Feed, Mapper
 from alte.mappers.domain import Domain
 from alte.params import Record, param
 from alte.registration.odometry import OdometryParams
@@ -139,9 +139,11 @@ class FrameSpec(Record):
 
 @dataclass(frozen=True)
 class MapSpec(Record):
-    """Which map: mapper name and parameters, domain (or policy), feed, time-lapse.
+    """Which map: mapper and parameters, domain (or policy), feed, time-lapse.
 
-    ``feed`` None uses the mapper's own protocol (``Mapper.default_feed``: the thesis
+    ``mapper`` is a mapper class or a name the registry resolves
+    (:mod:`alte.mappers.registry`); once made, ``mapper`` holds the name and ``cls`` the
+    class. ``feed`` None uses the mapper's own protocol (``Mapper.default_feed``: the thesis
     built Quadtree once on the final cloud and fed the others frame by frame);
     ``snapshots`` keeps the cells that many times over the run (time-lapse figures)
     and counts the basis functions after every frame. The mapper's class (``cls``) and
@@ -150,18 +152,19 @@ class MapSpec(Record):
     """
 
     OWNER: ClassVar[str] = "map spec"
-    mapper: str
+    mapper: type[Mapper] | str
     params: Mapping[str, object] | Record = field(default_factory=dict)
     domain: Domain | DomainPolicy = DomainPolicy.AUTO
     feed: Feed | None = None
     snapshots: int = param(0, lambda v: v >= 0, "snapshots >= 0",
                            "cell snapshots kept over the run (time-lapse figures)")
-    cls: MapperClass = field(init=False, repr=False, compare=False)
+    cls: type[Mapper] = field(init=False, repr=False, compare=False)
     record: Record = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        cls = mapper_class(self.mapper)
+        cls = registry.resolve(self.mapper) if isinstance(self.mapper, str) else self.mapper
+        object.__setattr__(self, "mapper", cls.name)
         given = self.params
         record = given if isinstance(given, cls.Params) else cls.Params.parse(
             given.as_dict() if isinstance(given, Record) else given)

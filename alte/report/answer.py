@@ -16,7 +16,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from alte.studies.analysis.tradeoff import MAPPER_NAMES
+from alte.studies.analysis.tradeoff import mapper_title
 from alte.studies.answer import Choice, UseAnswer, bottom_line, interval_text, pick_text
 from alte.studies.answer.orders import metric_words
 
@@ -63,7 +63,7 @@ class AnswerView:
 def _rival(choice: Choice) -> str:
     if choice.rival is None:
         other = [m for m in choice.use.mappers if choice.best and m != choice.best.mapper]
-        names = ", ".join(MAPPER_NAMES.get(m, m) for m in other)
+        names = ", ".join(mapper_title(m) for m in other)
         return f"no {names} map fits" if names else ""
     if choice.budget.kind == "need":
         return (f"{choice.rival.name} at the least: {choice.rival.setting}, "
@@ -95,7 +95,7 @@ def _row(choice: Choice) -> ChoiceRow:
 
 
 def _use(found: UseAnswer, sequence: str) -> UseView:
-    names = " or ".join(MAPPER_NAMES.get(m, m) for m in found.use.mappers)
+    names = " or ".join(mapper_title(m) for m in found.use.mappers)
     title = (f"{found.use.name.capitalize()}: {names}, ranked by "
              f"{metric_words(found.use.truth)}")
     orders = [f"{metric_words(o.metric)}: {o.text()}" for o in found.orders]

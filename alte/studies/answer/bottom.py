@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from alte.studies.analysis.tradeoff import MAPPER_NAMES, METRICS
+from alte.studies.analysis.tradeoff import METRICS, mapper_title
 from alte.studies.analysis.uncertainty import Interval
 from alte.studies.answer.choose import (
     GROUPS,
@@ -105,9 +105,9 @@ def _summary(use: Use, choices: Sequence[Choice]) -> str:
         return f"No {use.name} map of the grid meets a budget."
     wins = Counter(c.best.mapper for c in picked if c.best is not None)
     sure = Counter(c.best.mapper for c in picked if c.best is not None and c.decided)
-    parts = [f"{MAPPER_NAMES.get(m, m)} under {n} of {len(picked)} ({sure[m]} beyond the "
+    parts = [f"{mapper_title(m)} under {n} of {len(picked)} ({sure[m]} beyond the "
              f"interval of the difference)" for m, n in wins.most_common()]
-    absent = [MAPPER_NAMES.get(m, m) for m in use.mappers if m not in wins]
+    absent = [mapper_title(m) for m in use.mappers if m not in wins]
     mhd = [c for c in picked if c.by_mhd is not None and c.best is not None
            and c.by_mhd.mapper != c.best.mapper]
     text = (f"For {use.name}, ranked by {metric_words(use.truth)}: " + "; ".join(parts)
@@ -126,9 +126,9 @@ def _disagreement(use: Use, orders: Sequence[Order]) -> str:
         return ""
     names = ", ".join(metric_words(o.metric) for o in differs)
     return (f"The thesis' MHD and the truth rank the {use.name} maps differently: at equal "
-            f"size MHD favours {MAPPER_NAMES.get(mhd.leader, mhd.leader)}, {names} "
+            f"size MHD favours {mapper_title(mhd.leader)}, {names} "
             f"{'favour' if len(differs) > 1 else 'favours'} "
-            f"{MAPPER_NAMES.get(differs[0].leader, differs[0].leader)}.")
+            f"{mapper_title(differs[0].leader)}.")
 
 
 def _metrics(use: Use, table: pd.DataFrame) -> list[str]:

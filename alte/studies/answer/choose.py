@@ -34,7 +34,7 @@ from typing import Literal
 import numpy as np
 import pandas as pd
 
-from alte.studies.analysis.tradeoff import MAPPER_NAMES, METRICS
+from alte.studies.analysis.tradeoff import METRICS, mapper_title
 from alte.studies.analysis.uncertainty import Interval, bootstrap_ci
 from alte.studies.obstacles import setting_text
 
@@ -98,7 +98,7 @@ class Pick:
     @property
     def name(self) -> str:
         """The mapper's display name."""
-        return MAPPER_NAMES.get(self.mapper, self.mapper)
+        return mapper_title(self.mapper)
 
 
 @dataclass(frozen=True)

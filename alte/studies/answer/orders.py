@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 
 import pandas as pd
 
-from alte.studies.analysis.tradeoff import MAPPER_NAMES, equal_size, label, prepare
+from alte.studies.analysis.tradeoff import equal_size, label, mapper_title, prepare
 from alte.studies.analysis.uncertainty import bootstrap_ci
 from alte.studies.answer.choose import Use
 
@@ -60,7 +60,7 @@ class Order:
         for mapper, n in sorted(self.leads.items(), key=lambda kv: -kv[1]):
             if n:
                 places = ", ".join(self.where.get(mapper, ())) if where else ""
-                parts.append(f"{MAPPER_NAMES.get(mapper, mapper)} on {n} of {self.reads} "
+                parts.append(f"{mapper_title(mapper)} on {n} of {self.reads} "
                              f"read{'s' if self.reads != 1 else ''}"
                              + (f" ({places})" if places and not parts else ""))
         if self.undecided:

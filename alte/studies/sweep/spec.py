@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import ClassVar, TypeVar
 
 from alte.errors import AlteError, ParameterError
-from alte.mappers import make_mapper
+from alte.mappers import Mapper, registry
 from alte.metrics.maps import TruthOptions
 from alte.params import Record, param
 from alte.sim import TERRAINS
@@ -78,13 +78,18 @@ _TOP_KEYS = (*SweepSettings.names(), "terrains", "truth", "mappers", "variants")
 
 @dataclass(frozen=True)
 class MapperGrid(Record):
-    """A mapper's parameter rows (grid product and explicit rows, coerced by the mapper's
-    own record) and its terrains."""
+    """A mapper (its class) with its parameter rows (grid product and explicit rows,
+    coerced by the mapper's own record) and its terrains."""
 
     OWNER: ClassVar[str] = "mapper grid"
-    mapper: str = param("", help="the mapper's name")
+    cls: type[Mapper]
     rows: tuple[Mapping[str, object], ...] = param((), help="its parameter rows")
     terrains: tuple[str, ...] = param((), _known, "known terrain names", "its terrains")
+
+    @property
+    def mapper(self) -> str:
+        """The mapper's name."""
+        return self.cls.name
 
 
 @dataclass(frozen=True)
@@ -185,8 +190,8 @@ def _grid_rows(source: str, key: str, grid: object) -> list[dict[str, object]]:
     return [dict(zip(lists, combo, strict=True)) for combo in itertools.product(*lists.values())]
 
 
-def _coerce_row(source: str, key: str, mapper: str, row: object) -> dict[str, object]:
-    """Validate one parameter row by constructing the mapper; values come back coerced."""
+def _coerce_row(source: str, key: str, mapper: type[Mapper], row: object) -> dict[str, object]:
+    """Validate one parameter row by the mapper's record; values come back coerced."""
     if not isinstance(row, Mapping):
         raise spec_error(source, key, f"{row!r} must map parameter names to values")
     for name, value in row.items():
@@ -194,7 +199,7 @@ def _coerce_row(source: str, key: str, mapper: str, row: object) -> dict[str, ob
             raise spec_error(source, f"{key}.{name}", f"{value!r} must be a number, string or "
                              "bool")
     try:
-        resolved = make_mapper(mapper, dict(row)).params.as_dict()
+        resolved = mapper.Params.parse({str(k): v for k, v in row.items()}).as_dict()
     except AlteError as err:
         raise spec_error(source, key, str(err)) from err
     return {str(name): resolved[str(name)] for name in row}
@@ -202,6 +207,10 @@ def _coerce_row(source: str, key: str, mapper: str, row: object) -> dict[str, ob
 
 def _mapper(source: str, name: str, body: object, terrains: tuple[str, ...]) -> MapperGrid:
     key = f"mappers.{name}"
+    try:
+        cls = registry.resolve(name)  # the spec's names become classes here, once
+    except AlteError as err:
+        raise spec_error(source, key, str(err)) from err
     if not isinstance(body, Mapping) or not ({"grid", "rows"} & set(body)):
         raise spec_error(source, key, "needs a 'grid' of parameter lists and/or explicit "
                          "'rows'")
@@ -213,12 +222,12 @@ def _mapper(source: str, name: str, body: object, terrains: tuple[str, ...]) -> 
         raise spec_error(source, f"{key}.rows", f"{explicit!r} must be a list of parameter "
                          "mappings")
     rows += explicit
-    coerced = tuple(_coerce_row(source, key, name, row) for row in rows)
+    coerced = tuple(_coerce_row(source, key, cls, row) for row in rows)
     own = _terrains(source, f"{key}.terrains", body["terrains"]) if "terrains" in body else terrains
     outside = sorted(set(own) - set(terrains))
     if outside:
         raise spec_error(source, f"{key}.terrains", f"{outside} not in the top-level terrains")
-    return MapperGrid(name, coerced, own)
+    return MapperGrid(cls, coerced, own)
 
 
 def parse_spec(raw: object, source: str = "spec") -> SweepSpec:
@@ -239,7 +248,7 @@ def parse_spec(raw: object, source: str = "spec") -> SweepSpec:
         terrains=terrains, mappers=mappers, settings=settings,
         truth=_truth(source, raw.get("truth")), source=source,
         variants=parse_variants(source, raw.get("variants"), terrains,
-                                tuple(g.mapper for g in mappers)))
+                                tuple(g.cls for g in mappers)))
 
 
 def load_spec(path: str | os.PathLike[str]) -> SweepSpec:
