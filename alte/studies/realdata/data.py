@@ -25,7 +25,6 @@ from tqdm.auto import tqdm
 
 from alte.errors import ParameterError
 from alte.io.pointfiles import local_origin, read_points
-from alte.mappers import make_mapper
 from alte.paths import realdata_dir
 from alte.pipeline import (
     DomainPolicy,
@@ -162,7 +161,8 @@ def _ground_run(sample: IsprsSample, name: str, params: Mapping[str, object],
     if name == BASELINE:
         heights = pts[:, 2]
     else:
-        mapper = make_mapper(name, params)
+        spec = MapSpec(name, dict(params))
+        mapper = spec.cls(None, record=spec.record)
         start = time.perf_counter()
         mapper.build(pts)
         extra = {"basis_functions": int(mapper.basis_functions),
