@@ -154,7 +154,7 @@ def run(args: argparse.Namespace) -> int:
     if args.mappers:
         return _mappers(args.json)
     if args.input is None:
-        raise ParameterError("alte info: give INPUT (a bag, terrain folder or point file) "
+        raise ParameterError("give INPUT (a bag, terrain folder or point file) "
                              "or --mappers")
     source = open_input(args.input)
     if source.kind is InputKind.POINTS:

@@ -40,7 +40,8 @@ from alte.mappers.quadtree import Quadtree
 from alte.params import Record
 
 __all__ = ["BUILTIN", "ENV", "GROUP", "MapperEntry", "builtin", "check_contract", "classes",
-           "create", "describe", "entries", "names", "refresh", "refused", "resolve", "title"]
+           "create", "describe", "entries", "names", "plugins", "refresh", "refused", "resolve",
+           "title"]
 
 #: The entry-point group plugins declare their mappers in.
 GROUP = "alte.mappers"
@@ -235,6 +236,12 @@ def classes(*, plugins: bool = True) -> tuple[type[Mapper], ...]:
     if not plugins:
         return BUILTIN
     return tuple(resolve(name) for name in names())
+
+
+def plugins(dims: int | None = None) -> tuple[type[Mapper], ...]:
+    """Every plugin's class (loaded and checked; ``dims``: only 2D or 3D maps)."""
+    return tuple(cls for cls in classes() if not builtin(cls)
+                 and (dims is None or cls.dims == dims))
 
 
 def create(mapper: str | type[Mapper], params: Mapping[str, object] | Record | None = None, /,

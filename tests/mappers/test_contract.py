@@ -1,10 +1,7 @@
 """The mapper contract: the thesis' four and the documented example meet it; check_mapper
 refuses each way a class can break it, naming the rule."""
 
-import importlib.util
-import sys
 from dataclasses import dataclass
-from pathlib import Path
 from typing import ClassVar
 
 import numpy as np
@@ -14,21 +11,7 @@ from alte.errors import ContractError, MapperError
 from alte.mappers import registry
 from alte.mappers.api import API_VERSION, VARIANCE, Cells, MapperBase, Record, param
 from alte.testing import check_mapper, scene
-
-EXAMPLE = Path(__file__).parents[2] / "docs" / "examples" / "mean_grid.py"
-
-
-def example_module() -> object:
-    """docs/examples/mean_grid.py, the mapper of the plugin authors' how-to, imported."""
-    spec = importlib.util.spec_from_file_location("mean_grid", EXAMPLE)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    sys.modules["mean_grid"] = module
-    spec.loader.exec_module(module)
-    return module
-
-
-MeanGrid = example_module().MeanGrid  # type: ignore[attr-defined]
+from support.example import EXAMPLE, MeanGrid, NoisyGrid
 
 
 def test_builtins_meet_the_contract() -> None:
@@ -39,6 +22,7 @@ def test_builtins_meet_the_contract() -> None:
 def test_example_is_short_and_meets_the_contract() -> None:
     assert len(EXAMPLE.read_text().splitlines()) <= 50
     check_mapper(MeanGrid)
+    check_mapper(NoisyGrid)
     mapper = MeanGrid(cell=2.0)
     for points, origin in scene():
         mapper.insert(points, origin)
