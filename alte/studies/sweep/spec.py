@@ -3,7 +3,10 @@
 A spec names terrains, the scans kept per terrain (``frames``), the simulation
 ``seeds`` (or one ``seed``), where results go (``output``), per mapper a ``grid`` of
 parameter lists (their cartesian product) and/or explicit ``rows``, and optionally
-ablation ``variants`` (:mod:`alte.studies.sweep.variants`). The top-level scalars are a
+ablation ``variants`` (:mod:`alte.studies.sweep.variants`). With ``plugins: true`` (or
+:func:`with_plugins`) every installed plugin mapper the spec does not list joins the
+grid with its own ``settings_grid`` on every terrain (a plugin the spec lists keeps the
+spec's rows). The top-level scalars are a
 :class:`SweepSettings` parameter record, checked and coerced like mapper parameters
 (:mod:`alte.params`); errors name the spec and the key. The runs a spec plans are in
 :mod:`~alte.studies.sweep.runs`.
@@ -11,6 +14,7 @@ ablation ``variants`` (:mod:`alte.studies.sweep.variants`). The top-level scalar
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import os
 from collections.abc import Mapping, Sequence
@@ -25,7 +29,7 @@ from alte.params import Record, param
 from alte.sim import TERRAINS
 from alte.studies.sweep.variants import Variant, parse_variants, spec_error
 
-__all__ = ["MapperGrid", "SweepSettings", "SweepSpec", "load_spec", "parse_spec"]
+__all__ = ["MapperGrid", "SweepSettings", "SweepSpec", "load_spec", "parse_spec", "with_plugins"]
 
 _MAPPER_KEYS = ("grid", "rows", "terrains")
 _SCALARS = (bool, int, float, str)
@@ -57,6 +61,8 @@ class SweepSettings(Record):
     output: str | None = param(None, help="results folder (default: reports/sweeps/NAME)")
     obstacles: bool = param(False, help="also score each map's obstacle identification "
                                         "against the simulator's objects")
+    plugins: bool = param(False, help="add every installed plugin mapper the spec does not "
+                                      "list, with its own settings grid")
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -230,6 +236,22 @@ def _mapper(source: str, name: str, body: object, terrains: tuple[str, ...]) -> 
     return MapperGrid(cls, coerced, own)
 
 
+def with_plugins(spec: SweepSpec) -> SweepSpec:
+    """``spec`` with a grid for every installed plugin mapper it does not list: the rows of
+    the plugin's ``settings_grid`` (its defaults when empty) on every terrain of the spec."""
+    listed = {g.cls for g in spec.mappers}
+    grids = []
+    for cls in registry.plugins():
+        if cls in listed:
+            continue
+        key = f"plugin {cls.name} settings_grid"
+        lists = {k: list(v) for k, v in cls.settings_grid.items()}
+        rows = _grid_rows(spec.source, key, lists) if lists else [{}]
+        grids.append(MapperGrid(cls, tuple(_coerce_row(spec.source, key, cls, r) for r in rows),
+                                spec.terrains))
+    return dataclasses.replace(spec, mappers=spec.mappers + tuple(grids))
+
+
 def parse_spec(raw: object, source: str = "spec") -> SweepSpec:
     """Validate a spec mapping (as read from YAML); errors name ``source`` and the key."""
     if not isinstance(raw, Mapping):
@@ -244,11 +266,12 @@ def parse_spec(raw: object, source: str = "spec") -> SweepSpec:
     settings = _record(source, SweepSettings,
                        {k: raw[k] for k in SweepSettings.names() if k in raw})
     mappers = tuple(_mapper(source, str(m), body, terrains) for m, body in raw["mappers"].items())
-    return SweepSpec(
+    spec = SweepSpec(
         terrains=terrains, mappers=mappers, settings=settings,
         truth=_truth(source, raw.get("truth")), source=source,
         variants=parse_variants(source, raw.get("variants"), terrains,
                                 tuple(g.cls for g in mappers)))
+    return with_plugins(spec) if settings.plugins else spec
 
 
 def load_spec(path: str | os.PathLike[str]) -> SweepSpec:
