@@ -11,7 +11,7 @@ whether the real sequence agrees.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import pandas as pd
@@ -50,6 +50,8 @@ class UseView:
     rows: list[ChoiceRow]
     orders: list[str]
     real: list[str]
+    duels: list[str] = field(default_factory=list)
+    calibration: list[str] = field(default_factory=list)
 
 
 @dataclass(frozen=True)
@@ -100,7 +102,8 @@ def _use(found: UseAnswer, sequence: str) -> UseView:
              f"{metric_words(found.use.truth)}")
     orders = [f"{metric_words(o.metric)}: {o.text()}" for o in found.orders]
     return UseView(title, found.summary, found.disagreement, [_row(c) for c in found.choices],
-                   orders, [check.text(sequence) for check in found.real])
+                   orders, [check.text(sequence) for check in found.real],
+                   [d.text() for d in found.duels], [c.text() for c in found.calibration])
 
 
 def _read(path: Path) -> pd.DataFrame | None:

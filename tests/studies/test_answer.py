@@ -108,3 +108,45 @@ def test_orders_count_the_equal_size_reads_each_mapper_wins():
     assert bottom_line(table).uses[1].choices == []  # no navigation rows
     single = order(table[table["seed"] == 0], LANDING, "mhd_m")
     assert single.leader == "quadtree" and single.reads == 6  # one recording: no interval
+
+
+def _with_challenger(calibrated: float) -> pd.DataFrame:
+    """Quadtree and 2D-ALTE as in the orders test, and an elevation map (a 2D plugin) that
+    beats both on sim_lan_1 and loses to both on sim_lan_2, claiming a height sigma whose
+    2-sigma share is ``calibrated``; a 3D map in the same table is no challenger."""
+    fronts = {"quadtree": 0.3, "alte2d": 0.2, "elevation": 0.25, "octomap": 0.2}
+    table = grid({m: {f"{m}{i}": (100 * 3**i, k / (i + 1), k / (i + 1), 0.9)
+                      for i in range(5)} for m, k in fronts.items()})
+    table["dims"] = np.where(table["mapper"] == "octomap", 3, 2)
+    elevation = table["mapper"] == "elevation"
+    better = elevation & (table["terrain"] == "sim_lan_1")
+    table.loc[better, "height_rmse_m"] *= 0.2
+    table.loc[elevation & ~better, "height_rmse_m"] *= 1.3
+    table["within_2sigma"] = np.where(elevation, calibrated, np.nan)
+    table["sigma_mean_m"] = np.where(elevation, 0.01, np.nan)
+    return table
+
+
+def test_a_challenger_joins_the_candidates_and_is_read_terrain_by_terrain():
+    answer = bottom_line(_with_challenger(0.9)).uses[0]
+    assert answer.use.mappers == ("quadtree", "alte2d")
+    assert {d.rival for d in answer.duels} == {"quadtree", "alte2d"}
+    assert all(d.challenger == "elevation" for d in answer.duels)
+    text = answer.duels[0].text()
+    assert text == ("Elevation map against Quadtree, height RMSE at equal size: leads on "
+                    "sim_lan_1 (3 of 3 reads); loses on sim_lan_2 (3 of 3)")
+    assert any(c.best is not None and c.best.mapper == "elevation" for c in answer.choices)
+    (calibration,) = answer.calibration
+    assert calibration.median == 0.9 and calibration.maps == 30
+    assert calibration.text().startswith(
+        "Elevation map on the simulated terrains (sim_lan_1, sim_lan_2): the true height lies "
+        "within 2 claimed sigma on 90.0 % of the mapped area (median of 30 maps")
+    assert "over-confident" in calibration.text()
+    assert "cautious" in bottom_line(_with_challenger(0.99)).uses[0].calibration[0].text()
+    assert "): calibrated" in bottom_line(_with_challenger(0.95)).uses[0].calibration[0].text()
+
+
+def test_without_a_dims_column_there_is_no_challenger():
+    table = _with_challenger(0.9).drop(columns=["dims", "within_2sigma"])
+    answer = bottom_line(table).uses[0]
+    assert answer.duels == [] and answer.calibration == []

@@ -7,20 +7,24 @@ the choice under every budget on each terrain group (:mod:`~alte.studies.answer.
 a one-sentence summary, the orders at equal size by the thesis' MHD and by the truth
 (:mod:`~alte.studies.answer.orders`) with whether they rank the maps differently, and
 for each of those comparisons whether the real sequence agrees with the simulated
-terrains. Every sentence is built from these numbers; nothing is typed in.
+terrains; with further mappers of the use's dimension in the grid (plugins), where each
+beats or loses against the thesis' two, terrain by terrain, and how well the height
+sigma a map claims covers the truth (:mod:`~alte.studies.answer.challengers`). Every
+sentence is built from these numbers; nothing is typed in.
 """
 
 from __future__ import annotations
 
 from collections import Counter
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import pandas as pd
 
 from alte.studies.analysis.tradeoff import METRICS, mapper_title
 from alte.studies.analysis.uncertainty import Interval
+from alte.studies.answer.challengers import Calibration, Duel, calibrations, challengers, duels
 from alte.studies.answer.choose import (
     GROUPS,
     USES,
@@ -64,6 +68,8 @@ class UseAnswer:
     orders: list[Order]
     disagreement: str
     real: list[RealCheck] = field(default_factory=list)
+    duels: list[Duel] = field(default_factory=list)
+    calibration: list[Calibration] = field(default_factory=list)
 
 
 @dataclass(frozen=True)
@@ -140,13 +146,14 @@ def _metrics(use: Use, table: pd.DataFrame) -> list[str]:
 def _use_answer(grid: pd.DataFrame, real: pd.DataFrame | None, use: Use) -> UseAnswer:
     cases = grid["case"] if "case" in grid else grid["terrain"].map(TERRAIN_CASE)
     mine = grid[cases == use.case]
+    wide = replace(use, mappers=use.mappers + challengers(mine, use))
     choices = []
     for group, prefix in GROUPS.items():
         terrains = sorted({t for t in mine["terrain"].astype(str) if t.startswith(prefix)})
         if not terrains:
             continue
-        pool = candidates(mine, use, group)
-        choices += [choose(pool, use, group, terrains, b) for b in budgets(pool, use)]
+        pool = candidates(mine, wide, group)
+        choices += [choose(pool, wide, group, terrains, b) for b in budgets(pool, wide)]
     orders = [order(mine, use, m) for m in _metrics(use, mine)]
     checks = []
     if real is not None and not real.empty:
@@ -155,8 +162,10 @@ def _use_answer(grid: pd.DataFrame, real: pd.DataFrame | None, use: Use) -> UseA
                 there = order(real, use, simulated.metric)
                 checks.append(RealCheck(simulated.metric, simulated, there,
                                         agreement(simulated, there)))
-    return UseAnswer(use, choices, _summary(use, choices), orders,
-                     _disagreement(use, orders), checks)
+    mapped = mine[mine["dims"] == use.dims] if "dims" in mine and use.dims else mine
+    return UseAnswer(use, choices, _summary(wide, choices), orders,
+                     _disagreement(use, orders), checks, duels(mine, use),
+                     calibrations(mapped))
 
 
 def bottom_line(grid: pd.DataFrame, real: pd.DataFrame | None = None) -> BottomLine:

@@ -96,7 +96,7 @@ class ElevationMap(MapperBase[ElevationParams]):
                                                        "spread"})
     layers: ClassVar[frozenset[str]] = LAYERS
     settings_grid: ClassVar[Mapping[str, tuple[object, ...]]] = {
-        "resolution": (0.05, 0.1, 0.2, 0.35, 0.5, 1.0, 2.0)}
+        "resolution": (0.05, 0.1, 0.2, 0.5, 1.0, 2.0)}
 
     def clear(self) -> None:
         """No cell."""
