@@ -6,12 +6,12 @@ from typing import ClassVar
 
 import numpy as np
 import pytest
+from support.example import EXAMPLE, MeanGrid, NoisyGrid
 
 from alte.errors import ContractError, MapperError
 from alte.mappers import registry
 from alte.mappers.api import API_VERSION, VARIANCE, Cells, MapperBase, Record, param
 from alte.testing import check_mapper, scene
-from support.example import EXAMPLE, MeanGrid, NoisyGrid
 
 
 def test_builtins_meet_the_contract() -> None:

@@ -6,7 +6,6 @@ import re
 from pathlib import Path
 
 import pandas as pd
-
 from support.tradeoff import Curve, synthetic_tradeoff
 
 from alte.report.answer import answer_view
