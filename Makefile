@@ -24,7 +24,7 @@ report-quick: bootstrap
 	$(PY) -m alte report --quick $(REPORT_ARGS)
 
 lint: bootstrap
-	$(PY) -m ruff check alte tests bench
+	$(PY) -m ruff check alte tests bench plugins
 	$(PY) -m mypy
 
 # mypy and the compilation of the mappers' numba kernels (`alte warmup`, cached for every
@@ -35,9 +35,9 @@ lint: bootstrap
 # so make test writes the bytecode caches (__pycache__, git-ignored) whatever the caller says.
 test: export PYTHONDONTWRITEBYTECODE :=
 test: bootstrap
-	$(PY) -m ruff check alte tests bench
+	$(PY) -m ruff check alte tests bench plugins
 	@$(PY) -m alte warmup & warm=$$!; $(PY) -m mypy; typed=$$?; wait $$warm && exit $$typed
-	$(PY) -m pytest -n 2 --dist loadfile --no-loadscope-reorder tests notebooks --nbval-lax $(PYTEST_ARGS)
+	$(PY) -m pytest -n 2 --dist loadfile --no-loadscope-reorder tests plugins/alte-elevation/tests notebooks --nbval-lax $(PYTEST_ARGS)
 
 # Rewrite the checked-in reference results (tests/reference) from a fresh quick chapter 5
 # run, after a deliberate change; `git diff tests/reference` shows what moved.

@@ -163,7 +163,9 @@ def _row(run: LandingRun, params: Mapping[str, object]) -> JSONDict:
             "best_y": float(best["y"].iloc[0]) if len(best) else float("nan"),
             "radius_m": landing.radius, "keep_out_m": landing.keep_out,
             "max_height_sigma_m": (float("nan") if landing.max_height_sigma is None
-                                   else landing.max_height_sigma)}
+                                   else landing.max_height_sigma),
+            "bound": ("" if landing.max_height_sigma is None
+                      else f"sigma <= {landing.max_height_sigma:.3g} m")}
 
 
 def _evaluations(data: Registered, job: ParamSet, landing: LandingParams, *,
@@ -181,16 +183,19 @@ def _evaluations(data: Registered, job: ParamSet, landing: LandingParams, *,
 
 def landing_table(datasets: Sequence[Registered],
                   landing: Mapping[str, LandingParams] | None = None, *,
-                  extra: Sequence[type[Mapper]] = (), sigma: bool = True,
-                  progress: bool = True) -> tuple[pd.DataFrame, list[LandingRun]]:
+                  plugins: bool = False, extra: Sequence[type[Mapper]] = (),
+                  sigma: bool = True, progress: bool = True
+                  ) -> tuple[pd.DataFrame, list[LandingRun]]:
     """One row per terrain x mapper x parameter set (:func:`landing_param_sets`, with the
-    ``extra`` mappers' settings grids) and, with ``sigma``, one more per map with a height
-    variance under the sigma bound (``max_height_sigma_m``).
+    settings grids of the ``extra`` mappers and, with ``plugins``, of every installed 2D
+    plugin) and, with ``sigma``, one more per map with a height variance under the sigma
+    bound (``max_height_sigma_m``, ``bound``).
 
     ``landing`` maps terrain names to parameters (default: :func:`landing_params`).
     The truth is computed once per terrain.
     """
-    jobs = [(d, *s) for d in datasets for s in landing_param_sets(d.source.name, extra)]
+    more = tuple(dict.fromkeys((*extra, *(registry.plugins(dims=2) if plugins else ()))))
+    jobs = [(d, *s) for d in datasets for s in landing_param_sets(d.source.name, more)]
     rows, runs, truths = [], [], {}
     for data, label, mapper, params in tqdm(jobs, desc="landing", unit="map",
                                             disable=not progress):
@@ -215,13 +220,15 @@ def load_terrains(names: Sequence[str], data_dir: str | os.PathLike[str] = "data
 
 
 def landing_summary(table: pd.DataFrame) -> pd.DataFrame:
-    """Mean scores per terrain and mapper over the parameter sets of :func:`landing_table`."""
+    """Mean scores per terrain and mapper (and height sigma ``bound``, when the table has
+    one) over the parameter sets of :func:`landing_table`."""
     scores = ["precision", "area_precision", "recall", "recall_known", "detected_area_m2",
               "safe_area_m2"]
     missing = sorted({"terrain", "mapper", *scores} - set(table.columns))
     if missing:
         raise ParameterError(f"landing summary: table lacks columns {', '.join(missing)}")
-    return table.groupby(["terrain", "mapper"], sort=False)[scores].mean().reset_index()
+    keys = ["terrain", "mapper", *(["bound"] if "bound" in table else [])]
+    return table.groupby(keys, sort=False)[scores].mean().reset_index()
 
 
 def write_landing_table(table: pd.DataFrame, out_dir: str | os.PathLike[str],
