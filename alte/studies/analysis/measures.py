@@ -268,9 +268,9 @@ def _by_cost(check: Check, table: pd.DataFrame) -> CheckValues:
         return replace(_measure(timed, table), time="cpu")
     found = _measure(renamed(check, ELAPSED, "cost"), table)
     units = ", ".join(dict.fromkeys(str(u) for u in mine["cost_unit"].dropna())
-                      if "cost_unit" in mine else ())
-    return replace(found, what=f"{found.what}; cost in {units}", time="cost",
-                   crosscheck=_measure(timed, table))
+                      if "cost_unit" in mine else ())  # the rows carry their cost's unit
+    return replace(found, what=f"{found.what}; cost in {units}" if units else found.what,
+                   time="cost", crosscheck=_measure(timed, table))
 
 
 def measure_check(check: Check, table: pd.DataFrame) -> CheckValues:
