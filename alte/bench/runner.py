@@ -18,9 +18,11 @@ from tqdm.auto import tqdm
 
 from alte.bench.clouds import cloud_stages, hausdorff_speed
 from alte.bench.core import BenchConfig, Context, Result
+from alte.bench.ground import ground_speed
 from alte.bench.maps import batch_builds, insert_latency, octomap_memory, octomap_speed
 from alte.bench.memory import map_memory
 from alte.bench.poses import pose_speed
+from alte.bench.realterrain import real_terrain
 from alte.bench.scaling import scaling
 from alte.bench.stream import scan_peer, streaming_chain
 from alte.bench.sweep import sweep_throughput
@@ -49,6 +51,8 @@ ROWS: dict[int, tuple[str, Row]] = {
     12: ("odometry / refinement per real scan vs kiss-icp's pipeline", pose_speed),
     13: ("sweep runs per core-second (20 scans, whole missions) and the grid's time",
          sweep_throughput),
+    14: ("a real LiDAR tile imported and flown vs a built-in mission simulated", real_terrain),
+    15: ("ground stage per real tile vs pysmrf and CSF (CPU s)", ground_speed),
 }
 
 

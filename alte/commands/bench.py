@@ -25,7 +25,7 @@ def _sizes(text: str) -> tuple[int, ...]:
 def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Register ``bench``."""
     parser = subparsers.add_parser(
-        "bench", help="run the performance benchmark (issue 6)",
+        "bench", help="run the performance benchmark",
         description="Time our stages beside their peers (pyoctomap, open3d, numpy.argsort) "
                     "and write reports/bench.md, bench.json and bench_scaling.png.")
     parser.add_argument("--quick", action="store_true",

@@ -14,11 +14,14 @@ from __future__ import annotations
 import argparse
 import json
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from alte.errors import ParameterError
 from alte.io.baginfo import BagInfo, inspect_bag
-from alte.io.pointfiles import PointSummary, describe_points
-from alte.pipeline import InputKind, Source, open_input
+from alte.pipeline.source import InputKind, Source, open_input
+
+if TYPE_CHECKING:
+    from alte.io.pointfiles import PointSummary
 
 __all__ = ["add_parser", "format_info", "format_mappers", "format_points", "imu_topics",
            "odometry_choice", "pose_source", "run"]
@@ -158,6 +161,8 @@ def run(args: argparse.Namespace) -> int:
                              "or --mappers")
     source = open_input(args.input)
     if source.kind is InputKind.POINTS:
+        from alte.io.pointfiles import describe_points  # pandas, numba: point files only
+
         about = describe_points(source.path)
         print(json.dumps(about, sort_keys=True) if args.json else "\n".join(format_points(about)))
         return 0

@@ -20,7 +20,7 @@ from alte.export import ExportOptions
 from alte.export import export_map as export_mcap
 from alte.fsutil import refuse_overwrite
 from alte.ground.surface import SurfaceRule
-from alte.mappers import Domain, Feed, check_export, export_map, registry
+from alte.mappers import Domain, Feed, check_export, export_map
 from alte.pipeline import DomainPolicy, MapRun, MapSpec, open_input, run
 
 __all__ = ["add_map_options", "add_parser", "export_options", "map_spec", "mapped",
@@ -37,7 +37,7 @@ _SUMMARY_KEYS = ("mapper", "params", "input", "input_kind", "pose_source", "doma
 def add_map_options(p: argparse.ArgumentParser) -> None:
     """The flags that choose the map (shared by ``alte map`` and ``alte export``)."""
     p.add_argument("--mapper", required=True,
-                   help=f"{', '.join(c.name for c in registry.BUILTIN)} or an installed plugin "
+                   help="the thesis' quadtree, octomap, alte2d, alte3d or an installed plugin "
                         "(alte info --mappers lists them)")
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", dest="sets",
                    help="mapper parameter (repeatable), e.g. --set kappa=0.1")

@@ -40,8 +40,8 @@ from alte.mappers.quadtree import Quadtree
 from alte.params import Record
 
 __all__ = ["BUILTIN", "ENV", "GROUP", "MapperEntry", "builtin", "check_contract", "classes",
-           "create", "describe", "entries", "names", "plugins", "refresh", "refused", "resolve",
-           "title"]
+           "create", "describe", "entries", "make_mapper", "names", "plugins", "refresh",
+           "refused", "resolve", "title"]
 
 #: The entry-point group plugins declare their mappers in.
 GROUP = "alte.mappers"
@@ -259,6 +259,10 @@ def create(mapper: str | type[Mapper], params: Mapping[str, object] | Record | N
         raise ContractError(f"{cls.__qualname__}: an instance does not meet the Mapper "
                             "protocol (run alte.testing.check_mapper on the class)")
     return made
+
+
+#: A mapper by class or by registered name, with its parameters (:func:`create`).
+make_mapper = create
 
 
 def describe(entry: MapperEntry) -> dict[str, str]:

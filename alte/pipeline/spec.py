@@ -14,12 +14,11 @@ import enum
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import ClassVar
+from typing import ClassVar, cast
 
 import numpy as np
 
 from alte.errors import ParameterError
-from alte.mappers import registry
 from alte.mappers.base import Feed, Mapper
 from alte.mappers.domain import Domain
 from alte.params import Record, param
@@ -158,17 +157,29 @@ class MapSpec(Record):
     feed: Feed | None = None
     snapshots: int = param(0, lambda v: v >= 0, "snapshots >= 0",
                            "cell snapshots kept over the run (time-lapse figures)")
-    cls: type[Mapper] = field(init=False, repr=False, compare=False)
     record: Record = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        cls = registry.resolve(self.mapper) if isinstance(self.mapper, str) else self.mapper
-        object.__setattr__(self, "mapper", cls.name)
+        if not isinstance(self.mapper, str):  # a class: kept, and its name is the mapper
+            object.__setattr__(self, "_cls", self.mapper)
+            object.__setattr__(self, "mapper", self.mapper.name)
+        cls = self.cls
         given = self.params
         record = given if isinstance(given, cls.Params) else cls.Params.parse(
             given.as_dict() if isinstance(given, Record) else given)
-        object.__setattr__(self, "cls", cls)
         object.__setattr__(self, "record", record)
         object.__setattr__(self, "params", given.as_dict() if isinstance(given, Record)
                            else dict(given))
+
+    @property
+    def cls(self) -> type[Mapper]:
+        """The mapper's class: the one given, or the registry's for the name (the registry,
+        and with it the mappers' kernels, loads on first use: a spec is light to import)."""
+        found = self.__dict__.get("_cls")
+        if found is None:
+            from alte.mappers import registry
+
+            found = registry.resolve(str(self.mapper))
+            object.__setattr__(self, "_cls", found)
+        return cast("type[Mapper]", found)

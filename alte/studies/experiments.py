@@ -21,7 +21,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import pandas as pd
-from tqdm.auto import tqdm
 
 from alte.errors import ParameterError
 from alte.mappers import Mapper
@@ -39,6 +38,7 @@ from alte.pipeline import (
     prepare,
     run,
 )
+from alte.progress import bar as progress_bar
 from alte.registration.odometry import OdometryParams
 from alte.studies.thesis.numbers import SWEEPS, sweep_table
 
@@ -173,7 +173,8 @@ def sweep(data: Registered, table: int, rows: Sequence[int] | None = None, *,
         raise ParameterError(f"table 5.{table}: rows {bad or chosen} not in 0..5")
     thesis = sweep_table(table).iloc[chosen].reset_index(drop=True)
     runs = [measure(data, spec["mapper"], {**spec["rows"][r][0], **(extra or {})}, truth=truth)
-            for r in tqdm(chosen, desc=f"table 5.{table}", unit="map", disable=not progress)]
+            for r in progress_bar(chosen, desc=f"table 5.{table}", unit="map",
+                                  disable=not progress)]
     ours = pd.DataFrame([m.metrics.flat() for m in runs])
     ours.insert(0, "thesis_row", chosen)
     return pd.concat([thesis, ours], axis=1), runs

@@ -91,7 +91,10 @@ def tradeoff_table(rows: pd.DataFrame) -> pd.DataFrame:
     ``params`` as JSON, the terrain's ``case``, :data:`TRADEOFF_COLUMNS` first."""
     if rows.empty:
         raise ParameterError("trade-off grid: no finished runs to tabulate")
-    out = rows.assign(params=rows["params_json"], case=rows["terrain"].map(TERRAIN_CASE))
+    # An imported terrain's case is its maps' (the mappers the thesis applies to it).
+    by_mapper = {m: case for case, pair in CASE_MAPPERS.items() for m in pair}
+    case = rows["terrain"].map(TERRAIN_CASE).fillna(rows["mapper"].map(by_mapper))
+    out = rows.assign(params=rows["params_json"], case=case)
     out = out.drop(columns=[c for c in _DROP if c in out])
     first = [c for c in ("variant", *TRADEOFF_COLUMNS) if c in out]
     params = sorted(c for c in out.columns if str(c).startswith("p_"))

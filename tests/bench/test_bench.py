@@ -119,7 +119,7 @@ def test_config_and_row_selection_errors():
         BenchConfig(budget_s=0)
     with pytest.raises(ParameterError, match=r"unknown row\(s\) \[99\]"):
         select_rows([1, 99])
-    assert select_rows(None) == sorted(ROWS) == list(range(1, 14))
+    assert select_rows(None) == sorted(ROWS) == list(range(1, 15))
     assert BenchConfig(quick=True).scaling_sizes == (3000, 6000, 12000)
     assert BenchConfig().scaling_sizes[-1] == 10**7
 
@@ -179,10 +179,14 @@ def quick_bench(tmp_path_factory):
     return run_bench(config)
 
 
+@pytest.mark.full
 @pytest.mark.slow
 def test_quick_bench_runs_every_row_and_writes_its_outputs(quick_bench):
     assert quick_bench.errors == {}
-    rows = set(range(1, 14)) if (REALDATA / "balm_seq").exists() else set(range(1, 12)) | {13}
+    rows = set(range(1, 12)) | {13}
+    rows |= {12} if (REALDATA / "balm_seq").exists() else set()
+    rows |= {14} if (REALDATA / "als").exists() else set()
+    rows |= {15} if (REALDATA / "isprs_terrain").exists() else set()
     assert {r.row for r in quick_bench.results} == rows
     for r in quick_bench.results:
         if r.row != 8:

@@ -63,6 +63,24 @@ def test_real_fronts_add_the_agreement_of_the_real_sequence(tmp_path: Path) -> N
     assert "Real data: balm_seq, 20 real scans" in view.real_note
 
 
+def test_real_terrain_classes_show_where_the_built_in_answer_holds(tmp_path: Path) -> None:
+    run = tmp_path / "run"
+    record = make_front_run(run)
+    sites = {"quadtree": ("ign_farmland",), "alte2d": ("ign_farmland",),
+             "octomap": ("bcts_slope",), "alte3d": ("bcts_slope",)}
+    real = synthetic_tradeoff({"alte2d": Curve(scale=0.5)}, terrains=sites).assign(
+        evidence="flown", terrain_class=lambda t: t["terrain"].map(
+            {"ign_farmland": "flat open", "bcts_slope": "slope"}))
+    write_csv(real, run / "tables", "realterrain_fronts")
+    view = answer_view(run / "tables")
+    landing, navigation = view.uses
+    assert [(r.terrain_class, r.terrains, r.verdict) for r in landing.classes] == [
+        ("flat open", "ign_farmland", "holds")]
+    assert navigation.classes[0].terrain_class == "slope"
+    page = run_index_html(record, run, sorted((run / "tables").glob("*.csv")))
+    assert "On real terrain, by class" in page and "<td>flat open</td>" in page
+
+
 def test_a_plugin_in_the_grid_is_read_against_the_thesis_two(tmp_path: Path) -> None:
     """A 2D mapper beyond the thesis' two (a plugin, ``dims`` 2) with a height variance:
     the page says where it beats or loses and how often its sigma covers the truth."""

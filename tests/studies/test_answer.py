@@ -110,6 +110,61 @@ def test_orders_count_the_equal_size_reads_each_mapper_wins():
     assert single.leader == "quadtree" and single.reads == 6  # one recording: no interval
 
 
+def _fronts(first, second, terrains, case="lan"):
+    """Two mappers' fronts (five sizes), the first's truth ``first`` x the second's."""
+    pair = {"lan": ("quadtree", "alte2d"), "nav": ("octomap", "alte3d")}[case]
+    settings = {pair[0]: {f"a{i}": (100 * 3**i, first / (i + 1), 0.1, 0.9) for i in range(5)},
+                pair[1]: {f"b{i}": (100 * 3**i, second / (i + 1), 0.1, 0.9) for i in range(5)}}
+    table = grid(settings, terrains)
+    if case == "nav":
+        table = table.assign(case="nav", accuracy_mean_m=table["height_rmse_m"])
+    return table
+
+
+def test_real_terrain_classes_say_where_the_built_in_answer_holds():
+    from alte.studies.answer.classes import class_checks
+
+    builtin = _fronts(0.3, 0.2, ("sim_lan_1", "sim_lan_2"))  # 2D-ALTE leads
+    agree = _fronts(0.3, 0.2, ("ign_farmland",)).assign(terrain_class="flat open",
+                                                         evidence="flown")
+    disagree = _fronts(0.2, 0.3, ("pyfor_forest",)).assign(terrain_class="flat under forest",
+                                                           evidence="points")
+    checks = class_checks(builtin, pd.concat([agree, disagree]), LANDING)
+    assert [(c.terrain_class, c.evidence, c.verdict) for c in checks] == [
+        ("flat open", "flown", "holds"), ("flat under forest", "points", "does not hold")]
+    assert "flat open (ign_farmland; flown over the real surface" in checks[0].text()
+    assert class_checks(builtin, None, LANDING) == []
+    line = bottom_line(builtin, terrain=pd.concat([agree, disagree])).uses[0]
+    assert [c.verdict for c in line.classes] == ["holds", "does not hold"]
+
+
+def test_a_sequence_whose_landing_maps_are_metres_off_says_why_it_cannot_rank_them():
+    builtin = _fronts(0.3, 0.2, ("sim_lan_1", "sim_lan_2"))
+    far = _fronts(25.0, 21.5, ("balm_seq",)).query("seed == 0")  # best 4.3 m
+    landing = bottom_line(builtin, far).uses[0]
+    assert landing.real == []
+    assert landing.real_why.startswith("balm_seq cannot rank landing maps: its best map is 4.")
+    near = _fronts(0.3, 0.2, ("balm_seq",)).query("seed == 0")
+    ranked = bottom_line(builtin, near).uses[0]
+    assert ranked.real and not ranked.real_why
+
+
+def test_a_completeness_need_picks_the_most_accurate_map_covering_that_much():
+    table = _fronts(0.3, 0.2, ("sim_nav_1", "sim_nav_2"), case="nav")
+    table.loc[table["mapper"] == "alte3d", "completeness"] = 0.6  # accurate, covers less
+    pool = candidates(table, NAVIGATION, "simulated")
+    found = budgets(pool, NAVIGATION, cover=(0.8,))
+    # read off the candidates: the median (0.75) and the best third (0.9) of 0.6 and 0.9
+    assert [b.limit for b in found if b.kind == "cover"] == [0.75, 0.8, 0.9]
+    need = choose(pool, NAVIGATION, "simulated", ("sim_nav_1", "sim_nav_2"), Budget("cover", 0.8))
+    assert need.best.mapper == "octomap" and need.rival is None
+    loose = choose(pool, NAVIGATION, "simulated", ("sim_nav_1", "sim_nav_2"), Budget("cover", 0.6))
+    assert loose.best.mapper == "alte3d"
+    assert Budget("cover", 0.8).text(NAVIGATION) == "completeness >= 0.8 on every terrain"
+    assert [b.kind for b in budgets(candidates(grid(), LANDING, "simulated"), LANDING)].count(
+        "cover") == 0
+
+
 def _with_challenger(calibrated: float) -> pd.DataFrame:
     """Quadtree and 2D-ALTE as in the orders test, and an elevation map (a 2D plugin) that
     beats both on sim_lan_1 and loses to both on sim_lan_2, claiming a height sigma whose

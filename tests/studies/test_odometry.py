@@ -58,6 +58,7 @@ def test_benchmark_errors_are_typed(tmp_path: Path, capsys) -> None:
     assert "--reference" in capsys.readouterr().err
 
 
+@pytest.mark.full
 @pytest.mark.slow
 @pytest.mark.realdata
 def test_balm_seq_figures(tmp_path: Path) -> None:

@@ -2,15 +2,18 @@
 
 :func:`bottom_line` takes the trade-off grid (``tradeoff.csv``, obstacle columns
 included) and, when chapter 6 ran, the real sequence's fronts (``realdata_fronts.csv``)
-and returns a :class:`BottomLine`: per use (:data:`~alte.studies.answer.choose.USES`)
-the choice under every budget on each terrain group (:mod:`~alte.studies.answer.choose`),
-a one-sentence summary, the orders at equal size by the thesis' MHD and by the truth
-(:mod:`~alte.studies.answer.orders`) with whether they rank the maps differently, and
-for each of those comparisons whether the real sequence agrees with the simulated
-terrains; with further mappers of the use's dimension in the grid (plugins), where each
-beats or loses against the thesis' two, terrain by terrain, and how well the height
-sigma a map claims covers the truth (:mod:`~alte.studies.answer.challengers`). Every
-sentence is built from these numbers; nothing is typed in.
+and the real-terrain evidence (``realterrain_fronts.csv``), and returns a
+:class:`BottomLine`: per use (:data:`~alte.studies.answer.choose.USES`) the choice under
+every budget on each terrain group (:mod:`~alte.studies.answer.choose`), a one-sentence
+summary, the orders at equal size by the thesis' MHD and by the truth
+(:mod:`~alte.studies.answer.orders`) with whether they rank the maps differently, for
+each of those comparisons whether the real sequence agrees with the simulated terrains
+(or why it cannot rank that use's maps), per class of real terrain whether the
+built-in answer holds there (:mod:`~alte.studies.answer.classes`), and, with further
+mappers of the use's dimension in the grid (plugins), where each beats or loses against
+the thesis' two, terrain by terrain, and how well the height sigma a map claims covers
+the truth (:mod:`~alte.studies.answer.challengers`). Every sentence is built from these
+numbers; nothing is typed in.
 """
 
 from __future__ import annotations
@@ -35,6 +38,7 @@ from alte.studies.answer.choose import (
     candidates,
     choose,
 )
+from alte.studies.answer.classes import RANKS_WITHIN, ClassCheck, class_checks, sequence_ranks
 from alte.studies.answer.orders import Order, agreement, metric_words, order
 from alte.studies.thesis.numbers import TERRAIN_CASE
 
@@ -68,6 +72,8 @@ class UseAnswer:
     orders: list[Order]
     disagreement: str
     real: list[RealCheck] = field(default_factory=list)
+    real_why: str = ""
+    classes: list[ClassCheck] = field(default_factory=list)
     duels: list[Duel] = field(default_factory=list)
     calibration: list[Calibration] = field(default_factory=list)
 
@@ -143,7 +149,30 @@ def _metrics(use: Use, table: pd.DataFrame) -> list[str]:
     return [m for m in dict.fromkeys(wanted) if m in table and table[m].notna().any()]
 
 
-def _use_answer(grid: pd.DataFrame, real: pd.DataFrame | None, use: Use) -> UseAnswer:
+def _real_checks(real: pd.DataFrame | None, use: Use, orders: Sequence[Order]
+                 ) -> tuple[list[RealCheck], str]:
+    """The real sequence's checks, or why it cannot rank this use's maps."""
+    if real is None or real.empty:
+        return [], ""
+    ranks, best = sequence_ranks(real, use)
+    if not ranks:
+        name = str(real["terrain"].iloc[0])
+        return [], (f"{name} cannot rank {use.name} maps: its best map is "
+                    f"{best:.2f} m ({metric_words(use.truth)}) from its reference cloud, "
+                    f"beyond the {RANKS_WITHIN:g} m within which its maps can be told apart; "
+                    "the real terrains below rank them instead.")
+    checks = []
+    for simulated in orders:
+        if simulated.metric in real and real[simulated.metric].notna().any():
+            there = order(real, use, simulated.metric)
+            checks.append(RealCheck(simulated.metric, simulated, there,
+                                    agreement(simulated, there)))
+    return checks, ""
+
+
+def _use_answer(grid: pd.DataFrame, real: pd.DataFrame | None, use: Use,
+                terrain: pd.DataFrame | None = None,
+                cover: Sequence[float] = ()) -> UseAnswer:
     cases = grid["case"] if "case" in grid else grid["terrain"].map(TERRAIN_CASE)
     mine = grid[cases == use.case]
     wide = replace(use, mappers=use.mappers + challengers(mine, use))
@@ -153,24 +182,23 @@ def _use_answer(grid: pd.DataFrame, real: pd.DataFrame | None, use: Use) -> UseA
         if not terrains:
             continue
         pool = candidates(mine, wide, group)
-        choices += [choose(pool, wide, group, terrains, b) for b in budgets(pool, wide)]
+        choices += [choose(pool, wide, group, terrains, b)
+                    for b in budgets(pool, wide, cover=cover)]
     orders = [order(mine, use, m) for m in _metrics(use, mine)]
-    checks = []
-    if real is not None and not real.empty:
-        for simulated in orders:
-            if simulated.metric in real and real[simulated.metric].notna().any():
-                there = order(real, use, simulated.metric)
-                checks.append(RealCheck(simulated.metric, simulated, there,
-                                        agreement(simulated, there)))
+    checks, why = _real_checks(real, use, orders)
     mapped = mine[mine["dims"] == use.dims] if "dims" in mine and use.dims else mine
     return UseAnswer(use, choices, _summary(wide, choices), orders,
-                     _disagreement(use, orders), checks, duels(mine, use),
-                     calibrations(mapped))
+                     _disagreement(use, orders), checks, why,
+                     class_checks(grid, terrain, use), duels(mine, use), calibrations(mapped))
 
 
-def bottom_line(grid: pd.DataFrame, real: pd.DataFrame | None = None) -> BottomLine:
-    """The bottom line of a run from its trade-off grid and real fronts (module docstring)."""
-    answers = [_use_answer(grid, real, use) for use in USES]
+def bottom_line(grid: pd.DataFrame, real: pd.DataFrame | None = None,
+                terrain: pd.DataFrame | None = None,
+                cover: Sequence[float] = ()) -> BottomLine:
+    """The bottom line of a run from its trade-off grid, the real sequence's fronts and the
+    real-terrain evidence (module docstring); ``cover``: completeness needs the reader
+    states for navigation (besides those read off the candidates)."""
+    answers = [_use_answer(grid, real, use, terrain, cover) for use in USES]
     sequence = ""
     note = "No real sequence in this run (chapter 6 skipped, or realdata_fronts.csv absent)."
     if real is not None and not real.empty:

@@ -22,11 +22,11 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
-from tqdm.auto import tqdm
 
 from alte.errors import MetricsError, ParameterError
 from alte.mappers import VARIANCE, Mapper, registry
 from alte.pipeline import MapRun, MapSpec, Registered, run
+from alte.progress import bar as progress_bar
 from alte.studies.analysis.tables import write_csv
 from alte.studies.experiments import ground_truth, terrain
 from alte.studies.landing.detect import Centres, Detection, detect_sites
@@ -197,7 +197,7 @@ def landing_table(datasets: Sequence[Registered],
     more = tuple(dict.fromkeys((*extra, *(registry.plugins(dims=2) if plugins else ()))))
     jobs = [(d, *s) for d in datasets for s in landing_param_sets(d.source.name, more)]
     rows, runs, truths = [], [], {}
-    for data, label, mapper, params in tqdm(jobs, desc="landing", unit="map",
+    for data, label, mapper, params in progress_bar(jobs, desc="landing", unit="map",
                                             disable=not progress):
         name = data.source.name
         chosen = (landing or {}).get(name) or landing_params(name)
@@ -216,7 +216,7 @@ def load_terrains(names: Sequence[str], data_dir: str | os.PathLike[str] = "data
     """Simulate (when missing or stale) and register the named terrains, ``frames`` scans
     each."""
     return [terrain(name, data_dir, seed, frames)
-            for name in tqdm(names, desc="terrains", unit="terrain", disable=not progress)]
+            for name in progress_bar(names, desc="terrains", unit="terrain", disable=not progress)]
 
 
 def landing_summary(table: pd.DataFrame) -> pd.DataFrame:

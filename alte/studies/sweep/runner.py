@@ -21,9 +21,9 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Protocol, TypeVar
 
 import pandas as pd
-from tqdm.auto import tqdm
 
 from alte.errors import ParameterError, SimulationError
+from alte.progress import bar as progress_bar
 from alte.studies.sweep.runs import SweepRun, plan_runs, plan_variants
 from alte.studies.sweep.spec import SweepSettings, SweepSpec, with_plugins
 from alte.studies.sweep.store import finished_ids, load_results, write_row
@@ -137,7 +137,8 @@ def _ensure_all(pool: MapUnordered, runs: Sequence[SweepRun], data_dir: str,
                 progress: bool) -> None:
     inputs = {r.input_key(): r for r in runs}
     items = [inputs[key] for key in sorted(inputs, key=str)]
-    bar = tqdm(total=len(items), desc="terrains", unit="terrain", disable=not progress)
+    bar = progress_bar(total=len(items), desc="sweep terrains", unit="terrain",
+                       disable=not progress)
     with bar:
         for i, _, err in pool(_ensure, items, data_dir):
             if err is not None:
@@ -159,7 +160,7 @@ def _map_all(pool: MapUnordered, runs: Sequence[SweepRun], data_dir: str, out: P
     groups = _by_input(runs)
     by_id = {r.run_id: r for r in runs}
     # smoothing 0: the ETA from the mean rate so far (maps of one input differ widely)
-    with tqdm(total=len(runs), desc="runs", unit="run", disable=not progress,
+    with progress_bar(total=len(runs), desc="sweep runs", unit="run", disable=not progress,
               smoothing=0) as bar:
         for i, done, err in pool(run_group, groups, data_dir):
             # err: the task itself failed (e.g. a lost worker), so did each of its runs

@@ -41,7 +41,14 @@ def _seed_list(value: tuple[int, ...]) -> bool:
 
 
 def _known(names: tuple[str, ...]) -> bool:
-    return bool(names) and all(n in TERRAINS for n in names)
+    """Non-empty names (built-in, or imported into the data folder: :func:`_terrains`
+    checks which when the spec is read)."""
+    return bool(names) and all(isinstance(n, str) and n for n in names)
+
+
+def _imported(name: str, data_dir: str) -> bool:
+    """Whether ``data_dir/NAME`` is a terrain imported with ``alte simulate TILE ...``."""
+    return (Path(data_dir) / name / "scenario.json").is_file()
 
 
 @dataclass(frozen=True)
@@ -157,13 +164,14 @@ def _check_keys(source: str, where: str, given: Mapping[object, object],
                          f"{', '.join(valid)}")
 
 
-def _terrains(source: str, key: str, value: object) -> tuple[str, ...]:
+def _terrains(source: str, key: str, value: object, data_dir: str = "data") -> tuple[str, ...]:
     names = [value] if isinstance(value, str) else value
     if not isinstance(names, list) or not names:
         raise spec_error(source, key, f"{value!r} must be a terrain name or a non-empty list")
-    bad = [n for n in names if n not in TERRAINS]
+    bad = [n for n in names if n not in TERRAINS and not _imported(str(n), data_dir)]
     if bad:
-        raise spec_error(source, key, f"unknown terrain(s) {bad}; valid: {', '.join(TERRAINS)}")
+        raise spec_error(source, key, f"unknown terrain(s) {bad}; valid: {', '.join(TERRAINS)}, "
+                         f"or a terrain imported into {data_dir} (alte simulate TILE.laz)")
     return tuple(dict.fromkeys(names))
 
 
@@ -260,7 +268,7 @@ def parse_spec(raw: object, source: str = "spec") -> SweepSpec:
     for key in ("terrains", "mappers"):
         if key not in raw:
             raise spec_error(source, key, "missing (required)")
-    terrains = _terrains(source, "terrains", raw["terrains"])
+    terrains = _terrains(source, "terrains", raw["terrains"], str(raw.get("data_dir", "data")))
     if not isinstance(raw["mappers"], Mapping) or not raw["mappers"]:
         raise spec_error(source, "mappers", "must map mapper names to their grids")
     settings = _record(source, SweepSettings,
