@@ -1,4 +1,4 @@
-"""Command-line entry point: ``alte COMMAND ...``.
+"""Command-line entry point: ``alte COMMAND ...`` (:data:`DESCRIPTION` is what it says).
 
 Each command lives in its own module under ``alte.commands`` exposing
 ``add_parser(subparsers)`` and ``run(args) -> int``; :data:`COMMANDS` lists them
@@ -20,7 +20,12 @@ from collections.abc import Sequence
 from alte import __version__
 from alte.errors import AlteError
 
-__all__ = ["COMMANDS", "main"]
+__all__ = ["COMMANDS", "DESCRIPTION", "build_parser", "full_parser", "main"]
+
+#: What ``alte --help`` says first: plain text, as a terminal shows it.
+DESCRIPTION = ("alte: UAV terrain mapping from LiDAR. Map a ROS bag, a point file or a "
+               "terrain tile with Quadtree, Octomap, 2D-ALTE or 3D-ALTE; run the thesis' "
+               "experiments into a report. 'alte COMMAND --help' explains each command.")
 
 #: Command name -> (module implementing it, its one-line help).
 COMMANDS: dict[str, tuple[str, str]] = {
@@ -51,7 +56,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
 def build_parser(command: str | None = None) -> argparse.ArgumentParser:
     """The argument parser: ``command``'s own (its module imported), every other command
     by name and help only. ``None``: none imported (``alte --help``); ``"*"``: all."""
-    parser = argparse.ArgumentParser(prog="alte", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="alte", description=DESCRIPTION)
     parser.add_argument("--version", action="version", version=f"alte {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for name, (module, summary) in COMMANDS.items():
@@ -67,6 +72,12 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
 def _command(argv: Sequence[str]) -> str | None:
     """The command named on the line (the first word that is not an option), if any."""
     return next((word for word in argv if not word.startswith("-")), None)
+
+
+def full_parser() -> argparse.ArgumentParser:
+    """The parser with every command's own options (each command module imported): what
+    the documentation's command-line reference and the help tests read."""
+    return build_parser("*")
 
 
 def main(argv: Sequence[str] | None = None) -> int:

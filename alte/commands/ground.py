@@ -51,7 +51,9 @@ def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) 
                    help="the classified tile to write (.las or .laz)")
     p.add_argument("--method", choices=list(METHODS), default=None,
                    help="ground filter with its published defaults; default: "
-                        f"{DEFAULT_METHOD} with {DEFAULT_SETTINGS.as_dict()}, chosen on real "
+                        f"{DEFAULT_METHOD} with "
+                        + ", ".join(f"{k}={v}" for k, v in DEFAULT_SETTINGS.as_dict().items())
+                        + ", chosen on real "
                         "data. " + "; ".join(f"{k}: {v}" for k, v in SOURCES.items()))
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", dest="sets",
                    help="the method's setting (repeatable), e.g. --set window=24; defaults: "

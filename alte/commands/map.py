@@ -57,7 +57,8 @@ def add_map_options(p: argparse.ArgumentParser) -> None:
                    dest="occupancy_sets",
                    help="with --mcap: landing criterion of the occupancy grids (repeatable): "
                         + "; ".join(f"{k}: {v}" for k, v in SurfaceRule.help().items())
-                        + f"; defaults {SurfaceRule().as_dict()}")
+                        + "; defaults: " + ", ".join(
+                            f"{k}={v}" for k, v in SurfaceRule().as_dict().items()))
 
 
 def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:

@@ -19,7 +19,7 @@ from alte.types import Box, Mount
 __all__ = ["add_frame_options", "add_odometry_options", "frame_spec", "odometry_spec",
            "parse_box", "parse_key_values", "parse_origin"]
 
-INPUT_HELP = ("ROS 1 .bag file or ROS 2 bag folder, a terrain folder made by `alte simulate` "
+INPUT_HELP = ("ROS 1 .bag file or ROS 2 bag folder, a terrain folder made by 'alte simulate' "
               "(its control volume and voxel are used), or a point file")
 
 

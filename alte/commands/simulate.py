@@ -24,7 +24,8 @@ __all__ = ["add_parser", "run"]
 def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Register ``alte simulate``."""
     p = subparsers.add_parser(
-        "simulate", help="simulate benchmark terrains as ROS 2 bags with ground truth",
+        "simulate", help="simulate the benchmark terrains, or import real terrain tiles and "
+                         "fly them, as ROS 2 bags with ground truth",
         description="Fly the simulated VLP-16 over a thesis terrain (or all eight) and write "
                     "DIR/NAME/: a ROS 2 bag, ground_truth.ply (object id per triangle) and "
                     "scenario.json. A folder whose spec and seed match is reused. "

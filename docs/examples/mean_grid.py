@@ -1,5 +1,6 @@
 """A minimal alte mapper: each cell of a regular grid holds the mean height of its points."""
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import ClassVar
 
@@ -24,7 +25,7 @@ class MeanGrid(MapperBase[MeanGridParams]):
     title = "Mean grid"
     dims = 2
     Params = MeanGridParams
-    settings_grid = {"cell": (0.25, 0.5, 1.0, 2.0)}
+    settings_grid: ClassVar[Mapping[str, tuple[object, ...]]] = {"cell": (0.25, 0.5, 1.0, 2.0)}
 
     def clear(self) -> None:
         self._keys = np.empty((0, 2), np.int64)

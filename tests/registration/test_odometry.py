@@ -42,7 +42,7 @@ def unposed(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, np.ndarray,
 def test_bag_without_poses_maps_with_odometry(unposed, capsys) -> None:
     """The point-to-plane backend on the simulated cart (KISS-ICP's defaults, chosen on real
     data, take its 1 m voxel from a 100 m range and underestimate this small hall's motion:
-    README, "Poses")."""
+    docs/results/poses.md)."""
     bag, positions, start = unposed
     assert main(["map", str(bag), "--poses", "odometry", "--odometry", "plane",
                  "--mapper", "alte2d", "--json"]) == 0
