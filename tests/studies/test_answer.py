@@ -8,6 +8,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from alte.studies.analysis.tradeoff import mapper_title
 from alte.studies.answer import (
     USES,
     Budget,
@@ -165,6 +166,10 @@ def test_a_completeness_need_picks_the_most_accurate_map_covering_that_much():
         "cover") == 0
 
 
+#: The elevation map's title: its plugin's when installed (make bootstrap installs it).
+ELEVATION = mapper_title("elevation")
+
+
 def _with_challenger(calibrated: float) -> pd.DataFrame:
     """Quadtree and 2D-ALTE as in the orders test, and an elevation map (a 2D plugin) that
     beats both on sim_lan_1 and loses to both on sim_lan_2, claiming a height sigma whose
@@ -188,13 +193,13 @@ def test_a_challenger_joins_the_candidates_and_is_read_terrain_by_terrain():
     assert {d.rival for d in answer.duels} == {"quadtree", "alte2d"}
     assert all(d.challenger == "elevation" for d in answer.duels)
     text = answer.duels[0].text()
-    assert text == ("Elevation map against Quadtree, height RMSE at equal size: leads on "
+    assert text == (f"{ELEVATION} against Quadtree, height RMSE at equal size: leads on "
                     "sim_lan_1 (3 of 3 reads); loses on sim_lan_2 (3 of 3)")
     assert any(c.best is not None and c.best.mapper == "elevation" for c in answer.choices)
     (calibration,) = answer.calibration
     assert calibration.median == 0.9 and calibration.maps == 30
     assert calibration.text().startswith(
-        "Elevation map on the simulated terrains (sim_lan_1, sim_lan_2): the true height lies "
+        f"{ELEVATION} on the simulated terrains (sim_lan_1, sim_lan_2): the true height lies "
         "within 2 claimed sigma on 90.0 % of the mapped area (median of 30 maps")
     assert "over-confident" in calibration.text()
     assert "cautious" in bottom_line(_with_challenger(0.99)).uses[0].calibration[0].text()
@@ -205,3 +210,19 @@ def test_without_a_dims_column_there_is_no_challenger():
     table = _with_challenger(0.9).drop(columns=["dims", "within_2sigma"])
     answer = bottom_line(table).uses[0]
     assert answer.duels == [] and answer.calibration == []
+
+
+def test_a_challenger_is_read_per_class_of_real_terrain():
+    """The real-terrain evidence with the challenger's rows: read against each of the
+    thesis' two per class and kind of evidence, and its flown maps' calibration per class."""
+    real = _with_challenger(0.9)
+    real = real[real["mapper"] != "octomap"].assign(
+        evidence="flown", terrain_class=lambda t: t["terrain"].map(
+            {"sim_lan_1": "flat open", "sim_lan_2": "slope"}))
+    answer = bottom_line(_with_challenger(0.9), terrain=real).uses[0]
+    (vs_quadtree,) = [d for d in answer.duels if d.where and d.rival == "quadtree"]
+    assert vs_quadtree.text() == (
+        f"{ELEVATION} against Quadtree on real terrain, height RMSE at equal size: leads on "
+        "flat open (flown) (3 of 3 reads); loses on slope (flown) (3 of 3)")
+    classes = [c.group for c in answer.calibration]
+    assert classes == ["simulated", "real flat open", "real slope"]

@@ -27,7 +27,14 @@ import pandas as pd
 
 from alte.studies.analysis.tradeoff import METRICS, mapper_title
 from alte.studies.analysis.uncertainty import Interval
-from alte.studies.answer.challengers import Calibration, Duel, calibrations, challengers, duels
+from alte.studies.answer.challengers import (
+    Calibration,
+    Duel,
+    calibrations,
+    challengers,
+    class_duels,
+    duels,
+)
 from alte.studies.answer.choose import (
     GROUPS,
     USES,
@@ -189,7 +196,10 @@ def _use_answer(grid: pd.DataFrame, real: pd.DataFrame | None, use: Use,
     mapped = mine[mine["dims"] == use.dims] if "dims" in mine and use.dims else mine
     return UseAnswer(use, choices, _summary(wide, choices), orders,
                      _disagreement(use, orders), checks, why,
-                     class_checks(grid, terrain, use), duels(mine, use), calibrations(mapped))
+                     class_checks(grid, terrain, use),
+                     duels(mine, use) + class_duels(terrain, use),
+                     calibrations(mapped, terrain[terrain["case"] == use.case]
+                                  if terrain is not None and "case" in terrain else None))
 
 
 def bottom_line(grid: pd.DataFrame, real: pd.DataFrame | None = None,
