@@ -24,7 +24,7 @@ report-quick: bootstrap
 	$(PY) -m alte report --quick $(REPORT_ARGS)
 
 lint: bootstrap
-	$(PY) -m ruff check alte tests bench docs
+	$(PY) -m ruff check alte tests bench docs plugins
 	$(PY) -m mypy
 
 # mypy and the compilation of the mappers' numba kernels (`alte warmup`, cached for every
@@ -36,10 +36,10 @@ lint: bootstrap
 # The long end-to-end checks (marker `full`: the whole quick bench, the 10-million-point
 # memory runs, chapters 5 and 6 headless, ...; tests/README.md says which smaller test
 # proves each one's parts) run in `make check-full`, which CI runs after `make test`.
-PYTEST := $(PY) -m pytest -n 2 --dist loadfile --no-loadscope-reorder tests notebooks --nbval-lax
+PYTEST := $(PY) -m pytest -n 2 --dist loadfile --no-loadscope-reorder tests plugins/alte-elevation/tests notebooks --nbval-lax
 test: export PYTHONDONTWRITEBYTECODE :=
 test: bootstrap
-	$(PY) -m ruff check alte tests bench docs
+	$(PY) -m ruff check alte tests bench docs plugins
 	@$(PY) -m alte warmup & warm=$$!; $(PY) -m mypy; typed=$$?; wait $$warm && exit $$typed
 	$(PYTEST) -m "not full" $(PYTEST_ARGS)
 

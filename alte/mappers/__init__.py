@@ -1,4 +1,5 @@
-"""The four terrain mappers, registered by name in :data:`MAPPERS`, and map export.
+"""The terrain mappers: the contract (:mod:`~alte.mappers.api`), the thesis' four, the
+registry that resolves every name (:mod:`~alte.mappers.registry`), and map export.
 
 The mappers (and numba) load on first use (``lazy_loader``, names declared in
 ``__init__.pyi``): the protocol, the domain and the feed are light to import.

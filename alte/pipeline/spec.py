@@ -14,19 +14,16 @@ import enum
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, ClassVar
+from typing import ClassVar, cast
 
 import numpy as np
 
 from alte.errors import ParameterError
-from alte.mappers.base import Feed
+from alte.mappers.base import Feed, Mapper
 from alte.mappers.domain import Domain
 from alte.params import Record, param
 from alte.registration.odometry import OdometryParams
 from alte.types import Box, Mount
-
-if TYPE_CHECKING:
-    from alte.mappers import MapperClass
 
 __all__ = ["DomainChoice", "DomainPolicy", "FrameSpec", "MapSpec", "PoseSource"]
 
@@ -141,9 +138,11 @@ class FrameSpec(Record):
 
 @dataclass(frozen=True)
 class MapSpec(Record):
-    """Which map: mapper name and parameters, domain (or policy), feed, time-lapse.
+    """Which map: mapper and parameters, domain (or policy), feed, time-lapse.
 
-    ``feed`` None uses the mapper's own protocol (``Mapper.default_feed``: the thesis
+    ``mapper`` is a mapper class or a name the registry resolves
+    (:mod:`alte.mappers.registry`); once made, ``mapper`` holds the name and ``cls`` the
+    class. ``feed`` None uses the mapper's own protocol (``Mapper.default_feed``: the thesis
     built Quadtree once on the final cloud and fed the others frame by frame);
     ``snapshots`` keeps the cells that many times over the run (time-lapse figures)
     and counts the basis functions after every frame. The mapper's class (``cls``) and
@@ -152,7 +151,7 @@ class MapSpec(Record):
     """
 
     OWNER: ClassVar[str] = "map spec"
-    mapper: str
+    mapper: type[Mapper] | str
     params: Mapping[str, object] | Record = field(default_factory=dict)
     domain: Domain | DomainPolicy = DomainPolicy.AUTO
     feed: Feed | None = None
@@ -162,6 +161,9 @@ class MapSpec(Record):
 
     def __post_init__(self) -> None:
         super().__post_init__()
+        if not isinstance(self.mapper, str):  # a class: kept, and its name is the mapper
+            object.__setattr__(self, "_cls", self.mapper)
+            object.__setattr__(self, "mapper", self.mapper.name)
         cls = self.cls
         given = self.params
         record = given if isinstance(given, cls.Params) else cls.Params.parse(
@@ -171,9 +173,13 @@ class MapSpec(Record):
                            else dict(given))
 
     @property
-    def cls(self) -> MapperClass:
-        """The mapper's class (the registry, and with it the mappers' kernels, loads on
-        first use: a spec is light to import)."""
-        from alte.mappers import mapper_class
+    def cls(self) -> type[Mapper]:
+        """The mapper's class: the one given, or the registry's for the name (the registry,
+        and with it the mappers' kernels, loads on first use: a spec is light to import)."""
+        found = self.__dict__.get("_cls")
+        if found is None:
+            from alte.mappers import registry
 
-        return mapper_class(self.mapper)
+            found = registry.resolve(str(self.mapper))
+            object.__setattr__(self, "_cls", found)
+        return cast("type[Mapper]", found)

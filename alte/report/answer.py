@@ -18,7 +18,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from alte.studies.analysis.tradeoff import MAPPER_NAMES
+from alte.studies.analysis.tradeoff import mapper_title
 from alte.studies.answer import Choice, UseAnswer, bottom_line, interval_text, pick_text
 from alte.studies.answer.classes import ClassCheck
 from alte.studies.answer.orders import metric_words
@@ -71,6 +71,8 @@ class UseView:
     real_why: str = ""
     classes: list[ClassRow] = field(default_factory=list)
     builtin: str = ""
+    duels: list[str] = field(default_factory=list)
+    calibration: list[str] = field(default_factory=list)
 
 
 @dataclass(frozen=True)
@@ -84,7 +86,7 @@ class AnswerView:
 def _rival(choice: Choice) -> str:
     if choice.rival is None:
         other = [m for m in choice.use.mappers if choice.best and m != choice.best.mapper]
-        names = ", ".join(MAPPER_NAMES.get(m, m) for m in other)
+        names = ", ".join(mapper_title(m) for m in other)
         return f"no {names} map fits" if names else ""
     if choice.budget.kind == "need":
         return (f"{choice.rival.name} at the least: {choice.rival.setting}, "
@@ -127,7 +129,7 @@ def _class_row(check: ClassCheck) -> ClassRow:
 
 
 def _use(found: UseAnswer, sequence: str) -> UseView:
-    names = " or ".join(MAPPER_NAMES.get(m, m) for m in found.use.mappers)
+    names = " or ".join(mapper_title(m) for m in found.use.mappers)
     title = (f"{found.use.name.capitalize()}: {names}, ranked by "
              f"{metric_words(found.use.truth)}")
     orders = [f"{metric_words(o.metric)}: {o.text()}" for o in found.orders]
@@ -135,7 +137,8 @@ def _use(found: UseAnswer, sequence: str) -> UseView:
         f"{metric_words(c.metric)}: {c.builtin.text(where=False)}" for c in found.classes))
     return UseView(title, found.summary, found.disagreement, [_row(c) for c in found.choices],
                    orders, [check.text(sequence) for check in found.real], found.real_why,
-                   [_class_row(c) for c in found.classes], builtin)
+                   [_class_row(c) for c in found.classes], builtin,
+                   [d.text() for d in found.duels], [c.text() for c in found.calibration])
 
 
 def _read(path: Path) -> pd.DataFrame | None:

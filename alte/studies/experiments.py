@@ -23,7 +23,7 @@ from pathlib import Path
 import pandas as pd
 
 from alte.errors import ParameterError
-from alte.mappers import Mapper, mapper_class
+from alte.mappers import Mapper
 from alte.metrics.maps import GroundTruth, MapMetrics, SetB, TruthOptions, measure_map
 from alte.metrics.timing import Timing
 from alte.params import Record
@@ -54,7 +54,7 @@ REPEATS = 3
 #: map, seconds long, is timed once: its repeats would cost more than the rest of its row).
 REPEAT_BELOW_S = 0.5
 #: (mapper, feed) pairs this process has mapped with: their kernels are loaded.
-_WARM: set[tuple[str, str]] = set()
+_WARM: set[tuple[type[Mapper], str]] = set()
 
 
 @dataclass(eq=False)
@@ -126,7 +126,7 @@ def timed_run(data: Registered, spec: MapSpec, *, repeats: int = REPEATS,
     and the :class:`Timing` of the timed ones."""
     if repeats < 1:
         raise ParameterError(f"repeats={repeats}: expected at least 1")
-    warm = (spec.mapper, (spec.feed or mapper_class(spec.mapper).default_feed).value)
+    warm = (spec.cls, (spec.feed or spec.cls.default_feed).value)
     if warm not in _WARM:
         run(data, spec)
         _WARM.add(warm)

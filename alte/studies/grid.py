@@ -105,11 +105,13 @@ def tradeoff_table(rows: pd.DataFrame) -> pd.DataFrame:
 def run_grid(spec_path: str | os.PathLike[str], *, scheduler: str = "local", workers: int = 2,
              frames: int | str | None = "spec", seeds: Sequence[int] | None = None,
              data_dir: str | None = None, output: str | os.PathLike[str] | None = None,
-             progress: bool = True) -> Grid:
+             plugins: bool = False, progress: bool = True) -> Grid:
     """Run the sweep spec at ``spec_path`` (``frames``/``seeds``/``data_dir`` override the
-    spec's; ``frames="spec"`` keeps its own) into ``output`` and tabulate it."""
+    spec's; ``frames="spec"`` keeps its own; ``plugins``: add every installed plugin
+    mapper with its settings grid) into ``output`` and tabulate it."""
     spec = load_spec(spec_path)
-    changes: dict[str, object] = {"data_dir": data_dir, "seeds": list(seeds) if seeds else None}
+    changes: dict[str, object] = {"data_dir": data_dir, "seeds": list(seeds) if seeds else None,
+                                  "plugins": plugins}
     if frames != "spec":
         changes["frames"] = frames
     spec = override(spec, **changes)

@@ -7,7 +7,8 @@
 - ``{alte-record} dotted.path.Record``: the settings of a :class:`alte.params.Record` as a
   table (name, type, default, rule, meaning), read from its fields.
 - ``{alte-mappers}``: the settings of every mapper of the registry
-  (:data:`alte.mappers.MAPPERS`), one table each.
+  (:func:`alte.mappers.registry.classes`: the thesis' four and the installed plugins),
+  one table each.
 
 The pages are written only when their text changes, through a temporary file and a
 rename, so two builds of the same tree at once (``make docs`` beside ``make test``) never
@@ -259,12 +260,12 @@ class MappersDirective(RecordDirective):
     required_arguments = 0
 
     def run(self) -> list[nodes.Node]:
-        from alte.mappers import MAPPERS
+        from alte.mappers import registry
 
         lines: list[str] = []
-        for name, cls in MAPPERS.items():
+        for cls in registry.classes():
             said = (cls.__doc__ or "").strip().splitlines()[0]
-            lines += [f"**{name}** (:class:`{cls.__module__}.{cls.__name__}`): {said}",
+            lines += [f"**{cls.name}** (:class:`{cls.__module__}.{cls.__name__}`): {said}",
                       "", *record_table(cls.Params), ""]
         return self._parse(lines)
 

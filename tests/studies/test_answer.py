@@ -8,6 +8,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from alte.studies.analysis.tradeoff import mapper_title
 from alte.studies.answer import (
     USES,
     Budget,
@@ -163,3 +164,65 @@ def test_a_completeness_need_picks_the_most_accurate_map_covering_that_much():
     assert Budget("cover", 0.8).text(NAVIGATION) == "completeness >= 0.8 on every terrain"
     assert [b.kind for b in budgets(candidates(grid(), LANDING, "simulated"), LANDING)].count(
         "cover") == 0
+
+
+#: The elevation map's title: its plugin's when installed (make bootstrap installs it).
+ELEVATION = mapper_title("elevation")
+
+
+def _with_challenger(calibrated: float) -> pd.DataFrame:
+    """Quadtree and 2D-ALTE as in the orders test, and an elevation map (a 2D plugin) that
+    beats both on sim_lan_1 and loses to both on sim_lan_2, claiming a height sigma whose
+    2-sigma share is ``calibrated``; a 3D map in the same table is no challenger."""
+    fronts = {"quadtree": 0.3, "alte2d": 0.2, "elevation": 0.25, "octomap": 0.2}
+    table = grid({m: {f"{m}{i}": (100 * 3**i, k / (i + 1), k / (i + 1), 0.9)
+                      for i in range(5)} for m, k in fronts.items()})
+    table["dims"] = np.where(table["mapper"] == "octomap", 3, 2)
+    elevation = table["mapper"] == "elevation"
+    better = elevation & (table["terrain"] == "sim_lan_1")
+    table.loc[better, "height_rmse_m"] *= 0.2
+    table.loc[elevation & ~better, "height_rmse_m"] *= 1.3
+    table["within_2sigma"] = np.where(elevation, calibrated, np.nan)
+    table["sigma_mean_m"] = np.where(elevation, 0.01, np.nan)
+    return table
+
+
+def test_a_challenger_joins_the_candidates_and_is_read_terrain_by_terrain():
+    answer = bottom_line(_with_challenger(0.9)).uses[0]
+    assert answer.use.mappers == ("quadtree", "alte2d")
+    assert {d.rival for d in answer.duels} == {"quadtree", "alte2d"}
+    assert all(d.challenger == "elevation" for d in answer.duels)
+    text = answer.duels[0].text()
+    assert text == (f"{ELEVATION} against Quadtree, height RMSE at equal size: leads on "
+                    "sim_lan_1 (3 of 3 reads); loses on sim_lan_2 (3 of 3)")
+    assert any(c.best is not None and c.best.mapper == "elevation" for c in answer.choices)
+    (calibration,) = answer.calibration
+    assert calibration.median == 0.9 and calibration.maps == 30
+    assert calibration.text().startswith(
+        f"{ELEVATION} on the simulated terrains (sim_lan_1, sim_lan_2): the true height lies "
+        "within 2 claimed sigma on 90.0 % of the mapped area (median of 30 maps")
+    assert "over-confident" in calibration.text()
+    assert "cautious" in bottom_line(_with_challenger(0.99)).uses[0].calibration[0].text()
+    assert "): calibrated" in bottom_line(_with_challenger(0.95)).uses[0].calibration[0].text()
+
+
+def test_without_a_dims_column_there_is_no_challenger():
+    table = _with_challenger(0.9).drop(columns=["dims", "within_2sigma"])
+    answer = bottom_line(table).uses[0]
+    assert answer.duels == [] and answer.calibration == []
+
+
+def test_a_challenger_is_read_per_class_of_real_terrain():
+    """The real-terrain evidence with the challenger's rows: read against each of the
+    thesis' two per class and kind of evidence, and its flown maps' calibration per class."""
+    real = _with_challenger(0.9)
+    real = real[real["mapper"] != "octomap"].assign(
+        evidence="flown", terrain_class=lambda t: t["terrain"].map(
+            {"sim_lan_1": "flat open", "sim_lan_2": "slope"}))
+    answer = bottom_line(_with_challenger(0.9), terrain=real).uses[0]
+    (vs_quadtree,) = [d for d in answer.duels if d.where and d.rival == "quadtree"]
+    assert vs_quadtree.text() == (
+        f"{ELEVATION} against Quadtree on real terrain, height RMSE at equal size: leads on "
+        "flat open (flown) (3 of 3 reads); loses on slope (flown) (3 of 3)")
+    classes = [c.group for c in answer.calibration]
+    assert classes == ["simulated", "real flat open", "real slope"]

@@ -1,13 +1,15 @@
 """Which map to build under a budget, read off the trade-off grid.
 
 A *use* is one of the thesis' cases with its two mappers and the ground-truth metric that
-ranks their maps (:data:`USES`): landing (Quadtree or 2D-ALTE, ranked by the true height
-RMSE, obstacle recall shown beside it) and urban navigation (Octomap or 3D-ALTE, ranked
-by mean accuracy, the distance of the occupied cells to the true surface, completeness
-shown beside it). A map covering less than half of the true surface
-(:data:`MIN_COMPLETENESS`) is never chosen: few cells are accurate cheaply, and a
-planner cannot use a map that misses most surfaces. Terrains are taken in two groups of
-one scale (:data:`GROUPS`): the simulated urban-scale terrains and the lab terrains.
+ranks their maps (:data:`USES`; further mappers of the use's dimension in the grid, e.g. a
+plugin, join its candidates: :mod:`~alte.studies.answer.challengers`): landing (Quadtree
+or 2D-ALTE, ranked by the true height RMSE, obstacle recall shown beside it) and urban
+navigation (Octomap or 3D-ALTE, ranked by mean accuracy, the distance of the occupied
+cells to the true surface, completeness shown beside it). A map covering less than half
+of the true surface (:data:`MIN_COMPLETENESS`) is never chosen: few cells are accurate
+cheaply, and a planner cannot use a map that misses most surfaces. Terrains are taken in
+two groups of one scale (:data:`GROUPS`): the simulated urban-scale terrains and the lab
+terrains.
 
 A *candidate* is one mapper setting; on a group its size and time per scan are the
 worst (largest) of its terrains' means over seeds, so a budget met holds on every terrain,
@@ -39,7 +41,7 @@ from typing import Literal
 import numpy as np
 import pandas as pd
 
-from alte.studies.analysis.tradeoff import MAPPER_NAMES, METRICS
+from alte.studies.analysis.tradeoff import METRICS, mapper_title
 from alte.studies.analysis.uncertainty import Interval, bootstrap_ci
 from alte.studies.obstacles import setting_text
 
@@ -49,19 +51,23 @@ __all__ = ["GROUPS", "MIN_COMPLETENESS", "SIZE_BUDGETS", "USES", "Budget", "Choi
 
 @dataclass(frozen=True)
 class Use:
-    """A case of the thesis: its mappers, the truth that ranks them, a second one shown."""
+    """A case of the thesis: its mappers (the thesis' two first), the truth that ranks them,
+    a second one shown, and the dimension of its maps (``dims``)."""
 
     name: str
     case: str
-    mappers: tuple[str, str]
+    mappers: tuple[str, ...]
     truth: str
     second: str
     truth_higher: bool = False
+    dims: int | None = None
 
 
 #: The two uses the thesis studies.
-USES = (Use("landing", "lan", ("quadtree", "alte2d"), "height_rmse_m", "obstacle_recall"),
-        Use("navigation", "nav", ("octomap", "alte3d"), "accuracy_mean_m", "completeness"))
+USES = (Use("landing", "lan", ("quadtree", "alte2d"), "height_rmse_m", "obstacle_recall",
+            dims=2),
+        Use("navigation", "nav", ("octomap", "alte3d"), "accuracy_mean_m", "completeness",
+            dims=3))
 #: The least completeness of a map that may be chosen.
 MIN_COMPLETENESS = 0.5
 #: Terrain groups of one scale: name -> terrain-name prefix.
@@ -105,7 +111,7 @@ class Pick:
     @property
     def name(self) -> str:
         """The mapper's display name."""
-        return MAPPER_NAMES.get(self.mapper, self.mapper)
+        return mapper_title(self.mapper)
 
 
 @dataclass(frozen=True)

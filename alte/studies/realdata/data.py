@@ -26,7 +26,6 @@ from alte.errors import ParameterError
 from alte.ground.filters import MIN_POINTS, filter_ground
 from alte.ground.settings import GroundSettings, ground_settings
 from alte.io.pointfiles import local_origin, read_points
-from alte.mappers import make_mapper
 from alte.paths import realdata_dir
 from alte.pipeline import (
     DomainPolicy,
@@ -172,7 +171,8 @@ def _ground_run(sample: IsprsSample, name: str, params: Mapping[str, object],
     if name == BASELINE:
         ground = filter_ground(pts, method, settings).ground
     else:
-        mapper = make_mapper(name, params)
+        spec = MapSpec(name, dict(params))
+        mapper = spec.cls(None, record=spec.record)
         start = time.perf_counter()
         mapper.build(pts)
         extra = {"basis_functions": int(mapper.basis_functions),

@@ -20,16 +20,23 @@ For each :class:`~alte.studies.realterrain.sites.Site` the tiles are imported on
   imported surface is bare earth (where a vehicle lands), as ground-filter benchmarks
   score against reference ground. Each seed holds back another 20 %.
 
+With ``plugins``, every installed plugin mapper of a case's dimension (2D: landing, 3D:
+navigation) is mapped beside the thesis' two, with the rows the grid gives it or else
+its own ``settings_grid``; ``mappers`` restricts a run to the mappers named (e.g. a
+plugin's rows added to committed evidence).
+
 Every row carries ``terrain`` (the site), ``terrain_class``, ``evidence``, ``case``,
 the mapper and setting, ``seed``, size, time, MHD/HD and the truth columns.
 """
 
 from __future__ import annotations
 
+import itertools
 import json
 import os
 import tempfile
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -50,7 +57,7 @@ from alte.studies.realdata.ground import map_heights
 from alte.studies.realterrain.sites import SITES, Site, surface_figures, terrain_class
 from alte.studies.thesis.numbers import CASE_MAPPERS
 
-__all__ = ["COLUMNS", "GRID", "HOLD_BACK", "evidence_rows", "site_rows"]
+__all__ = ["COLUMNS", "GRID", "HOLD_BACK", "Mappers", "evidence_rows", "site_rows"]
 
 #: Settings per mapper: each spans its mapper's sizes on a 120 m site.
 GRID: dict[str, list[dict[str, float]]] = {
@@ -94,25 +101,51 @@ def _row(measured: Measured, case: str, seed: int, extra: Mapping[str, object]
             "map_cpu_s": m.map_cpu_s, "mhd_m": m.mhd_m, "hd_m": m.hd_m, **extra}
 
 
-def _grid(case: str, grid: Mapping[str, Sequence[Mapping[str, float]]]
-          ) -> list[tuple[str, dict[str, float]]]:
-    return [(m, dict(p)) for m in CASE_MAPPERS[case] for p in grid.get(m, ())]
+@dataclass(frozen=True)
+class Mappers:
+    """Which mappers a run maps: the thesis' pair of each case, with ``plugins`` the
+    installed plugins of the case's dimension, restricted to ``only`` when given."""
+
+    plugins: bool = False
+    only: tuple[str, ...] = ()
+
+    def of(self, case: str, grid: _Grid) -> list[tuple[str, dict[str, object]]]:
+        """(mapper name, setting) of ``case``: the grid's rows, a plugin's own settings
+        grid where the grid has none."""
+        from alte.mappers import registry
+
+        names = list(CASE_MAPPERS[case])
+        own: dict[str, list[dict[str, object]]] = {}
+        if self.plugins:
+            for cls in registry.plugins(dims=2 if case == "lan" else 3):
+                names.append(cls.name)
+                keys = list(cls.settings_grid)
+                own[cls.name] = [dict(zip(keys, v, strict=True))
+                                 for v in itertools.product(*cls.settings_grid.values())]
+        return [(m, dict(p)) for m in names if not self.only or m in self.only
+                for p in (grid[m] if m in grid else own.get(m, []))]
 
 
-def _flown(site: Site, root: Path, case: str, seed: int, how: tuple[Path, int, _Grid]
-           ) -> list[dict[str, object]]:
-    data_dir, frames, grid = how
+def _grid(case: str, grid: _Grid, mappers: Mappers) -> list[tuple[str, dict[str, object]]]:
+    return mappers.of(case, grid)
+
+
+def _flown(site: Site, root: Path, case: str, seed: int,
+           how: tuple[Path, int, _Grid, Mappers]) -> list[dict[str, object]]:
+    data_dir, frames, grid, mappers = how
     imported = _import(site, root, _MISSION[case])
     folder = write_imported(imported, data_dir, seed=seed, frames=frames, force=True)
     data = prepare(open_input(folder))
     rows = []
-    for mapper, params in _grid(case, grid):
+    for mapper, params in _grid(case, grid, mappers):
         found = measure(data, mapper, params, truth=_TRUTH)
         t = found.metrics.truth
         extra: dict[str, object] = {
             "accuracy_mean_m": t.accuracy_mean_m if t else np.nan,
             "completeness": t.completeness if t else np.nan,
             "height_rmse_m": t.height_rmse_m if t else np.nan,
+            "within_2sigma": t.within_2sigma if t else np.nan,
+            "sigma_mean_m": t.sigma_mean_m if t else np.nan,
             "frames": len(data), "points": len(data.cloud)}
         if case == "lan":
             extra |= _obstacles(data, found, site.name)
@@ -149,8 +182,8 @@ def _bare_cells(imported: Imported, points: NDArray[np.float64]) -> NDArray[np.b
     return bare
 
 
-def _points(site: Site, root: Path, case: str, seed: int,
-            grid: Mapping[str, Sequence[Mapping[str, float]]]) -> list[dict[str, object]]:
+def _points(site: Site, root: Path, case: str, seed: int, *, grid: _Grid,
+            mappers: Mappers) -> list[dict[str, object]]:
     imported = _import(site, root, _MISSION[case])
     pts, ground = _tile_points(imported, site, root)
     held = np.random.default_rng(seed).random(len(pts)) < HOLD_BACK
@@ -161,9 +194,9 @@ def _points(site: Site, root: Path, case: str, seed: int,
         path = write_points(Path(tmp) / "kept.npz", kept)
         above = (*np.mean(kept[:, :2], axis=0).tolist(), float(kept[:, 2].max()) + 100.0)
         data = prepare(open_input(path), FrameSpec(origin=above))
-        for mapper, setting in _grid(case, grid):
+        for mapper, setting in _grid(case, grid, mappers):
             # An airborne sensor: Octomap's rays longer than a VLP-16's.
-            if mapper == "octomap" and float(setting["resolution"]) > 2.0:
+            if mapper == "octomap" and float(str(setting["resolution"])) > 2.0:
                 continue  # 0.25 m voxels along 100 m rays: millions of free leaves
             params = {**setting, "max_range": -1.0} if mapper == "octomap" else setting
             found = measure(data, mapper, spec=MapSpec(mapper, params,
@@ -191,22 +224,27 @@ def _tile_points(imported: Imported, site: Site, root: Path
 def site_rows(site: Site, root: str | os.PathLike[str], data_dir: str | os.PathLike[str], *,
               seeds: Sequence[int] = (0, 1, 2), frames: int = 20,
               grid: Mapping[str, Sequence[Mapping[str, float]]] | None = None,
-              evidence: Sequence[str] = ("flown", "points")) -> pd.DataFrame:
-    """Both kinds of evidence on one site (module docstring), every seed and use."""
+              evidence: Sequence[str] = ("flown", "points"),
+              mappers: Mappers | None = None) -> pd.DataFrame:
+    """Both kinds of evidence on one site (module docstring), every seed and use (a case
+    none of whose mappers runs is skipped)."""
     grid = grid or GRID
+    mappers = mappers or Mappers()
     where, data = Path(root), Path(data_dir)
     imported = _import(site, where, "landing")
     figures = surface_figures(imported.surfaces)
     label = terrain_class(imported.surfaces, site.stated)
     rows: list[dict[str, object]] = []
-    for case in ("lan", "nav"):
+    for case in [c for c in ("lan", "nav") if _grid(c, grid, mappers)]:
         for seed in seeds:
             if "flown" in evidence:
                 rows += [{"evidence": "flown", **r}
-                         for r in _flown(site, where, case, seed, (data, frames, grid))]
+                         for r in _flown(site, where, case, seed,
+                                         (data, frames, grid, mappers))]
             if "points" in evidence:
                 rows += [{"evidence": "points", **r}
-                         for r in _points(site, where, case, seed, grid)]
+                         for r in _points(site, where, case, seed, grid=grid,
+                                          mappers=mappers)]
     table = pd.DataFrame(rows).assign(terrain=site.name, terrain_class=label, **figures)
     return table.reindex(columns=[*COLUMNS, *[c for c in table if c not in COLUMNS]])
 

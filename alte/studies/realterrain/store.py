@@ -24,7 +24,7 @@ import pandas as pd
 from alte.paths import realdata_dir, resolve
 from alte.studies.analysis.tables import write_csv
 from alte.studies.missions import git_commit
-from alte.studies.realterrain.evidence import COLUMNS, GRID, evidence_rows
+from alte.studies.realterrain.evidence import COLUMNS, GRID, Mappers, evidence_rows
 from alte.studies.realterrain.sites import SITES
 
 __all__ = ["EVIDENCE", "TABLE", "load_evidence", "main", "summary", "write_evidence"]
@@ -38,7 +38,7 @@ TABLE = "realterrain_fronts"
 def write_evidence(folder: str | os.PathLike[str] = EVIDENCE, *,
                    seeds: tuple[int, ...] = (0, 1), frames: int = 20,
                    data_dir: str | os.PathLike[str] = "data/real", command: str = "",
-                   only: list[str] | None = None) -> Path:
+                   only: list[str] | None = None, mappers: Mappers | None = None) -> Path:
     """Run the evidence on every site present (or those named ``only``) and write the
     folder (module docstring); each site's rows are kept in ``FOLDER/sites/`` as it
     finishes, so a rerun does only the sites missing (delete them to redo)."""
@@ -50,7 +50,7 @@ def write_evidence(folder: str | os.PathLike[str] = EVIDENCE, *,
         done = parts / f"{site.name}.csv"  # each site kept as it finishes: a rerun resumes
         if not done.is_file():
             rows = evidence_rows(root, resolve(data_dir), sites=(site,), seeds=seeds,
-                                 frames=frames, progress=False)
+                                 frames=frames, progress=False, mappers=mappers)
             write_csv(rows, parts, site.name, overwrite=True)
     table = pd.concat([pd.read_csv(p) for p in sorted(parts.glob("*.csv"))],
                       ignore_index=True)
@@ -106,11 +106,16 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--sites", default=None, help="comma-separated site names (default: all)")
     p.add_argument("--frames", type=int, default=20)
     p.add_argument("--data", default="data/real", help="where the flown terrains go")
+    p.add_argument("--plugins", action="store_true",
+                   help="also map the installed plugin mappers (their settings grids)")
+    p.add_argument("--mappers", default=None,
+                   help="comma-separated mapper names: only these (e.g. a plugin's rows)")
     args = p.parse_args(argv)
     seeds = tuple(int(s) for s in args.seeds.split(","))
     only = args.sites.split(",") if args.sites else None
     path = write_evidence(args.folder, seeds=seeds, frames=args.frames, data_dir=args.data,
-                          only=only,
+                          only=only, mappers=Mappers(args.plugins, tuple(
+                              args.mappers.split(",")) if args.mappers else ()),
                           command=" ".join(["python -m alte.studies.realterrain",
                                             *(argv if argv is not None else sys.argv[1:])]))
     print(f"wrote {path}")

@@ -25,7 +25,7 @@ import pandas as pd
 from alte.errors import ParameterError, SimulationError
 from alte.progress import bar as progress_bar
 from alte.studies.sweep.runs import SweepRun, plan_runs, plan_variants
-from alte.studies.sweep.spec import SweepSettings, SweepSpec
+from alte.studies.sweep.spec import SweepSettings, SweepSpec, with_plugins
 from alte.studies.sweep.store import finished_ids, load_results, write_row
 from alte.studies.sweep.work import MapGroup, group_runs, input_data, run_group, run_one
 
@@ -202,11 +202,15 @@ def run_sweep(spec: SweepSpec, *, scheduler: str = "local", workers: int = 2,
 def override(spec: SweepSpec, **changes: object) -> SweepSpec:
     """``spec`` with other ``frames``/``data_dir``/``output``/``seed``/``seeds`` (CLI and
     notebook), checked as :class:`SweepSettings`; ``None`` keeps the spec's value, except
-    for ``frames`` (the whole mission)."""
-    allowed = ("frames", "data_dir", "output", "seed", "seeds")
+    for ``frames`` (the whole mission). ``plugins=True`` adds the installed plugin mappers
+    (:func:`~alte.studies.sweep.spec.with_plugins`)."""
+    allowed = ("frames", "data_dir", "output", "seed", "seeds", "plugins")
     unknown = sorted(set(changes) - set(allowed))
     if unknown:
         raise ParameterError(f"sweep override {', '.join(unknown)}: valid: {', '.join(allowed)}")
+    if changes.pop("plugins", None):
+        spec = with_plugins(dataclasses.replace(
+            spec, settings=spec.settings.replace(plugins=True)))
     given = {k: v for k, v in changes.items() if k == "frames" or v is not None}
     new = SweepSettings.parse(given)  # checked alone first: errors name only what was given
     kept = {**spec.settings.as_dict(), "output": spec.output}
