@@ -18,14 +18,14 @@ import enum
 import math
 import types
 import typing
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, ClassVar, Generic, Literal, Self, TypeVar, get_args, get_origin, overload
 
 from alte.errors import ParameterError
 
-__all__ = ["Record", "Rule", "coerce", "param"]
+__all__ = ["Record", "Rule", "coerce", "key_values", "param"]
 
 _T = TypeVar("_T")
 _V_contra = TypeVar("_V_contra", contravariant=True)
@@ -270,3 +270,16 @@ def _choices(kind: object) -> str:
     if isinstance(kind, type) and issubclass(kind, enum.Enum):
         return "|".join(str(m.value) for m in kind)
     return ""
+
+
+def key_values(items: Iterable[str]) -> dict[str, str]:
+    """``["k=v", ...]`` -> ``{"k": "v"}`` (keys and values stripped, the value may hold
+    '='): the one parser of settings given as text; an item without '=' or key raises
+    ParameterError naming the item (a caller adds where it came from)."""
+    out: dict[str, str] = {}
+    for item in items:
+        key, sep, value = item.partition("=")
+        if not sep or not key.strip():
+            raise ParameterError(f"{item!r}: expected KEY=VALUE")
+        out[key.strip()] = value.strip()
+    return out

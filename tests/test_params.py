@@ -112,3 +112,13 @@ def test_structured_kinds_are_coerced_from_yaml_values():
 def test_structured_kinds_name_the_field_in_errors(given, pattern):
     with pytest.raises(ParameterError, match=pattern):
         Outer.parse(given)
+
+
+def test_key_values_is_the_one_settings_parser() -> None:
+    from alte.params import key_values
+
+    assert key_values([" a = 1 ", "b=x=y", "c="]) == {"a": "1", "b": "x=y", "c": ""}
+    with pytest.raises(ParameterError, match=r"^'a': expected KEY=VALUE$"):
+        key_values(["a"])
+    with pytest.raises(ParameterError, match=r"^' =2': expected KEY=VALUE$"):
+        key_values([" =2"])

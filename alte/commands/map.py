@@ -24,7 +24,7 @@ from alte.mappers import Domain, Feed, check_export, export_map
 from alte.pipeline import DomainPolicy, MapRun, MapSpec, open_input, run
 
 __all__ = ["add_map_options", "add_parser", "export_options", "map_spec", "mapped",
-           "parse_domain", "parse_sets", "print_summary", "run_command"]
+           "parse_domain", "print_summary", "run_command"]
 
 _SUMMARY_KEYS = ("mapper", "params", "input", "input_kind", "pose_source", "domain_policy",
                  "domain", "feed",
@@ -83,11 +83,6 @@ def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) 
     p.set_defaults(func=run_command)
 
 
-def parse_sets(items: list[str], flag: str = "--set") -> dict[str, str]:
-    """``["k=v", ...]`` -> ``{"k": "v"}``; an item without '=' raises (naming ``flag``)."""
-    return parse_key_values(items, flag)
-
-
 def parse_domain(text: str) -> Domain | DomainPolicy:
     """``--domain``: a policy name or ``xmin,ymin[,zmin],size``."""
     names = {p.value: p for p in DomainPolicy}
@@ -125,7 +120,7 @@ def print_summary(summary: dict[str, object], as_json: bool) -> None:
 
 def map_spec(args: argparse.Namespace) -> MapSpec:
     """The :class:`MapSpec` of the parsed flags, parameters checked before any read."""
-    return MapSpec(args.mapper, parse_sets(args.sets), parse_domain(args.domain),
+    return MapSpec(args.mapper, parse_key_values(args.sets, "--set"), parse_domain(args.domain),
                    Feed(args.feed) if args.feed else None)
 
 
@@ -153,7 +148,7 @@ def export_options(args: argparse.Namespace, mcap: Path | None) -> ExportOptions
     if mcap.suffix.lower() != ".mcap":
         raise ParameterError(f"--mcap {mcap}: the file name must end in .mcap")
     try:
-        rule = SurfaceRule.parse(parse_sets(args.occupancy_sets, "--occupancy-set"))
+        rule = SurfaceRule.parse(parse_key_values(args.occupancy_sets, "--occupancy-set"))
     except ParameterError as err:
         raise ParameterError(f"--occupancy-set: {err}") from err
     refuse_overwrite(mcap, args.force)

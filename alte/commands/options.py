@@ -23,6 +23,7 @@ from alte.ground.settings import (
     ground_settings,
 )
 from alte.ground.settings import METHODS as GROUND_METHODS
+from alte.params import key_values
 from alte.pipeline import FrameSpec, PoseSource
 from alte.registration.odometry import METHODS, OdometryParams, odometry_params
 from alte.types import Box, Mount
@@ -89,14 +90,12 @@ def add_odometry_options(p: argparse.ArgumentParser) -> None:
 
 
 def parse_key_values(items: list[str], flag: str) -> dict[str, str]:
-    """``["k=v", ...]`` -> ``{"k": "v"}``; an item without '=' is an error naming ``flag``."""
-    out: dict[str, str] = {}
-    for item in items:
-        key, sep, value = item.partition("=")
-        if not sep or not key.strip():
-            raise ParameterError(f"{flag} {item!r}: expected KEY=VALUE")
-        out[key.strip()] = value.strip()
-    return out
+    """``["k=v", ...]`` -> ``{"k": "v"}`` (:func:`alte.params.key_values`); an error names
+    ``flag``."""
+    try:
+        return key_values(items)
+    except ParameterError as err:
+        raise ParameterError(f"{flag} {err}") from err
 
 
 def add_ground_options(p: argparse._ActionsContainer, prefix: str = "",

@@ -17,7 +17,7 @@ from pathlib import Path
 from typing import ClassVar
 
 from alte.errors import ParameterError, ReportError
-from alte.params import Record, param
+from alte.params import Record, key_values, param
 from alte.sim.terrains import TERRAINS as SIMULATED
 from alte.types import JSON, JSONDict, JSONMap
 
@@ -110,9 +110,11 @@ PLAN: tuple[Entry, ...] = (
 
 def parse_param(text: str) -> tuple[str, JSON]:
     """``"NAME=VALUE"`` -> (NAME, value); VALUE is a Python literal or else a string."""
-    name, sep, raw = text.partition("=")
-    name = name.strip()
-    if not sep or not name.isidentifier():
+    try:
+        ((name, raw),) = key_values([text]).items()
+    except ParameterError as err:
+        raise ParameterError(f"--param {err}") from err
+    if not name.isidentifier():
         raise ParameterError(f"--param {text!r}: expected NAME=VALUE")
     try:
         value: JSON = ast.literal_eval(raw)

@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from alte.cli import main
-from alte.commands.map import parse_domain, parse_sets
-from alte.commands.options import parse_origin
+from alte.commands.map import parse_domain
+from alte.commands.options import parse_key_values, parse_origin
 from alte.errors import ParameterError
 from alte.mappers.alte2d import Alte2D
 from alte.mappers.domain import Domain
@@ -125,12 +125,12 @@ def test_missing_input(capsys, tmp_path: Path) -> None:
 
 
 def test_parsers() -> None:
-    assert parse_sets(["a=1", " b = x=y "]) == {"a": "1", "b": "x=y"}
+    assert parse_key_values(["a=1", " b = x=y "], "--set") == {"a": "1", "b": "x=y"}
     assert np.array_equal(parse_origin("1,2,3"), [1.0, 2.0, 3.0])
     assert parse_domain("Data") is DomainPolicy.DATA
     assert parse_domain("1,2,3") == Domain(1.0, 2.0, 0.0, 3.0)
-    with pytest.raises(ParameterError, match="KEY=VALUE"):
-        parse_sets(["=3"])
+    with pytest.raises(ParameterError, match=r"^--set '=3': expected KEY=VALUE"):
+        parse_key_values(["=3"], "--set")
     with pytest.raises(ParameterError, match="--origin"):
         parse_origin("a,b,c")
 

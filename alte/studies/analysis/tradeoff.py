@@ -24,6 +24,7 @@ import pandas as pd
 from numpy.typing import NDArray
 
 from alte.errors import ParameterError
+from alte.params import key_values
 from alte.studies.analysis.uncertainty import CONFIDENCE, bootstrap_ci
 from alte.studies.thesis.numbers import COMPARISONS, SWEEPS
 
@@ -83,15 +84,16 @@ def parse_params(text: object) -> dict[str, object]:
             return dict(json.loads(raw))
         except ValueError as err:
             raise ParameterError(f"trade-off table: params {raw!r} is not JSON") from err
+    try:
+        pairs = key_values(filter(None, (p.strip() for p in raw.split(","))))
+    except ParameterError as err:
+        raise ParameterError(f"trade-off table: params {raw!r}: expected k=v, k=v") from err
     out: dict[str, object] = {}
-    for item in filter(None, (p.strip() for p in raw.split(","))):
-        key, sep, value = item.partition("=")
-        if not sep:
-            raise ParameterError(f"trade-off table: params {raw!r}: expected k=v, k=v")
+    for key, value in pairs.items():
         try:
-            out[key.strip()] = float(value)
+            out[key] = float(value)
         except ValueError:
-            out[key.strip()] = value.strip()
+            out[key] = value
     return out
 
 
