@@ -112,10 +112,10 @@ def parse_param(text: str) -> tuple[str, JSON]:
     """``"NAME=VALUE"`` -> (NAME, value); VALUE is a Python literal or else a string."""
     try:
         ((name, raw),) = key_values([text]).items()
+        if not name.isidentifier():
+            raise ParameterError(f"{name!r} is not a name")
     except ParameterError as err:
-        raise ParameterError(f"--param {err}") from err
-    if not name.isidentifier():
-        raise ParameterError(f"--param {text!r}: expected NAME=VALUE")
+        raise ParameterError(f"--param {text!r}: expected NAME=VALUE") from err
     try:
         value: JSON = ast.literal_eval(raw)
     except (ValueError, SyntaxError):
