@@ -89,7 +89,7 @@ def _machine(bench: Bench) -> list[str]:
             f"peak RSS {m.get('peak_rss_gib')} GiB"]
 
 
-def _row8(results: list[Result]) -> list[str]:
+def _report_share_lines(results: list[Result]) -> list[str]:
     out = []
     for r in (r for r in results if r.row == 8 and r.detail.get("shares")):
         out += ["", "Row 8 stage shares of the report's wall time:", "",
@@ -98,7 +98,7 @@ def _row8(results: list[Result]) -> list[str]:
     return out
 
 
-def _row7(results: list[Result]) -> list[str]:
+def _scaling_lines(results: list[Result]) -> list[str]:
     out = []
     for r in (r for r in results if r.row == 7):
         sizes = ", ".join(f"{n:.0e}: {s:.3g} s" for n, s in zip(
@@ -109,7 +109,7 @@ def _row7(results: list[Result]) -> list[str]:
     return (["", "Row 7 timings (plot: bench_scaling.png):", "", *out]) if out else []
 
 
-def _row13(results: list[Result]) -> list[str]:
+def _grid_estimate_lines(results: list[Result]) -> list[str]:
     out = [f"- {r.case}: {d['sample_runs']} runs in {d['sample_cpu_s']:.1f} CPU s, inputs "
            f"prepared in {d['prepare_cpu_s_per_input']:.1f} CPU s each; the grid's "
            f"{d['grid_runs']:,} runs on {d['grid_inputs']} inputs: {d['grid_cpu_h']:.2f} CPU h, "
@@ -135,8 +135,8 @@ def render_markdown(bench: Bench) -> str:
     if bench.errors:
         lines += ["", "Rows that failed:", ""]
         lines += [f"- row {n} ({ROWS[n][0]}): {msg}" for n, msg in bench.errors.items()]
-    return "\n".join([*lines, *_row7(bench.results), *_row8(bench.results),
-                      *_row13(bench.results), ""])
+    return "\n".join([*lines, *_scaling_lines(bench.results), *_report_share_lines(bench.results),
+                      *_grid_estimate_lines(bench.results), ""])
 
 
 def plot_scaling(results: list[Result], path: Path) -> Path | None:

@@ -1,6 +1,6 @@
 """Row 13: the sweep's throughput in runs per core-second, and a grid's time from it.
 
-A sweep spends its time in its per-run work (:mod:`alte.studies.sweep.work`): feeding a
+A sweep spends its time in its per-run work (:mod:`alte.studies.sweep.groups`): feeding a
 map once for the runs that share it, measuring it per run. The row draws a stratified
 sample of a spec's map groups: one group per stratum (mapper, the value of its size
 parameter, domain), each stratum having one group per terrain and seed, on a terrain
@@ -35,8 +35,8 @@ from alte.types import JSONDict
 
 if TYPE_CHECKING:
     from alte.studies.sweep import SweepSpec
+    from alte.studies.sweep.groups import MapGroup
     from alte.studies.sweep.runs import SweepRun
-    from alte.studies.sweep.work import MapGroup
 
 __all__ = ["GRID_HOURS", "WORKERS", "Sample", "grid_estimate", "size_param", "stratified_groups",
            "sweep_throughput"]
@@ -92,7 +92,7 @@ def stratified_groups(spec: SweepSpec, seed: int = 0) -> list[tuple[MapGroup, in
     """One map group per stratum of ``spec`` (its first seed, terrain drawn with
     ``seed``) and the stratum's number of runs in the whole grid (every seed)."""
     from alte.studies.sweep import override, plan_runs
-    from alte.studies.sweep.work import group_runs
+    from alte.studies.sweep.groups import group_runs
 
     everything: Counter[tuple[str, float, str]] = Counter()
     for g in group_runs(plan_runs(spec)):
@@ -114,8 +114,8 @@ def _thinned(items: list[_T], most: int | None) -> list[_T]:
 
 def _prepare_input(run: SweepRun, data_dir: str) -> float:
     """CPU seconds to simulate/register (if needed) and prepare one run's input."""
+    from alte.studies.sweep.groups import _inputs
     from alte.studies.sweep.runner import _ensure
-    from alte.studies.sweep.work import _inputs
 
     start = time.process_time()
     _ensure(run, data_dir)
@@ -131,7 +131,7 @@ def measure_sample(spec: SweepSpec, data_dir: str, *, seed: int = 0, strata: int
                    progress: bool = False) -> Sample:
     """Run :func:`stratified_groups` of ``spec`` (``strata``: at most that many, evenly
     spaced) as a sweep does; see :class:`Sample`."""
-    from alte.studies.sweep.work import run_group
+    from alte.studies.sweep.groups import run_group
 
     every = stratified_groups(spec, seed)
     chosen = _thinned(every, strata)
@@ -174,7 +174,7 @@ def _peer(sample_spec: SweepSpec, data_dir: str, seed: int, strata: int | None
     on the first run of each sampled group."""
     from alte.pipeline import DomainPolicy, MapSpec
     from alte.studies.experiments import measure
-    from alte.studies.sweep.work import _inputs
+    from alte.studies.sweep.groups import _inputs
 
     runs, cpu = 0, 0.0
     for group, _ in _thinned(stratified_groups(sample_spec, seed), strata):

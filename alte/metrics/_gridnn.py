@@ -28,10 +28,10 @@ from numpy.typing import NDArray
 
 from alte._numba import threads_for
 
-__all__ = ["CELLS_PER_TARGET", "COARSER", "MAX_LOAD", "PARALLEL_MIN", "RINGS", "Grid",
+__all__ = ["CELLS_PER_TARGET", "COARSER", "MAX_LOAD", "PARALLEL_MIN", "RINGS", "CellIndex",
            "bounds", "build_grid", "first_side", "query_grid"]
 
-#: Grid cells allowed per target point: the dense cell index costs O(cells + points);
+#: Cells allowed per target point: the dense cell index costs O(cells + points);
 #: fewer, fuller cells were faster on the benchmark's clouds than emptier ones.
 CELLS_PER_TARGET = 0.5
 #: Rings of cells searched around a query's cell before it goes to a coarser grid.
@@ -54,7 +54,7 @@ Floats: TypeAlias = NDArray[np.float64]
 Ints: TypeAlias = NDArray[np.int64]
 
 @dataclass(frozen=True)
-class Grid:
+class CellIndex:
     """Targets sorted by cell: cell ``c`` holds ``points[start[c]:start[c + 1]]``.
 
     ``load`` is the mean number of targets in a target's cell (the cost of scanning one);
@@ -257,16 +257,16 @@ def first_side(box: tuple[Floats, Floats], n: int) -> float:
     return _side_for_cells(box[1] - box[0], CELLS_PER_TARGET * n, 1e3 * _TOL * (1.0 + scale))
 
 
-def build_grid(points: Floats, h: float, box: tuple[Floats, Floats]) -> Grid:
+def build_grid(points: Floats, h: float, box: tuple[Floats, Floats]) -> CellIndex:
     """Bucket ``points`` (N, 3) into cells of side ``h`` over their bounding ``box``."""
     lo, hi = box
     dims = np.maximum(np.ceil((hi - lo) / h), 1).astype(np.int64)
     start, ordered, load = _bucket(points, lo, h, dims)
     scale = float(max(np.abs(lo).max(), np.abs(hi).max()))
-    return Grid(lo, h, dims, start, ordered, load, scale)
+    return CellIndex(lo, h, dims, start, ordered, load, scale)
 
 
-def query_grid(grid: Grid, queries: Floats, rings: int,
+def query_grid(grid: CellIndex, queries: Floats, rings: int,
                ) -> tuple[Floats, NDArray[np.bool_]]:
     """(distance to the nearest target, settled) for every query (M, 3): exact where
     settled, inf where no target lies within ``rings`` rings of the query's cell."""

@@ -32,7 +32,7 @@ __all__ = [
     "SET_B",
     "GroundTruth",
     "MapMetrics",
-    "SetB",
+    "MapPointSet",
     "TruthMetrics",
     "TruthOptions",
     "measure_map",
@@ -46,7 +46,7 @@ _NAN = float("nan")
 #: of every cell with a height (2D: a height map's free cells are ground); ``occupied``:
 #: corners of the cells the mapper marks occupied (2D: Quadtree's height-above-ground
 #: rule; every known cell of 2D-ALTE; 3D: the same as ``corners``).
-class SetB(enum.StrEnum):
+class MapPointSet(enum.StrEnum):
     """Which points of a map are set B of its HD/MHD (comment above)."""
 
     CORNERS = "corners"
@@ -54,14 +54,14 @@ class SetB(enum.StrEnum):
     OCCUPIED = "occupied"
 
 
-#: The names of :class:`SetB` (what a sweep spec or a notebook may give).
-SET_B = tuple(s.value for s in SetB)
+#: The names of :class:`MapPointSet` (what a sweep spec or a notebook may give).
+SET_B = tuple(s.value for s in MapPointSet)
 
 
-def set_b_rule(value: SetB | str) -> SetB:
-    """``value`` as a :class:`SetB`, or :class:`MetricsError` naming the valid ones."""
+def set_b_rule(value: MapPointSet | str) -> MapPointSet:
+    """``value`` as a :class:`MapPointSet`, or :class:`MetricsError` naming the valid ones."""
     try:
-        return SetB(value)
+        return MapPointSet(value)
     except ValueError as err:
         raise MetricsError(f"set B {value!r}: expected one of {', '.join(SET_B)}") from err
 
@@ -141,16 +141,16 @@ def _size_spread(cells: Cells) -> tuple[float, float, float]:
     return lo, hi, float(np.log2(hi / lo))
 
 
-def set_b_points(mapper: Mapper, cells: Cells, rule: SetB = SetB.CORNERS,
+def set_b_points(mapper: Mapper, cells: Cells, rule: MapPointSet = MapPointSet.CORNERS,
                  ) -> NDArray[np.float64]:
-    """Set B of the thesis' HD/MHD by ``rule`` (see :class:`SetB`), (M, 3)."""
+    """Set B of the thesis' HD/MHD by ``rule`` (see :class:`MapPointSet`), (M, 3)."""
     rule = set_b_rule(rule)
-    if rule is SetB.CORNERS or (rule is SetB.OCCUPIED and mapper.dims == 3):
+    if rule is MapPointSet.CORNERS or (rule is MapPointSet.OCCUPIED and mapper.dims == 3):
         return mapper.corners()
     keep = rows_all(np.isfinite(cells.centers))
-    if mapper.dims == 3 or rule is SetB.OCCUPIED:
+    if mapper.dims == 3 or rule is MapPointSet.OCCUPIED:
         keep &= cells.occupied.astype(bool)
-    if rule is SetB.OCCUPIED:
+    if rule is MapPointSet.OCCUPIED:
         return rectangle_corners(cells, keep)
     return np.asarray(cells.centers[keep], dtype=np.float64)
 
@@ -168,11 +168,11 @@ def _thesis(points: NDArray[np.float64], cloud: NDArray[np.float64],
 
 def measure_map(mapper: Mapper, cloud: NDArray[np.float64], *, elapsed_s: float | Timing,
                 truth: GroundTruth | None = None, options: TruthOptions | None = None,
-                set_b: SetB = SetB.CORNERS, reference: Reference | None = None,
+                set_b: MapPointSet = MapPointSet.CORNERS, reference: Reference | None = None,
                 cells: Cells | None = None) -> MapMetrics:
     """Every metric of ``mapper`` against the registered ``cloud`` (and ``truth``);
     ``elapsed_s``: the mapping's time (one wall reading, or a :class:`Timing`);
-    ``set_b`` defines the map's points of HD/MHD (:class:`SetB`). ``reference``: the
+    ``set_b`` defines the map's points of HD/MHD (:class:`MapPointSet`). ``reference``: the
     same ``cloud``, ``truth`` and ``options`` prepared once for many maps
     (:class:`~alte.metrics.reference.Reference`): the same values, with the work the
     maps of one input share done once. ``cells``: the map's cells when the caller has

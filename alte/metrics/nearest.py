@@ -14,7 +14,7 @@ from alte.metrics._gridnn import (
     COARSER,
     MAX_LOAD,
     RINGS,
-    Grid,
+    CellIndex,
     bounds,
     build_grid,
     first_side,
@@ -43,7 +43,7 @@ class NearestIndex:
             self._tree = KDTree(self.targets)
         return np.asarray(self._tree.query(queries, k=1)[0], dtype=np.float64)
 
-    def _grid(self, i: int) -> Grid:
+    def _grid(self, i: int) -> CellIndex:
         if i == len(self.grids):
             self.grids.append(build_grid(self.targets, self.grids[-1].h * COARSER, self.box))
         return self.grids[i]

@@ -24,7 +24,7 @@ import pandas as pd
 
 from alte.errors import ParameterError
 from alte.mappers import Mapper
-from alte.metrics.maps import GroundTruth, MapMetrics, SetB, TruthOptions, measure_map
+from alte.metrics.maps import GroundTruth, MapMetrics, MapPointSet, TruthOptions, measure_map
 from alte.metrics.timing import Timing
 from alte.params import Record
 from alte.pipeline import (
@@ -141,10 +141,10 @@ def timed_run(data: Registered, spec: MapSpec, *, repeats: int = REPEATS,
 
 def measure(data: Registered, mapper: str, params: Mapping[str, object] | None = None, *,
             truth: TruthOptions | None = None, spec: MapSpec | None = None,
-            set_b: SetB = SetB.CORNERS, progress: bool = False) -> Measured:
+            set_b: MapPointSet = MapPointSet.CORNERS, progress: bool = False) -> Measured:
     """Map ``data`` with ``mapper`` and ``params`` and measure it (``truth``: also against
     the true surface; ``set_b``: the map's points of HD/MHD, see
-    :class:`alte.metrics.maps.SetB`). ``spec`` replaces
+    :class:`alte.metrics.maps.MapPointSet`). ``spec`` replaces
     the default map specification. The map is timed by :func:`timed_run`."""
     chosen = spec or MapSpec(mapper, dict(params or {}))
     result, timing = timed_run(data, chosen, progress=progress)

@@ -5,8 +5,8 @@ from __future__ import annotations
 import pytest
 
 from alte.cli import main
+from alte.studies.sweep import groups as sweep_groups
 from alte.studies.sweep import load_results
-from alte.studies.sweep import work as sweep_work
 
 SPEC = """\
 name: cli
@@ -62,7 +62,7 @@ def test_failed_runs_exit_1(spec_file, capsys, monkeypatch):
     def broken(*args, **kwargs):
         raise RuntimeError("mapper crashed")
 
-    monkeypatch.setattr(sweep_work, "timed_run", broken)
+    monkeypatch.setattr(sweep_groups, "timed_run", broken)
     assert main(["sweep", str(spec_file), "--scheduler", "serial", "--no-progress"]) == 1
     out = capsys.readouterr().out
     assert "failed: sim_lan_1 quadtree {'max_points': 300}: RuntimeError: mapper crashed" in out
@@ -73,7 +73,7 @@ def test_evidence_is_not_written_while_runs_fail(spec_file, tmp_path, capsys, mo
     def broken(*args, **kwargs):
         raise RuntimeError("mapper crashed")
 
-    monkeypatch.setattr(sweep_work, "timed_run", broken)
+    monkeypatch.setattr(sweep_groups, "timed_run", broken)
     folder = tmp_path / "evidence"
     assert main(["sweep", str(spec_file), "--scheduler", "serial", "--no-progress",
                  "--evidence", str(folder)]) == 1

@@ -5,7 +5,7 @@ from our sweep (every row of a tie: :func:`alte.studies.analysis.tables.rule_pic
 Pareto fronts at equal size or equal fidelity. Each seed's value carries bounds: a tie
 spans its rows, and a time (the mapper's CPU time, for the thesis' elapsed time) its
 spread (:func:`alte.studies.analysis.uncertainty.run_time_spreads`; a time for a fidelity:
-:mod:`alte.studies.analysis.timefronts`, where a censored read is an upper bound); the
+:mod:`alte.studies.analysis.time_needed`, where a censored read is an upper bound); the
 statistic's bounds follow (log ratio or difference, :func:`oriented`), so a comparison
 is decided only where the difference exceeds them.
 """
@@ -17,7 +17,7 @@ import pandas as pd
 
 from alte.studies.analysis.checks import ELAPSED, CheckValues, NoDataError, case_rows, name, unit
 from alte.studies.analysis.tables import TIME_COLUMN, rule_criteria, rule_picks
-from alte.studies.analysis.timefronts import time_at_fidelity
+from alte.studies.analysis.time_needed import time_at_fidelity
 from alte.studies.analysis.tradeoff import (
     equal_fidelity,
     equal_size,

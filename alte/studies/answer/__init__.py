@@ -3,10 +3,10 @@
 :mod:`~alte.studies.answer.choose` picks a mapper and setting per use, terrain group and
 budget from the trade-off grid; :mod:`~alte.studies.answer.orders` reads which mapper
 leads at equal size by a metric (the thesis' MHD, the truth, a real sequence);
-:mod:`~alte.studies.answer.bottom` assembles the front page's answer from the tables.
+:mod:`~alte.studies.answer.assemble` assembles the front page's answer from the tables.
 """
 
-from alte.studies.answer.bottom import (
+from alte.studies.answer.assemble import (
     BottomLine,
     RealCheck,
     UseAnswer,

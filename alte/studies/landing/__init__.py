@@ -40,8 +40,8 @@ from alte.studies.landing.params import (
     landing_params,
 )
 from alte.studies.landing.raster import (
-    Grid,
     PlaneFeatures,
+    RasterGeometry,
     plane_features,
     rasterise,
     rasterise_sigma,
@@ -64,10 +64,10 @@ __all__ = [
     "SWEEP_ROWS",
     "Centres",
     "Detection",
-    "Grid",
     "LandingParams",
     "LandingRun",
     "PlaneFeatures",
+    "RasterGeometry",
     "detect_sites",
     "evaluate_landing",
     "feasible_centres",

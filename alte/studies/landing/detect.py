@@ -23,7 +23,7 @@ from scipy import ndimage
 from alte.errors import ParameterError
 from alte.ground.surface import ground_obstacles, planar, plane_features
 from alte.studies.landing.params import LandingParams
-from alte.studies.landing.raster import Grid
+from alte.studies.landing.raster import RasterGeometry
 
 __all__ = ["SITE_COLUMNS", "Centres", "Detection", "detect_sites", "feasible_centres",
            "map_obstacles", "rank_sites"]
@@ -50,7 +50,7 @@ class Centres:
 class Detection:
     """Detected landing sites on one raster: the per-pixel tests and the ranked sites."""
 
-    grid: Grid
+    grid: RasterGeometry
     height: NDArray[np.float64]
     centres: Centres
     sites: pd.DataFrame
@@ -73,7 +73,7 @@ def _distance_to(mask: NDArray[np.bool_], step: float, pad_true: bool) -> NDArra
     return dist[1:-1, 1:-1] if pad_true else dist
 
 
-def map_obstacles(height: NDArray[np.float64], grid: Grid, params: LandingParams,
+def map_obstacles(height: NDArray[np.float64], grid: RasterGeometry, params: LandingParams,
                   ground: float | None = None, seed: int = 0) -> NDArray[np.bool_]:
     """Known pixels more than ``obstacle_height`` above or below the ground.
 
@@ -111,7 +111,7 @@ def _pixel_terms(centres: Centres, params: LandingParams,
     return room / (2.0 * params.keep_out), np.clip(np.nan_to_num(flat, nan=0.0), 0.0, 1.0)
 
 
-def rank_sites(centres: Centres, height: NDArray[np.float64], grid: Grid,
+def rank_sites(centres: Centres, height: NDArray[np.float64], grid: RasterGeometry,
                params: LandingParams) -> pd.DataFrame:
     """Sites = 8-connected components of feasible centres, best first (:data:`SITE_COLUMNS`).
 
@@ -144,7 +144,7 @@ def rank_sites(centres: Centres, height: NDArray[np.float64], grid: Grid,
     return table.reset_index(drop=True)[list(SITE_COLUMNS)]
 
 
-def detect_sites(height: NDArray[np.float64], grid: Grid, params: LandingParams,
+def detect_sites(height: NDArray[np.float64], grid: RasterGeometry, params: LandingParams,
                  ground: float | None = None, seed: int = 0) -> Detection:
     """Landing sites on a height raster (NaN = unknown); ``ground`` as in :func:`map_obstacles`."""
     height = np.asarray(height, dtype=np.float64)

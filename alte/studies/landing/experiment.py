@@ -31,7 +31,7 @@ from alte.studies.analysis.tables import write_csv
 from alte.studies.experiments import ground_truth, terrain
 from alte.studies.landing.detect import Centres, Detection, detect_sites
 from alte.studies.landing.params import SIGMA_OF_OBSTACLE, LandingParams, landing_params
-from alte.studies.landing.raster import Grid, rasterise, rasterise_sigma
+from alte.studies.landing.raster import RasterGeometry, rasterise, rasterise_sigma
 from alte.studies.landing.truth import score_detection, truth_centres
 from alte.studies.thesis.numbers import SWEEPS, mapper_params
 from alte.types import JSONDict
@@ -63,10 +63,10 @@ class LandingRun:
     scores: dict[str, float]
 
 
-def landing_grid(data: Registered, params: LandingParams) -> Grid:
+def landing_grid(data: Registered, params: LandingParams) -> RasterGeometry:
     """The raster over the input's control volume (its points' extent when it has none)."""
     box = data.spec.crop if data.spec.crop is not None else data.bounds()
-    return Grid.from_bounds(box.array(), params.step)
+    return RasterGeometry.from_bounds(box.array(), params.step)
 
 
 def landing_truth(data: Registered, params: LandingParams) -> Centres:

@@ -21,11 +21,11 @@ from alte.ground.surface import PlaneFeatures, pixel_centres, plane_features
 from alte.mappers.base import VARIANCE, Cells
 from alte.metrics import cell_at_xy
 
-__all__ = ["Grid", "PlaneFeatures", "plane_features", "rasterise", "rasterise_sigma"]
+__all__ = ["PlaneFeatures", "RasterGeometry", "plane_features", "rasterise", "rasterise_sigma"]
 
 
 @dataclass(frozen=True)
-class Grid:
+class RasterGeometry:
     """A raster: lower-left corner ``origin`` (x, y), pixel ``step`` (m), ``shape`` (ny, nx)."""
 
     origin: tuple[float, float]
@@ -33,7 +33,7 @@ class Grid:
     shape: tuple[int, int]
 
     @classmethod
-    def from_bounds(cls, bounds: NDArray[np.float64], step: float) -> Grid:
+    def from_bounds(cls, bounds: NDArray[np.float64], step: float) -> RasterGeometry:
         """The grid of ``step`` pixels covering ``bounds`` ((2, 2) or (2, 3): min/max corner)."""
         box = np.asarray(bounds, dtype=np.float64)
         if box.ndim != 2 or box.shape[0] != 2 or box.shape[1] < 2:
@@ -70,7 +70,7 @@ class Grid:
         return (x0, x0 + nx * self.step, y0, y0 + ny * self.step)
 
 
-def _sample(cells: Cells, grid: Grid, values: NDArray[np.float64]) -> NDArray[np.float64]:
+def _sample(cells: Cells, grid: RasterGeometry, values: NDArray[np.float64]) -> NDArray[np.float64]:
     """``values`` (one per cell) of the known cell holding each pixel centre; NaN elsewhere."""
     known = np.isfinite(cells.centers[:, 2])
     idx = cell_at_xy(grid.centers(), cells.centers[known], cells.sizes[known])
@@ -79,12 +79,12 @@ def _sample(cells: Cells, grid: Grid, values: NDArray[np.float64]) -> NDArray[np
     return out.reshape(grid.shape)
 
 
-def rasterise(cells: Cells, grid: Grid) -> NDArray[np.float64]:
+def rasterise(cells: Cells, grid: RasterGeometry) -> NDArray[np.float64]:
     """Height (ny, nx) of the cell holding each pixel centre; NaN where unknown."""
     return _sample(cells, grid, cells.centers[:, 2])
 
 
-def rasterise_sigma(cells: Cells, grid: Grid) -> NDArray[np.float64]:
+def rasterise_sigma(cells: Cells, grid: RasterGeometry) -> NDArray[np.float64]:
     """Height standard deviation (ny, nx) of the cell holding each pixel centre (the square
     root of its ``variance`` layer); NaN where unknown. A map without the layer raises."""
     variance = cells.layer(VARIANCE)

@@ -29,7 +29,7 @@ from alte.errors import MetricsError
 from alte.metrics import TrueSurface
 from alte.studies.landing.detect import Centres, Detection, feasible_centres
 from alte.studies.landing.params import LandingParams
-from alte.studies.landing.raster import Grid
+from alte.studies.landing.raster import RasterGeometry
 from alte.tensors import to_array, to_tensor
 
 __all__ = ["GROUND_CLASSES", "object_footprints", "score_detection", "top_surface",
@@ -48,7 +48,7 @@ def _hull(xy: NDArray[np.float64]) -> NDArray[np.float64]:
         return xy[[far[0], far[-1]]]
 
 
-def _square_overlaps(grid: Grid, rows: NDArray[np.intp], cols: NDArray[np.intp],
+def _square_overlaps(grid: RasterGeometry, rows: NDArray[np.intp], cols: NDArray[np.intp],
                      hull: NDArray[np.float64]) -> NDArray[np.bool_]:
     """Separating-axis test of the pixel squares (rows, cols) against a convex polygon."""
     xs, ys = grid.axes()
@@ -66,7 +66,7 @@ def _square_overlaps(grid: Grid, rows: NDArray[np.intp], cols: NDArray[np.intp],
     return overlaps
 
 
-def object_footprints(surface: TrueSurface, grid: Grid, ids: NDArray[np.int64],
+def object_footprints(surface: TrueSurface, grid: RasterGeometry, ids: NDArray[np.int64],
                       ) -> NDArray[np.bool_]:
     """Pixels (ny, nx) whose square overlaps the x/y convex hull of any object in ``ids``."""
     out = np.zeros(grid.shape, dtype=bool)
@@ -104,7 +104,7 @@ def top_surface(surface: TrueSurface, xy: NDArray[np.float64], z_start: float,
     return np.where(found, z_start - t_hit, np.nan), ids
 
 
-def truth_centres(surface: TrueSurface, grid: Grid, params: LandingParams,
+def truth_centres(surface: TrueSurface, grid: RasterGeometry, params: LandingParams,
                   z_start: float) -> Centres:
     """Truly safe centres on ``grid`` (module docstring); rays start at ``z_start``."""
     if not surface.classes:

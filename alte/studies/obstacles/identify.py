@@ -31,7 +31,7 @@ from scipy import ndimage
 from alte.mappers.base import Cells
 from alte.pipeline import Registered
 from alte.studies.experiments import ground_truth
-from alte.studies.landing.raster import Grid
+from alte.studies.landing.raster import RasterGeometry
 from alte.studies.obstacles.truth import ObstacleOptions, TrueObstacles, terrain_obstacles
 
 __all__ = [
@@ -68,7 +68,7 @@ def _spans(lo: NDArray[np.float64], hi: NDArray[np.float64], origin: float, step
 
 
 def _paint(centers: NDArray[np.float64], half: NDArray[np.float64],
-           values: NDArray[np.float64], grid: Grid, centres: bool) -> NDArray[np.float64]:
+           values: NDArray[np.float64], grid: RasterGeometry, centres: bool) -> NDArray[np.float64]:
     """Per pixel, the largest of ``values`` over the cells covering it (NaN: none)."""
     ny, nx = grid.shape
     out = np.full(ny * nx, -np.inf)
@@ -97,7 +97,7 @@ class MapRaster:
     floor: NDArray[np.float64]
 
 
-def map_raster(cells: Cells, dims: int, grid: Grid, min_height: float) -> MapRaster:
+def map_raster(cells: Cells, dims: int, grid: RasterGeometry, min_height: float) -> MapRaster:
     """The map as a :class:`MapRaster` (see the module docstring)."""
     if dims == 2:
         keep = np.isfinite(cells.centers).all(axis=1)

@@ -35,7 +35,7 @@ from alte.metrics import TrueSurface
 from alte.params import Record, param
 from alte.studies.landing import (
     GROUND_CLASSES,
-    Grid,
+    RasterGeometry,
     landing_params,
     object_footprints,
     top_surface,
@@ -75,7 +75,7 @@ class TrueObstacles:
     ``hidden``: names of the objects tall enough but covered from above.
     """
 
-    grid: Grid
+    grid: RasterGeometry
     options: ObstacleOptions
     ground: float
     ids: NDArray[np.int64]
@@ -118,7 +118,7 @@ def true_obstacles(surface: TrueSurface, bounds: Box, options: ObstacleOptions) 
         raise MetricsError("obstacle truth: the true surface has no object classes, so the "
                            "ground cannot be told from obstacles")
     box = bounds.array()
-    grid = Grid.from_bounds(box, options.step)
+    grid = RasterGeometry.from_bounds(box, options.step)
     height, top_ids = top_surface(surface, grid.centers(), float(box[1, 2]))
     ground_ids = np.array([i for i, c in surface.classes.items() if c in GROUND_CLASSES])
     ground = _ground_level(height, top_ids, ground_ids)

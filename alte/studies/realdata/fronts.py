@@ -38,7 +38,7 @@ from alte.pipeline import DomainPolicy, FrameSpec, MapSpec, PoseSource, Register
 from alte.pipeline import prepare as register
 from alte.progress import bar as progress_bar
 from alte.studies.experiments import measure
-from alte.studies.landing import Grid
+from alte.studies.landing import RasterGeometry
 from alte.studies.obstacles import map_raster
 from alte.studies.realdata.data import RealData
 from alte.studies.thesis.numbers import CASE_MAPPERS
@@ -91,7 +91,7 @@ def sequence_data(data: RealData, *, frames: int = 20, voxel: float = 0.2,
     return RealSequence(name, some, np.asarray(every.cloud, dtype=np.float64))
 
 
-def _top_raster(points: NDArray[np.float64], grid: Grid) -> NDArray[np.float64]:
+def _top_raster(points: NDArray[np.float64], grid: RasterGeometry) -> NDArray[np.float64]:
     """Highest point per pixel (NaN where none)."""
     ny, nx = grid.shape
     rc = grid.index(points[:, :2])
@@ -120,7 +120,7 @@ def reference_metrics(cells: Cells, dims: int, reference: NDArray[np.float64], *
         near = distance_to_boxes(pick, cells.centers[keep], cells.sizes[keep], tolerance)
         out["completeness"] = float(np.isfinite(near).mean())
         return out
-    grid = Grid.from_bounds(np.array([reference.min(0), reference.max(0)]), step)
+    grid = RasterGeometry.from_bounds(np.array([reference.min(0), reference.max(0)]), step)
     truth = _top_raster(reference, grid)
     shown = map_raster(cells, 2, grid, 0.0).height
     both = np.isfinite(truth) & np.isfinite(shown)

@@ -4,7 +4,7 @@ Data flows one way: spec -> runs (minus those already stored) -> terrains ensure
 (one task per distinct terrain and seed: it simulates the folder if needed and
 registers it once into the cache ``DATA_DIR/.cache``, so no two workers simulate or
 register the same data) -> one task per map the runs share on the workers
-(:func:`~alte.studies.sweep.work.run_group`: load the cached registration, feed the map
+(:func:`~alte.studies.sweep.groups.run_group`: load the cached registration, feed the map
 once, measure it for each of its runs, return their flat rows), ordered by seed and
 terrain so that each worker prepares an input once -> the client writes each finished
 row to its own Parquet file, with a progress bar over runs and its ETA. The client is
@@ -24,10 +24,10 @@ import pandas as pd
 
 from alte.errors import ParameterError, SimulationError
 from alte.progress import bar as progress_bar
+from alte.studies.sweep.groups import MapGroup, group_runs, input_data, run_group, run_one
 from alte.studies.sweep.runs import SweepRun, plan_runs, plan_variants
 from alte.studies.sweep.spec import SweepSettings, SweepSpec, with_plugins
 from alte.studies.sweep.store import finished_ids, load_results, write_row
-from alte.studies.sweep.work import MapGroup, group_runs, input_data, run_group, run_one
 
 __all__ = ["SERIAL", "MapUnordered", "SweepResult", "executor", "override", "run_one", "run_sweep",
            "variant_table"]

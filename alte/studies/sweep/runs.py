@@ -14,7 +14,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 from alte.mappers import Mapper
-from alte.metrics.maps import SetB, TruthOptions
+from alte.metrics.maps import MapPointSet, TruthOptions
 from alte.studies.sweep.spec import SweepSpec
 from alte.studies.sweep.variants import Variant
 
@@ -34,7 +34,7 @@ class SweepRun:
     voxel: float | None = None
     truth: TruthOptions = field(default_factory=TruthOptions)
     domain: str = "auto"
-    set_b: SetB = SetB.CORNERS
+    set_b: MapPointSet = MapPointSet.CORNERS
     sensor: str = "thesis"
     deskew: bool = True
     obstacles: bool = False
@@ -54,7 +54,7 @@ class SweepRun:
                "voxel": self.voxel, "truth": dataclasses.asdict(self.truth)}
         if self.domain != "auto":
             key["domain"] = self.domain
-        if self.set_b != SetB.CORNERS:
+        if self.set_b != MapPointSet.CORNERS:
             key["set_b"] = str(self.set_b)
         if self.sensor != "thesis":
             key["sensor"] = self.sensor

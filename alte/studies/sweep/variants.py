@@ -22,7 +22,7 @@ from typing import ClassVar, Literal, get_args
 
 from alte.errors import AlteError, ParameterError
 from alte.mappers import DomainUse, Mapper
-from alte.metrics.maps import SetB
+from alte.metrics.maps import MapPointSet
 from alte.params import Record, param
 from alte.sim.profile import PROFILES
 
@@ -50,7 +50,7 @@ class Variant(Record):
     name: str = param(BASE, help="the variant's name")
     text: str = param("the grid as specified", help="what it changes, in words")
     domain: DomainName = param("auto", help="the maps' root cell")
-    set_b: SetB = param(SetB.CORNERS, help="set B of HD/MHD")
+    set_b: MapPointSet = param(MapPointSet.CORNERS, help="set B of HD/MHD")
     params: Mapping[str, Mapping[str, object]] = field(default_factory=dict)
     terrains: tuple[str, ...] = param((), help="the terrains it runs on (empty: the sweep's)")
     sensor: str = param("thesis", _profile, "|".join(PROFILES), "the simulated sensor")
@@ -61,9 +61,9 @@ class Variant(Record):
         """The domain policy a run of ``mapper`` gets (``auto`` where it uses none)."""
         return "auto" if mapper.domain_use is DomainUse.UNUSED else self.domain
 
-    def set_b_for(self, mapper: type[Mapper]) -> SetB:
+    def set_b_for(self, mapper: type[Mapper]) -> MapPointSet:
         """The set B a run of ``mapper`` gets (``occupied`` is ``corners`` in 3D)."""
-        return (SetB.CORNERS if self.set_b is SetB.OCCUPIED and mapper.dims == 3
+        return (MapPointSet.CORNERS if self.set_b is MapPointSet.OCCUPIED and mapper.dims == 3
                 else self.set_b)
 
     def params_for(self, mapper: type[Mapper], row: Mapping[str, object]) -> dict[str, object]:

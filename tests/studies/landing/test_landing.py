@@ -24,8 +24,8 @@ from alte.studies.landing import (
     SITE_COLUMNS,
     Centres,
     Detection,
-    Grid,
     LandingParams,
+    RasterGeometry,
     detect_sites,
     evaluate_landing,
     feasible_centres,
@@ -48,8 +48,8 @@ from alte.studies.landing import (
 PARAMS = LandingParams(radius=1.0, margin=0.5, clearance=1.0, step=0.25, max_sites=3)
 
 
-def _flat(size: float = 20.0, step: float = 0.25) -> tuple[Grid, np.ndarray]:
-    grid = Grid.from_bounds(np.array([[0.0, 0.0], [size, size]]), step)
+def _flat(size: float = 20.0, step: float = 0.25) -> tuple[RasterGeometry, np.ndarray]:
+    grid = RasterGeometry.from_bounds(np.array([[0.0, 0.0], [size, size]]), step)
     return grid, np.zeros(grid.shape)
 
 
@@ -88,7 +88,7 @@ def test_rasterise_takes_the_height_of_the_cell_holding_each_pixel():
     cells = Cells(np.array([[1.0, 1.0, 0.5], [3.0, 1.0, np.nan], [2.0, 3.0, 2.0]]),
                   np.array([[2.0, 2.0, 0.0], [2.0, 2.0, 0.0], [4.0, 2.0, 0.0]]),
                   np.zeros(3), np.zeros(3, bool), np.zeros(3, np.int64))
-    grid = Grid.from_bounds(np.array([[0.0, 0.0, -1.0], [5.0, 4.0, 1.0]]), 0.5)
+    grid = RasterGeometry.from_bounds(np.array([[0.0, 0.0, -1.0], [5.0, 4.0, 1.0]]), 0.5)
     height = rasterise(cells, grid)
     assert height.shape == (8, 10)
     assert np.all(height[:4, :4] == 0.5) and np.all(height[4:, :8] == 2.0)
@@ -97,11 +97,11 @@ def test_rasterise_takes_the_height_of_the_cell_holding_each_pixel():
 
 def test_grid_rejects_bad_bounds_and_steps():
     with pytest.raises(ParameterError, match="step=0"):
-        Grid.from_bounds(np.array([[0.0, 0.0], [1.0, 1.0]]), 0)
+        RasterGeometry.from_bounds(np.array([[0.0, 0.0], [1.0, 1.0]]), 0)
     with pytest.raises(ParameterError, match=r"smaller than one 2\.0 m pixel"):
-        Grid.from_bounds(np.array([[0.0, 0.0], [1.0, 1.0]]), 2.0)
+        RasterGeometry.from_bounds(np.array([[0.0, 0.0], [1.0, 1.0]]), 2.0)
     with pytest.raises(ParameterError, match=r"must be \(2, 2\) or \(2, 3\)"):
-        Grid.from_bounds(np.zeros(4), 0.1)
+        RasterGeometry.from_bounds(np.zeros(4), 0.1)
 
 
 def test_plane_features_measure_slope_and_roughness():
@@ -234,7 +234,7 @@ def _centres(feasible: np.ndarray) -> Centres:
 
 
 def test_scores_count_chosen_sites_and_areas():
-    grid = Grid((0.0, 0.0), 1.0, (4, 4))
+    grid = RasterGeometry((0.0, 0.0), 1.0, (4, 4))
     params = LandingParams(radius=1.0, step=1.0, max_sites=2)
     detected = np.zeros((4, 4), bool)
     detected[0, :] = True
@@ -327,7 +327,7 @@ def test_rasterise_sigma_and_its_refusal():
     cells = Cells(np.array([[1.0, 1.0, 0.0], [3.0, 1.0, 2.0]]), np.array([[2.0, 2.0, 0.0]] * 2),
                   np.zeros(2), np.ones(2, bool), np.zeros(2, np.int64),
                   {"variance": np.array([0.04, 0.01])})
-    grid = Grid.from_bounds(np.array([[0.0, 0.0], [4.0, 2.0]]), 1.0)
+    grid = RasterGeometry.from_bounds(np.array([[0.0, 0.0], [4.0, 2.0]]), 1.0)
     assert rasterise_sigma(cells, grid).tolist() == [[0.2, 0.2, 0.1, 0.1]] * 2
     with pytest.raises(ParameterError, match="carry no height variance"):
         rasterise_sigma(dataclasses.replace(cells, layers={}), grid)

@@ -10,7 +10,7 @@ from support.example import EXAMPLE
 from alte.errors import ParameterError
 from alte.mappers import registry
 from alte.studies.sweep import override, parse_spec, plan_runs
-from alte.studies.sweep.work import map_key
+from alte.studies.sweep.groups import map_key
 
 RAW = {"terrains": ["sim_lan_1", "sim_nav_1"], "frames": 4,
        "mappers": {"quadtree": {"rows": [{"max_points": 100}]}}}

@@ -22,8 +22,8 @@ from alte.studies.sweep import (
     sensitivity_table,
     write_row,
 )
+from alte.studies.sweep import groups as sweep_groups
 from alte.studies.sweep import runner as sweep_runner
-from alte.studies.sweep import work as sweep_work
 
 
 def _raw(**changes):
@@ -243,19 +243,19 @@ def test_serial_sweep_writes_rows_and_resumes(spec, serial):
 
 
 def test_failed_runs_are_reported_not_written_and_retried(spec, tmp_path, monkeypatch):
-    real = sweep_work.measure_map
+    real = sweep_groups.measure_map
 
     def flaky(mapper, cloud, **kw):
         if mapper.name == "quadtree":
             raise MemoryError("boom")
         return real(mapper, cloud, **kw)
 
-    monkeypatch.setattr(sweep_work, "measure_map", flaky)
+    monkeypatch.setattr(sweep_groups, "measure_map", flaky)
     result = run_sweep(spec, scheduler="serial", output=tmp_path, progress=False)
     assert result.ran == 4 and len(result.table) == 4
     assert [(r.mapper, msg) for r, msg in result.failed] == [("quadtree", "MemoryError: boom")] * 2
     assert result.summary()["failed"][0]["params"] == {"max_points": 100}
-    monkeypatch.setattr(sweep_work, "measure_map", real)
+    monkeypatch.setattr(sweep_groups, "measure_map", real)
     retry = run_sweep(spec, scheduler="serial", output=tmp_path, progress=False)
     assert (retry.ran, retry.skipped, retry.failed) == (2, 4, [])
 

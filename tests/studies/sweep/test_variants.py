@@ -7,7 +7,7 @@ import pytest
 
 from alte.errors import ParameterError
 from alte.mappers import Alte2D, Alte3D, Octomap, Quadtree
-from alte.metrics.maps import SetB
+from alte.metrics.maps import MapPointSet
 from alte.studies.sweep import (
     BASE,
     Variant,
@@ -72,9 +72,10 @@ def test_variants_run_only_what_they_change():
 
 
 def test_variant_helpers():
-    v = Variant("v", domain="data", set_b=SetB.OCCUPIED, params={"alte2d": {"kappa": 2.0}})
+    v = Variant("v", domain="data", set_b=MapPointSet.OCCUPIED, params={"alte2d": {"kappa": 2.0}})
     assert v.domain_for(Octomap) == "auto" and v.domain_for(Alte2D) == "data"
-    assert v.set_b_for(Alte3D) is SetB.CORNERS and v.set_b_for(Quadtree) is SetB.OCCUPIED
+    assert v.set_b_for(Alte3D) is MapPointSet.CORNERS
+    assert v.set_b_for(Quadtree) is MapPointSet.OCCUPIED
     assert v.params_for(Alte2D, {"kappa": 1.0, "max_res": 3}) == {"kappa": 2.0, "max_res": 3}
     assert v.params_for(Quadtree, {"max_points": 9}) == {"max_points": 9}
 
@@ -168,6 +169,7 @@ def test_an_odometry_variant_poses_the_whole_mission_then_keeps_the_sweeps_scans
 
 def test_a_variants_set_b_is_a_typed_choice():
     spec = parse_spec(_raw(variants={"c": {"set_b": "centers"}}))
-    assert spec.variants[0].set_b is SetB.CENTERS
+    assert spec.variants[0].set_b is MapPointSet.CENTERS
     runs = [r for n, r in plan_variants(spec) if n == "c"]
-    assert runs and all(r.set_b is SetB.CENTERS and r.key()["set_b"] == "centers" for r in runs)
+    assert runs
+    assert all(r.set_b is MapPointSet.CENTERS and r.key()["set_b"] == "centers" for r in runs)

@@ -6,7 +6,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from alte.studies.analysis.timefronts import READ_COLUMNS, time_at_fidelity
+from alte.studies.analysis.time_needed import READ_COLUMNS, time_at_fidelity
 from alte.studies.analysis.uncertainty import RUN_TIME_SPREAD
 
 

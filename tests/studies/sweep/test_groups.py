@@ -16,7 +16,7 @@ from alte.pipeline import DomainPolicy, MapSpec
 from alte.sim import ensure_terrain, terrain_folder
 from alte.studies.experiments import measure
 from alte.studies.sweep import TIMING_COLUMNS, parse_spec, plan_runs, run_sweep
-from alte.studies.sweep.work import _dataset, group_runs, map_key, run_group, run_one
+from alte.studies.sweep.groups import _dataset, group_runs, map_key, run_group, run_one
 
 RAW = {
     "terrains": ["sim_lan_2", "sim_nav_1"], "frames": 6, "seeds": [0],
@@ -105,27 +105,27 @@ def test_run_one_is_a_group_of_one_and_raises_what_the_run_raised(spec, monkeypa
     run = next(r for r in plan_runs(spec) if r.mapper == "quadtree")
     row = run_one(run, spec.data_dir)
     assert row["run_id"] == run.run_id and row["cpu_s"] > 0 and row["wall_s"] > 0
-    from alte.studies.sweep import work
+    from alte.studies.sweep import groups
 
     def broken(*args, **kwargs):
         raise MemoryError("no room")
 
-    monkeypatch.setattr(work, "timed_run", broken)
+    monkeypatch.setattr(groups, "timed_run", broken)
     with pytest.raises(MemoryError, match="no room"):
         run_one(run, spec.data_dir)
 
 
 def test_a_run_failing_alone_leaves_its_group_going(spec, tmp_path, monkeypatch):
-    from alte.studies.sweep import work
+    from alte.studies.sweep import groups
 
-    real = work.measure_map
+    real = groups.measure_map
 
     def picky(mapper, cloud, **kw):
         if kw["set_b"] == "centers":
             raise ValueError("not today")
         return real(mapper, cloud, **kw)
 
-    monkeypatch.setattr(work, "measure_map", picky)
+    monkeypatch.setattr(groups, "measure_map", picky)
     small = parse_spec({**RAW, "terrains": ["sim_lan_2"],
                         "mappers": {"quadtree": {"grid": {"max_points": [300]}}},
                         "variants": {"c": {"set_b": "centers"}},
