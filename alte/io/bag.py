@@ -17,7 +17,6 @@ from typing import TypedDict, Unpack, cast
 import numpy as np
 from numpy.typing import NDArray
 from rosbags.highlevel import AnyReader
-from tqdm.auto import tqdm
 
 from alte.errors import BagError, ParameterError, PoseError
 from alte.io.messages import PointCloud2Msg, StampedMsg, VelodyneScanMsg
@@ -25,6 +24,7 @@ from alte.io.pointcloud2 import decode_timed
 from alte.io.pose import PoseTrack, header_stamp
 from alte.io.reader import SCAN_TYPE, open_bag, read_messages
 from alte.io.topics import NO_POSE_NOTE, bag_sources
+from alte.progress import bar as progress_bar
 from alte.types import Counts, Frame, Mount
 
 __all__ = ["NO_POSE_NOTE", "FrameSet", "FrameStream", "ReadCounts", "ReadOptions",
@@ -199,7 +199,7 @@ def _scan_frames(reader: AnyReader, stream: FrameStream, counts: ReadCounts,
     opts, topic = stream.options, stream.cloud_topic
     messages = read_messages(reader, topic, stream.path, opts.select)
     total = stream.scans if opts.select is None else len(opts.select)
-    for log_time, msgtype, msg in tqdm(messages, total=total, desc=topic, unit="scan",
+    for log_time, msgtype, msg in progress_bar(messages, total=total, desc=topic, unit="scan",
                                        disable=not opts.progress):
         if msg is None:
             counts.scans_skipped += 1

@@ -20,12 +20,12 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from rosbags.rosbag2 import StoragePlugin, Writer
 from rosbags.typesys import Stores, get_typestore
-from tqdm.auto import tqdm
 
 from alte.errors import BagError, ParameterError
 from alte.fsutil import atomic_dir
 from alte.io.imu import IMU_TYPE, ImuSamples
 from alte.io.pointcloud2 import CoordType, encode_pointcloud2, make_header
+from alte.progress import bar as progress_bar
 from alte.types import Frame, Mount
 
 if TYPE_CHECKING:  # rosbags declares MsgType (its message classes' type) for checkers only
@@ -148,7 +148,7 @@ class _BagOut:
     def clouds(self, clouds: Iterable[Cloud], poses: _Poses, progress: bool) -> None:
         """Write every scan, each preceded by the poses (and IMU samples) up to its stamp."""
         topic = self.names.cloud
-        for cloud in tqdm(clouds, desc=topic, unit="scan", disable=not progress):
+        for cloud in progress_bar(clouds, desc=topic, unit="scan", disable=not progress):
             stamp, points = cloud[0], cloud[1]
             extra = cloud[2] if len(cloud) > 2 else None
             self.poses_until(poses, int(stamp))

@@ -16,7 +16,6 @@ from typing import Protocol
 
 import numpy as np
 from numpy.typing import NDArray
-from tqdm.auto import tqdm
 
 from alte.errors import ParameterError, RegistrationError
 from alte.io.pointfiles import local_origin
@@ -24,6 +23,7 @@ from alte.mappers import Domain, DomainUse, Feed, Mapper
 from alte.pipeline.maprun import FrameLog, FrameObserver, MapRun, RunInfo, Snapshot
 from alte.pipeline.source import Source, StreamCounts
 from alte.pipeline.spec import DomainChoice, DomainPolicy, FrameSpec, MapSpec
+from alte.progress import bar as progress_bar
 from alte.registration.register import empty_reason
 from alte.types import Box, RegisteredFrame, Trajectory
 
@@ -135,7 +135,7 @@ class Feeder:
     def run(self, frames: Iterator[RegisteredFrame],
             cloud: Callable[[], NDArray[np.float64] | None], progress: bool) -> FrameLog:
         """Feed every frame (insert, or record then build once on the merged cloud)."""
-        bar = tqdm(_timed(frames), total=self.total or None, desc=self.mapper.name,
+        bar = progress_bar(_timed(frames), total=self.total or None, desc=self.mapper.name,
                    unit="frame", disable=not progress, leave=False)
         for frame, waited in bar:
             self.frame(frame, waited)

@@ -20,7 +20,7 @@ import pandas as pd
 from alte.errors import ParameterError
 from alte.plot.figure import Caption, Plot
 from alte.plot.render import Draw, save_figures
-from alte.plot.tradeoff import COLORS, PAIRS, legend, log_axis, mean_front, panels
+from alte.plot.tradeoff import PAIRS, legend, log_axis, mapper_color, mean_front, panels
 from alte.studies.analysis.tradeoff import fronts, label, prepare
 from alte.studies.thesis.numbers import TERRAIN_CASE
 
@@ -56,7 +56,7 @@ def _panel(ax: Axes, rows: pd.DataFrame, mappers: Sequence[str], axes: tuple[str
         if mine.empty:
             continue
         dots = fronts(mine, size, metric)
-        ax.scatter(dots["x"], dots["y"], s=8, alpha=0.25, color=COLORS.get(mapper), lw=0)
+        ax.scatter(dots["x"], dots["y"], s=8, alpha=0.25, color=mapper_color(mapper), lw=0)
         mean_front(ax, mine, mapper, (size, metric), False)
     ax.set_xscale("log")
     ax.set_yscale("log" if log_axis(metric) else "linear")

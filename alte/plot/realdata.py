@@ -132,7 +132,7 @@ def fronts_figure(table: pd.DataFrame) -> Plot | None:
     :data:`FRONT_PANELS` (size on a log axis); None for an empty table."""
     if table.empty:
         return None
-    from alte.plot.tradeoff import COLORS, log_axis
+    from alte.plot.tradeoff import log_axis, mapper_color
     from alte.studies.analysis.tradeoff import fronts, label, mapper_title
 
     fig = Figure(figsize=(4.0 * len(FRONT_PANELS), 3.6), layout="constrained")
@@ -142,9 +142,9 @@ def fronts_figure(table: pd.DataFrame) -> Plot | None:
         for mapper in pair:
             dots = fronts(rows[rows["mapper"] == mapper], "basis_functions", metric, higher)
             name = mapper_title(mapper)
-            ax.scatter(dots["x"], dots["y"], s=14, alpha=0.5, color=COLORS.get(mapper), lw=0)
+            ax.scatter(dots["x"], dots["y"], s=14, alpha=0.5, color=mapper_color(mapper), lw=0)
             line = dots[dots["on_front"]].sort_values("x")
-            ax.plot(line["x"], line["y"], color=COLORS.get(mapper), lw=2, label=name)
+            ax.plot(line["x"], line["y"], color=mapper_color(mapper), lw=2, label=name)
         ax.set_xscale("log")
         ax.set_yscale("log" if log_axis(metric) else "linear")
         against = "the cloud mapped" if metric.startswith(("mhd", "hd")) else "the reference"

@@ -10,6 +10,7 @@ and a star at the thesis' chosen setting. Size is on a log axis.
 from __future__ import annotations
 
 import os
+import zlib
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from functools import partial
@@ -41,12 +42,20 @@ if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
 __all__ = ["COLORS", "CURVES", "EQUAL_FIDELITY", "EQUAL_SIZE", "FRONT", "PAIRS",
-           "TradeoffCurve", "equal_fidelity_figure", "equal_size_figure",
+           "TradeoffCurve", "equal_fidelity_figure", "equal_size_figure", "mapper_color",
            "save_tradeoff_figures", "tradeoff_figure"]
 
 #: One colour per mapper, the same in every figure.
 COLORS = {"quadtree": "tab:blue", "alte2d": "tab:orange", "octomap": "tab:green",
           "alte3d": "tab:red"}
+#: Colours of further mappers (plugins), none of the thesis' four's.
+_MORE_COLORS = ("tab:purple", "tab:brown", "tab:pink", "tab:olive", "tab:cyan", "tab:gray")
+
+
+def mapper_color(mapper: str) -> str:
+    """A mapper's colour: the thesis' four's from :data:`COLORS`, any other mapper's picked
+    from its name (the same in every figure and run), never one of the four's."""
+    return COLORS.get(mapper) or _MORE_COLORS[zlib.crc32(mapper.encode()) % len(_MORE_COLORS)]
 _GRID_POINTS = 25
 
 
@@ -108,7 +117,7 @@ def mean_front(ax: Axes, rows: pd.DataFrame, mapper: str, axes: tuple[str, str],
     if grid.empty:
         return
     mean, low, high = bootstrap_columns(grid.to_numpy())
-    color = COLORS.get(mapper)
+    color = mapper_color(mapper)
     ax.plot(grid.columns, mean, color=color, lw=2,
             label=f"{mapper_title(mapper)} front")
     ax.fill_between(grid.columns, low, high, color=color, alpha=0.2, lw=0)
@@ -124,7 +133,7 @@ def _thesis_star(ax: Axes, rows: pd.DataFrame, mapper: str, axes: tuple[str, str
     chosen = rows[matching(rows, setting)] if setting else rows.iloc[:0]
     if not chosen.empty:
         ax.plot(chosen[axes[0]].mean(), chosen[axes[1]].mean(), "*", ms=14, mec="k",
-                color=COLORS.get(mapper), label=f"{mapper_title(mapper)}: "
+                color=mapper_color(mapper), label=f"{mapper_title(mapper)}: "
                 "thesis' setting")
 
 
@@ -146,7 +155,7 @@ def tradeoff_figure(table: pd.DataFrame, metric: str = "mhd_m", *,
             dots = fronts(mine, size, metric, higher_is_better)
             for on, alpha in ((False, 0.25), (True, 0.7)):
                 part = dots[dots["on_front"] == on]
-                ax.scatter(part["x"], part["y"], s=10, alpha=alpha, color=COLORS.get(mapper),
+                ax.scatter(part["x"], part["y"], s=10, alpha=alpha, color=mapper_color(mapper),
                            lw=0)
             mean_front(ax, mine, mapper, (size, metric), higher_is_better)
             _thesis_star(ax, mine, mapper, (size, metric))
@@ -176,7 +185,7 @@ def _levelpanels(summary: pd.DataFrame, names: Sequence[str], ylabel: str, xlabe
             pos = np.arange(len(levels)) + (k - (len(names) - 1) / 2) * 0.15
             err = np.vstack([mine["mean"] - mine["low"], mine["high"] - mine["mean"]])
             ax.errorbar(pos, mine["mean"], yerr=err, fmt="o", capsize=3,
-                        color=COLORS.get(mapper), label=mapper_title(mapper))
+                        color=mapper_color(mapper), label=mapper_title(mapper))
         ax.set_xticks(range(len(levels)), [f"{v:,.0f}" if v >= 100 else f"{v:.3g}"
                                            for v in levels])
         ax.set(title=terrain, xlabel=xlabel, ylabel=ylabel)

@@ -21,9 +21,9 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
-from tqdm import tqdm
 
 from alte.errors import ParameterError, RegistrationError
+from alte.progress import bar as progress_bar
 from alte.registration.grid import GridAccumulator, check_voxel, grid_average
 from alte.registration.transform import register_with_origin
 from alte.types import Counts, Frame, Mount, finite_rows, rows_all
@@ -153,7 +153,7 @@ def _iterate(
     progress: bool,
 ) -> Iterator[tuple[Frame, NDArray[np.float64], NDArray[np.float64]]]:
     box = None if crop_box is None else np.asarray(crop_box, dtype=np.float64)
-    for frame in tqdm(frames, desc="register", unit="frame", disable=not progress):
+    for frame in progress_bar(frames, desc="register", unit="frame", disable=not progress):
         counts.frames_in += 1
         reason = gate.reason(frame)
         if reason is not None:

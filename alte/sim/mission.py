@@ -22,9 +22,9 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
-from tqdm.auto import tqdm
 
 from alte.errors import ParameterError
+from alte.progress import bar as progress_bar
 from alte.sim.imu import ImuStream, imu_stream
 from alte.sim.platform import Cart, Trajectory, mocap_stream
 from alte.sim.profile import SensorProfile
@@ -159,7 +159,7 @@ def simulate(terrain: Terrain, seed: int = 0, frames: int | None = None,
     scans: list[NDArray[np.float64]] = []
     times: list[NDArray[np.float64]] = []
     counts: dict[str, int] = {}
-    for lo in tqdm(range(0, len(index), _BATCH), desc=spec.name, unit="batch",
+    for lo in progress_bar(range(0, len(index), _BATCH), desc=spec.name, unit="batch",
                    disable=not progress):
         sl = slice(lo, lo + _BATCH)
         hits = caster.hits(acq[sl])

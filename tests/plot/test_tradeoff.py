@@ -107,3 +107,13 @@ def test_save_tradeoff_figures_writes_every_captioned_figure(tmp_path):
     assert set(out) <= set(captions)
     assert {k: read_caption(tmp_path / "figures" / f"{k}.png").caption
             for k in drawn} == {k: captions[k] for k in drawn}
+
+
+def test_a_further_mapper_gets_its_own_colour() -> None:
+    """A plugin is never drawn in one of the thesis' four's colours (it was Quadtree's blue)."""
+    from alte.plot.tradeoff import COLORS, mapper_color
+
+    assert [mapper_color(m) for m in COLORS] == list(COLORS.values())
+    others = [mapper_color(name) for name in ("elevation", "topgrid", "voxblox", "ufomap")]
+    assert not set(others) & set(COLORS.values())
+    assert mapper_color("elevation") == mapper_color("elevation")

@@ -25,11 +25,11 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 from scipy.interpolate import LinearNDInterpolator
-from tqdm.auto import tqdm
 
 from alte.errors import ParameterError
 from alte.ground.filters import filter_ground
 from alte.ground.settings import DEFAULT_METHOD, DEFAULT_SETTINGS, GroundSettings, ground_settings
+from alte.progress import bar as progress_bar
 from alte.studies.realdata.data import RealData, isprs_sample, isprs_samples
 from alte.studies.realdata.ground import ground_errors
 
@@ -120,7 +120,7 @@ def filter_table(clouds: Sequence[LabelledCloud], names: Sequence[str] | None = 
     errors and kappa (%), ground shares, CPU seconds."""
     rows = []
     runs = [(c, name, spec) for c in clouds for name, spec in _candidates(names).items()]
-    for cloud, name, (method, settings) in tqdm(runs, desc="ground filters", unit="run",
+    for cloud, name, (method, settings) in progress_bar(runs, desc="ground filters", unit="run",
                                                 disable=not progress):
         result = filter_ground(cloud.points, method, settings)
         scores = ground_errors(result.ground, cloud.reference)

@@ -42,13 +42,13 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
-from tqdm.auto import tqdm
 
 from alte.errors import AlteError
 from alte.io.pointfiles import write_points
 from alte.mappers.base import Cells
 from alte.metrics.options import TruthOptions
 from alte.pipeline import DomainPolicy, FrameSpec, MapSpec, open_input, prepare
+from alte.progress import bar as progress_bar
 from alte.sim.real import Flight, Imported, import_terrain, terrain_tiles, write_imported
 from alte.studies.experiments import Measured, measure
 from alte.studies.obstacles import obstacle_columns, obstacle_options, obstacle_scores
@@ -255,5 +255,6 @@ def evidence_rows(root: str | os.PathLike[str], data_dir: str | os.PathLike[str]
     """:func:`site_rows` of every site whose tiles are present under ``root``."""
     present = [s for s in sites if all((Path(root) / t).is_file() for t in s.tiles)]
     parts = [site_rows(s, root, data_dir, **options)  # type: ignore[arg-type]
-             for s in tqdm(present, desc="real terrains", unit="site", disable=not progress)]
+             for s in progress_bar(present, desc="real terrains", unit="site",
+                                   disable=not progress)]
     return pd.concat(parts, ignore_index=True) if parts else pd.DataFrame(columns=list(COLUMNS))
