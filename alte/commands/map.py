@@ -151,9 +151,13 @@ def export_options(args: argparse.Namespace, mcap: Path | None) -> ExportOptions
         rule = SurfaceRule.parse(parse_key_values(args.occupancy_sets, "--occupancy-set"))
     except ParameterError as err:
         raise ParameterError(f"--occupancy-set: {err}") from err
+    try:
+        options = ExportOptions(args.timeline, scans=not getattr(args, "no_scans", False),
+                                all_cells=getattr(args, "all_cells", False), surface=rule)
+    except ParameterError as err:
+        raise ParameterError(f"--timeline: {err}") from err
     refuse_overwrite(mcap, args.force)
-    return ExportOptions(args.timeline, scans=not getattr(args, "no_scans", False),
-                         all_cells=getattr(args, "all_cells", False), surface=rule)
+    return options
 
 
 def run_command(args: argparse.Namespace) -> int:
