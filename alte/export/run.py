@@ -29,7 +29,7 @@ from alte.pipeline import FrameSpec, MapRun, MapSpec, Registered, Source, run
 from alte.types import RegisteredFrame
 
 __all__ = ["BODY", "LOCAL", "WORLD", "ExportOptions", "MapExporter", "export_map",
-           "export_registered"]
+           "export_registered", "timeline_feed"]
 
 WORLD, BODY, LOCAL = "map", "base_link", "alte_local"
 _IDENTITY = np.array([0.0, 0.0, 0.0, 1.0])
@@ -134,15 +134,15 @@ class MapExporter:
             self.out.put("/alte/cloud", first, cloud_msg(cloud, first, WORLD), opening=True)
 
 
-def _frames_feed(spec: MapSpec, options: ExportOptions) -> MapSpec:
-    """A timeline needs the map fed scan by scan: switch a default batch feed, refuse an
-    explicit one."""
+def timeline_feed(spec: MapSpec, options: ExportOptions) -> MapSpec:
+    """``spec`` as an export with ``options`` maps: a timeline needs the map fed scan by
+    scan, so a default batch feed is switched and an explicit one refused."""
     if options.timeline is None or (spec.feed or spec.cls.default_feed) \
             is Feed.FRAMES:
         return spec
     if spec.feed is Feed.BATCH:
-        raise ParameterError("--timeline needs the map fed scan by scan: use --feed frames "
-                             "(a batch build has no map before the last scan)")
+        raise ParameterError("export: a timeline needs feed=frames (a batch build has no map "
+                             "before the last scan)")
     return replace(spec, feed=Feed.FRAMES)
 
 
@@ -153,7 +153,7 @@ def export_map(source: Source | Registered, target: Path, spec: MapSpec,
     """Map ``source`` as :func:`alte.pipeline.run` does and write the MCAP ``target``;
     returns the run and the message count per topic."""
     options = options or ExportOptions()
-    spec = _frames_feed(spec, options)
+    spec = timeline_feed(spec, options)
     with McapFile(target, overwrite) as out:
         exporter = MapExporter(out, options)
         result = run(source, spec, frames, cache=cache, cloud=True, progress=progress,
