@@ -25,7 +25,7 @@ from typing import Any, ClassVar, Generic, Literal, Self, TypeVar, get_args, get
 
 from alte.errors import ParameterError
 
-__all__ = ["Record", "Rule", "coerce", "key_values", "param"]
+__all__ = ["Record", "Rule", "coerce", "key_values", "param", "required"]
 
 _T = TypeVar("_T")
 _V_contra = TypeVar("_V_contra", contravariant=True)
@@ -63,6 +63,14 @@ def param(default: object, check: Callable[[_T], bool] = _always, rule: str = ""
     """A :class:`Record` field with its default and validity rule; ``check`` sees the
     coerced value, never None (an optional field's None is always valid)."""
     return field(default=default, metadata={"rule": Rule(check, rule, help)})
+
+
+def required(check: Callable[[Any], bool] = _always, rule: str = "",
+             help: str = "") -> dict[str, Rule[Any]]:
+    """The metadata of a :class:`Record` field without a default, with its rule:
+    ``name: str = field(metadata=required(help="..."))`` (a plain ``field()`` call, so
+    type checkers see the field as required)."""
+    return {"rule": Rule(check, rule, help)}
 
 
 def _bool(owner: str, name: str, value: object) -> bool:

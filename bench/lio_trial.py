@@ -23,7 +23,6 @@ from __future__ import annotations
 import json
 import sys
 import time
-from dataclasses import replace
 from importlib.resources import files
 from pathlib import Path
 
@@ -93,12 +92,11 @@ def _alte(stream: FrameStream, imu: ImuSamples, truth: TruePoses,
           settings: dict[str, str]) -> list[tuple[int, np.ndarray]]:
     """``lio.FIELD=VALUE`` settings set a :class:`LioSettings` field that ``--odometry-set``
     does not reach (trials of the filter's internals)."""
-    fields = {k[4:]: int(v) if v.isdigit() else float(v) for k, v in settings.items()
-              if k.startswith("lio.")}
+    fields = {k[4:]: v for k, v in settings.items() if k.startswith("lio.")}
     settings = {k: v for k, v in settings.items() if not k.startswith("lio.")}
     if fields:
         base = odometry.lio_settings
-        odometry.lio_settings = lambda params: replace(base(params), **fields)  # type: ignore[assignment]
+        odometry.lio_settings = lambda params: base(params).replace(**fields)  # type: ignore[assignment]
     counts = PoseCounts()
     frames = odometry_frames(stream, stream.mount, counts=counts, imu=imu,
                              params=odometry_params("lio", settings),

@@ -16,7 +16,7 @@ import numpy as np
 
 from alte.commands.options import add_frame_options, frame_spec, parse_key_values
 from alte.errors import ParameterError
-from alte.export import ExportOptions
+from alte.export import ExportOptions, timeline_feed
 from alte.export import export_map as export_mcap
 from alte.fsutil import refuse_overwrite
 from alte.ground.surface import SurfaceRule
@@ -128,7 +128,13 @@ def mapped(args: argparse.Namespace, mcap: Path | None, options: ExportOptions,
            cloud: bool = False, spec: MapSpec | None = None) -> tuple[MapRun, dict[str, int]]:
     """Run the map as ``spec`` says (default: the flags'; and write the MCAP when ``mcap``
     is given); message counts per topic."""
-    spec, frames, source = spec or map_spec(args), frame_spec(args), open_input(args.input)
+    spec, frames = spec or map_spec(args), frame_spec(args)
+    try:
+        timeline_feed(spec, options)
+    except ParameterError as err:
+        raise ParameterError(f"--timeline {options.timeline} with --feed {args.feed}: {err}; "
+                             "use --feed frames") from err
+    source = open_input(args.input)
     if mcap is None:
         return run(source, spec, frames, cache=args.cache, cloud=cloud,
                    progress=not args.json), {}
@@ -151,9 +157,13 @@ def export_options(args: argparse.Namespace, mcap: Path | None) -> ExportOptions
         rule = SurfaceRule.parse(parse_key_values(args.occupancy_sets, "--occupancy-set"))
     except ParameterError as err:
         raise ParameterError(f"--occupancy-set: {err}") from err
+    try:
+        options = ExportOptions(args.timeline, scans=not getattr(args, "no_scans", False),
+                                all_cells=getattr(args, "all_cells", False), surface=rule)
+    except ParameterError as err:
+        raise ParameterError(f"--timeline: {err}") from err
     refuse_overwrite(mcap, args.force)
-    return ExportOptions(args.timeline, scans=not getattr(args, "no_scans", False),
-                         all_cells=getattr(args, "all_cells", False), surface=rule)
+    return options
 
 
 def run_command(args: argparse.Namespace) -> int:

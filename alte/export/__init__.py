@@ -7,7 +7,13 @@ GridMap definitions rosbags lacks), :mod:`~alte.export.maps` the map messages,
 """
 
 from alte.export.mcap import MAP_TOPICS, TOPICS, McapFile
-from alte.export.run import ExportOptions, MapExporter, export_map, export_registered
+from alte.export.run import (
+    ExportOptions,
+    MapExporter,
+    export_map,
+    export_registered,
+    timeline_feed,
+)
 
 __all__ = ["MAP_TOPICS", "TOPICS", "ExportOptions", "MapExporter", "McapFile", "export_map",
-           "export_registered"]
+           "export_registered", "timeline_feed"]

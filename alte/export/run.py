@@ -12,7 +12,7 @@ writes a registration without a map (``alte register --mcap``).
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -24,33 +24,32 @@ from alte.export.mcap import McapFile
 from alte.export.rosmsg import cloud_msg, path_msg, pose_stamped, tf_msg
 from alte.ground.surface import SurfaceRule
 from alte.mappers import Feed, Mapper, Octomap
+from alte.params import Record, param
 from alte.pipeline import FrameSpec, MapRun, MapSpec, Registered, Source, run
 from alte.types import RegisteredFrame
 
 __all__ = ["BODY", "LOCAL", "WORLD", "ExportOptions", "MapExporter", "export_map",
-           "export_registered"]
+           "export_registered", "timeline_feed"]
 
 WORLD, BODY, LOCAL = "map", "base_link", "alte_local"
 _IDENTITY = np.array([0.0, 0.0, 0.0, 1.0])
 
 
 @dataclass(frozen=True)
-class ExportOptions:
-    """``timeline``: a map update every that many mapped scans (None: the final map only);
-    ``scans``: write each registered scan; ``all_cells``: free cells of 3D maps too;
-    ``max_grid_cells``: largest 2D grid (coarsened by powers of two beyond it);
-    ``surface``: the landing criterion that makes grid cells free or occupied."""
+class ExportOptions(Record):
+    """What an MCAP export writes besides the final map and the trajectory."""
 
-    timeline: int | None = None
-    scans: bool = True
-    all_cells: bool = False
-    max_grid_cells: int = 4_000_000
-    surface: SurfaceRule = field(default_factory=SurfaceRule)
+    OWNER = "export"
 
-    def __post_init__(self) -> None:
-        t = self.timeline
-        if t is not None and (isinstance(t, bool) or not isinstance(t, int) or t < 1):
-            raise ParameterError(f"--timeline {t!r}: expected a positive number of scans")
+    timeline: int | None = param(None, lambda v: v >= 1, "timeline >= 1",
+                                 "a map update every that many mapped scans (None: the final "
+                                 "map only)")
+    scans: bool = param(True, help="write each registered scan")
+    all_cells: bool = param(False, help="free cells of 3D maps too")
+    max_grid_cells: int = param(4_000_000, lambda v: v >= 1, "max_grid_cells >= 1",
+                                "largest 2D grid (cells; coarsened by powers of two beyond it)")
+    surface: SurfaceRule = param(SurfaceRule(), help="the landing criterion that makes grid "
+                                                     "cells free or occupied")
 
 
 class MapExporter:
@@ -135,15 +134,15 @@ class MapExporter:
             self.out.put("/alte/cloud", first, cloud_msg(cloud, first, WORLD), opening=True)
 
 
-def _frames_feed(spec: MapSpec, options: ExportOptions) -> MapSpec:
-    """A timeline needs the map fed scan by scan: switch a default batch feed, refuse an
-    explicit one."""
+def timeline_feed(spec: MapSpec, options: ExportOptions) -> MapSpec:
+    """``spec`` as an export with ``options`` maps: a timeline needs the map fed scan by
+    scan, so a default batch feed is switched and an explicit one refused."""
     if options.timeline is None or (spec.feed or spec.cls.default_feed) \
             is Feed.FRAMES:
         return spec
     if spec.feed is Feed.BATCH:
-        raise ParameterError("--timeline needs the map fed scan by scan: use --feed frames "
-                             "(a batch build has no map before the last scan)")
+        raise ParameterError("export: a timeline needs feed=frames (a batch build has no map "
+                             "before the last scan)")
     return replace(spec, feed=Feed.FRAMES)
 
 
@@ -154,7 +153,7 @@ def export_map(source: Source | Registered, target: Path, spec: MapSpec,
     """Map ``source`` as :func:`alte.pipeline.run` does and write the MCAP ``target``;
     returns the run and the message count per topic."""
     options = options or ExportOptions()
-    spec = _frames_feed(spec, options)
+    spec = timeline_feed(spec, options)
     with McapFile(target, overwrite) as out:
         exporter = MapExporter(out, options)
         result = run(source, spec, frames, cache=cache, cloud=True, progress=progress,

@@ -24,6 +24,8 @@ from alte.io.pointcloud2 import decode_timed
 from alte.io.pose import PoseTrack, header_stamp
 from alte.io.reader import SCAN_TYPE, open_bag, read_messages
 from alte.io.topics import NO_POSE_NOTE, bag_sources
+from alte.io.velodyne import RETURN_MODES
+from alte.params import Record, param
 from alte.progress import bar as progress_bar
 from alte.types import Counts, Frame, Mount
 
@@ -90,13 +92,18 @@ def evenly_spaced(total: int, limit: int | None) -> frozenset[int] | None:
 
 
 @dataclass(frozen=True)
-class ReadOptions:
-    """How scans are read: gap limit, Velodyne return mode, which scans (None: all)."""
+class ReadOptions(Record):
+    """How scans are read (:class:`FrameStream` makes one from its keywords, checked before
+    the bag is opened)."""
 
-    max_gap_s: float = 0.5
-    return_mode: str = "strongest"
-    select: frozenset[int] | None = None
-    progress: bool = False
+    OWNER = "read"
+
+    max_gap_s: float = param(0.5, lambda v: v > 0, "max_gap_s > 0",
+                             "a scan inside a longer gap of the pose track is dropped (s)")
+    return_mode: str = param("strongest", lambda v: v in RETURN_MODES, "|".join(RETURN_MODES),
+                             "which returns of dual-return Velodyne packets are kept")
+    select: frozenset[int] | None = param(None, help="the scans read, by index (None: all)")
+    progress: bool = param(False, help="a progress bar over the scans")
 
 
 class FrameStream:
@@ -114,8 +121,7 @@ class FrameStream:
                  frames: int | None = None, max_gap_s: float = 0.5,
                  return_mode: str = "strongest", progress: bool = False,
                  pose_file: str | Path | None = None, read_all: bool = False) -> None:
-        if not max_gap_s > 0:
-            raise ParameterError(f"max_gap_s={max_gap_s!r} must be > 0")
+        options = ReadOptions(max_gap_s, return_mode, None, progress)
         self.path = Path(path)
         self.notes: list[str] = []
         with open_bag(self.path) as reader:
@@ -130,8 +136,7 @@ class FrameStream:
         #: read (odometry needs them) and :attr:`selection` only says which go on.
         self.selection = evenly_spaced(self.scans, frames)
         self.read_all = read_all and self.selection is not None
-        self.options = ReadOptions(max_gap_s, return_mode,
-                                   None if self.read_all else self.selection, progress)
+        self.options = options.replace(select=None if self.read_all else self.selection)
         self.counts = self._new_counts()
 
     def _use_pose_file(self, pose_file: Path, pose_topic: str | None) -> None:

@@ -25,6 +25,8 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
+from alte.params import Record, param
+
 __all__ = ["GRAVITY", "STEADY_TURN", "ImuNoise", "InertialFilter", "NavState", "Residuals", "hat",
            "integrate", "still", "strong_directions"]
 
@@ -37,22 +39,34 @@ STEADY_TURN = 4.594
 Residuals = tuple[NDArray[np.float64], NDArray[np.float64]]
 
 
+def _positive(value: float) -> bool:
+    return value > 0
+
+
 def hat(v: NDArray[np.float64]) -> NDArray[np.float64]:
     """Skew-symmetric matrix of a 3-vector (``hat(a) @ b == cross(a, b)``)."""
     return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
 
 
 @dataclass(frozen=True)
-class ImuNoise:
-    """Continuous-time noise densities: white noise (rad/s/sqrt(Hz), m/s^2/sqrt(Hz)) and
-    bias random walk (rad/s^2/sqrt(Hz), m/s^3/sqrt(Hz)); turn-on bias sigmas (rad/s, m/s^2)."""
+class ImuNoise(Record):
+    """Continuous-time noise densities: white noise and bias random walk; turn-on bias
+    sigmas (the ADIS16448's figures by default)."""
 
-    gyro: float = 3.39e-4
-    accel: float = 4.0e-3
-    gyro_walk: float = 3.88e-5
-    accel_walk: float = 6.0e-3
-    gyro_bias: float = 8.73e-3
-    accel_bias: float = 0.196
+    OWNER = "imu noise"
+
+    gyro: float = param(3.39e-4, _positive, "gyro > 0",
+                        "gyroscope white noise (rad/s/sqrt(Hz))")
+    accel: float = param(4.0e-3, _positive, "accel > 0",
+                         "accelerometer white noise (m/s^2/sqrt(Hz))")
+    gyro_walk: float = param(3.88e-5, _positive, "gyro_walk > 0",
+                             "gyroscope bias random walk (rad/s^2/sqrt(Hz))")
+    accel_walk: float = param(6.0e-3, _positive, "accel_walk > 0",
+                              "accelerometer bias random walk (m/s^3/sqrt(Hz))")
+    gyro_bias: float = param(8.73e-3, _positive, "gyro_bias > 0",
+                             "gyroscope turn-on bias sigma (rad/s)")
+    accel_bias: float = param(0.196, _positive, "accel_bias > 0",
+                              "accelerometer turn-on bias sigma (m/s^2)")
 
 
 @dataclass

@@ -37,7 +37,7 @@ the filter starts with a yaw uncertainty of 1 mrad
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Iterator
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -45,6 +45,7 @@ from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
 from alte.errors import RegistrationError
+from alte.params import Record, param
 from alte.registration.inertial import (
     ImuNoise,
     InertialFilter,
@@ -63,25 +64,44 @@ if TYPE_CHECKING:
 __all__ = ["LioOdometry", "LioSettings", "check_overlap", "lio_frames"]
 
 
-@dataclass(frozen=True)
-class LioSettings:
-    """What the LIO reads from :class:`~alte.registration.odometry.OdometryParams`
-    (``noise`` from its six IMU figures; ``gate``, ``gate_sigma`` (m) and ``iterations``
-    are not settings of ``--odometry-set``)."""
+def _positive(value: float) -> bool:
+    return value > 0
 
-    voxel: float = 0.5
-    max_range: float = 100.0
-    min_range: float = 1.0
-    plane_sigma: float = 0.15
-    max_distance: float = 2.0
-    neighbours: int = 5
-    wide_points: int = 20
-    wide_reach: float = 3.0
-    least: float = 30.0
-    gate: float = 3.0
-    gate_sigma: float = 0.05
-    iterations: int = 5
-    noise: ImuNoise = field(default_factory=ImuNoise)
+
+@dataclass(frozen=True)
+class LioSettings(Record):
+    """What the LIO reads from :class:`~alte.registration.odometry.OdometryParams`
+    (``noise`` from its six IMU figures; ``gate``, ``gate_sigma`` and ``iterations`` are
+    not settings of ``--odometry-set``); the rules are OdometryParams'."""
+
+    OWNER = "lio"
+
+    voxel: float = param(0.5, _positive, "voxel > 0", "scan down-sampling voxel (m); the "
+                                                      "map's is half of it")
+    max_range: float = param(100.0, _positive, "max_range > 0",
+                             "points beyond are not used, nor kept in the map (m)")
+    min_range: float = param(1.0, lambda v: v >= 0, "min_range >= 0",
+                             "nearer points are not used (m)")
+    plane_sigma: float = param(0.15, _positive, "plane_sigma > 0",
+                               "point-to-plane noise, the Cauchy kernel width (m)")
+    max_distance: float = param(2.0, _positive, "max_distance > 0",
+                                "farthest map neighbour of a small plane fit (m)")
+    neighbours: int = param(5, lambda v: v >= 3, "neighbours >= 3",
+                            "map points of a small plane fit")
+    wide_points: int = param(20, lambda v: v == 0 or v >= 3, "wide_points 0 or >= 3",
+                             "map points of the plane fit across scan rings (0: small only)")
+    wide_reach: float = param(3.0, _positive, "wide_reach > 0",
+                              "farthest map neighbour of the plane fit across rings (m)")
+    least: float = param(30.0, lambda v: v >= 0, "least >= 0",
+                         "least information a scan gives a pose direction for the update "
+                         "to move it (1/m^2; 0: every direction)")
+    gate: float = param(3.0, _positive, "gate > 0",
+                        "a correspondence is kept within that many sigmas of the prior pose")
+    gate_sigma: float = param(0.05, _positive, "gate_sigma > 0",
+                              "point and plane noise the gate allows for (m)")
+    iterations: int = param(5, lambda v: v >= 1, "iterations >= 1",
+                            "iterated Kalman updates per scan")
+    noise: ImuNoise = param(ImuNoise(), help="the IMU's noise figures")
 
 
 def _matrix(position: NDArray[np.float64], rotation: Rotation[tuple[()]]) -> NDArray[np.float64]:

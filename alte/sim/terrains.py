@@ -11,10 +11,11 @@ placed by a constant-seeded generator), so only the run seed varies the noise.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
+from alte.params import Record, param, required
 from alte.sim.platform import Cart, Quadrotor, tripod_mount
 from alte.sim.scene import Scene, SceneBuilder
 from alte.types import Mount, thesis_mount
@@ -25,20 +26,32 @@ __all__ = ["TERRAINS", "Terrain", "TerrainSpec"]
 CONTROL_VOLUME = (0.0, 0.0, -0.2, 8.0, 6.0, 2.5)
 
 
-@dataclass(frozen=True)
-class TerrainSpec:
-    """Everything that defines a terrain's mission besides its mesh."""
+def _box(values: tuple[float, ...]) -> bool:
+    return len(values) == 6 and all(values[i] < values[i + 3] for i in range(3))
 
-    name: str
-    section: str
-    title: str
-    case: str
-    kind: str
-    frames: int
-    platform: Quadrotor | Cart
-    crop_box: tuple[float, ...]
-    registration_voxel: float
-    landing_zone: tuple[float, float, float] | None = None
+
+@dataclass(frozen=True)
+class TerrainSpec(Record):
+    """Everything that defines a terrain's mission besides its mesh (hashed into the
+    simulation's cache key by :func:`~alte.sim.scenario.spec_hash`)."""
+
+    OWNER = "terrain"
+
+    name: str = field(metadata=required(bool, "a name", "the terrain's name"))
+    section: str = field(metadata=required(help="the thesis section (real: imported)"))
+    title: str = field(metadata=required(help="the title of its figures"))
+    case: str = field(metadata=required(help="the mission: nav (urban flight) or lan "
+                                             "(landing)"))
+    kind: str = field(metadata=required(help="sim (simulated), exp (the lab cart) or real"))
+    frames: int = field(metadata=required(lambda v: v >= 1, "frames >= 1", "scans taken"))
+    platform: Quadrotor | Cart = field(metadata=required(help="the vehicle and its path"))
+    crop_box: tuple[float, ...] = field(metadata=required(
+        _box, "xmin,ymin,zmin,xmax,ymax,zmax with min < max",
+        "the control volume points are kept in (m)"))
+    registration_voxel: float = field(metadata=required(
+        lambda v: v > 0, "registration_voxel > 0", "grid-average size of the registration (m)"))
+    landing_zone: tuple[float, float, float] | None = param(
+        None, help="the landing target (m; None: a navigation case)")
 
     @property
     def mount(self) -> Mount:

@@ -158,8 +158,7 @@ def ablations(grid: Grid, claims: Sequence[Claim] = CLAIMS,
     here = rows[rows["terrain"].isin(places)]
     base = here[here["variant"] == BASE]
     tables = {BASE: (base, options),
-              OCCUPIED_SIZE: (base, EvidenceOptions(**{**options.__dict__,
-                                                        "size": "occupied_cells"}))}
+              OCCUPIED_SIZE: (base, options.replace(size="occupied_cells"))}
     tables[THESIS_ROWS] = (thesis_rows(prepare(base)), options)
     tables |= {v.name: (here[here["variant"] == v.name], options) for v in grid.spec.variants}
     findings = {name: evaluate_all(claims, table, opts, rows)

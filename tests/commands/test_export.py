@@ -46,8 +46,11 @@ def test_export_writes_the_mcap_with_a_timeline(bag: Path, tmp_path: Path, capsy
 
 @pytest.mark.parametrize(("extra", "message"), [
     (["--mcap", "run.bag"], "--mcap run.bag: the file name must end in .mcap"),
-    (["--mcap", "run.mcap", "--timeline", "0"], "--timeline 0: expected a positive number"),
-    (["--mcap", "run.mcap", "--timeline", "2", "--feed", "batch"], "use --feed frames"),
+    (["--mcap", "run.mcap", "--timeline", "0"],
+     "--timeline: export: timeline=0 out of range (timeline >= 1)"),
+    (["--mcap", "run.mcap", "--timeline", "2", "--feed", "batch"],
+     "--timeline 2 with --feed batch: export: a timeline needs feed=frames (a batch build "
+     "has no map before the last scan); use --feed frames"),
     (["--mcap", "run.mcap", "--occupancy-set", "max_slope_deg=95"],
      r"--occupancy-set: occupancy: max_slope_deg=95.0 out of range (0 < max_slope_deg < 90)"),
     (["--mcap", "run.mcap", "--occupancy-set", "slope=5"],

@@ -204,8 +204,12 @@ def test_empty_bag(ros, tmp_path):
 
 
 def test_bad_max_gap(ros, tmp_path):
-    with pytest.raises(ParameterError, match=r"max_gap_s=0"):
+    """Read options are checked before the bag is opened (``tmp_path`` is none)."""
+    with pytest.raises(ParameterError, match=r"read: max_gap_s=0.0 out of range \(max_gap_s > 0\)"):
         read_frames(tmp_path, max_gap_s=0)
+    with pytest.raises(ParameterError, match=r"read: return_mode='first' out of range "
+                                             r"\(strongest\|last\|dual\)"):
+        read_frames(tmp_path, return_mode="first")
 
 
 @pytest.mark.parametrize("storage", ["sqlite3", "mcap"])

@@ -463,3 +463,15 @@ def test_the_uav_mission_starts_the_filter_at_rest(uav_mission):
     assert np.abs(odometry.filter.state.gyro_bias - settled).max() < 1e-3
     late = LioOdometry(imu, stream.mount, LioSettings(), None, first.stamp + 3_000_000_000)
     assert late.rest_s == 0.0  # the 2 s before are flight: no rest, the old start
+
+
+def test_lio_settings_are_a_checked_record_naming_the_field():
+    """The LIO's settings keep the bounds of the odometry settings they come from, and its
+    internals (gate, iterations) are checked as well; text converts (trial scripts)."""
+    assert LioSettings.parse({"gate": "4", "iterations": "3"}).iterations == 3
+    with pytest.raises(ParameterError, match=r"lio: neighbours=2 out of range \(neighbours >= 3\)"):
+        LioSettings(neighbours=2)
+    with pytest.raises(ParameterError, match=r"lio: iterations=0 out of range"):
+        replace(LioSettings(), iterations=0)
+    with pytest.raises(ParameterError, match=r"lio: noise: imu noise: gyro=0.0 out of range"):
+        LioSettings.parse({"noise": {"gyro": 0}})

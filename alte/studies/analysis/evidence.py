@@ -34,6 +34,7 @@ from dataclasses import dataclass, fields
 import numpy as np
 import pandas as pd
 
+from alte.params import Record, param
 from alte.studies.analysis.measures import CheckValues, NoDataError, measure_check
 from alte.studies.analysis.tradeoff import mapper_title, prepare
 from alte.studies.analysis.uncertainty import (
@@ -74,16 +75,20 @@ _PRIORITY = ("metric", "view", "mapper", "case", "parameter")
 
 
 @dataclass(frozen=True)
-class EvidenceOptions:
-    """Interval level, bootstrap resamples and seed, the fewest seeds that make an
-    interval, and ``size``: a column replacing ``basis_functions`` in every check (the
-    ablation that counts Octomap's occupied cells only: ``size="occupied_cells"``)."""
+class EvidenceOptions(Record):
+    """How a claim's cells are judged: the interval and the seeds it needs (module docstring)."""
 
-    level: float = CONFIDENCE
-    n_resamples: int = 2000
-    seed: int = 0
-    min_seeds: int = 2
-    size: str | None = None
+    OWNER = "evidence"
+
+    level: float = param(CONFIDENCE, lambda v: 0 < v < 1, "0 < level < 1",
+                         "confidence level of the bootstrap intervals")
+    n_resamples: int = param(2000, lambda v: v >= 1, "n_resamples >= 1", "bootstrap resamples")
+    seed: int = param(0, lambda v: v >= 0, "seed >= 0", "bootstrap seed")
+    min_seeds: int = param(2, lambda v: v >= 1, "min_seeds >= 1",
+                           "fewest seeds that make an interval (fewer: inconclusive)")
+    size: str | None = param(None, bool, "a column name",
+                             "a column replacing basis_functions in every check (Octomap's "
+                             "occupied cells only: occupied_cells)")
 
 
 @dataclass(frozen=True)

@@ -8,6 +8,7 @@ import pandas as pd
 import pytest
 from support.tradeoff import Curve, synthetic_tradeoff
 
+from alte.errors import ParameterError
 from alte.studies.analysis.evidence import (
     CELL_COLUMNS,
     VERDICTS,
@@ -337,3 +338,15 @@ def test_a_single_checks_cells_say_what_they_read_in_which_unit(check, what, uni
     assert (cells["low"] <= cells["estimate"]).all() and (cells["estimate"] <= cells["high"]).all()
     if unit == "x":  # factors: Quadtree needs several times 2D-ALTE's basis functions
         assert (cells["low"] > 1).all()
+
+
+@pytest.mark.parametrize(("given", "message"), [
+    ({"level": "1"}, r"evidence: level=1.0 out of range \(0 < level < 1\)"),
+    ({"min_seeds": 0}, r"evidence: min_seeds=0 out of range \(min_seeds >= 1\)"),
+    ({"n_resamples": "many"}, r"evidence: n_resamples='many' is not a valid int"),
+    ({"sizes": "occupied_cells"}, r"evidence: unknown parameter\(s\) sizes"),
+])
+def test_evidence_options_name_the_bad_setting(given, message):
+    with pytest.raises(ParameterError, match=message):
+        EvidenceOptions.parse(given)
+    assert EvidenceOptions.parse({"level": "0.9"}).level == 0.9
