@@ -309,7 +309,7 @@ class CsvDirective(RecordDirective):
 
 class ProvenanceDirective(RecordDirective):
     """``{alte-provenance} path.json``: the command, commit, dates and cost a committed
-    result was written with (a sweep's ``provenance.json``)."""
+    result was written with (a sweep's or a study's ``provenance.json``), and its note."""
 
     def run(self) -> list[nodes.Node]:
         import json
@@ -318,18 +318,30 @@ class ProvenanceDirective(RecordDirective):
         self.env.note_dependency(str(path))
         said = json.loads(path.read_text())
         machine = said.get("machine", {})
-        lines = [".. list-table::", "   :stub-columns: 1", ""]
+        count = said.get("runs", said.get("rows"))
         items = [("command", f"``{said.get('command', '-')}``"),
                  ("commit", f"``{str(said.get('commit', '-'))[:10]}``"),
                  ("started", said.get("started", "-")), ("finished", said.get("finished", "-")),
-                 ("runs", f"{said.get('runs', '-'):,}" if isinstance(said.get("runs"), int)
-                  else "-"),
-                 ("CPU", f"{said['cpu_s'] / 3600:.2f} h" if "cpu_s" in said else "-"),
-                 ("machine", f"{machine.get('cpu', '-')}, {machine.get('cores', '-')} cores"),
+                 ("runs" if "runs" in said else "rows",
+                  f"{count:,}" if isinstance(count, int) else "-"),
+                 ("CPU", _cpu(said.get("cpu_s"))),
+                 ("machine", f"{machine.get('cpu', machine.get('platform', '-'))}, "
+                             f"{machine.get('cores', machine.get('cpus', '-'))} cores"),
                  ("file", f"``{self.arguments[0]}``")]
+        if said.get("note"):
+            items.append(("note", _escape(str(said["note"])).replace("--", "\\-\\-")))
+        lines = [".. list-table::", "   :stub-columns: 1", ""]
         for key, value in items:
-            lines += [f"   * - {key}", f"     - {value}"]
+            shown = "(not recorded)" if value in ("-", "") else value
+            lines += [f"   * - {key}", f"     - {shown}"]
         return self._parse(lines)
+
+
+def _cpu(seconds: object) -> str:
+    """CPU seconds as hours or minutes ("-" when not recorded)."""
+    if not isinstance(seconds, int | float):
+        return "-"
+    return f"{seconds / 3600:.2f} h" if seconds >= 3600 else f"{seconds / 60:.1f} min"
 
 
 def _shared_prefix(name: str, module: str) -> int:
