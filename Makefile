@@ -65,6 +65,9 @@ mutants: bootstrap
 
 # The documentation site (docs/): Sphinx with myst-nb, the tutorials executed on small
 # inputs, warnings as errors; open docs/_build/html/index.html. DOCS_ARGS=-E rebuilds all.
+# ALTE_DOCS_EXECUTE=cache re-runs only the notebooks whose code changed;
+# ALTE_DOCS_TUTORIALS=skip shows the tutorials unexecuted (what make test builds; make
+# check-full builds the site with them executed).
 DOCS_ARGS ?=
 docs: bootstrap
 	$(PY) -m sphinx -W --keep-going -b html -j 2 $(DOCS_ARGS) docs docs/_build/html

@@ -44,7 +44,9 @@ myst_enable_extensions = ["colon_fence", "deflist"]
 myst_heading_anchors = 3
 
 # Notebooks: executed on every build (the tutorials' parameters are small), in a temporary
-# folder, a failing cell fails the build.
+# folder, a failing cell fails the build. ALTE_DOCS_EXECUTE=cache re-executes only the
+# notebooks whose code changed (myst-nb's jupyter-cache in docs/_build/.jupyter_cache:
+# quick rebuilds while writing; a change in alte alone does not re-run them).
 nb_execution_mode = os.environ.get("ALTE_DOCS_EXECUTE", "force")
 nb_execution_in_temp = True
 nb_execution_raise_on_error = True
@@ -55,6 +57,11 @@ nb_execution_timeout = 300
 REAL_TUTORIALS = ["tutorials/map-a-terrain-tile.ipynb", "tutorials/compare-mappers.ipynb"]
 nb_execution_excludepatterns = [] if (DOCS.parent.parent / "shared" / "realdata").is_dir() \
     else REAL_TUTORIALS
+# ALTE_DOCS_TUTORIALS=skip: the tutorials shown unexecuted, every other page as usual (the
+# results pages still compute their tables). make test builds the site so (links,
+# references, warnings, in a fraction of the time); make docs and make check-full run them.
+if os.environ.get("ALTE_DOCS_TUTORIALS", "run") == "skip":
+    nb_execution_excludepatterns = ["tutorials/*"]
 nb_merge_streams = True
 
 # API reference from the docstrings: members as __all__ lists them, in source order.

@@ -9,6 +9,9 @@
 - ``{alte-mappers}``: the settings of every mapper of the registry
   (:func:`alte.mappers.registry.classes`: the thesis' four and the installed plugins),
   one table each.
+- **Short type names** in signatures (``tiles: list[Tile]``) that two modules define
+  (``alte.io.tiles.Tile``, ``alte.sim.real.tiles.Tile``) link to the one nearest the
+  signature's module (:class:`NearestTarget`), where Sphinx would warn and pick any.
 
 The pages are written only when their text changes, through a temporary file and a
 rename, so two builds of the same tree at once (``make docs`` beside ``make test``) never
@@ -31,7 +34,9 @@ from typing import Any, ClassVar
 
 from docutils import nodes
 from docutils.statemachine import StringList
+from sphinx import addnodes
 from sphinx.application import Sphinx
+from sphinx.transforms.post_transforms import SphinxPostTransform
 from sphinx.util.docutils import SphinxDirective
 
 REPO = Path(__file__).resolve().parents[2]
@@ -304,7 +309,7 @@ class CsvDirective(RecordDirective):
 
 class ProvenanceDirective(RecordDirective):
     """``{alte-provenance} path.json``: the command, commit, dates and cost a committed
-    result was written with (a sweep's ``provenance.json``)."""
+    result was written with (a sweep's or a study's ``provenance.json``), and its note."""
 
     def run(self) -> list[nodes.Node]:
         import json
@@ -313,23 +318,70 @@ class ProvenanceDirective(RecordDirective):
         self.env.note_dependency(str(path))
         said = json.loads(path.read_text())
         machine = said.get("machine", {})
-        lines = [".. list-table::", "   :stub-columns: 1", ""]
+        count = said.get("runs", said.get("rows"))
         items = [("command", f"``{said.get('command', '-')}``"),
                  ("commit", f"``{str(said.get('commit', '-'))[:10]}``"),
                  ("started", said.get("started", "-")), ("finished", said.get("finished", "-")),
-                 ("runs", f"{said.get('runs', '-'):,}" if isinstance(said.get("runs"), int)
-                  else "-"),
-                 ("CPU", f"{said['cpu_s'] / 3600:.2f} h" if "cpu_s" in said else "-"),
-                 ("machine", f"{machine.get('cpu', '-')}, {machine.get('cores', '-')} cores"),
+                 ("runs" if "runs" in said else "rows",
+                  f"{count:,}" if isinstance(count, int) else "-"),
+                 ("CPU", _cpu(said.get("cpu_s"))),
+                 ("machine", f"{machine.get('cpu', machine.get('platform', '-'))}, "
+                             f"{machine.get('cores', machine.get('cpus', '-'))} cores"),
                  ("file", f"``{self.arguments[0]}``")]
+        if said.get("note"):
+            items.append(("note", _escape(str(said["note"])).replace("--", "\\-\\-")))
+        lines = [".. list-table::", "   :stub-columns: 1", ""]
         for key, value in items:
-            lines += [f"   * - {key}", f"     - {value}"]
+            shown = "(not recorded)" if value in ("-", "") else value
+            lines += [f"   * - {key}", f"     - {shown}"]
         return self._parse(lines)
 
 
+def _cpu(seconds: object) -> str:
+    """CPU seconds as hours or minutes ("-" when not recorded)."""
+    if not isinstance(seconds, int | float):
+        return "-"
+    return f"{seconds / 3600:.2f} h" if seconds >= 3600 else f"{seconds / 60:.1f} min"
+
+
+def _shared_prefix(name: str, module: str) -> int:
+    """How many leading dotted parts ``name`` shares with ``module``."""
+    count = 0
+    for mine, theirs in zip(name.split("."), module.split("."), strict=False):
+        if mine != theirs:
+            break
+        count += 1
+    return count
+
+
+class NearestTarget(SphinxPostTransform):
+    """A short Python name a signature refers to (``Tile``) that several documented
+    objects end with: the one whose module is nearest the signature's own (the longest
+    shared dotted prefix), set before Sphinx resolves it (it would warn and pick any)."""
+
+    default_priority = 5  # before sphinx's ReferencesResolver (10)
+
+    def run(self, **_kwargs: object) -> None:
+        """Qualify each ambiguous short target of this document."""
+        objects = self.env.get_domain("py").objects
+        by_last: dict[str, list[str]] = {}
+        for name in objects:
+            by_last.setdefault(name.rpartition(".")[2], []).append(name)
+        for node in self.document.findall(addnodes.pending_xref):
+            target = str(node.get("reftarget", ""))
+            module = str(node.get("py:module") or "")
+            if (node.get("refdomain") != "py" or "." in target or target in objects
+                    or f"{module}.{target}" in objects):
+                continue
+            found = by_last.get(target, [])
+            if len(found) > 1:
+                node["reftarget"] = max(found, key=lambda name: _shared_prefix(name, module))
+
+
 def setup(app: Sphinx) -> dict[str, object]:
-    """Register the page generator and the two directives."""
+    """Register the page generator, the directives and the reference transform."""
     app.connect("builder-inited", write_api_pages)
+    app.add_post_transform(NearestTarget)
     app.add_directive("alte-record", RecordDirective)
     app.add_directive("alte-mappers", MappersDirective)
     app.add_directive("alte-csv", CsvDirective)
@@ -337,5 +389,5 @@ def setup(app: Sphinx) -> dict[str, object]:
     return {"parallel_read_safe": True, "parallel_write_safe": True}
 
 
-__all__ = ["owned_names", "public_modules", "record_rows", "record_table", "setup",
+__all__ = ["NearestTarget", "owned_names", "public_modules", "record_rows", "record_table", "setup",
            "write_api_pages"]

@@ -1,10 +1,12 @@
-"""The documentation site, built once as ``make docs`` builds it, then checked.
+"""The documentation site, built with ``make docs``'s flags, then checked.
 
-One build per test session (this module's fixture, into a temporary folder: parallel-safe
-beside ``make docs``): warnings are errors, every tutorial executes on its small
-parameters, and the checks read the built site: links, the reference's coverage of the
-command line and of every public module, the tutorials' outputs, and the site as a
-browser shows it.
+``make test`` builds it once (``site``, into a temporary folder: parallel-safe beside
+``make docs``) with warnings as errors and the tutorials shown unexecuted
+(``ALTE_DOCS_TUTORIALS=skip``; every other page as usual, the results pages computing
+their tables): links and anchors, the reference's coverage of the command line and of
+every public module, the settings tables, the results pages, the README, and the site as
+a browser shows it. The tutorials' execution (a minute or two of CPU) is ``make
+check-full``'s: marked ``full``, on a second build (``executed_site``) that runs them.
 """
 
 from __future__ import annotations
@@ -38,16 +40,12 @@ def _extension():  # the docs' own Sphinx extension (docs/_ext), for its module 
     return module
 
 
-@pytest.fixture(scope="module")
-def site(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """The site, built from scratch with warnings as errors (``make docs``'s flags).
-    ``ALTE_DOCS_SITE=FOLDER`` checks a site built there instead (``make docs`` then
-    ``ALTE_DOCS_SITE=docs/_build/html pytest tests/docs``: the checks without the build)."""
+def _build(out: Path, **env: str) -> Path:
+    """The site built into ``out`` with warnings as errors (``make docs``'s flags)."""
     given = os.environ.get("ALTE_DOCS_SITE")
     if given:
         return Path(given).resolve()
-    out = tmp_path_factory.mktemp("site") / "html"
-    env = {**os.environ, "PYTHONWARNINGS": "ignore::DeprecationWarning"}
+    env = {**os.environ, "PYTHONWARNINGS": "ignore::DeprecationWarning", **env}
     done = subprocess.run(
         [sys.executable, "-m", "sphinx", "-W", "--keep-going", "-E", "-q", "-b", "html",
          str(DOCS), str(out)], capture_output=True, text=True, env=env, check=False)
@@ -56,6 +54,20 @@ def site(tmp_path_factory: pytest.TempPathFactory) -> Path:
     problems = [p for p in problems if "IPKernelApp" not in p]  # the kernel's TCP notice
     assert done.returncode == 0 and not problems, done.stderr[-6000:]
     return out
+
+
+@pytest.fixture(scope="module")
+def site(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The site with the tutorials unexecuted (``make test``). ``ALTE_DOCS_SITE=FOLDER``
+    checks a site built there instead (``make docs`` then ``ALTE_DOCS_SITE=docs/_build/html
+    pytest tests/docs``: the checks without the build)."""
+    return _build(tmp_path_factory.mktemp("site") / "html", ALTE_DOCS_TUTORIALS="skip")
+
+
+@pytest.fixture(scope="module")
+def executed_site(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The site with every tutorial executed, as ``make docs`` builds it."""
+    return _build(tmp_path_factory.mktemp("executed") / "html", ALTE_DOCS_TUTORIALS="run")
 
 
 class _Links(HTMLParser):
@@ -151,15 +163,35 @@ def test_settings_tables_list_every_mapper_setting(site: Path) -> None:
 
 
 @pytest.mark.parametrize("notebook", [p.stem for p in TUTORIALS])
-def test_tutorial_ran_on_the_site_and_keeps_no_outputs_in_git(site: Path, notebook: str) -> None:
+def test_tutorial_keeps_no_outputs_in_git_and_is_on_the_site(site: Path, notebook: str) -> None:
     source = (DOCS / "tutorials" / f"{notebook}.ipynb").read_text()
     assert '"outputs": []' in source and '"output_type"' not in source  # stripped in git
+    page = (site / "tutorials" / f"{notebook}.html").read_text()
+    assert page.count('class="cell_input') >= 3 and "Traceback" not in page
+
+
+@pytest.mark.full
+@pytest.mark.parametrize("notebook", [p.stem for p in TUTORIALS])
+def test_tutorial_ran_on_the_site(executed_site: Path, notebook: str) -> None:
     if notebook in NEEDS_REAL and not realdata_dir().is_dir():
         pytest.skip(f"{notebook} needs ../shared/realdata (absent: shown unexecuted)")
-    page = (site / "tutorials" / f"{notebook}.html").read_text()
+    page = (executed_site / "tutorials" / f"{notebook}.html").read_text()
     assert page.count('class="cell_output') >= 3
     assert "Traceback" not in page and "output traceback" not in page
     assert "<img" in page  # every tutorial draws at least one figure
+
+
+def test_real_terrain_results_are_read_from_the_committed_evidence(site: Path) -> None:
+    import pandas as pd
+
+    evidence = pd.read_csv(REPO_ROOT / "notebooks" / "realterrain" / "realterrain_fronts.csv")
+    page = (site / "results" / "real-terrain.html").read_text()
+    text = _text(site / "results" / "real-terrain.html")
+    assert [t for t in sorted(set(evidence["terrain"])) if t not in text] == []
+    assert [c for c in sorted(set(evidence["terrain_class"])) if c not in text] == []
+    assert page.count("<table") >= 5 and "holds" in text and "does not hold" in text
+    assert "cell_input" not in page  # the computing code is hidden
+    assert "Traceback" not in page and page.count("<img") >= 1
 
 
 def test_results_pages_date_every_figure_and_name_their_command(site: Path) -> None:
@@ -180,6 +212,12 @@ def test_the_readme_is_short_and_points_at_the_site() -> None:
     assert [link for link in linked if not (REPO_ROOT / link).exists()] == []
 
 
+def _figures(driver: object) -> list[int]:
+    return driver.execute_script(  # type: ignore[attr-defined]
+        "return Array.from(document.querySelectorAll('.cell_output img'))"
+        ".map(i => i.complete ? i.naturalWidth : 0)")
+
+
 def test_the_site_in_a_browser_shows_its_navigation_and_a_figure(
         site: Path, tmp_path: Path) -> None:
     with chromium(tmp_path) as driver:
@@ -193,15 +231,30 @@ def test_the_site_in_a_browser_shows_its_navigation_and_a_figure(
             "const i = document.querySelector('img[src$=\"pipeline.svg\"]');"
             "return i && i.complete ? i.naturalWidth : 0")
         assert diagram > 0
-        driver.get((site / "tutorials" / "map-your-bag.html").as_uri())
-        figures = driver.execute_script(
-            "return Array.from(document.querySelectorAll('.cell_output img'))"
-            ".map(i => i.complete ? i.naturalWidth : 0)")
+        driver.get((site / "results" / "real-terrain.html").as_uri())
+        figures = _figures(driver)
         assert figures and min(figures) > 100  # rendered, not broken
         sidebar = driver.execute_script(
             "return Array.from(document.querySelectorAll('.bd-sidebar-primary a'))"
             ".map(a => a.textContent.trim())")
-        assert "Compare mappers on your data" in sidebar
+        assert "Results: real terrain" in sidebar
         assert browser_logs(driver) == []
-        shot = tmp_path / "tutorial.png"
+        driver.get((site / "tutorials" / "write-a-mapper.html").as_uri())
+        sidebar = driver.execute_script(
+            "return Array.from(document.querySelectorAll('.bd-sidebar-primary a'))"
+            ".map(a => a.textContent.trim())")
+        assert {"Compare mappers on your data", "Write your own mapper"} <= set(sidebar)
+        assert browser_logs(driver) == []
+        shot = tmp_path / "results.png"
         assert driver.save_screenshot(str(shot)) and shot.stat().st_size > 10_000
+
+
+@pytest.mark.full
+def test_the_executed_tutorials_show_their_figures_in_a_browser(
+        executed_site: Path, tmp_path: Path) -> None:
+    with chromium(tmp_path) as driver:
+        for page in ("map-your-bag", "write-a-mapper"):
+            driver.get((executed_site / "tutorials" / f"{page}.html").as_uri())
+            figures = _figures(driver)
+            assert figures and min(figures) > 100, page  # rendered, not broken
+            assert browser_logs(driver) == []
