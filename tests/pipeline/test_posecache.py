@@ -8,8 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from alte.pipeline import FrameSpec, PoseSource, StreamCounts, open_input, stream_frames
-from alte.pipeline import posecache
+from alte.pipeline import FrameSpec, PoseSource, StreamCounts, open_input, posecache, stream_frames
 from alte.registration.odometry import OdometryParams
 from alte.types import RegisteredFrame
 

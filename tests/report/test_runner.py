@@ -51,13 +51,19 @@ def test_failure_is_isolated(two_reports: tuple[Path, Any, Any]) -> None:
 
 @pytest.mark.slow
 def test_record_and_index(two_reports: tuple[Path, Any, Any]) -> None:
-    _, first, _ = two_reports
+    _, first, second = two_reports
     record = json.loads((first.run_dir / "run.json").read_text())
     assert record["mode"] == "quick" and record["tables"] == ["table_5_1.csv"]
     assert record["runs"][0]["parameters"]["OUT_DIR"] == str(first.run_dir / "good")
     assert record["runs"][0]["parameters"]["TABLES_DIR"] == str(first.run_dir / "tables")
     page = (first.run_dir / "index.html").read_text()
     assert '<a href="#bad">bad</a>: failed' in page and "table_5_1.csv" in page
+    # CPU seconds: each kernel's when the runs did not overlap, the whole report's always
+    assert all(r["cpu_s"] > 0 for r in record["runs"])
+    assert record["cpu_s"] >= sum(r["cpu_s"] for r in record["runs"])
+    assert set(record["load_average"]) == {"start", "end"}
+    again = json.loads((second.run_dir / "run.json").read_text())
+    assert [r["cpu_s"] for r in again["runs"]] == [None, None] and again["cpu_s"] > 0
 
 
 @pytest.mark.slow
