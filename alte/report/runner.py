@@ -191,7 +191,10 @@ def _execute_all(runs: Sequence[Run], run_dir: Path, data_dir: Path, skip: dict[
     with (ThreadPoolExecutor(max_workers=max(1, jobs)) as pool,
           tqdm(total=len(todo), desc="notebooks", unit="run", disable=not progress) as bar,
           _kernel_bars(bar, progress)):
-        futures = {pool.submit(execute_run, run, run_dir, data_dir, cwd): run for run in todo}
+        # the runs marked first start first (the longest: the others fill the other
+        # worker meanwhile); the record keeps the plan's order
+        order = sorted(todo, key=lambda run: not run.first)
+        futures = {pool.submit(execute_run, run, run_dir, data_dir, cwd): run for run in order}
         for future in as_completed(futures):
             result = future.result()
             if jobs > 1:  # kernels overlapped: a run's share of the children is unknown

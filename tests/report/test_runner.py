@@ -135,6 +135,27 @@ def test_unreadable_notebook_is_a_failure_not_a_crash(tmp_path: Path) -> None:
     assert os.listdir(tmp_path) == []
 
 
+def test_runs_marked_first_start_first_and_keep_their_place(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Notebooks start in the plan's order, those marked ``first`` before the rest; the
+    record lists them in the plan's order whatever order they ran in."""
+    from alte.report import runner
+    from alte.report.runner import RunResult
+
+    started: list[str] = []
+
+    def fake(run: Run, *_: object) -> RunResult:
+        started.append(run.name)
+        return RunResult(run.name, "ok")
+
+    monkeypatch.setattr(runner, "execute_run", fake)
+    runs = [Run(name, Path(f"{name}.ipynb"), first=name == "long") for name in ("a", "long", "b")]
+    report = run_report(runs, tmp_path / "reports", tmp_path / "data", quick=True,
+                        progress=False)
+    assert started == ["long", "a", "b"]
+    assert [r.name for r in report.results] == ["a", "long", "b"]
+
+
 def test_empty_plan(tmp_path: Path) -> None:
     with pytest.raises(ReportError, match="nothing to run"):
         run_report([], tmp_path, tmp_path, quick=True)
