@@ -13,16 +13,6 @@ from alte.registration.odometry import OdometryParams
 from alte.types import RegisteredFrame
 
 
-@pytest.fixture(scope="module")
-def uav(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """``sim_lan_1`` with 4 scans of the UAV sensor: per-point time and an IMU (LIO)."""
-    from alte.sim.profile import PROFILES
-    from alte.sim.scenario import ensure_terrain
-
-    return ensure_terrain("sim_lan_1", tmp_path_factory.mktemp("uav"), 0, 4,
-                          profile=PROFILES["uav"])
-
-
 def _run(folder: Path, spec: FrameSpec, cache: Path | None,
          ) -> tuple[list[RegisteredFrame], StreamCounts]:
     source = open_input(folder)
@@ -88,3 +78,19 @@ def test_an_unfinished_run_leaves_no_cache(terrain: Path, tmp_path: Path) -> Non
     _, counts = _run(terrain, spec, cache)
     assert counts.poses.frames == 4
     assert not any("pose cache" in n for n in counts.notes)
+
+
+def test_a_cache_that_lacks_a_scan_is_refused(terrain: Path, tmp_path: Path) -> None:
+    """A cached run whose stamps do not match the bag's scans (a damaged cache) raises a
+    PoseError that says which folder to delete, never poses from the wrong scan."""
+    from alte.errors import PoseError
+
+    cache = tmp_path / "poses"
+    spec = FrameSpec(poses=PoseSource.ODOMETRY, odometry=OdometryParams(method="kiss"))
+    _run(terrain, spec, cache)
+    (folder,) = cache.iterdir()
+    with np.load(folder / "arrays.npz") as arrays:
+        kept = {k: arrays[k] for k in arrays.files}
+    np.savez(folder / "arrays.npz", **(kept | {"stamps": kept["stamps"] + 1}))
+    with pytest.raises(PoseError, match=r"pose cache: no posed scan at stamp \d+; delete"):
+        _run(terrain, spec, cache)
