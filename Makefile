@@ -11,17 +11,25 @@ export PATH := $(CURDIR)/$(VENV)/bin:$(PATH)
 
 REPORT_ARGS ?=
 PYTEST_ARGS ?=
+# Notebooks executed side by side: chapter 5 (the longest, its grid and sensor study on
+# two Dask workers) starts first and the other chapters fill the second core meanwhile.
+REPORT_JOBS ?= 2
 
-.PHONY: bootstrap report report-quick test check-full lint docs bench reference mutants clean-venv
+.PHONY: bootstrap report report-full report-quick test check-full lint docs bench reference mutants clean-venv
 
 bootstrap:
 	@bash .ci/bootstrap
 
 report: bootstrap
-	$(PY) -m alte report $(REPORT_ARGS)
+	$(PY) -m alte report --jobs $(REPORT_JOBS) $(REPORT_ARGS)
+
+# The report with the sensor study over every seed (SENSOR_SEEDS_ALL of alte/report/plan.py:
+# seeds 0-2, its worst-seed columns; about 10 more minutes than `make report`).
+report-full: bootstrap
+	$(PY) -m alte report --jobs $(REPORT_JOBS) --param "SENSOR_SEEDS=[0, 1, 2]" $(REPORT_ARGS)
 
 report-quick: bootstrap
-	$(PY) -m alte report --quick $(REPORT_ARGS)
+	$(PY) -m alte report --quick --jobs $(REPORT_JOBS) $(REPORT_ARGS)
 
 lint: bootstrap
 	$(PY) -m ruff check alte tests bench docs plugins

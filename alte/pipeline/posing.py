@@ -10,6 +10,7 @@ from __future__ import annotations
 import itertools
 from collections.abc import Iterator
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
@@ -17,6 +18,7 @@ from numpy.typing import NDArray
 from alte.errors import PoseError
 from alte.io.bag import FrameStream
 from alte.io.imu import ImuSamples, imu_topic, read_imu
+from alte.pipeline.posecache import PosedScans, pose_key, read_poses, record_poses
 from alte.pipeline.spec import FrameSpec
 from alte.registration.odometry import (
     OdometryParams,
@@ -27,7 +29,10 @@ from alte.registration.odometry import (
 )
 from alte.types import Frame
 
-__all__ = ["odometry_poses"]
+__all__ = ["PoseCache", "odometry_poses"]
+
+#: Where odometry keeps its posed scans: the cache folder and the input's identity.
+PoseCache = tuple[Path, str]
 
 
 def _start(probe: FrameStream, stamp: int,
@@ -54,10 +59,12 @@ def _imu(stream: FrameStream, params: OdometryParams) -> ImuSamples | None:
 
 
 def odometry_poses(stream: FrameStream, probe: FrameStream, spec: FrameSpec,
-                   counts: PoseCounts) -> Iterator[Frame]:
+                   counts: PoseCounts, cache: PoseCache | None = None) -> Iterator[Frame]:
     """The selected scans of ``stream`` posed by odometry (LiDAR-inertial when the bag has
     an IMU and the method is ``auto`` or ``lio``), anchored at the recorded pose of the
-    first scan when ``probe`` (the stream with the pose topic) has one."""
+    first scan when ``probe`` (the stream with the pose topic) has one. With ``cache``
+    (the cache folder and the input's identity) every posed scan is kept there and a run
+    with the same key reads them back (:mod:`alte.pipeline.posecache`)."""
     chosen: set[int] = set()
     frames = _tagged(stream, chosen)
     if not spec.deskew:  # --no-deskew: the odometry aligns, and the map keeps, scans as taken
@@ -74,9 +81,35 @@ def odometry_poses(stream: FrameStream, probe: FrameStream, spec: FrameSpec,
     with_imu = f", IMU {imu.frame_id} at {imu.rate_hz:.0f} Hz" if imu is not None else ""
     stream.notes.append(f"poses from {kind} ({odometry_label(params)}{with_imu}), "
                         f"anchored at {anchor}")
-    posed = odometry_frames(itertools.chain([first], frames), stream.mount, counts=counts,
-                            params=params, start=start, imu=imu)
+    scans = itertools.chain([first], frames)
+    folder = None if cache is None else cache[0] / pose_key(cache[1], spec, params)
+    kept = None if folder is None else read_poses(folder)
+    if kept is not None:
+        yield from _cached(scans, kept, chosen, counts, stream.notes)
+        return
+    posed = odometry_frames(scans, stream.mount, counts=counts, params=params, start=start,
+                            imu=imu)
+    if folder is not None:
+        posed = record_poses(folder, posed, counts)
     yield from (frame for frame in posed if frame.stamp in chosen)
+
+
+def _cached(scans: Iterator[Frame], kept: PosedScans, chosen: set[int], counts: PoseCounts,
+            notes: list[str]) -> Iterator[Frame]:
+    """The chosen ``scans`` posed as the cached run ``kept`` posed them; every scan is
+    still read (the stream's counts stay those of a run that aligns them)."""
+    for name, value in kept.counts.as_dict().items():
+        setattr(counts, name, value)
+    notes.append(f"odometry poses of all {len(kept.stamps)} scans read from the pose cache "
+                 f"(aligned once in {kept.counts.seconds:.1f} s)")
+    for frame in scans:
+        if frame.stamp not in chosen:
+            continue
+        posed = kept.posed(frame)
+        if posed is None:
+            raise PoseError(f"pose cache: no posed scan at stamp {frame.stamp}; delete the "
+                            "cache folder (DATA_DIR/.cache/poses) to align the scans again")
+        yield posed
 
 
 def _tagged(stream: FrameStream, chosen: set[int]) -> Iterator[Frame]:

@@ -39,6 +39,8 @@ __all__ = ["Merged", "Registered", "cache_key", "merge_frames", "merged_cloud", 
 #: Bump when the registered output of the same input and spec changes.
 CACHE_VERSION = 5
 _POINTS, _ARRAYS, _META = "points.f64", "arrays.npz", "meta.json"
+#: The odometry's pose cache inside a registration cache folder.
+POSE_DIR = "poses"
 
 
 @dataclass(frozen=True, eq=False)
@@ -80,16 +82,17 @@ def cache_key(source: Source, spec: FrameSpec) -> str:
     return hashlib.sha256(text.encode()).hexdigest()[:32]
 
 
-def _collect(source: Source, spec: FrameSpec, sink: BinaryIO | None,
-             progress: bool) -> tuple[list[NDArray[np.float64]], NDArray[np.int64], Trajectory,
-                                      NDArray[np.float64], StreamCounts]:
+def _collect(source: Source, spec: FrameSpec, sink: BinaryIO | None, progress: bool,
+             pose_cache: Path | None) -> tuple[list[NDArray[np.float64]], NDArray[np.int64],
+                                               Trajectory, NDArray[np.float64], StreamCounts]:
     """Stream the frames once: points to ``sink`` (or a list), trajectory, merged cloud."""
     counts = StreamCounts()
     merge = GridAccumulator(spec.voxel) if spec.voxel is not None else None
     parts: list[NDArray[np.float64]] = []
     sizes: list[int] = []
     poses: list[RegisteredFrame] = []
-    for frame in stream_frames(source, spec, counts, merge=merge, progress=progress):
+    for frame in stream_frames(source, spec, counts, merge=merge, progress=progress,
+                               pose_cache=pose_cache):
         points = np.ascontiguousarray(frame.points, dtype=np.float64)
         if sink is None:
             parts.append(points)
@@ -110,12 +113,13 @@ def _meta(source: Source, spec: FrameSpec, counts: StreamCounts) -> dict[str, ob
     return {"input": str(source.path), "spec": spec.key(), "counts": counts.as_dict()}
 
 
-def _write(target: Path, source: Source, spec: FrameSpec, progress: bool) -> None:
+def _write(target: Path, source: Source, spec: FrameSpec, progress: bool,
+           pose_cache: Path | None) -> None:
     with ExitStack() as stack:
         tmp = stack.enter_context(atomic_dir(target, overwrite=False))
         tmp.mkdir(parents=True)
         sink = stack.enter_context((tmp / _POINTS).open("wb"))
-        _, offsets, traj, cloud, counts = _collect(source, spec, sink, progress)
+        _, offsets, traj, cloud, counts = _collect(source, spec, sink, progress, pose_cache)
         sink.close()
         np.savez(tmp / _ARRAYS, offsets=offsets, stamps=traj.stamps, positions=traj.positions,
                  quaternions=traj.quaternions, origins=traj.origins, cloud=cloud)
@@ -147,19 +151,27 @@ def _load(folder: Path, source: Source, spec: FrameSpec, key: str) -> Registered
 
 
 def prepare(source: Source, spec: FrameSpec | None = None, *, cache: Path | None = None,
-            progress: bool = False) -> Registered:
-    """Register ``source`` once (module docstring); ``spec`` is resolved against the input."""
+            progress: bool = False, pose_cache: Path | None = None) -> Registered:
+    """Register ``source`` once (module docstring); ``spec`` is resolved against the input.
+
+    Odometry keeps its poses in ``pose_cache`` (default with ``cache``: ``cache/poses``;
+    :mod:`alte.pipeline.posecache`), so another frame selection of the same input and
+    pose settings reads them instead of aligning the scans again.
+    """
     resolved = source.resolve(spec or FrameSpec())
     key = cache_key(source, resolved)
+    if pose_cache is None and cache is not None:
+        pose_cache = Path(cache) / POSE_DIR
     if cache is None:
-        parts, offsets, traj, cloud, counts = _collect(source, resolved, None, progress)
+        parts, offsets, traj, cloud, counts = _collect(source, resolved, None, progress,
+                                                       pose_cache)
         points = np.concatenate(parts) if parts else np.empty((0, 3))
         return Registered(source, resolved, points, offsets, traj,
                           cloud if resolved.voxel is not None else points, counts, key)
     folder = Path(cache) / key
     if not (folder / _META).is_file():
         try:
-            _write(folder, source, resolved, progress)
+            _write(folder, source, resolved, progress, pose_cache)
         except AlteError:  # another process finished it first: read theirs
             if not (folder / _META).is_file():
                 raise

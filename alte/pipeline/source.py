@@ -152,8 +152,10 @@ def _deskewed(stream: FrameStream, spec: FrameSpec, counts: DeskewCounts) -> Ite
 
 
 def _posed(source: Source, spec: FrameSpec, counts: PoseCounts, progress: bool,
-           deskew: DeskewCounts | None = None) -> tuple[FrameStream, Iterator[Frame]]:
-    """The scan stream and its frames posed as ``spec.poses`` says (:class:`PoseSource`)."""
+           deskew: DeskewCounts | None = None, *, pose_cache: Path | None = None,
+           ) -> tuple[FrameStream, Iterator[Frame]]:
+    """The scan stream and its frames posed as ``spec.poses`` says (:class:`PoseSource`);
+    odometry keeps its poses in ``pose_cache`` (:mod:`alte.pipeline.posecache`)."""
     deskew = DeskewCounts() if deskew is None else deskew
     choice = spec.poses
     counts.source = choice.value
@@ -185,12 +187,15 @@ def _posed(source: Source, spec: FrameSpec, counts: PoseCounts, progress: bool,
     if stream.read_all:
         stream.notes.append(f"odometry over all {stream.scans} scans; {stream.selected} of "
                             "them (evenly spaced) registered")
-    return stream, odometry_poses(stream, probe, spec, counts)
+    cache = None if pose_cache is None else (pose_cache, source.identity)
+    return stream, odometry_poses(stream, probe, spec, counts, cache)
 
 
 def _bag_frames(source: Source, spec: FrameSpec, counts: StreamCounts,
-                merge: GridAccumulator | None, progress: bool) -> Iterator[RegisteredFrame]:
-    stream, posed = _posed(source, spec, counts.poses, progress, counts.deskew)
+                merge: GridAccumulator | None, progress: bool, *,
+                pose_cache: Path | None) -> Iterator[RegisteredFrame]:
+    stream, posed = _posed(source, spec, counts.poses, progress, counts.deskew,
+                           pose_cache=pose_cache)
     counts.scans, counts.selected, counts.notes = stream.scans, stream.selected, stream.notes
     frames = register_frames(posed, stream.mount, voxel=spec.voxel,
                              crop_box=None if spec.crop is None else spec.crop.values(),
@@ -240,12 +245,14 @@ def _file_frames(source: Source, spec: FrameSpec, counts: StreamCounts,
 
 
 def stream_frames(source: Source, spec: FrameSpec, counts: StreamCounts, *,
-                  merge: GridAccumulator | None = None,
-                  progress: bool = False) -> Iterator[RegisteredFrame]:
+                  merge: GridAccumulator | None = None, progress: bool = False,
+                  pose_cache: Path | None = None) -> Iterator[RegisteredFrame]:
     """Registered frames of ``source`` one at a time (``spec`` already resolved).
 
-    ``merge`` receives every frame's raw cropped points (the thesis' box-grid merge).
+    ``merge`` receives every frame's raw cropped points (the thesis' box-grid merge);
+    ``pose_cache``: a folder where odometry keeps the poses it aligned, per input and
+    settings, and reads them back (:mod:`alte.pipeline.posecache`).
     """
     if source.kind is InputKind.POINTS:
         return _file_frames(source, spec, counts, merge)
-    return _bag_frames(source, spec, counts, merge, progress)
+    return _bag_frames(source, spec, counts, merge, progress, pose_cache=pose_cache)

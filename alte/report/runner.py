@@ -33,7 +33,7 @@ from alte.types import JSONDict
 if TYPE_CHECKING:
     from traitlets.config import Config
 
-__all__ = ["Report", "RunResult", "ensure_terrains", "execute_run", "run_report"]
+__all__ = ["Report", "RunResult", "cpu_seconds", "ensure_terrains", "execute_run", "run_report"]
 
 class EnsureTerrain(Protocol):
     """``ensure(name, out_dir=..., seed=..., frames=...)`` makes a terrain's data exist
@@ -54,6 +54,7 @@ class RunResult:
     html: str | None = None
     error: str | None = None
     parameters: JSONDict = field(default_factory=dict)
+    cpu_s: float | None = None
 
 
 @dataclass
@@ -70,6 +71,16 @@ class Report:
     def failed(self) -> list[RunResult]:
         """Runs that did not succeed (failed or skipped)."""
         return [r for r in self.results if r.status != "ok"]
+
+
+def cpu_seconds(children: bool = True) -> float:
+    """User + system CPU seconds of this process, or of its finished children (notebook
+    kernels and the workers they waited for): a report's cost on a shared machine, where
+    wall time counts the other users' load too."""
+    import resource
+
+    use = resource.getrusage(resource.RUSAGE_CHILDREN if children else resource.RUSAGE_SELF)
+    return use.ru_utime + use.ru_stime
 
 
 def _default_ensure() -> EnsureTerrain:
@@ -143,7 +154,7 @@ def execute_run(run: Run, run_dir: Path, data_dir: Path, cwd: Path = REPO_ROOT,
 
     params: JSONDict = {**run.parameters, **_injected(run, run_dir, data_dir)}
     tmp = run_dir / f".{run.name}.part.ipynb"
-    start = time.perf_counter()
+    start, cpu = time.perf_counter(), cpu_seconds()
     status, error = "ok", None
     try:
         papermill.execute_notebook(str(run.notebook), str(tmp), parameters=params,
@@ -163,6 +174,7 @@ def execute_run(run: Run, run_dir: Path, data_dir: Path, cwd: Path = REPO_ROOT,
         except ReportError as err:
             result.error = f"{error or ''}; {err}".lstrip("; ")
     result.seconds = time.perf_counter() - start
+    result.cpu_s = cpu_seconds() - cpu  # its kernel's (exact when runs do not overlap)
     return result
 
 
@@ -179,9 +191,14 @@ def _execute_all(runs: Sequence[Run], run_dir: Path, data_dir: Path, skip: dict[
     with (ThreadPoolExecutor(max_workers=max(1, jobs)) as pool,
           tqdm(total=len(todo), desc="notebooks", unit="run", disable=not progress) as bar,
           _kernel_bars(bar, progress)):
-        futures = {pool.submit(execute_run, run, run_dir, data_dir, cwd): run for run in todo}
+        # the runs marked first start first (the longest: the others fill the other
+        # worker meanwhile); the record keeps the plan's order
+        order = sorted(todo, key=lambda run: not run.first)
+        futures = {pool.submit(execute_run, run, run_dir, data_dir, cwd): run for run in order}
         for future in as_completed(futures):
             result = future.result()
+            if jobs > 1:  # kernels overlapped: a run's share of the children is unknown
+                result.cpu_s = None
             done[result.name] = result
             bar.set_postfix_str(f"{result.name}: {result.status}")
             bar.update()
@@ -219,15 +236,19 @@ def run_report(runs: Sequence[Run], reports: str | os.PathLike[str],
         raise ReportError("nothing to run: the plan selects no notebooks")
     reports, data_dir = Path(reports).resolve(), Path(data_dir).resolve()
     started = datetime.now(UTC)
-    t0 = time.perf_counter()
+    t0, cpu0 = time.perf_counter(), cpu_seconds(False) + cpu_seconds()
+    load = os.getloadavg()[0]
     skip = ensure_terrains(runs, data_dir, ensure, progress=progress)
     run_dir = new_run_dir(reports, started)
     results = _execute_all(runs, run_dir, data_dir, skip, jobs=jobs, progress=progress,
                            cwd=Path(cwd))
     tables = sorted((run_dir / "tables").glob("*.csv"))
     seconds = time.perf_counter() - t0
+    cpu = cpu_seconds(False) + cpu_seconds() - cpu0
     record: JSONDict = {"mode": "quick" if quick else "full",
               "started": started.isoformat(timespec="seconds"), "seconds": seconds,
+              "cpu_s": round(cpu, 1),
+              "load_average": {"start": load, "end": os.getloadavg()[0]},
               "runs": [asdict(r) for r in results],
               "problems": sorted(skip.values()), "tables": [t.name for t in tables]}
     write_html(run_dir / "index.html", run_index_html(record, run_dir, tables))

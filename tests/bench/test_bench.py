@@ -148,6 +148,24 @@ def test_row8_reads_the_latest_report_record_or_says_not_run(tmp_path):
     assert row.detail["shares"]["ch5"] == pytest.approx(0.75)
 
 
+@pytest.mark.parametrize(("mode", "cpu_s", "met"), [("full", 1100.0, True),
+                                                    ("full", 1300.0, False),
+                                                    ("quick", 1300.0, None)])
+def test_row8_holds_a_full_report_to_its_budget_in_cpu_seconds(tmp_path, mode, cpu_s, met):
+    """A record with the report's CPU seconds adds the budget line: CPU s over the two
+    cores against 600 s, judged for a full report only."""
+    run_dir = tmp_path / "runs" / "20240101T000000Z"
+    run_dir.mkdir(parents=True)
+    write_record(run_dir, {"mode": mode, "started": "2024-01-01", "seconds": 2000.0,
+                           "cpu_s": cpu_s, "load_average": {"start": 9.0, "end": 12.0},
+                           "runs": []})
+    point_latest(tmp_path, run_dir)
+    wall, budget = report_wall_time(Context(BenchConfig(reports_dir=tmp_path)))
+    assert wall.ours == 2000.0
+    assert (budget.ours, budget.peer, budget.met) == (cpu_s / 2, 600.0, met)
+    assert budget.detail["load_average"] == {"start": 9.0, "end": 12.0}
+
+
 def test_a_failing_row_is_recorded_and_the_others_still_run(monkeypatch, tmp_path):
     def broken(ctx):
         raise ValueError("boom")

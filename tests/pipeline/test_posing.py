@@ -30,14 +30,9 @@ def test_odometry_reads_every_scan_and_registers_the_selected_ones(terrain: Path
     assert not any("odometry over all" in n for n in every.notes)
 
 
-def test_odometry_keeps_scans_as_taken_with_no_deskew(tmp_path_factory) -> None:
+def test_odometry_keeps_scans_as_taken_with_no_deskew(uav: Path) -> None:
     """LIO deskews every timed scan and the frames carry it so; ``deskew=False``
     (``--no-deskew``) keeps the scans as taken for the odometry and the map alike."""
-    from alte.sim.profile import PROFILES
-    from alte.sim.scenario import ensure_terrain
-
-    uav = ensure_terrain("sim_lan_1", tmp_path_factory.mktemp("uav"), 0, 4,
-                         profile=PROFILES["uav"])
     source = open_input(uav / "bag")
     first = {}
     for deskew, deskewed in ((True, 4), (False, 0)):

@@ -11,6 +11,8 @@ from alte.paths import REPO_ROOT
 from alte.report.plan import (
     PLAN,
     QUICK_FRAMES,
+    SENSOR_SEEDS,
+    SENSOR_SEEDS_ALL,
     TERRAINS,
     Entry,
     build_plan,
@@ -147,6 +149,18 @@ def test_builtin_plan_shape() -> None:
     assert all(e.full.get("FRAMES", None) is None for e in PLAN)
     assert {e.quick["FRAMES"] for e in PLAN if e.quick is not None} == {QUICK_FRAMES}
     assert {e.notebook for e in PLAN} >= {"ch2_test_benchmark.ipynb", "ch5_analysis.ipynb"}
+    # chapter 5, the longest, starts first when notebooks run side by side
+    assert [e.name for e in PLAN if e.first] == ["ch5_analysis"]
+
+
+def test_the_sensor_studys_seeds_full_and_in_the_report() -> None:
+    """``make report`` runs the sensor study on SENSOR_SEEDS, ``make report-full`` on
+    every seed of SENSOR_SEEDS_ALL (the Makefile's literal is the plan's)."""
+    (ch5,) = [e for e in PLAN if e.name == "ch5_analysis"]
+    assert ch5.full is not None and ch5.full["SENSOR_SEEDS"] == list(SENSOR_SEEDS)
+    assert set(SENSOR_SEEDS) < set(SENSOR_SEEDS_ALL)
+    makefile = (ROOT / "Makefile").read_text()
+    assert f'--param "SENSOR_SEEDS={list(SENSOR_SEEDS_ALL)}"' in makefile
 
 
 def test_terrains_match_the_simulator() -> None:

@@ -51,13 +51,19 @@ def test_failure_is_isolated(two_reports: tuple[Path, Any, Any]) -> None:
 
 @pytest.mark.slow
 def test_record_and_index(two_reports: tuple[Path, Any, Any]) -> None:
-    _, first, _ = two_reports
+    _, first, second = two_reports
     record = json.loads((first.run_dir / "run.json").read_text())
     assert record["mode"] == "quick" and record["tables"] == ["table_5_1.csv"]
     assert record["runs"][0]["parameters"]["OUT_DIR"] == str(first.run_dir / "good")
     assert record["runs"][0]["parameters"]["TABLES_DIR"] == str(first.run_dir / "tables")
     page = (first.run_dir / "index.html").read_text()
     assert '<a href="#bad">bad</a>: failed' in page and "table_5_1.csv" in page
+    # CPU seconds: each kernel's when the runs did not overlap, the whole report's always
+    assert all(r["cpu_s"] > 0 for r in record["runs"])
+    assert record["cpu_s"] >= sum(r["cpu_s"] for r in record["runs"])
+    assert set(record["load_average"]) == {"start", "end"}
+    again = json.loads((second.run_dir / "run.json").read_text())
+    assert [r["cpu_s"] for r in again["runs"]] == [None, None] and again["cpu_s"] > 0
 
 
 @pytest.mark.slow
@@ -127,6 +133,27 @@ def test_unreadable_notebook_is_a_failure_not_a_crash(tmp_path: Path) -> None:
     assert result.status == "failed" and result.notebook is None
     assert "FileNotFoundError" in result.error
     assert os.listdir(tmp_path) == []
+
+
+def test_runs_marked_first_start_first_and_keep_their_place(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Notebooks start in the plan's order, those marked ``first`` before the rest; the
+    record lists them in the plan's order whatever order they ran in."""
+    from alte.report import runner
+    from alte.report.runner import RunResult
+
+    started: list[str] = []
+
+    def fake(run: Run, *_: object) -> RunResult:
+        started.append(run.name)
+        return RunResult(run.name, "ok")
+
+    monkeypatch.setattr(runner, "execute_run", fake)
+    runs = [Run(name, Path(f"{name}.ipynb"), first=name == "long") for name in ("a", "long", "b")]
+    report = run_report(runs, tmp_path / "reports", tmp_path / "data", quick=True,
+                        progress=False)
+    assert started == ["long", "a", "b"]
+    assert [r.name for r in report.results] == ["a", "long", "b"]
 
 
 def test_empty_plan(tmp_path: Path) -> None:

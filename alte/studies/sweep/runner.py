@@ -29,8 +29,8 @@ from alte.studies.sweep.runs import SweepRun, plan_runs, plan_variants
 from alte.studies.sweep.spec import SweepSettings, SweepSpec, with_plugins
 from alte.studies.sweep.store import finished_ids, load_results, write_row
 
-__all__ = ["SERIAL", "MapUnordered", "SweepResult", "executor", "override", "run_one", "run_sweep",
-           "variant_table"]
+__all__ = ["SERIAL", "MapUnordered", "SweepResult", "executor", "input_order", "override",
+           "run_one", "run_sweep", "variant_table"]
 
 #: How long to wait for a scheduler given by address.
 CONNECT_TIMEOUT = "10s"
@@ -133,10 +133,17 @@ def executor(scheduler: str, workers: int) -> Iterator[MapUnordered]:
         yield _dask_map(client)
 
 
+def input_order(key: tuple[object, ...]) -> tuple[bool, str]:
+    """Inputs posed by odometry first (a whole mission simulated and aligned: the longest
+    tasks, ~45 CPU s of LIO each), so that no worker starts one while the other has
+    nothing left to do; the rest by key."""
+    return key[-1] != "odometry", str(key)
+
+
 def _ensure_all(pool: MapUnordered, runs: Sequence[SweepRun], data_dir: str,
                 progress: bool) -> None:
     inputs = {r.input_key(): r for r in runs}
-    items = [inputs[key] for key in sorted(inputs, key=str)]
+    items = [inputs[key] for key in sorted(inputs, key=input_order)]
     bar = progress_bar(total=len(items), desc="sweep terrains", unit="terrain",
                        disable=not progress)
     with bar:

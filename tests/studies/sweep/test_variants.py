@@ -173,3 +173,18 @@ def test_a_variants_set_b_is_a_typed_choice():
     runs = [r for n, r in plan_variants(spec) if n == "c"]
     assert runs
     assert all(r.set_b is MapPointSet.CENTERS and r.key()["set_b"] == "centers" for r in runs)
+
+
+def test_inputs_posed_by_odometry_are_made_first():
+    """The tradeoff grid's inputs: the whole missions posed by LIO (uav_lio) come first,
+    so the two workers do not end on one long alignment; the rest keep their key order."""
+    from alte.paths import REPO_ROOT
+    from alte.studies.sweep.runner import input_order
+    from alte.studies.sweep.runs import plan_runs
+    from alte.studies.sweep.spec import load_spec
+
+    spec = load_spec(REPO_ROOT / "notebooks" / "sweeps" / "tradeoff.yaml")
+    keys = sorted({r.input_key() for r in plan_runs(spec)}, key=input_order)
+    posed = [k for k in keys if k[-1] == "odometry"]
+    assert len(posed) == 6 and keys[:6] == posed
+    assert keys[6:] == sorted(keys[6:], key=str)
