@@ -12,7 +12,7 @@ export PATH := $(CURDIR)/$(VENV)/bin:$(PATH)
 REPORT_ARGS ?=
 PYTEST_ARGS ?=
 
-.PHONY: bootstrap report report-quick test lint bench reference mutants clean-venv
+.PHONY: bootstrap report report-quick test check-full lint docs bench reference mutants clean-venv
 
 bootstrap:
 	@bash .ci/bootstrap
@@ -24,7 +24,7 @@ report-quick: bootstrap
 	$(PY) -m alte report --quick $(REPORT_ARGS)
 
 lint: bootstrap
-	$(PY) -m ruff check alte tests bench
+	$(PY) -m ruff check alte tests bench docs plugins
 	$(PY) -m mypy
 
 # mypy and the compilation of the mappers' numba kernels (`alte warmup`, cached for every
@@ -33,11 +33,20 @@ lint: bootstrap
 # with PYTHONDONTWRITEBYTECODE set in the caller's environment each of them compiled
 # numpy, pandas, alte ... from source again (about 4 of its 6 CPU seconds of imports),
 # so make test writes the bytecode caches (__pycache__, git-ignored) whatever the caller says.
+# The long end-to-end checks (marker `full`: the whole quick bench, the 10-million-point
+# memory runs, chapters 5 and 6 headless, ...; tests/README.md says which smaller test
+# proves each one's parts) run in `make check-full`, which CI runs after `make test`.
+PYTEST := $(PY) -m pytest -n 2 --dist loadfile --no-loadscope-reorder tests plugins/alte-elevation/tests notebooks --nbval-lax
 test: export PYTHONDONTWRITEBYTECODE :=
 test: bootstrap
-	$(PY) -m ruff check alte tests bench
+	$(PY) -m ruff check alte tests bench docs plugins
 	@$(PY) -m alte warmup & warm=$$!; $(PY) -m mypy; typed=$$?; wait $$warm && exit $$typed
-	$(PY) -m pytest -n 2 --dist loadfile --no-loadscope-reorder tests notebooks --nbval-lax $(PYTEST_ARGS)
+	$(PYTEST) -m "not full" $(PYTEST_ARGS)
+
+check-full: export PYTHONDONTWRITEBYTECODE :=
+check-full: bootstrap
+	@$(PY) -m alte warmup
+	$(PYTEST) -m full $(PYTEST_ARGS)
 
 # Rewrite the checked-in reference results (tests/reference) from a fresh quick chapter 5
 # run, after a deliberate change; `git diff tests/reference` shows what moved.
@@ -53,6 +62,13 @@ MODULES ?=
 mutants: bootstrap
 	$(PY) tests/mutation_run.py $(MODULES) --max-children 2 $(if $(MUTANTS),--mutants='$(MUTANTS)')
 	$(PY) tests/mutation_score.py
+
+# The documentation site (docs/): Sphinx with myst-nb, the tutorials executed on small
+# inputs, warnings as errors; open docs/_build/html/index.html. DOCS_ARGS=-E rebuilds all.
+DOCS_ARGS ?=
+docs: bootstrap
+	$(PY) -m sphinx -W --keep-going -b html -j 2 $(DOCS_ARGS) docs docs/_build/html
+	@echo "docs: open docs/_build/html/index.html"
 
 bench: bootstrap
 	$(PY) -m alte bench

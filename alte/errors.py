@@ -9,6 +9,7 @@ from __future__ import annotations
 __all__ = [
     "AlteError",
     "BagError",
+    "ContractError",
     "GroundError",
     "MapperError",
     "MetricsError",
@@ -56,6 +57,11 @@ class ParameterError(AlteError, ValueError):
 
 class MapperError(AlteError):
     """A mapper was used wrongly (unknown name, bad input array)."""
+
+
+class ContractError(MapperError):
+    """A mapper class breaks the mapper contract (:mod:`alte.mappers.api`): a plugin the
+    registry refuses, or a failure of :func:`alte.testing.check_mapper`."""
 
 
 class MetricsError(AlteError):

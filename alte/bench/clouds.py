@@ -56,17 +56,17 @@ def open3d_hausdorff(pa: o3d.geometry.PointCloud, pb: o3d.geometry.PointCloud
 
 def corner_sets(ctx: Context) -> dict[str, Points]:
     """Corners of the occupied cells of Octomap (native) and 3D-ALTE maps of sim_nav_1."""
-    from alte.mappers import make_mapper
+    from alte.mappers import Alte3D, Octomap, make_mapper
 
     def octomap() -> Mapper:
         if ctx.has("octomap-passes"):
             return octomap_passes(ctx).maps["native"]
-        mapper = mapper_setup(ctx, "octomap").make()
+        mapper = mapper_setup(ctx, Octomap).make()
         for points, origin in ctx.scans(NAV):
             mapper.insert(points, origin)
         return mapper
 
-    alte3d = make_mapper("alte3d", mapper_params(NAV)["alte3d"])
+    alte3d = make_mapper(Alte3D, mapper_params(NAV)["alte3d"])
     alte3d.build(ctx.workload(NAV).cloud)
     return {"octomap": ctx.memo("octomap-native-map", octomap).corners(),
             "alte3d": alte3d.corners()}

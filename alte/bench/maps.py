@@ -6,6 +6,10 @@ by pass; the last map of each gives the Jaccard index and the memory figures.
 Row 3: batch builds at the chapter 4 parameters against ``numpy.argsort`` of as many
 float64 keys (the floor of any sort-based build). Row 5: per-frame ``insert``
 latency of every incremental mapper against one VLP-16 rotation (100 ms).
+
+Rows 3 and 5 take every registered mapper (plugins included, :mod:`alte.mappers.registry`):
+a 2D map on the landing terrain, a 3D map on the navigation one, with the thesis'
+chapter 4 parameters for the thesis' four and a plugin's defaults.
 """
 
 from __future__ import annotations
@@ -29,6 +33,7 @@ from alte.types import JSONDict
 if TYPE_CHECKING:
     from alte.mappers import Mapper, Octomap
     from alte.mappers.domain import Domain
+    from alte.params import Record
 
 __all__ = [
     "JACCARD_MIN",
@@ -44,17 +49,28 @@ __all__ = [
     "octomap_memory",
     "octomap_passes",
     "octomap_speed",
+    "terrain_of",
 ]
 
 #: One VLP-16 rotation at 10 Hz: a mapper keeping up with the sensor inserts faster.
 ROTATION_S = 0.1
 #: Row 1's agreement bar between the backends.
 JACCARD_MIN = 0.999
-#: Row 3's bar per mapper where it is tighter than ``LIMITS[3]``.
+#: Row 3's bar per mapper (by name) where it is tighter than ``LIMITS[3]``.
 BUILD_LIMITS = {"quadtree": 3.0}
 NAV, LAN = "sim_nav_1", "sim_lan_2"
-#: Terrain each mapper is benchmarked on (its thesis case, chapter 4).
-TERRAIN_OF = {"octomap": NAV, "alte3d": NAV, "quadtree": LAN, "alte2d": LAN}
+
+
+def terrain_of(cls: type[Mapper]) -> str:
+    """The terrain a mapper is benchmarked on: its thesis case (3D: navigation, 2D:
+    landing, chapter 4)."""
+    return NAV if cls.dims == 3 else LAN
+
+
+def bench_params(cls: type[Mapper]) -> dict[str, float]:
+    """The chapter 4 parameters of one of the thesis' four on its terrain; a plugin's
+    defaults (empty)."""
+    return mapper_params(terrain_of(cls)).get(cls.name, {})
 
 
 class Inserts(Protocol):
@@ -114,31 +130,35 @@ def interleaved_passes(makers: Mapping[str, Callable[[], _T]],
 
 @dataclass(frozen=True)
 class MapperSetup:
-    """A mapper as the bench makes it: ``name``, its chapter 4 ``params`` on its terrain and,
-    for mappers with a domain, the control volume's cube (as the pipeline gives it)."""
+    """A mapper as the bench makes it: its class, its :func:`bench_params` and, for
+    mappers with a domain, the control volume's cube (as the pipeline gives it)."""
 
-    name: str
+    cls: type[Mapper]
     params: dict[str, float]
     domain: Domain | None = None
+
+    @property
+    def name(self) -> str:
+        """The mapper's name."""
+        return self.cls.name
 
     def make(self, **given: object) -> Mapper:
         """A fresh mapper (``given``: further keywords, e.g. Octomap's ``backend``)."""
         from alte.mappers import make_mapper
 
-        return make_mapper(self.name, self.params, domain=self.domain, **given)
+        return make_mapper(self.cls, self.params, domain=self.domain, **given)
 
 
-def mapper_setup(ctx: Context, name: str) -> MapperSetup:
-    """How the bench makes ``name`` (:class:`MapperSetup`)."""
-    from alte.mappers import DomainUse, mapper_class
+def mapper_setup(ctx: Context, cls: type[Mapper]) -> MapperSetup:
+    """How the bench makes ``cls`` (:class:`MapperSetup`)."""
+    from alte.mappers import DomainUse
     from alte.mappers.domain import Domain
     from alte.types import Box
 
-    terrain = TERRAIN_OF[name]
-    params = mapper_params(terrain)[name]
-    if mapper_class(name).domain_use is DomainUse.UNUSED:
-        return MapperSetup(name, params)
-    return MapperSetup(name, params, Domain.over(Box.of(ctx.workload(terrain).bounds)))
+    if cls.domain_use is DomainUse.UNUSED:
+        return MapperSetup(cls, bench_params(cls))
+    return MapperSetup(cls, bench_params(cls),
+                       Domain.over(Box.of(ctx.workload(terrain_of(cls)).bounds)))
 
 
 def octomap_passes(ctx: Context) -> Passes[Octomap]:
@@ -147,11 +167,11 @@ def octomap_passes(ctx: Context) -> Passes[Octomap]:
 
     def octomap(setup: MapperSetup, backend: str) -> Octomap:
         mapper = setup.make(backend=backend)
-        assert isinstance(mapper, Octomap), "the registry's octomap is Octomap"
+        assert isinstance(mapper, Octomap), "the setup makes an Octomap"
         return mapper
 
     def run() -> Passes[Octomap]:
-        setup = mapper_setup(ctx, "octomap")
+        setup = mapper_setup(ctx, Octomap)
         makers = {b: partial(octomap, setup, b) for b in ("native", "reference")}
         cfg = ctx.config
         return interleaved_passes(makers, ctx.scans(NAV), repeats=cfg.repeats,
@@ -196,22 +216,31 @@ def octomap_memory(ctx: Context) -> list[Result]:
                    "ratio <= 1", bool(ours <= LIMITS[2] * peer), detail)]
 
 
-def _build(name: str, params: Mapping[str, object], cloud: Points) -> None:
-    """A fresh ``name`` map built from ``cloud`` (the timed call of row 3)."""
+def _build(cls: type[Mapper], params: Mapping[str, object] | Record, cloud: Points) -> None:
+    """A fresh ``cls`` map built from ``cloud`` (the timed call of row 3)."""
     from alte.mappers import make_mapper
 
-    make_mapper(name, params).build(cloud)
+    make_mapper(cls, params).build(cloud)
+
+
+def cloud_mappers() -> tuple[type[Mapper], ...]:
+    """The mappers built from a bare cloud: all but those casting rays to free space
+    (Octomap, whose build needs the scans' origins)."""
+    from alte.mappers import registry
+
+    return tuple(cls for cls in registry.classes() if not cls.free_space)
 
 
 def batch_builds(ctx: Context) -> list[Result]:
-    """Row 3: Quadtree and 2D-ALTE on sim_lan_2, 3D-ALTE on sim_nav_1 vs argsort floor."""
+    """Row 3: Quadtree, 2D-ALTE (and 2D plugins) on sim_lan_2, 3D-ALTE (and 3D plugins) on
+    sim_nav_1 vs the argsort floor."""
     out = []
-    for name in ("quadtree", "alte2d", "alte3d"):
-        terrain = TERRAIN_OF[name]
+    for cls in cloud_mappers():
+        name, terrain = cls.name, terrain_of(cls)
         cloud = ctx.workload(terrain).cloud
-        params = mapper_params(terrain)[name]
+        params = bench_params(cls)
         keys = np.random.default_rng(0).random(len(cloud))
-        times = measure({"ours": partial(_build, name, params, cloud),
+        times = measure({"ours": partial(_build, cls, params, cloud),
                          "peer": partial(np.argsort, keys)},
                         ctx.config.repeats, ctx.config.warmup)
         ratio = times["ours"].median / times["peer"].median
@@ -255,23 +284,23 @@ def _same_as_batch(mapper: Mapper, frames: Sequence[Scan],
 def insert_latency(ctx: Context) -> list[Result]:
     """Row 5: p99 per-frame insert latency of each incremental mapper over EVERY frame
     (``--frames`` does not apply: later frames meet a bigger map), median over passes."""
-    from alte.mappers import MAPPERS
+    from alte.mappers import Octomap, registry
 
     cfg = ctx.config
     out = []
-    for name, cls in MAPPERS.items():
-        if not getattr(cls, "incremental", False) or name not in TERRAIN_OF:
+    for cls in registry.classes():
+        if not cls.incremental:
             continue
-        terrain = TERRAIN_OF[name]
+        name, terrain = cls.name, terrain_of(cls)
         frames = ctx.workload(terrain).frames
         passes: Passes[Mapper]
-        if name == "octomap" and cfg.frames is None and ctx.has("octomap-passes"):
+        if cls is Octomap and cfg.frames is None and ctx.has("octomap-passes"):
             passes, key = octomap_passes(ctx), "native"  # row 1 already inserted every frame
         else:
             passes, key = interleaved_passes(
-                {name: mapper_setup(ctx, name).make}, frames,
+                {name: mapper_setup(ctx, cls).make}, frames,
                 repeats=cfg.repeats, warmup=cfg.warmup, progress=cfg.progress, desc=name), name
-        extra = (_same_as_batch(passes.maps[key], frames, mapper_setup(ctx, name))
-                 if cls.dims == 2 else {})
+        extra = (_same_as_batch(passes.maps[key], frames, mapper_setup(ctx, cls))
+                 if cls.dims == 2 and registry.builtin(cls) else {})
         out.append(_latency_result(name, terrain, passes.latencies[key], passes.cpu[key], extra))
     return out

@@ -1,4 +1,6 @@
-"""Row 9: peak memory of ``alte map BAG`` on a mission and on that mission flown four times.
+"""Row 9: peak memory of ``alte map BAG`` on a mission and on that mission flown four times,
+and of the commands that only read or print (``alte --version``, ``alte info BAG``) against
+the bare interpreter: a CLI that imports only what its command runs.
 
 Frames stream from the bag through registration into the map, so the peak resident
 set should be the map plus a few frames, whatever the bag's length. The long mission
@@ -22,8 +24,8 @@ import numpy as np
 from alte.bench.core import LIMITS, Context, Result
 from alte.bench.workload import Points, workload_dir
 
-__all__ = ["LAPS", "MAPPER_SETS", "RSS_CEILING_MB", "RSS_SPREAD", "long_mission",
-           "map_memory", "peak_rss_mb"]
+__all__ = ["LAPS", "LIGHT_CEILINGS_MB", "MAPPER_SETS", "RSS_CEILING_MB", "RSS_SPREAD",
+           "light_memory", "long_mission", "map_memory", "peak_rss_mb"]
 
 #: How many times the long mission flies the short one.
 LAPS = 4
@@ -34,6 +36,8 @@ RSS_CEILING_MB = 300.0
 #: ``--set`` arguments of each measured mapper (Octomap at the bench's 0.2 m).
 MAPPER_SETS: dict[str, tuple[str, ...]] = {"alte3d": (), "octomap": ("--set", "resolution=5")}
 TERRAIN = "sim_nav_1"
+#: Ceilings (MB) of the commands that load no mapper, study or viewer.
+LIGHT_CEILINGS_MB: dict[str, float] = {"--version": 80.0, "info": 150.0}
 
 
 def _laps(bag: Path, laps: int, gap_ns: int) -> Iterator[tuple[int, Points]]:
@@ -79,11 +83,15 @@ sys.exit(code)
 """
 
 
-def peak_rss_mb(args: Sequence[str]) -> tuple[float, float]:
+#: The interpreter alone, reporting its high-water mark as :data:`_CHILD` does.
+_BARE = _CHILD.replace("from alte.cli import main", "").replace("main(sys.argv[1:])", "0")
+
+
+def peak_rss_mb(args: Sequence[str], code: str = _CHILD) -> tuple[float, float]:
     """Peak resident set (MB, the process's own ``VmHWM``) and wall time (s) of one
-    ``alte ARGS`` child process."""
+    ``alte ARGS`` child process (``code``: another program with the same report)."""
     start = time.perf_counter()
-    child = subprocess.run([sys.executable, "-c", _CHILD, *args], stdout=subprocess.DEVNULL,
+    child = subprocess.run([sys.executable, "-c", code, *args], stdout=subprocess.DEVNULL,
                            stderr=subprocess.PIPE, text=True, check=False)
     wall = time.perf_counter() - start
     if child.returncode != 0:
@@ -128,4 +136,17 @@ def map_memory(ctx: Context) -> list[Result]:
                           long_mb, short_mb, "MB", target, bool(met),
                           {"wall_s_long": long_s, "wall_s_short": short_s,
                            "repeats": repeats, "laps": LAPS, "frames_short": frames}))
+    return out + light_memory(bag)
+
+
+def light_memory(bag: Path) -> list[Result]:
+    """Row 9's light commands: their peak RSS against the bare interpreter's."""
+    bare_mb, _ = peak_rss_mb([], _BARE)
+    out = []
+    for command, ceiling in LIGHT_CEILINGS_MB.items():
+        args = [command, str(bag)] if command == "info" else [command]
+        mb, wall = peak_rss_mb(args)
+        name = "alte info BAG" if command == "info" else f"alte {command}"
+        out.append(Result(9, f"{name} peak RSS vs the bare interpreter", mb, bare_mb, "MB",
+                          f"< {ceiling:g} MB", mb < ceiling, {"wall_s": wall}))
     return out

@@ -129,7 +129,8 @@ def render_markdown(bench: Bench) -> str:
     lines += [_line(r) for r in bench.results]
     misses = [miss_note(r) for r in bench.results if r.met is False]
     if misses:
-        lines += ["", "Targets missed (profiles and causes: bench/README.md):", ""]
+        lines += ["", "Targets missed (profiles and causes: docs/results/bench.md, "
+                  "docs/design-notes/bench.md):", ""]
         lines += [f"- {m}" for m in misses]
     if bench.errors:
         lines += ["", "Rows that failed:", ""]

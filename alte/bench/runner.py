@@ -16,11 +16,14 @@ from datetime import UTC, datetime
 
 from tqdm.auto import tqdm
 
+from alte.bench.catalog import TITLES
 from alte.bench.clouds import cloud_stages, hausdorff_speed
 from alte.bench.core import BenchConfig, Context, Result
+from alte.bench.ground import ground_speed
 from alte.bench.maps import batch_builds, insert_latency, octomap_memory, octomap_speed
 from alte.bench.memory import map_memory
 from alte.bench.poses import pose_speed
+from alte.bench.realterrain import real_terrain
 from alte.bench.scaling import scaling
 from alte.bench.stream import scan_peer, streaming_chain
 from alte.bench.sweep import sweep_throughput
@@ -33,23 +36,15 @@ __all__ = ["ROWS", "Bench", "run_bench", "select_rows"]
 
 Row = Callable[[Context], list[Result]]
 
-#: Row number -> (what it compares, the function measuring it).
-ROWS: dict[int, tuple[str, Row]] = {
-    1: ("Octomap native vs pyoctomap insertPointCloud", octomap_speed),
-    2: ("Octomap native memory vs memoryUsage()", octomap_memory),
-    3: ("batch builds vs numpy.argsort floor", batch_builds),
-    4: ("HD/MHD vs open3d compute_point_cloud_distance", hausdorff_speed),
-    5: ("per-frame insert latency vs one 10 Hz rotation", insert_latency),
-    6: ("grid average / MSAC / clustering vs open3d", cloud_stages),
-    7: ("scaling 10^4..10^7 points", scaling),
-    8: ("make report wall time vs thesis MATLAB", report_wall_time),
-    9: ("alte map peak RSS: a mission flown 4x vs once", map_memory),
-    10: ("alte map BAG: wall time vs mission time, per-frame latency", streaming_chain),
-    11: ("Octomap native vs DUFOMap (UFOMap) scan integration", scan_peer),
-    12: ("odometry / refinement per real scan vs kiss-icp's pipeline", pose_speed),
-    13: ("sweep runs per core-second (20 scans, whole missions) and the grid's time",
-         sweep_throughput),
+#: Row number -> (what it compares, the function measuring it); the titles are
+#: :data:`alte.bench.catalog.TITLES`, the registry the command line lists.
+_MEASURES: dict[int, Row] = {
+    1: octomap_speed, 2: octomap_memory, 3: batch_builds, 4: hausdorff_speed,
+    5: insert_latency, 6: cloud_stages, 7: scaling, 8: report_wall_time, 9: map_memory,
+    10: streaming_chain, 11: scan_peer, 12: pose_speed, 13: sweep_throughput,
+    14: real_terrain, 15: ground_speed,
 }
+ROWS: dict[int, tuple[str, Row]] = {n: (TITLES[n], fn) for n, fn in sorted(_MEASURES.items())}
 
 
 @dataclass

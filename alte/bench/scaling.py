@@ -19,7 +19,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from alte.bench.core import Context, Result
-from alte.bench.maps import NAV, TERRAIN_OF
+from alte.bench.maps import NAV, bench_params, cloud_mappers, terrain_of
 from alte.bench.timing import fit_exponent, measure, nlogn_exponent, peak_rss_bytes
 from alte.bench.workload import Points, Scan, tile_points
 from alte.studies.thesis.numbers import mapper_params
@@ -56,26 +56,26 @@ def scaling_cases(ctx: Context) -> dict[str, Case]:
     Octomap gets whole scans (:func:`whole_scans`): thinning every scan instead would
     keep the 569 per-scan costs fixed and hide how the map's growth costs.
     """
-    from alte.mappers import make_mapper
+    from alte.mappers import Mapper, Octomap, make_mapper
     from alte.metrics import hausdorff
 
-    def cloud_build(name: str) -> Case:
+    def cloud_build(cls: type[Mapper]) -> Case:
         def make(n: int) -> tuple[int, Callable[[], object]]:
-            (pts,) = tile_points(ctx.workload(TERRAIN_OF[name]).cloud, n)
-            params = mapper_params(TERRAIN_OF[name])[name]
-            return len(pts), lambda: make_mapper(name, params).build(pts)
+            (pts,) = tile_points(ctx.workload(terrain_of(cls)).cloud, n)
+            params = bench_params(cls)
+            return len(pts), lambda: make_mapper(cls, params).build(pts)
         return make
 
     def octomap(n: int) -> tuple[int, Callable[[], object]]:
         pts, origins = whole_scans(ctx.workload(NAV).frames, n)
         params = mapper_params(NAV)["octomap"]
-        return len(pts), lambda: make_mapper("octomap", params).build(pts, origins)
+        return len(pts), lambda: make_mapper(Octomap, params).build(pts, origins)
 
     def metrics(n: int) -> tuple[int, Callable[[], object]]:
         (pts,) = tile_points(ctx.workload(NAV).cloud, n)
         return len(pts), lambda: hausdorff(pts, pts[::4])
 
-    return {"octomap": octomap, **{m: cloud_build(m) for m in ("quadtree", "alte2d", "alte3d")},
+    return {"octomap": octomap, **{c.name: cloud_build(c) for c in cloud_mappers()},
             "hausdorff": metrics}
 
 

@@ -42,10 +42,7 @@ from alte.types import JSONDict
 if TYPE_CHECKING:
     from alte.pipeline import MapRun, MapSpec
 
-__all__ = ["STREAM_MAPPERS", "UfoPeer", "mission_seconds", "scan_peer", "streaming_chain"]
-
-#: Mappers row 10 streams, each on both terrains.
-STREAM_MAPPERS = ("octomap", "alte3d", "quadtree", "alte2d")
+__all__ = ["UfoPeer", "mission_seconds", "scan_peer", "streaming_chain"]
 
 
 def mission_seconds(stamps_ns: NDArray[np.int64]) -> float:
@@ -101,8 +98,9 @@ def _chain_result(terrain: str, name: str, times: tuple[list[float], list[float]
 
 
 def streaming_chain(ctx: Context) -> list[Result]:
-    """Row 10: real-time factor and per-frame latency of ``alte map BAG`` per mapper."""
-    from alte.mappers import Feed
+    """Row 10: real-time factor and per-frame latency of ``alte map BAG`` per mapper (every
+    registered one, plugins included), each on both terrains."""
+    from alte.mappers import Feed, registry
     from alte.pipeline import DomainPolicy, MapSpec
     from alte.studies.thesis.numbers import mapper_params
 
@@ -111,8 +109,8 @@ def streaming_chain(ctx: Context) -> list[Result]:
     for terrain in (NAV, LAN):
         bag = _bag(ctx, terrain)
         params = mapper_params(terrain)
-        specs = {name: MapSpec(name, dict(params.get(name, {})), DomainPolicy.AUTO,
-                               Feed.FRAMES) for name in STREAM_MAPPERS}
+        specs = {cls.name: MapSpec(cls, dict(params.get(cls.name, {})), DomainPolicy.AUTO,
+                                   Feed.FRAMES) for cls in registry.classes()}
         times: dict[str, tuple[list[float], list[float]]] = {name: ([], []) for name in specs}
         runs: dict[str, list[MapRun]] = {name: [] for name in specs}
         rounds = list(interleave(list(specs), cfg.warmup + cfg.repeats))
@@ -148,8 +146,9 @@ class UfoPeer:
 def scan_peer(ctx: Context) -> list[Result]:
     """Row 11: native Octomap vs DUFOMap (UFOMap) integrating the same scans at 0.2 m."""
     from alte.bench.maps import Inserts, mapper_setup
+    from alte.mappers import Octomap
 
-    setup = mapper_setup(ctx, "octomap")
+    setup = mapper_setup(ctx, Octomap)
     voxel = 1.0 / float(setup.params.get("resolution", 5.0))
     threads = 1  # the native Octomap walks a scan's rays on one thread
     makers: dict[str, Callable[[], Inserts]] = {

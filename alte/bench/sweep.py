@@ -38,12 +38,8 @@ if TYPE_CHECKING:
     from alte.studies.sweep.runs import SweepRun
     from alte.studies.sweep.work import MapGroup
 
-__all__ = ["GRID_HOURS", "SIZE_PARAM", "WORKERS", "Sample", "grid_estimate", "stratified_groups",
+__all__ = ["GRID_HOURS", "WORKERS", "Sample", "grid_estimate", "size_param", "stratified_groups",
            "sweep_throughput"]
-
-#: The parameter that sets each mapper's map size (its strata in the sample).
-SIZE_PARAM = {"quadtree": "max_points", "alte2d": "max_res", "octomap": "resolution",
-              "alte3d": "max_res"}
 #: Workers the grid's wall time is estimated for (this machine's cores).
 WORKERS = 2
 #: The whole-mission grid's target wall time on WORKERS cores (hours).
@@ -75,9 +71,16 @@ class Sample:
         return self.runs / self.cpu_s if self.cpu_s else float("nan")
 
 
+def size_param(run: SweepRun) -> str | None:
+    """The parameter that sets the run's map size (its stratum in the sample): the first
+    of its mapper's ``settings_grid`` (None: a mapper without one)."""
+    return next(iter(run.cls.settings_grid), None)
+
+
 def _size(run: SweepRun) -> float:
     """The run's size parameter (a number, as the spec's rows were coerced)."""
-    value = run.params.get(SIZE_PARAM[run.mapper], 0)
+    name = size_param(run)
+    value = run.params.get(name, 0) if name is not None else 0
     return value if isinstance(value, int | float) else float("nan")
 
 

@@ -3,7 +3,10 @@
 from __future__ import annotations
 
 import argparse
+import textwrap
 from pathlib import Path
+
+from alte.bench.catalog import TITLES, describe
 
 __all__ = ["add_parser", "run"]
 
@@ -23,15 +26,20 @@ def _sizes(text: str) -> tuple[int, ...]:
 
 
 def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
-    """Register ``bench``."""
+    """Register ``bench``; its help lists the rows of the benchmark's own registry."""
+    first, last = min(TITLES), max(TITLES)
     parser = subparsers.add_parser(
-        "bench", help="run the performance benchmark (issue 6)",
-        description="Time our stages beside their peers (pyoctomap, open3d, numpy.argsort) "
-                    "and write reports/bench.md, bench.json and bench_scaling.png.")
+        "bench", help="run the performance benchmark",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        description=textwrap.fill(
+            "Time our stages beside their peers (pyoctomap, open3d, numpy.argsort, "
+            "kiss-icp, ...) and write reports/bench.md, bench.json and bench_scaling.png.")
+        + "\n\nThe rows:\n\n" + describe())
     parser.add_argument("--quick", action="store_true",
                         help="tiny inputs (a few simulated scans): a smoke run in seconds")
     parser.add_argument("--only", type=_rows, default=None, metavar="ROWS",
-                        help="comma-separated row numbers to run (default: all, 1-11)")
+                        help=f"comma-separated row numbers to run (default: all, {first}-{last}: "
+                             "the rows above)")
     parser.add_argument("--repeats", type=int, default=5, help="timed repeats (default 5)")
     parser.add_argument("--warmup", type=int, default=1, help="discarded warm-up runs")
     parser.add_argument("--frames", type=int, default=None,
@@ -50,7 +58,9 @@ def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) 
 
 def run(args: argparse.Namespace) -> int:
     """Run the benchmark, write its outputs, print the table; 1 when a row failed."""
-    from alte.bench import BenchConfig, render_markdown, run_bench, select_rows, write_outputs
+    from alte.bench.core import BenchConfig
+    from alte.bench.output import render_markdown, write_outputs
+    from alte.bench.runner import run_bench, select_rows
 
     config = BenchConfig(quick=args.quick, repeats=args.repeats, warmup=args.warmup,
                          frames=args.frames, sizes=args.sizes, budget_s=args.budget,

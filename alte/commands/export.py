@@ -1,10 +1,10 @@
 """``alte export INPUT --mcap FILE --mapper M``: a map run as one ROS 2 MCAP file.
 
 Open the file in Foxglove Studio, or play it into RViz (``ros2 bag play FILE``); the
-topics and their types are listed in :mod:`alte.export.mcap` and the README. The final
-map is there from the file's first instant; with ``--timeline N`` it is also written
-every N mapped scans, stamped with the scan's time, so scrubbing the timeline replays
-the mapping.
+topics and their types are listed in :mod:`alte.export.mcap` and in the documentation's
+Foxglove / RViz guide (docs/how-to/foxglove-rviz.md). The final map is there from the
+file's first instant; with ``--timeline N`` it is also written every N mapped scans,
+stamped with the scan's time, so scrubbing the timeline replays the mapping.
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) 
     """Register ``alte export``."""
     p = subparsers.add_parser(
         "export", help="map an input and write the result as a ROS 2 MCAP (Foxglove, RViz)",
-        description="Map INPUT like `alte map` and write one ROS 2 MCAP file: registered "
+        description="Map INPUT as 'alte map' does and write one ROS 2 MCAP file: registered "
                     "cloud and scans (PointCloud2), trajectory (Path), pose (PoseStamped, "
                     "/tf), map cells (MarkerArray), occupancy for landing (OccupancyGrid: 0 "
                     "free, 100 occupied, -1 unseen; see --occupancy-set), height and "

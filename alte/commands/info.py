@@ -1,5 +1,9 @@
 """``alte info INPUT``: a bag's topics, counts, duration and the cloud/pose topics alte would use.
 
+``alte info --mappers`` lists the mappers instead: the thesis' four and every plugin the
+registry finds (:mod:`alte.mappers.registry`), each loaded and checked, with where it came
+from and, for a plugin it refuses, why.
+
 For a terrain folder (``alte simulate``) it also shows what the pipeline takes from it:
 the control volume (crop and domain) and the registration voxel. For a point file it
 describes the file: format, encoding, fields, points, NaN rows, bounds.
@@ -10,13 +14,17 @@ from __future__ import annotations
 import argparse
 import json
 from pathlib import Path
+from typing import TYPE_CHECKING
 
+from alte.errors import ParameterError
 from alte.io.baginfo import BagInfo, inspect_bag
-from alte.io.pointfiles import PointSummary, describe_points
-from alte.pipeline import InputKind, Source, open_input
+from alte.pipeline.source import InputKind, Source, open_input
 
-__all__ = ["add_parser", "format_info", "format_points", "imu_topics", "odometry_choice",
-           "pose_source", "run"]
+if TYPE_CHECKING:
+    from alte.io.pointfiles import PointSummary
+
+__all__ = ["add_parser", "format_info", "format_mappers", "format_points", "imu_topics",
+           "odometry_choice", "pose_source", "run"]
 
 
 def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -29,8 +37,11 @@ def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) 
         "pose topics and the /tf_static sensor mount; or describe a point file (.pcd, .ply, "
         ".las, .laz, .npz, .xyz): format, encoding, fields, points, NaN rows, bounds.",
     )
-    p.add_argument("input", type=Path,
+    p.add_argument("input", type=Path, nargs="?", default=None,
                    help="ROS 1 .bag file, ROS 2 bag folder, a terrain folder, or a point file")
+    p.add_argument("--mappers", action="store_true",
+                   help="list the mappers (built-in and plugins, each checked against the "
+                        "mapper contract) instead of describing INPUT")
     p.add_argument("--json", action="store_true", help="print one JSON object instead of text")
     p.add_argument("--cloud-topic", default=None, help="PointCloud2 / VelodyneScan topic")
     p.add_argument("--pose-topic", default=None, help="pose / odometry / TF topic")
@@ -118,10 +129,40 @@ def format_points(about: PointSummary) -> list[str]:
     return lines
 
 
+def format_mappers(rows: list[dict[str, str]]) -> list[str]:
+    """One line per mapper (:func:`alte.mappers.registry.describe`), refusals after it."""
+    width = max(len(r["name"]) for r in rows)
+    lines = []
+    for r in rows:
+        if r["status"] == "ok":
+            lines.append(f"{r['name']:<{width}}  {r['dims']}  {r['title']}  ({r['origin']}: "
+                         f"{r['target']})")
+        else:
+            lines.append(f"{r['name']:<{width}}  REFUSED  {r['status']}")
+    return lines
+
+
+def _mappers(as_json: bool) -> int:
+    from alte.mappers import registry
+
+    rows = [registry.describe(e) for e in registry.entries()]
+    rows += [{"name": key, "title": "", "dims": "", "origin": "", "target": "",
+              "status": why} for key, why in registry.refused().items()]
+    print(json.dumps(rows) if as_json else "\n".join(format_mappers(rows)))
+    return 0 if all(r["status"] == "ok" for r in rows) else 1
+
+
 def run(args: argparse.Namespace) -> int:
-    """Inspect the input and print the summary."""
+    """Inspect the input (or list the mappers) and print the summary."""
+    if args.mappers:
+        return _mappers(args.json)
+    if args.input is None:
+        raise ParameterError("give INPUT (a bag, terrain folder or point file) "
+                             "or --mappers")
     source = open_input(args.input)
     if source.kind is InputKind.POINTS:
+        from alte.io.pointfiles import describe_points  # pandas, numba: point files only
+
         about = describe_points(source.path)
         print(json.dumps(about, sort_keys=True) if args.json else "\n".join(format_points(about)))
         return 0

@@ -14,13 +14,13 @@ from pathlib import Path
 
 import numpy as np
 
-from alte.commands.options import add_frame_options, frame_spec
+from alte.commands.options import add_frame_options, frame_spec, parse_key_values
 from alte.errors import ParameterError
 from alte.export import ExportOptions
 from alte.export import export_map as export_mcap
 from alte.fsutil import refuse_overwrite
 from alte.ground.surface import SurfaceRule
-from alte.mappers import MAPPERS, Domain, Feed, check_export, export_map
+from alte.mappers import Domain, Feed, check_export, export_map
 from alte.pipeline import DomainPolicy, MapRun, MapSpec, open_input, run
 
 __all__ = ["add_map_options", "add_parser", "export_options", "map_spec", "mapped",
@@ -36,7 +36,9 @@ _SUMMARY_KEYS = ("mapper", "params", "input", "input_kind", "pose_source", "doma
 
 def add_map_options(p: argparse.ArgumentParser) -> None:
     """The flags that choose the map (shared by ``alte map`` and ``alte export``)."""
-    p.add_argument("--mapper", required=True, help=", ".join(MAPPERS))
+    p.add_argument("--mapper", required=True,
+                   help="the thesis' quadtree, octomap, alte2d, alte3d or an installed plugin "
+                        "(alte info --mappers lists them)")
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", dest="sets",
                    help="mapper parameter (repeatable), e.g. --set kappa=0.1")
     p.add_argument("--domain", default="auto", metavar="POLICY|XMIN,YMIN[,ZMIN],SIZE",
@@ -55,14 +57,16 @@ def add_map_options(p: argparse.ArgumentParser) -> None:
                    dest="occupancy_sets",
                    help="with --mcap: landing criterion of the occupancy grids (repeatable): "
                         + "; ".join(f"{k}: {v}" for k, v in SurfaceRule.help().items())
-                        + f"; defaults {SurfaceRule().as_dict()}")
+                        + "; defaults: " + ", ".join(
+                            f"{k}={v}" for k, v in SurfaceRule().as_dict().items()))
 
 
 def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Register ``alte map``."""
     p = subparsers.add_parser(
         "map", help="build a terrain map from a bag, a terrain folder or a point cloud file",
-        description="Build a map with one of the mappers (quadtree, octomap, alte2d, alte3d) "
+        description="Build a map with one of the mappers (quadtree, octomap, alte2d, alte3d, "
+                    "or a plugin's) "
                     "through the pipeline: read, register, crop, down-sample, map. Values that "
                     "start with '-' need '=': --origin=-1,0,2.")
     add_frame_options(p, origin=True)
@@ -81,13 +85,7 @@ def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) 
 
 def parse_sets(items: list[str], flag: str = "--set") -> dict[str, str]:
     """``["k=v", ...]`` -> ``{"k": "v"}``; an item without '=' raises (naming ``flag``)."""
-    out: dict[str, str] = {}
-    for item in items:
-        key, sep, value = item.partition("=")
-        if not sep or not key.strip():
-            raise ParameterError(f"{flag} {item!r}: expected KEY=VALUE")
-        out[key.strip()] = value.strip()
-    return out
+    return parse_key_values(items, flag)
 
 
 def parse_domain(text: str) -> Domain | DomainPolicy:

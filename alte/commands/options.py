@@ -1,7 +1,10 @@
-"""Command-line options shared by the commands that read an input (``register``, ``map``).
+"""Command-line options shared by the commands that read an input (``register``, ``map``),
+and a ground filter's ``--method`` / ``--set`` (``ground``; ``simulate`` as
+``--ground-method`` / ``--ground-set``).
 
-They map one to one onto :class:`alte.pipeline.FrameSpec`; a bad value is a
-:class:`~alte.errors.ParameterError` naming the flag, raised before any input is read.
+They map one to one onto :class:`alte.pipeline.FrameSpec` and the ground stage's settings
+records; a bad value is a :class:`~alte.errors.ParameterError` naming the flag, raised
+before any input is read.
 """
 
 from __future__ import annotations
@@ -12,14 +15,22 @@ from pathlib import Path
 import numpy as np
 
 from alte.errors import ParameterError
+from alte.ground.settings import (
+    DEFAULT_METHOD,
+    DEFAULT_SETTINGS,
+    SOURCES,
+    GroundSettings,
+    ground_settings,
+)
+from alte.ground.settings import METHODS as GROUND_METHODS
 from alte.pipeline import FrameSpec, PoseSource
 from alte.registration.odometry import METHODS, OdometryParams, odometry_params
 from alte.types import Box, Mount
 
-__all__ = ["add_frame_options", "add_odometry_options", "frame_spec", "odometry_spec",
-           "parse_box", "parse_key_values", "parse_origin"]
+__all__ = ["add_frame_options", "add_ground_options", "add_odometry_options", "frame_spec",
+           "ground_spec", "odometry_spec", "parse_box", "parse_key_values", "parse_origin"]
 
-INPUT_HELP = ("ROS 1 .bag file or ROS 2 bag folder, a terrain folder made by `alte simulate` "
+INPUT_HELP = ("ROS 1 .bag file or ROS 2 bag folder, a terrain folder made by 'alte simulate' "
               "(its control volume and voxel are used), or a point file")
 
 
@@ -86,6 +97,40 @@ def parse_key_values(items: list[str], flag: str) -> dict[str, str]:
             raise ParameterError(f"{flag} {item!r}: expected KEY=VALUE")
         out[key.strip()] = value.strip()
     return out
+
+
+def add_ground_options(p: argparse._ActionsContainer, prefix: str = "",
+                       what: str = "the ground filter") -> None:
+    """A ground filter's ``--{prefix}method`` and ``--{prefix}set`` (``what``: what naming
+    the method does, leading its help)."""
+    p.add_argument(f"--{prefix}method", choices=list(GROUND_METHODS), default=None,
+                   help=f"{what}, with the method's published defaults; default: "
+                        f"{DEFAULT_METHOD} with "
+                        + ", ".join(f"{k}={v}" for k, v in DEFAULT_SETTINGS.as_dict().items())
+                        + ", chosen on real "
+                        "data. Sources: " + "; ".join(f"{k}: {v}" for k, v in SOURCES.items()))
+    p.add_argument(f"--{prefix}set", action="append", default=[], metavar="KEY=VALUE",
+                   dest=f"{prefix}sets".replace("-", "_"),
+                   help=f"a setting of the method (repeatable; without --{prefix}method, of "
+                        f"the default), e.g. --{prefix}set window=24; published defaults: "
+                        + "; ".join(f"{name}: " + ", ".join(f"{k}={v}" for k, v in
+                                                           cls().as_dict().items())
+                                    for name, cls in GROUND_METHODS.items()))
+
+
+def ground_spec(args: argparse.Namespace, prefix: str = "") -> tuple[str | None,
+                                                                     GroundSettings]:
+    """The method (None: not named) and settings of ``--{prefix}method`` /
+    ``--{prefix}set``; errors name ``--{prefix}set``."""
+    flag, key = f"--{prefix}set", prefix.replace("-", "_")
+    method: str | None = getattr(args, f"{key}method")
+    try:
+        return method, ground_settings(method, parse_key_values(getattr(args, f"{key}sets"),
+                                                                flag))
+    except ParameterError as err:
+        if str(err).startswith(flag):
+            raise
+        raise ParameterError(f"{flag}: {err}") from err
 
 
 def odometry_spec(args: argparse.Namespace) -> OdometryParams:

@@ -42,6 +42,9 @@ def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) 
                              "equal-fidelity tables, fronts and provenance there (the "
                              "whole-mission evidence make report reads, e.g. "
                              "notebooks/sweeps/tradeoff-full)")
+    parser.add_argument("--plugins", action="store_true",
+                        help="add every installed plugin mapper the spec does not list, with "
+                             "its own settings grid (alte info --mappers lists them)")
     parser.add_argument("--no-progress", action="store_true", help="hide progress bars")
     parser.set_defaults(func=run)
 
@@ -57,6 +60,8 @@ def _command(args: argparse.Namespace) -> str:
             words += [flag, str(value)]
     if args.seeds is not None:
         words += ["--seeds", *map(str, args.seeds)]
+    if args.plugins:
+        words.append("--plugins")
     return shlex.join(words)
 
 
@@ -87,6 +92,8 @@ def run(args: argparse.Namespace) -> int:
         spec = override(spec, data_dir=str(args.data))
     if args.seeds is not None:
         spec = override(spec, seeds=args.seeds)
+    if args.plugins:
+        spec = override(spec, plugins=True)
     started, start = datetime.now(UTC).isoformat(timespec="seconds"), time.perf_counter()
     result = run_sweep(spec, scheduler=args.scheduler, workers=args.workers, output=args.out,
                        progress=not args.no_progress)

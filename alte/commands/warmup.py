@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from alte._numba import CLOUD_MIN
-from alte.mappers import MAPPERS, Feed, Mapper, make_mapper
+from alte.mappers import Feed, Mapper, make_mapper, registry
 from alte.metrics.hausdorff import hausdorff
 from alte.pipeline import MapSpec, run
 from alte.sim import ensure_terrain
@@ -53,24 +53,26 @@ def _touch(mapper: Mapper) -> int:
 
 
 def warm_kernels() -> dict[str, int]:
-    """Map the flight with every mapper and feed; returns ``mapper/feed -> cells``."""
+    """Map the flight with every mapper (plugins included) and feed; returns
+    ``mapper/feed -> cells``."""
     cells: dict[str, int] = {}
+    mappers = registry.classes()
     with tempfile.TemporaryDirectory(prefix="alte-warmup-") as tmp:
         folder = ensure_terrain(TERRAIN, Path(tmp), frames=SCANS)
-        for name in MAPPERS:
+        for kind in mappers:
             for feed in Feed:
-                result = run(folder, MapSpec(name, feed=feed))
-                cells[f"{name}/{feed.value}"] = _touch(result.mapper)
+                result = run(folder, MapSpec(kind, feed=feed))
+                cells[f"{kind.name}/{feed.value}"] = _touch(result.mapper)
     corners = result.mapper.corners()
     hausdorff(corners, corners[::3])
     cloud = np.random.default_rng(0).uniform((0.0, 0.0, -1.0), (50.0, 50.0, 3.0), (CLOUD_MIN, 3))
-    for name, kind in MAPPERS.items():
+    for kind in mappers:
         if kind.dims == 2:
             for writeable in (True, False):  # a cached, memory-mapped cloud is read-only
                 cloud.setflags(write=writeable)
-                mapper = make_mapper(name)
+                mapper = make_mapper(kind)
                 mapper.build(cloud)
-            cells[f"{name}/cloud"] = _touch(mapper)
+            cells[f"{kind.name}/cloud"] = _touch(mapper)
     return cells
 
 
@@ -79,6 +81,7 @@ def run_warmup(args: argparse.Namespace) -> int:
     start = time.perf_counter()
     cells = warm_kernels()
     runs = ", ".join(f"{run} {count}" for run, count in cells.items())
-    print(f"compiled and cached the kernels of {len(MAPPERS)} mappers in "
+    mappers = len({run.split("/")[0] for run in cells})
+    print(f"compiled and cached the kernels of {mappers} mappers in "
           f"{time.perf_counter() - start:.1f} s; cells per run: {runs}")
     return 0

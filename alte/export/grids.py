@@ -15,14 +15,19 @@
   int8 and ``red``/``green``/``blue``/``alpha`` uint8, the height in viridis with
   unknown pixels transparent, which Foxglove picks by default).
 
+A 2D map whose cells carry layers (``Cells.layers``: the elevation map's ``variance``,
+``min``, ``max``, ``count``) has them painted too (:attr:`Raster.layers`), each one more
+``grid_map`` layer and one more float32 ``foxglove_msgs/msg/Grid`` field after ``alpha``
+(NaN where unknown): a viewer can colour the grid by the map's own height variance.
+
 The flat grids lie one cell below the lowest known height (:attr:`Raster.floor`; the
 Foxglove grid half a cell lower still) so they never hide the map or the cloud.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-from dataclasses import dataclass
+from collections.abc import Iterator, Mapping
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -36,16 +41,15 @@ from alte.mappers import Cells
 if TYPE_CHECKING:  # rosbags declares its message classes' type for checkers only
     from rosbags.typesys.store import MsgType
 
-__all__ = ["GRID_FIELDS", "Raster", "foxglove_grid", "grid_cells", "grid_map",
+__all__ = ["GRID_FIELDS", "Raster", "foxglove_grid", "grid_cells", "grid_fields", "grid_map",
            "height_colours", "occupancy_grid", "raster"]
 
 _UINT8, _INT8, _FLOAT32 = 1, 2, 7
 #: ``foxglove_msgs/msg/Grid`` fields: (name, byte offset, PackedElementField type).
 GRID_FIELDS = (("elevation", 0, _FLOAT32), ("occupancy", 4, _INT8), ("red", 5, _UINT8),
                ("green", 6, _UINT8), ("blue", 7, _UINT8), ("alpha", 8, _UINT8))
-_CELL = np.dtype({"names": [n for n, _, _ in GRID_FIELDS],
-                  "formats": ["<f4", "i1", "u1", "u1", "u1", "u1"],
-                  "offsets": [o for _, o, _ in GRID_FIELDS], "itemsize": 9})
+_FORMATS = {_UINT8: "u1", _INT8: "i1", _FLOAT32: "<f4"}
+_BASE = 9  # bytes of the GRID_FIELDS
 _IDENTITY = np.array([0.0, 0.0, 0.0, 1.0])
 
 
@@ -64,12 +68,14 @@ def height_colours(z: NDArray[np.float64]) -> NDArray[np.float64]:
 class Raster:
     """A map on a regular grid: row ``i`` is y, column ``j`` is x, cell (0, 0) has its
     lower-left corner at ``origin``; NaN height where no surface is known, occupancy
-    0 free / 100 occupied / -1 unknown."""
+    0 free / 100 occupied / -1 unknown; ``layers``: the 2D map's cell layers by name,
+    painted like the height (NaN where unknown)."""
 
     origin: NDArray[np.float64]
     resolution: float
     height: NDArray[np.float64]
     occupancy: NDArray[np.int8]
+    layers: Mapping[str, NDArray[np.float64]] = field(default_factory=dict)
 
     @property
     def shape(self) -> tuple[int, int]:
@@ -124,10 +130,15 @@ def raster(cells: Cells, shift: NDArray[np.float64], max_cells: int = 4_000_000,
     seen = np.zeros((rows, cols), dtype=bool)
     occupied = np.asarray(cells.occupied, dtype=bool)[known]
     top = centers[:, 2] + cells.sizes[known, 2] / 2
+    values = {name: np.asarray(v, np.float64)[known] for name, v in cells.layers.items()
+              } if dims == 2 else {}
+    layers = {name: np.full((rows, cols), np.nan) for name in values}
     for sel, r, c in _pixels(centers, edge, lo, res, (rows, cols)):
         seen[r, c] = True
         if dims == 2:
             height[r, c] = centers[sel, 2, None]
+            for name, painted in layers.items():
+                painted[r, c] = values[name][sel, None]
             continue
         hit = occupied[sel]
         np.fmax.at(height, (r[hit], c[hit]), np.broadcast_to(top[sel][hit, None],
@@ -135,7 +146,7 @@ def raster(cells: Cells, shift: NDArray[np.float64], max_cells: int = 4_000_000,
     surface = classify_surface(height, lo, res, rule)
     occupancy = surface.occupancy()
     occupancy[seen & ~np.isfinite(height)] = 100  # seen, but no surface to rest on
-    return Raster(np.array([lo[0], lo[1]]), res, height, occupancy)
+    return Raster(np.array([lo[0], lo[1]]), res, height, occupancy, layers)
 
 
 def occupancy_grid(grid: Raster, stamp: int, frame: str) -> MsgType:
@@ -162,7 +173,8 @@ def _layer(values: NDArray[np.float64]) -> MsgType:
 
 
 def grid_map(grid: Raster, stamp: int, frame: str) -> MsgType:
-    """``grid_map_msgs/msg/GridMap`` with layers ``elevation`` (m) and ``occupancy`` (0-100)."""
+    """``grid_map_msgs/msg/GridMap`` with layers ``elevation`` (m), ``occupancy`` (0-100) and
+    the raster's cell layers (e.g. ``variance``, m^2)."""
     rows, cols = grid.shape
     length = np.array([cols, rows], dtype=np.float64) * grid.resolution
     centre = grid.origin + length / 2
@@ -171,15 +183,30 @@ def grid_map(grid: Raster, stamp: int, frame: str) -> MsgType:
                  pose=pose(np.array([centre[0], centre[1], 0.0]), _IDENTITY))
     occupancy = np.where(grid.occupancy < 0, np.nan, grid.occupancy.astype(np.float64))
     return blank("grid_map_msgs/msg/GridMap", header=header(stamp, frame), info=info,
-                 layers=["elevation", "occupancy"], basic_layers=["elevation"],
-                 data=[_layer(grid.height), _layer(occupancy)])
+                 layers=["elevation", "occupancy", *grid.layers], basic_layers=["elevation"],
+                 data=[_layer(grid.height), _layer(occupancy),
+                       *(_layer(v) for v in grid.layers.values())])
+
+
+def grid_fields(grid: Raster) -> tuple[tuple[str, int, int], ...]:
+    """The raster's ``foxglove_msgs/msg/Grid`` fields: :data:`GRID_FIELDS`, then one float32
+    per cell layer."""
+    return GRID_FIELDS + tuple((name, _BASE + 4 * k, _FLOAT32)
+                               for k, name in enumerate(grid.layers))
 
 
 def grid_cells(grid: Raster) -> NDArray[np.void]:
-    """The raster as ``foxglove_msgs/msg/Grid`` cells (rows, cols) of :data:`GRID_FIELDS`."""
-    cells = np.zeros(grid.shape, dtype=_CELL)
+    """The raster as ``foxglove_msgs/msg/Grid`` cells (rows, cols) of :func:`grid_fields`."""
+    fields = grid_fields(grid)
+    kind = np.dtype({"names": [n for n, _, _ in fields],
+                     "formats": [_FORMATS[t] for _, _, t in fields],
+                     "offsets": [o for _, o, _ in fields],
+                     "itemsize": _BASE + 4 * len(grid.layers)})
+    cells = np.zeros(grid.shape, dtype=kind)
     cells["elevation"] = grid.height
     cells["occupancy"] = grid.occupancy
+    for name, values in grid.layers.items():
+        cells[name] = values
     known = np.isfinite(grid.height)
     rgba = np.rint(height_colours(grid.height[known]) * 255).astype(np.uint8)
     for k, name in enumerate(("red", "green", "blue", "alpha")):
@@ -192,10 +219,11 @@ def foxglove_grid(grid: Raster, stamp: int, frame: str) -> MsgType:
     types = typestore().types
     cols = grid.shape[1]
     fields = [types["foxglove_msgs/msg/PackedElementField"](name, offset, kind)
-              for name, offset, kind in GRID_FIELDS]
-    data = np.frombuffer(grid_cells(grid).tobytes(), dtype=np.uint8)
+              for name, offset, kind in grid_fields(grid)]
+    cells = grid_cells(grid)
+    data = np.frombuffer(cells.tobytes(), dtype=np.uint8)
     corner = np.array([grid.origin[0], grid.origin[1], grid.floor - grid.resolution / 2])
     return types["foxglove_msgs/msg/Grid"](
         time_msg(stamp), frame, pose(corner, _IDENTITY), cols,
         types["foxglove_msgs/msg/Vector2"](float(grid.resolution), float(grid.resolution)),
-        cols * _CELL.itemsize, _CELL.itemsize, fields, data)
+        cols * cells.dtype.itemsize, cells.dtype.itemsize, fields, data)

@@ -2,21 +2,21 @@
 
 Topics (frame ``map``; the body is ``base_link``):
 
-========================  ==================================  ===================================
-topic                     type                                what
-========================  ==================================  ===================================
-``/alte/cloud``           ``sensor_msgs/msg/PointCloud2``     merged registered cloud
-``/alte/scan``            ``sensor_msgs/msg/PointCloud2``     each registered scan, at its stamp
-``/alte/pose``            ``geometry_msgs/msg/PoseStamped``   body pose per scan
-``/tf``                   ``tf2_msgs/msg/TFMessage``          ``map -> base_link`` per scan
-``/tf_static``            ``tf2_msgs/msg/TFMessage``          ``map -> alte_local`` (shifted maps)
-``/alte/trajectory``      ``nav_msgs/msg/Path``               the poses (whole flight, or so far)
-``/alte/map/cells``       ``visualization_msgs/msg/MarkerArray``  cube lists coloured by height
-``/alte/map/occupancy``   ``nav_msgs/msg/OccupancyGrid``      0 free, 100 occupied, -1 unseen
-``/alte/map/grid``        ``foxglove_msgs/msg/Grid``          height + occupancy (Foxglove)
-``/alte/map/grid_map``    ``grid_map_msgs/msg/GridMap``       2D maps: ``elevation``, ``occupancy``
-``/alte/map/octomap``     ``octomap_msgs/msg/Octomap``        Octomap: binary tree (OctoMap plugin)
-========================  ==================================  ===================================
+=======================  ======================================  =================================
+topic                    type                                    what
+=======================  ======================================  =================================
+``/alte/cloud``          ``sensor_msgs/msg/PointCloud2``         merged registered cloud
+``/alte/scan``           ``sensor_msgs/msg/PointCloud2``         each scan, at its stamp
+``/alte/pose``           ``geometry_msgs/msg/PoseStamped``       body pose per scan
+``/tf``                  ``tf2_msgs/msg/TFMessage``              ``map -> base_link`` per scan
+``/tf_static``           ``tf2_msgs/msg/TFMessage``              ``map -> alte_local`` (shifted)
+``/alte/trajectory``     ``nav_msgs/msg/Path``                   poses (whole flight, or so far)
+``/alte/map/cells``      ``visualization_msgs/msg/MarkerArray``  cube lists coloured by height
+``/alte/map/occupancy``  ``nav_msgs/msg/OccupancyGrid``          0 free, 100 occupied, -1 unseen
+``/alte/map/grid``       ``foxglove_msgs/msg/Grid``              height + occupancy (Foxglove)
+``/alte/map/grid_map``   ``grid_map_msgs/msg/GridMap``           2D: ``elevation``, ``occupancy``
+``/alte/map/octomap``    ``octomap_msgs/msg/Octomap``            Octomap's tree (OctoMap plugin)
+=======================  ======================================  =================================
 
 Map topics and ``/tf_static`` are offered reliable + transient-local, so RViz's
 latched subscriptions get them on playback. Messages may be *opening* ones (the final

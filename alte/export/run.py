@@ -23,7 +23,7 @@ from alte.export import grids, maps
 from alte.export.mcap import McapFile
 from alte.export.rosmsg import cloud_msg, path_msg, pose_stamped, tf_msg
 from alte.ground.surface import SurfaceRule
-from alte.mappers import Feed, Mapper, Octomap, mapper_class
+from alte.mappers import Feed, Mapper, Octomap
 from alte.pipeline import FrameSpec, MapRun, MapSpec, Registered, Source, run
 from alte.types import RegisteredFrame
 
@@ -138,7 +138,7 @@ class MapExporter:
 def _frames_feed(spec: MapSpec, options: ExportOptions) -> MapSpec:
     """A timeline needs the map fed scan by scan: switch a default batch feed, refuse an
     explicit one."""
-    if options.timeline is None or (spec.feed or mapper_class(spec.mapper).default_feed) \
+    if options.timeline is None or (spec.feed or spec.cls.default_feed) \
             is Feed.FRAMES:
         return spec
     if spec.feed is Feed.BATCH:

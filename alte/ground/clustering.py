@@ -8,8 +8,9 @@ summarises each cluster by centroid and radius, the circles a path planner avoid
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
-import pandas as pd
 from numpy.typing import ArrayLike, NDArray
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
@@ -18,6 +19,9 @@ from scipy.spatial import cKDTree
 from alte.errors import ParameterError
 from alte.ground.plane import PlaneFit, height_above
 from alte.types import as_points
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 __all__ = ["OBSTACLE_COLUMNS", "euclidean_clusters", "obstacle_map"]
 
@@ -68,11 +72,15 @@ def euclidean_clusters(
 
 
 def _ground_height(
-    pts: NDArray[np.float64], starts: NDArray[np.intp], ground: PlaneFit | float | None
+    pts: NDArray[np.float64], starts: NDArray[np.intp],
+    ground: PlaneFit | float | NDArray[np.float64] | None,
 ) -> NDArray[np.float64]:
-    """Top of each cluster above the ground plane, a ground level, or its own bottom."""
+    """Top of each cluster above the ground plane, the bare earth under each point, a
+    ground level, or its own bottom."""
     if isinstance(ground, PlaneFit):
         return np.maximum.reduceat(height_above(pts, ground), starts)
+    if isinstance(ground, np.ndarray) and ground.ndim == 1:
+        return np.maximum.reduceat(pts[:, 2] - ground, starts)
     top = np.maximum.reduceat(pts[:, 2], starts)
     if ground is None:
         return top - np.minimum.reduceat(pts[:, 2], starts)
@@ -82,15 +90,18 @@ def _ground_height(
 
 
 def obstacle_map(
-    points: NDArray[np.float64], labels: ArrayLike, ground: PlaneFit | float | None = None
+    points: NDArray[np.float64], labels: ArrayLike,
+    ground: PlaneFit | float | NDArray[np.float64] | None = None,
 ) -> pd.DataFrame:
     """One row per cluster: size, centroid, radius, bounding box and height (thesis fig. 3.13).
 
     ``radius`` is the largest horizontal distance from the centroid to a point of
-    the cluster. ``height`` is measured from ``ground`` (a fitted plane or a ground
-    level z), or from the cluster's lowest point when no ground is given. Points
-    labelled -1 are ignored.
+    the cluster. ``height`` is measured from ``ground`` (a fitted plane, the bare-earth
+    height under every point as a ground filter gives it, or a ground level z), or from
+    the cluster's lowest point when no ground is given. Points labelled -1 are ignored.
     """
+    import pandas as pd  # on first use: the ground package is on ``alte map``'s path
+
     pts = _check(points, "obstacle_map")
     lab = np.asarray(labels).reshape(-1)
     if lab.shape[0] != len(pts) or not np.issubdtype(lab.dtype, np.integer):
@@ -98,11 +109,18 @@ def obstacle_map(
             f"obstacle_map: labels must be {len(pts)} integers, got {lab.shape} {lab.dtype}"
         )
     keep = lab >= 0
+    if isinstance(ground, np.ndarray) and ground.ndim == 1:
+        if len(ground) != len(keep):
+            raise ParameterError(f"obstacle_map: ground must be {len(keep)} heights, got "
+                                 f"{ground.shape}")
+        ground = np.asarray(ground, np.float64)[keep]
     pts, lab = pts[keep], lab[keep]
     if len(lab) == 0:
         return pd.DataFrame({name: [] for name in OBSTACLE_COLUMNS})
     order = np.argsort(lab, kind="stable")
     pts, lab = pts[order], lab[order]
+    if isinstance(ground, np.ndarray) and ground.ndim == 1:
+        ground = ground[order]
     starts = np.flatnonzero(np.r_[True, lab[1:] != lab[:-1]])
     counts = np.diff(np.r_[starts, len(lab)])
     centroid = np.add.reduceat(pts, starts, axis=0) / counts[:, None]

@@ -17,7 +17,9 @@ A known pixel of a height raster (NaN = unknown) is **landable** when
   ``max_slope_deg``) over the ground window: the slope tolerance of the progressive
   morphological filter (Zhang et al. 2003), measured around each pixel. On flat ground
   a roof or a box keeps nearly the bare ``obstacle_height``; only the ring its own
-  edges tilt adds to it.
+  edges tilt adds to it. ``ground=filter`` takes the bare earth of the ground stage's
+  filter run on the raster (SMRF, :func:`alte.ground.filters.bare_earth_raster`), the
+  allowance SMRF's own: its scaling factor times the bare earth's slope.
 
 :func:`classify_surface` applies it to every pixel at once (image filters, one
 vectorised pass); the landing study (:mod:`alte.studies.landing`) tests site centres
@@ -63,9 +65,10 @@ class SurfaceRule(Record):
     obstacle_height: float = param(0.3, lambda v: v > 0, "obstacle_height > 0",
                                    "height above the ground (or below a plane ground) "
                                    "that makes an obstacle (m)")
-    ground: Literal["plane", "local"] = param(
-        "local", rule="plane|local",
-        help="ground reference: one MSAC plane, or the local grey opening")
+    ground: Literal["plane", "local", "filter"] = param(
+        "local", rule="plane|local|filter",
+        help="ground reference: one MSAC plane, the local grey opening, or the ground "
+             "stage's filter (SMRF) bare earth")
     ground_window: float = param(20.0, lambda v: v > 0, "ground_window > 0",
                                  "side of the local ground's opening square (m): wider than "
                                  "the widest object to flag")
@@ -201,6 +204,14 @@ def _obstacles(height: NDArray[np.float64], origin: tuple[float, float] | NDArra
     if rule.ground == "plane":
         return ground_obstacles(height, pixel_centres(origin, step, height.shape),
                                 rule.obstacle_height, seed=seed)
+    if rule.ground == "filter":
+        from alte.ground.filters import bare_earth_raster
+
+        bare, rise = bare_earth_raster(height, step, rule.ground_window)
+        with np.errstate(invalid="ignore"):
+            above: NDArray[np.bool_] = np.isfinite(height) & (
+                np.nan_to_num(height - bare) > rule.obstacle_height + np.nan_to_num(rise))
+        return above
     ground = local_ground(height, step, rule.ground_window)
     known = np.isfinite(height) & np.isfinite(slope_deg)
     grade = np.tan(np.radians(np.minimum(np.where(known, slope_deg, 0.0), rule.max_slope_deg)))

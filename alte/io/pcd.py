@@ -14,14 +14,15 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TypeAlias
+from typing import TYPE_CHECKING, TypeAlias
 
 import numpy as np
-import pandas as pd
 from numpy.typing import NDArray
 
 from alte.errors import PointFileError
-from alte.io.lzf import lzf_decompress
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 __all__ = ["Fields", "PcdHeader", "pack_rgb", "pcd_header", "read_pcd", "read_pcd_table",
            "read_table", "unpack_rgb", "write_pcd"]
@@ -121,6 +122,8 @@ def pcd_header(raw: bytes, path: Path) -> PcdHeader:
 
 def read_table(path: Path, offset: int = 0) -> pd.DataFrame:
     """Whitespace-separated numbers (pandas' C parser), optionally after a byte offset."""
+    import pandas as pd  # on first use: pandas is ~80 MB resident
+
     with open(path, "rb") as fh:
         fh.seek(offset)
         return pd.read_csv(
@@ -143,6 +146,8 @@ def _last_row_width(raw: bytes, offset: int) -> int:
 
 def _ascii(raw: bytes, head: PcdHeader, path: Path) -> NDArray[np.void]:
     dtype = head.dtype
+    import pandas as pd
+
     width = sum(count for *_, count in head.fields)
     try:
         table = read_table(path, offset=head.offset) if head.points else None
@@ -192,6 +197,8 @@ def _compressed(raw: bytes, head: PcdHeader, path: Path) -> NDArray[np.void]:
     if packed > len(blob) - 8:
         raise PointFileError(f"{path}: truncated binary_compressed PCD: {len(blob) - 8} of the "
                              f"{packed} compressed bytes ({count} rows) it announces")
+    from alte.io.lzf import lzf_decompress  # numba: compressed bodies only
+
     body = lzf_decompress(np.frombuffer(blob, np.uint8, packed, 8), size)
     if body.size != size:
         raise PointFileError(f"{path}: corrupt LZF data in binary_compressed PCD")

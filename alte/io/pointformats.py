@@ -21,7 +21,6 @@ import datetime
 from pathlib import Path
 
 import numpy as np
-import pandas as pd
 from numpy.typing import NDArray
 
 from alte.errors import ParameterError, PointFileError
@@ -147,6 +146,8 @@ def read_text(path: Path) -> tuple[NDArray[np.float64], Fields, FileAbout]:
 def write_text(tmp: Path, points: NDArray[np.float64], fields: Fields) -> None:
     del fields  # plain text holds x y z only (:func:`storable`)
     # pandas prints the shortest repr that round-trips each float64 exactly
+    import pandas as pd  # on first use: pandas is ~80 MB resident
+
     pd.DataFrame(points).to_csv(tmp, sep=" ", header=False, index=False)
 
 

@@ -33,6 +33,7 @@ in thesis ch. 6 (mean height above a ground plane over a threshold).
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import ClassVar, Literal, get_args
 
@@ -67,10 +68,13 @@ class Alte2D(QuadMap):
     """2D Adaptive Learning Terrain Estimation (see the module docstring)."""
 
     name: ClassVar[str] = "alte2d"
+    title: ClassVar[str] = "2D-ALTE"
     Params: ClassVar[type[Record]] = Alte2DParams
     #: The cells' statistics do not depend on the split rule's thresholds, and neither
     #: does an insertion's work (the same touched cells get new flags).
     view_params: ClassVar[frozenset[str]] = frozenset({"kappa", "min_pts"})
+    settings_grid: ClassVar[Mapping[str, tuple[object, ...]]] = {
+        "max_res": (4, 5, 6, 7), "kappa": (0.01, 0.1, 1.0), "min_pts": (10,)}
 
     @property
     def depth(self) -> int:

@@ -23,6 +23,7 @@ z axis is cut into layers of ``cell_height`` metres from the domain's zmin.
 from __future__ import annotations
 
 import copy
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import ClassVar, Literal
@@ -33,6 +34,7 @@ from numpy.typing import NDArray
 from alte.errors import MapperError
 from alte.mappers._rows import unique_rows
 from alte.mappers.base import (
+    API_VERSION,
     CellCounts,
     Cells,
     Cost,
@@ -84,7 +86,9 @@ class Alte3D:
     Points outside the domain are dropped and counted (:attr:`points_outside`).
     """
 
+    api_version: ClassVar[int] = API_VERSION
     name: ClassVar[str] = "alte3d"
+    title: ClassVar[str] = "3D-ALTE"
     dims: ClassVar[int] = 3
     incremental: ClassVar[bool] = True
     domain_use: ClassVar[DomainUse] = DomainUse.REQUIRED
@@ -96,6 +100,9 @@ class Alte3D:
     view_params: ClassVar[frozenset[str]] = frozenset({"min_pts", "min_pts_split",
                                                        "occupancy_level"})
     cost_unit: ClassVar[Cost] = Cost.CELL_UPDATES
+    layers: ClassVar[frozenset[str]] = frozenset()
+    settings_grid: ClassVar[Mapping[str, tuple[object, ...]]] = {
+        "max_res": (4, 5, 6, 7, 8), "min_pts_split": (10, 40), "min_pts": (5, 20)}
     Params: ClassVar[type[Record]] = Alte3DParams
 
     def __init__(self, domain: Domain | None = None, *, record: Record | None = None,

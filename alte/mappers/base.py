@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import enum
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import ClassVar, Protocol, TypeVar, runtime_checkable
 
@@ -21,8 +21,14 @@ from alte.mappers.domain import Domain, DomainUse
 from alte.params import Record
 from alte.types import as_points
 
-__all__ = ["CellCounts", "Cells", "Cost", "Feed", "Mapper", "check_points", "check_view",
-           "parsed"]
+__all__ = ["API_VERSION", "VARIANCE", "CellCounts", "Cells", "Cost", "Feed", "Mapper",
+           "check_points", "check_view", "parsed"]
+
+#: The version of the mapper contract (:mod:`alte.mappers.api`); a mapper declares the one
+#: it was written against as ``api_version`` and the registry refuses another.
+API_VERSION = 1
+#: The layer of a 2D map's cells holding each cell's height variance (m^2).
+VARIANCE = "variance"
 
 
 @dataclass(frozen=True)
@@ -32,7 +38,9 @@ class Cells:
     ``centers`` (K, 3) and ``sizes`` (K, 3) in metres: 2D maps put the cell height
     in ``centers[:, 2]`` and 0 in ``sizes[:, 2]``. ``value`` is the mapper's own
     quantity (mean height, occupancy probability, point count), ``occupied`` the
-    binary state and ``level`` the tree depth (0 = root).
+    binary state and ``level`` the tree depth (0 = root). ``layers`` holds further
+    per-cell quantities by name, one float64 value per cell (the mapper's class lists
+    them in ``Mapper.layers``): :data:`VARIANCE` is a 2D cell's height variance (m^2).
     """
 
     centers: NDArray[np.float64]
@@ -40,18 +48,31 @@ class Cells:
     value: NDArray[np.float64]
     occupied: NDArray[np.bool_]
     level: NDArray[np.int64]
+    layers: Mapping[str, NDArray[np.float64]] = field(default_factory=dict)
 
     def __len__(self) -> int:
         return int(self.centers.shape[0])
 
+    def layer(self, name: str) -> NDArray[np.float64] | None:
+        """The per-cell layer ``name`` (None when the map has none)."""
+        return self.layers.get(name)
+
+    def subset(self, mask: NDArray[np.bool_]) -> Cells:
+        """The cells where ``mask`` holds, layers included."""
+        return Cells(self.centers[mask], self.sizes[mask], self.value[mask],
+                     self.occupied[mask], self.level[mask],
+                     {name: values[mask] for name, values in self.layers.items()})
+
     def as_dict(self) -> dict[str, NDArray[np.float64] | NDArray[np.bool_] | NDArray[np.int64]]:
-        """Arrays by name, as written by ``alte map --export cells.npz``."""
+        """Arrays by name, as written by ``alte map --export cells.npz`` (a layer ``L`` as
+        ``layer_L``)."""
         return {
             "centers": self.centers,
             "sizes": self.sizes,
             "value": self.value,
             "occupied": self.occupied,
             "level": self.level,
+            **{f"layer_{name}": values for name, values in self.layers.items()},
         }
 
 
@@ -91,17 +112,31 @@ class Feed(enum.Enum):
 
 @runtime_checkable
 class Mapper(Protocol):
-    """What every mapper offers; see ``alte.mappers.MAPPERS`` for the registry.
+    """What every mapper offers (the contract of :mod:`alte.mappers.api`, version
+    :data:`API_VERSION`); mappers are found through :mod:`alte.mappers.registry`.
+
+    A mapper class is constructed as ``cls(domain=None, *, record=None, **params)``: a
+    :class:`~alte.mappers.domain.Domain` or None, and its parameters either as an
+    instance of its ``Params`` record or as names and values that record parses.
 
     Capabilities are class attributes the pipeline reads (never probed with hasattr):
     ``dims``, ``incremental``, ``domain_use``, ``default_feed`` (the thesis' protocol:
     Quadtree ran once on the final cloud), ``exports`` (file suffixes it writes),
     ``free_space`` (its unoccupied cells were observed free), ``cost_unit`` (what
-    :attr:`cost` counts) and ``view_params`` (the parameters :meth:`reread` can
-    change).
+    :attr:`cost` counts), ``view_params`` (the parameters :meth:`reread` can
+    change), ``layers`` (the per-cell layers :meth:`cells` carries) and
+    ``settings_grid`` (the settings a trade-off grid crosses when its spec does not
+    list the mapper).
     """
 
+    #: The contract version the class was written against (:data:`API_VERSION`).
+    api_version: ClassVar[int]
+    #: The name the registry, the CLI (``--mapper``) and the sweep specs use.
     name: ClassVar[str]
+    #: The name tables, figures and the report show ("2D-ALTE").
+    title: ClassVar[str]
+    #: The parameter record: ``--set`` values and sweep rows are validated by it.
+    Params: ClassVar[type[Record]]
     #: 2 for height maps (Quadtree, 2D-ALTE), 3 for volumetric maps.
     dims: ClassVar[int]
     #: True when ``insert`` updates only what the new frame touches.
@@ -118,6 +153,17 @@ class Mapper(Protocol):
     view_params: ClassVar[frozenset[str]]
     #: The unit of :attr:`cost`.
     cost_unit: ClassVar[Cost]
+    #: Names of the per-cell layers of :meth:`cells` (``Cells.layers``), e.g. ``variance``.
+    layers: ClassVar[frozenset[str]]
+    #: Parameter values a trade-off grid crosses (their product) when its spec does not
+    #: list the mapper; empty: the defaults alone. The first parameter is the one that
+    #: sets the map's size (the bench samples a sweep by it).
+    settings_grid: ClassVar[Mapping[str, tuple[object, ...]]]
+
+    def __init__(self, domain: Domain | None = None, *, record: Record | None = None,
+                 **given: object) -> None:
+        """The map over ``domain`` (None: grown from the data or a key space of its own),
+        parameters as a ``Params`` record or as names and values it parses."""
 
     @property
     def params(self) -> Record:

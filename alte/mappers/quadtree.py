@@ -37,6 +37,7 @@ after the build first fills in the rest; ``memory_bytes`` counts what is held.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import ClassVar, Literal, get_args
 
@@ -111,11 +112,14 @@ class Quadtree(QuadMap):
     """Point-count quadtree with a height-above-ground occupancy rule (module docstring)."""
 
     name: ClassVar[str] = "quadtree"
+    title: ClassVar[str] = "Quadtree"
     default_feed: ClassVar[Feed] = Feed.BATCH
     Params: ClassVar[type[Record]] = QuadtreeParams
     #: The leaves keep the mean and the maximum height above the plane: the rule and the
     #: threshold only read them.
     view_params: ClassVar[frozenset[str]] = frozenset({"occupancy", "height_threshold"})
+    settings_grid: ClassVar[Mapping[str, tuple[object, ...]]] = {
+        "max_points": (10, 25, 50, 100, 150, 200, 350, 500, 1000, 2000)}
     _NVALUES: ClassVar[int] = 2  # z, height above the plane
 
     def __init__(self, domain: Domain | None = None, *, record: Record | None = None,

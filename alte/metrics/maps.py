@@ -78,6 +78,8 @@ class TruthMetrics:
     seen_share: float = _NAN
     height_rmse_m: float = _NAN
     unknown_share: float = _NAN
+    within_2sigma: float = _NAN
+    sigma_mean_m: float = _NAN
     free_truly_free_share: float = _NAN
     completeness_by_class: Mapping[str, float] = field(default_factory=dict)
     completeness_by_object: Mapping[str, float] = field(default_factory=dict)

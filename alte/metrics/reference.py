@@ -210,13 +210,14 @@ class Reference:
 
     def _heights(self, cells: Cells) -> TruthValues:
         """:func:`~alte.metrics.truth.height_metrics_2d` on the prepared probes."""
-        from alte.metrics.truth import height_summary
+        from alte.metrics.truth import height_summary, probe_sigma
 
         xy, true_h = self.probes
         known = np.isfinite(cells.centers[:, 2])
         idx = cell_at_xy(xy, cells.centers[known], cells.sizes[known])
         map_h = np.where(idx >= 0, cells.centers[known][np.maximum(idx, 0), 2], np.nan)
-        return height_summary(idx, map_h, true_h, self.options.tolerance)
+        return height_summary(idx, map_h, true_h, self.options.tolerance,
+                              probe_sigma(cells, known, idx))
 
     def _volume(self, leaves: LeafTruth, cells: Cells, occ: NDArray[np.bool_],
                 surface: TrueSurface) -> TruthValues:

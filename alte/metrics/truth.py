@@ -19,7 +19,13 @@ Definitions (``tol`` = ``tolerance`` in metres; "occupied" = ``Cells.occupied``)
   and the map height from the cell covering the grid point. ``height_rmse_m`` is the RMSE
   where both exist, ``unknown_share`` the share of grid points no cell with a finite
   height covers, and ``completeness`` the share of grid points whose map height is
-  within ``tol`` of the true top (uncovered points count as misses).
+  within ``tol`` of the true top (uncovered points count as misses). A map whose cells
+  carry a height variance (the ``variance`` layer, :data:`alte.mappers.VARIANCE`) is
+  also checked for the calibration of its claimed uncertainty: ``within_2sigma`` is the
+  share of the probes covered by a cell with a finite variance whose true height lies
+  within two standard deviations of the cell's height (0.954 for a calibrated Gaussian
+  sigma; lower: the map claims more certainty than it has), ``sigma_mean_m`` the mean
+  sigma over those probes.
 * **free space** (maps with free leaves, i.e. Octomap): ``free_truly_free_share`` is
   the volume share of free leaves whose centres lie outside every solid (see
   :meth:`TrueSurface.inside`; estimated from 200 000 volume-weighted leaves when there
@@ -55,6 +61,7 @@ __all__ = [
     "height_metrics_2d",
     "height_summary",
     "probe_grid",
+    "probe_sigma",
     "seen_mask",
     "size_groups",
 ]
@@ -74,6 +81,8 @@ class TruthValues(TypedDict, total=False):
     seen_share: float
     height_rmse_m: float
     unknown_share: float
+    within_2sigma: float
+    sigma_mean_m: float
     free_truly_free_share: float
     completeness_by_class: dict[str, float]
     completeness_by_object: dict[str, float]
@@ -226,7 +235,21 @@ def height_metrics_2d(cells: Cells, surface: TrueSurface, bounds: NDArray[np.flo
     idx = cell_at_xy(xy, cells.centers[known], cells.sizes[known])
     map_h = np.where(idx >= 0, cells.centers[known][np.maximum(idx, 0), 2], np.nan)
     true_h = surface.top_height(xy, z_start=float(bounds[1][2]))
-    return height_summary(idx, map_h, true_h, tolerance)
+    return height_summary(idx, map_h, true_h, tolerance, probe_sigma(cells, known, idx))
+
+
+def probe_sigma(cells: Cells, known: NDArray[np.bool_], idx: NDArray[np.int64],
+                ) -> NDArray[np.float64] | None:
+    """Each probe's height sigma: the square root of the ``variance`` layer of the known
+    cell ``idx`` covering it (NaN where none does); None for a map without the layer."""
+    from alte.mappers.base import VARIANCE
+
+    variance = cells.layer(VARIANCE)
+    if variance is None:
+        return None
+    var = np.asarray(variance, dtype=np.float64)[known]
+    sigma = np.sqrt(np.where(var >= 0, var, np.nan)) if len(var) else np.empty(0)
+    return np.where(idx >= 0, sigma[np.maximum(idx, 0)] if len(sigma) else np.nan, np.nan)
 
 
 def probe_grid(bounds: NDArray[np.float64], grid_step: float) -> NDArray[np.float64]:
@@ -240,17 +263,26 @@ def probe_grid(bounds: NDArray[np.float64], grid_step: float) -> NDArray[np.floa
 
 
 def height_summary(idx: NDArray[np.int64], map_h: NDArray[np.float64],
-                   true_h: NDArray[np.float64], tolerance: float) -> TruthValues:
-    """The 2D metrics from each probe's cell (-1: none), map height and true height."""
+                   true_h: NDArray[np.float64], tolerance: float,
+                   sigma: NDArray[np.float64] | None = None) -> TruthValues:
+    """The 2D metrics from each probe's cell (-1: none), map height and true height, and
+    with each probe's claimed ``sigma`` (:func:`probe_sigma`) its calibration."""
     has_truth = np.isfinite(true_h)
     both = has_truth & (idx >= 0)
     err = map_h[both] - true_h[both]
-    return {
+    out: TruthValues = {
         "height_rmse_m": float(np.sqrt(np.mean(err**2))) if err.size else np.nan,
         "unknown_share": float(np.mean(idx < 0)),
         "completeness": float(np.mean(np.abs(map_h[has_truth] - true_h[has_truth]) <= tolerance))
         if has_truth.any() else np.nan,
     }
+    if sigma is not None:
+        claimed = both & np.isfinite(sigma) & np.isfinite(map_h)
+        miss = np.abs(map_h[claimed] - true_h[claimed])
+        out["within_2sigma"] = (float(np.mean(miss <= 2.0 * sigma[claimed])) if claimed.any()
+                                else np.nan)
+        out["sigma_mean_m"] = float(np.mean(sigma[claimed])) if claimed.any() else np.nan
+    return out
 
 
 def check_truth_args(dims: int, tolerance: float) -> None:

@@ -6,42 +6,7 @@ an input once for several maps (:mod:`~alte.pipeline.prepare`); the specificatio
 and their policies are in :mod:`~alte.pipeline.spec`.
 """
 
-from alte.pipeline.feed import resolve_domain
-from alte.pipeline.maprun import FrameLog, FrameObserver, MapRun, RunInfo, Snapshot
-from alte.pipeline.prepare import (
-    Merged,
-    Registered,
-    cache_key,
-    merge_frames,
-    merged_cloud,
-    prepare,
-)
-from alte.pipeline.run import run
-from alte.pipeline.source import InputKind, Source, StreamCounts, open_input, stream_frames
-from alte.pipeline.spec import DomainChoice, DomainPolicy, FrameSpec, MapSpec, PoseSource
+import lazy_loader as lazy
 
-__all__ = [
-    "DomainChoice",
-    "DomainPolicy",
-    "FrameLog",
-    "FrameObserver",
-    "FrameSpec",
-    "InputKind",
-    "MapRun",
-    "MapSpec",
-    "Merged",
-    "PoseSource",
-    "Registered",
-    "RunInfo",
-    "Snapshot",
-    "Source",
-    "StreamCounts",
-    "cache_key",
-    "merge_frames",
-    "merged_cloud",
-    "open_input",
-    "prepare",
-    "resolve_domain",
-    "run",
-    "stream_frames",
-]
+# Submodules load on first use; the names are those of __init__.pyi.
+__getattr__, __dir__, __all__ = lazy.attach_stub(__name__, __file__)

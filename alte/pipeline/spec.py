@@ -14,13 +14,12 @@ import enum
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import ClassVar
+from typing import ClassVar, cast
 
 import numpy as np
 
 from alte.errors import ParameterError
-from alte.mappers import MapperClass, mapper_class
-from alte.mappers.base import Feed
+from alte.mappers.base import Feed, Mapper
 from alte.mappers.domain import Domain
 from alte.params import Record, param
 from alte.registration.odometry import OdometryParams
@@ -139,9 +138,11 @@ class FrameSpec(Record):
 
 @dataclass(frozen=True)
 class MapSpec(Record):
-    """Which map: mapper name and parameters, domain (or policy), feed, time-lapse.
+    """Which map: mapper and parameters, domain (or policy), feed, time-lapse.
 
-    ``feed`` None uses the mapper's own protocol (``Mapper.default_feed``: the thesis
+    ``mapper`` is a mapper class or a name the registry resolves
+    (:mod:`alte.mappers.registry`); once made, ``mapper`` holds the name and ``cls`` the
+    class. ``feed`` None uses the mapper's own protocol (``Mapper.default_feed``: the thesis
     built Quadtree once on the final cloud and fed the others frame by frame);
     ``snapshots`` keeps the cells that many times over the run (time-lapse figures)
     and counts the basis functions after every frame. The mapper's class (``cls``) and
@@ -150,22 +151,35 @@ class MapSpec(Record):
     """
 
     OWNER: ClassVar[str] = "map spec"
-    mapper: str
+    mapper: type[Mapper] | str
     params: Mapping[str, object] | Record = field(default_factory=dict)
     domain: Domain | DomainPolicy = DomainPolicy.AUTO
     feed: Feed | None = None
     snapshots: int = param(0, lambda v: v >= 0, "snapshots >= 0",
                            "cell snapshots kept over the run (time-lapse figures)")
-    cls: MapperClass = field(init=False, repr=False, compare=False)
     record: Record = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        cls = mapper_class(self.mapper)
+        if not isinstance(self.mapper, str):  # a class: kept, and its name is the mapper
+            object.__setattr__(self, "_cls", self.mapper)
+            object.__setattr__(self, "mapper", self.mapper.name)
+        cls = self.cls
         given = self.params
         record = given if isinstance(given, cls.Params) else cls.Params.parse(
             given.as_dict() if isinstance(given, Record) else given)
-        object.__setattr__(self, "cls", cls)
         object.__setattr__(self, "record", record)
         object.__setattr__(self, "params", given.as_dict() if isinstance(given, Record)
                            else dict(given))
+
+    @property
+    def cls(self) -> type[Mapper]:
+        """The mapper's class: the one given, or the registry's for the name (the registry,
+        and with it the mappers' kernels, loads on first use: a spec is light to import)."""
+        found = self.__dict__.get("_cls")
+        if found is None:
+            from alte.mappers import registry
+
+            found = registry.resolve(str(self.mapper))
+            object.__setattr__(self, "_cls", found)
+        return cast("type[Mapper]", found)

@@ -19,7 +19,7 @@ from alte.mappers.quad.quadmap import plane_height
 from alte.plot.arrays import Floats, polygons
 from alte.plot.figure import Caption, Plot, View
 from alte.plot.render import view
-from alte.studies.analysis.tradeoff import MAPPER_NAMES
+from alte.studies.analysis.tradeoff import mapper_title
 
 if TYPE_CHECKING:
     import pyvista as pv
@@ -220,7 +220,7 @@ def basis_functions_figure(runs: Mapping[str, MapRun]) -> Plot:
     for name, run in runs.items():
         plot_basis_functions_over_time(run.log.times, run.log.basis_functions,
                                        axes[0 if run.mapper.dims == 2 else 1],
-                                       MAPPER_NAMES.get(name, name))
+                                       mapper_title(name))
     return Plot(fig, BASIS_FUNCTIONS)
 
 

@@ -142,7 +142,7 @@ def fronts_figure(table: pd.DataFrame) -> Plot | None:
     if table.empty:
         return None
     from alte.plot.tradeoff import COLORS, log_axis
-    from alte.studies.analysis.tradeoff import MAPPER_NAMES, fronts, label
+    from alte.studies.analysis.tradeoff import fronts, label, mapper_title
 
     fig = Figure(figsize=(4.0 * len(FRONT_PANELS), 3.6), layout="constrained")
     axes = np.asarray(fig.subplots(1, len(FRONT_PANELS), squeeze=False)).ravel()
@@ -150,7 +150,7 @@ def fronts_figure(table: pd.DataFrame) -> Plot | None:
         rows = table[table["mapper"].isin(pair) & table[metric].notna()]
         for mapper in pair:
             dots = fronts(rows[rows["mapper"] == mapper], "basis_functions", metric, higher)
-            name = MAPPER_NAMES.get(mapper, mapper)
+            name = mapper_title(mapper)
             ax.scatter(dots["x"], dots["y"], s=14, alpha=0.5, color=COLORS.get(mapper), lw=0)
             line = dots[dots["on_front"]].sort_values("x")
             ax.plot(line["x"], line["y"], color=COLORS.get(mapper), lw=2, label=name)

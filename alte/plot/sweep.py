@@ -14,7 +14,7 @@ import pandas as pd
 
 from alte.errors import ParameterError
 from alte.plot.figure import Caption, Plot
-from alte.studies.analysis.tradeoff import MAPPER_NAMES
+from alte.studies.analysis.tradeoff import mapper_title
 from alte.studies.sweep.analysis import main_effects, mapper_rows, param_columns, sensitivity_table
 
 if TYPE_CHECKING:
@@ -74,7 +74,7 @@ def sensitivity_figure(table: pd.DataFrame, mapper: str, x: str, y: str,
     where = f" on {terrain}" if terrain else ""
     fixed_text = ", ".join(f"{k}={v}" for k, v in (fixed or {}).items())
     fig.suptitle(f"{mapper}{where}" + (f" ({fixed_text})" if fixed_text else ""))
-    return Plot(fig, Caption(f"{MAPPER_NAMES.get(mapper, mapper)}: {x} x {y}",
+    return Plot(fig, Caption(f"{mapper_title(mapper)}: {x} x {y}",
                              f"Each metric over the {x} x {y} grid."))
 
 

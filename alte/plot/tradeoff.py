@@ -23,12 +23,12 @@ from alte.errors import ParameterError
 from alte.plot.figure import Caption, Plot
 from alte.plot.render import Draw, save_figures
 from alte.studies.analysis.tradeoff import (
-    MAPPER_NAMES,
     equal_fidelity,
     equal_size,
     fronts,
     interval_table,
     label,
+    mapper_title,
     matching,
     prepare,
     thesis_setting,
@@ -110,7 +110,7 @@ def mean_front(ax: Axes, rows: pd.DataFrame, mapper: str, axes: tuple[str, str],
     mean, low, high = bootstrap_columns(grid.to_numpy())
     color = COLORS.get(mapper)
     ax.plot(grid.columns, mean, color=color, lw=2,
-            label=f"{MAPPER_NAMES.get(mapper, mapper)} front")
+            label=f"{mapper_title(mapper)} front")
     ax.fill_between(grid.columns, low, high, color=color, alpha=0.2, lw=0)
 
 
@@ -124,7 +124,7 @@ def _thesis_star(ax: Axes, rows: pd.DataFrame, mapper: str, axes: tuple[str, str
     chosen = rows[matching(rows, setting)] if setting else rows.iloc[:0]
     if not chosen.empty:
         ax.plot(chosen[axes[0]].mean(), chosen[axes[1]].mean(), "*", ms=14, mec="k",
-                color=COLORS.get(mapper), label=f"{MAPPER_NAMES.get(mapper, mapper)}: "
+                color=COLORS.get(mapper), label=f"{mapper_title(mapper)}: "
                 "thesis' setting")
 
 
@@ -176,7 +176,7 @@ def _levelpanels(summary: pd.DataFrame, names: Sequence[str], ylabel: str, xlabe
             pos = np.arange(len(levels)) + (k - (len(names) - 1) / 2) * 0.15
             err = np.vstack([mine["mean"] - mine["low"], mine["high"] - mine["mean"]])
             ax.errorbar(pos, mine["mean"], yerr=err, fmt="o", capsize=3,
-                        color=COLORS.get(mapper), label=MAPPER_NAMES.get(mapper, mapper))
+                        color=COLORS.get(mapper), label=mapper_title(mapper))
         ax.set_xticks(range(len(levels)), [f"{v:,.0f}" if v >= 100 else f"{v:.3g}"
                                            for v in levels])
         ax.set(title=terrain, xlabel=xlabel, ylabel=ylabel)

@@ -6,12 +6,11 @@
   (:mod:`~alte.registration.window`) follows it, which re-aligns every pose, its map is
   coarser (voxel ``1.5 x max_range / 100``, 10 points a voxel): on the real ``balm_seq``
   the pair lands as close to the reference as with KISS-ICP's own map at a third of its
-  CPU (README, "Poses"); the registration's nearest-neighbour search over 27 voxels of up
-  to that many points is what KISS-ICP spends its time on. Two switches follow its
-  maintainers' advice for
-  sparse (16-beam, Livox) sensors: ``single_downsample`` registers the 0.5-voxel cloud
-  instead of the 1.5-voxel one (PRBonn/kiss-icp#128) and ``fixed_threshold`` replaces
-  the adaptive one (PRBonn/kiss-icp#146).
+  CPU (docs/results/poses.md); the registration's nearest-neighbour search over 27 voxels
+  of up to that many points is what KISS-ICP spends its time on. Two switches follow its
+  maintainers' advice for sparse (16-beam, Livox) sensors: ``single_downsample``
+  registers the 0.5-voxel cloud instead of the 1.5-voxel one (PRBonn/kiss-icp#128) and
+  ``fixed_threshold`` replaces the adaptive one (PRBonn/kiss-icp#146).
 * :class:`Plane`: each scan aligned point-to-plane (Open3D) to a local map of the
   scans before it (:class:`PlaneMap`), from a constant-velocity guess.
 

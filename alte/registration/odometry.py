@@ -14,9 +14,9 @@
 * :func:`~alte.registration.refine.refine_frames`: recorded poses aligned scan-to-map,
   a correction applied only when it is well constrained and clearly better.
 
-The defaults were chosen on the real ``balm_seq`` recording (``alte odometry``; README,
-"Poses"). Every frame goes through: nothing is dropped here, only counted
-(:class:`PoseCounts`).
+The defaults were chosen on the real ``balm_seq`` recording (``alte odometry``; the
+documentation's results page on poses). Every frame goes through: nothing is dropped
+here, only counted (:class:`PoseCounts`).
 """
 
 from __future__ import annotations

@@ -1,30 +1,35 @@
 """The front page's bottom line as text: read from the run's tables, never typed in.
 
 :func:`answer_view` reads ``tradeoff.csv`` (the grid, obstacle columns included) and,
-when chapter 6 ran, ``realdata_fronts.csv`` from a run's tables folder, computes the
+when chapter 6 ran, ``realdata_fronts.csv`` and ``realterrain_fronts.csv`` from a run's
+tables folder, computes the
 :func:`~alte.studies.answer.bottom_line` and turns it into rows of text the template
 shows under ``id="answer"``: per use a summary, one row per terrain group and budget
 (the pick with its figures and intervals, the other mapper's best, the pick the thesis'
-MHD would make), the orders at equal size, where MHD and the truth disagree, and
-whether the real sequence agrees.
+MHD would make), the orders at equal size, where MHD and the truth disagree, whether
+the real sequence agrees (or why it cannot rank the use's maps), and per class of real
+terrain whether the built-in answer holds.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import pandas as pd
 
-from alte.studies.analysis.tradeoff import MAPPER_NAMES
+from alte.studies.analysis.tradeoff import mapper_title
 from alte.studies.answer import Choice, UseAnswer, bottom_line, interval_text, pick_text
+from alte.studies.answer.classes import ClassCheck
 from alte.studies.answer.orders import metric_words
 
-__all__ = ["REAL_CSV", "TRADEOFF_CSV", "AnswerView", "ChoiceRow", "UseView", "answer_view"]
+__all__ = ["REAL_CSV", "TERRAIN_CSV", "TRADEOFF_CSV", "AnswerView", "ChoiceRow", "ClassRow",
+           "UseView", "answer_view"]
 
 #: The tables the bottom line is read from (in the run's ``tables`` folder).
 TRADEOFF_CSV = "tradeoff.csv"
 REAL_CSV = "realdata_fronts.csv"
+TERRAIN_CSV = "realterrain_fronts.csv"
 
 
 @dataclass(frozen=True)
@@ -41,6 +46,19 @@ class ChoiceRow:
 
 
 @dataclass(frozen=True)
+class ClassRow:
+    """One class of real terrain and one kind of evidence: the order there and the
+    built-in one, and whether the built-in answer holds."""
+
+    terrain_class: str
+    terrains: str
+    evidence: str
+    real: str
+    verdict: str
+    css: str
+
+
+@dataclass(frozen=True)
 class UseView:
     """A use's part of the bottom line."""
 
@@ -50,6 +68,11 @@ class UseView:
     rows: list[ChoiceRow]
     orders: list[str]
     real: list[str]
+    real_why: str = ""
+    classes: list[ClassRow] = field(default_factory=list)
+    builtin: str = ""
+    duels: list[str] = field(default_factory=list)
+    calibration: list[str] = field(default_factory=list)
 
 
 @dataclass(frozen=True)
@@ -63,7 +86,7 @@ class AnswerView:
 def _rival(choice: Choice) -> str:
     if choice.rival is None:
         other = [m for m in choice.use.mappers if choice.best and m != choice.best.mapper]
-        names = ", ".join(MAPPER_NAMES.get(m, m) for m in other)
+        names = ", ".join(mapper_title(m) for m in other)
         return f"no {names} map fits" if names else ""
     if choice.budget.kind == "need":
         return (f"{choice.rival.name} at the least: {choice.rival.setting}, "
@@ -94,13 +117,28 @@ def _row(choice: Choice) -> ChoiceRow:
                      pick_text(choice.best, choice.use), _rival(choice), _mhd(choice))
 
 
+_EVIDENCE = {"flown": "flown (exact truth)", "points": "tile's points (held-back 20 %)"}
+_CSS = {"holds": "holds", "does not hold": "fails", "cannot tell": "depends"}
+
+
+def _class_row(check: ClassCheck) -> ClassRow:
+    return ClassRow(check.terrain_class, ", ".join(check.real.terrains),
+                    _EVIDENCE.get(check.evidence, check.evidence),
+                    f"{metric_words(check.metric)}: {check.real.text(where=False)} (built-in: "
+                    f"{check.builtin.text(where=False)})", check.verdict, _CSS[check.verdict])
+
+
 def _use(found: UseAnswer, sequence: str) -> UseView:
-    names = " or ".join(MAPPER_NAMES.get(m, m) for m in found.use.mappers)
+    names = " or ".join(mapper_title(m) for m in found.use.mappers)
     title = (f"{found.use.name.capitalize()}: {names}, ranked by "
              f"{metric_words(found.use.truth)}")
     orders = [f"{metric_words(o.metric)}: {o.text()}" for o in found.orders]
+    builtin = "; ".join(dict.fromkeys(
+        f"{metric_words(c.metric)}: {c.builtin.text(where=False)}" for c in found.classes))
     return UseView(title, found.summary, found.disagreement, [_row(c) for c in found.choices],
-                   orders, [check.text(sequence) for check in found.real])
+                   orders, [check.text(sequence) for check in found.real], found.real_why,
+                   [_class_row(c) for c in found.classes], builtin,
+                   [d.text() for d in found.duels], [c.text() for c in found.calibration])
 
 
 def _read(path: Path) -> pd.DataFrame | None:
@@ -117,5 +155,5 @@ def answer_view(tables_dir: str | Path) -> AnswerView | None:
     grid = _read(folder / TRADEOFF_CSV)
     if grid is None or grid.empty:
         return None
-    found = bottom_line(grid, _read(folder / REAL_CSV))
+    found = bottom_line(grid, _read(folder / REAL_CSV), _read(folder / TERRAIN_CSV))
     return AnswerView([_use(u, found.sequence) for u in found.uses], found.real_note)

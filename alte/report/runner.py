@@ -9,19 +9,22 @@ returns, so a killed report leaves nothing that looks finished.
 
 from __future__ import annotations
 
+import contextlib
 import os
+import sys
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import ThreadPoolExecutor, as_completed
 from dataclasses import asdict, dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
-from typing import TYPE_CHECKING, Protocol
+from typing import TYPE_CHECKING, NoReturn, Protocol
 
 from tqdm.auto import tqdm
 
 from alte.errors import AlteError, ReportError
 from alte.paths import REPO_ROOT
+from alte.progress import Relay, Throttle
 from alte.report.html import notebook_to_html, run_index_html, top_index_html, write_html
 from alte.report.plan import Run
 from alte.report.runs import list_runs, new_run_dir, point_latest, publish_tables, write_record
@@ -174,7 +177,8 @@ def _execute_all(runs: Sequence[Run], run_dir: Path, data_dir: Path, skip: dict[
         else:
             todo.append(run)
     with (ThreadPoolExecutor(max_workers=max(1, jobs)) as pool,
-          tqdm(total=len(todo), desc="notebooks", unit="run", disable=not progress) as bar):
+          tqdm(total=len(todo), desc="notebooks", unit="run", disable=not progress) as bar,
+          _kernel_bars(bar, progress)):
         futures = {pool.submit(execute_run, run, run_dir, data_dir, cwd): run for run in todo}
         for future in as_completed(futures):
             result = future.result()
@@ -182,6 +186,20 @@ def _execute_all(runs: Sequence[Run], run_dir: Path, data_dir: Path, skip: dict[
             bar.set_postfix_str(f"{result.name}: {result.status}")
             bar.update()
     return [done[run.name] for run in runs]
+
+
+@contextlib.contextmanager
+def _kernel_bars(bar: tqdm[NoReturn], progress: bool) -> Iterator[None]:
+    """The notebooks' own bars (grid runs, sensor missions ..., :mod:`alte.progress`)
+    shown here: on a terminal beside the bar over notebooks, on a log as lines."""
+    if not progress:
+        yield
+        return
+    show: Callable[[str], None] = (
+        bar.set_postfix_str if sys.stderr.isatty()
+        else Throttle(lambda line: tqdm.write(line, file=sys.stderr)))
+    with Relay(show):
+        yield
 
 
 def _publish(reports: Path, run_dir: Path) -> list[Path]:

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import pandas as pd
 
-from alte.studies.analysis.tradeoff import MAPPER_NAMES, METRICS
+from alte.studies.analysis.tradeoff import METRICS, mapper_title
 from alte.studies.thesis.numbers import SWEEPS
 
 __all__ = ["TableView", "cell_text", "header", "table_view"]
@@ -58,9 +58,9 @@ def cell_text(value: object, column: str = "") -> str:
     """One value as text: mapper names spelled out, numbers to 4 significant digits."""
     if value is None or (isinstance(value, float) and math.isnan(value)):
         return "\u2013"  # an en dash
-    names = {"mapper": MAPPER_NAMES, "metric": {m: header(m) for m in METRICS}}.get(column, {})
-    if isinstance(value, str) and value in names:
-        return names[value]
+    if isinstance(value, str) and column in ("mapper", "metric"):
+        return mapper_title(value) if column == "mapper" else (
+            header(value) if value in METRICS else value)
     if isinstance(value, bool):
         return "yes" if value else "no"
     if isinstance(value, int) or (isinstance(value, float) and value.is_integer()

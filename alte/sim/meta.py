@@ -4,7 +4,10 @@ from __future__ import annotations
 
 from typing import NotRequired, TypedDict
 
-__all__ = ["MountMeta", "ScenarioMeta"]
+__all__ = ["SCENARIO_FILE", "MountMeta", "ScenarioMeta"]
+
+#: The file of a terrain folder that describes it.
+SCENARIO_FILE = "scenario.json"
 
 
 class MountMeta(TypedDict):

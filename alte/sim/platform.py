@@ -30,11 +30,17 @@ _G = 9.81
 
 @dataclass(frozen=True)
 class Quadrotor:
-    """Waypoint flight at constant altitude (thesis 2.1.1); mount: ``thesis_mount()``."""
+    """Waypoint flight at constant altitude (thesis 2.1.1); mount: ``thesis_mount()``.
+
+    ``heights`` (over real terrain) replaces the constant altitude by a height profile:
+    heights at evenly spaced points of the path's spline parameter, from its first
+    waypoint to its last, linearly interpolated between them.
+    """
 
     waypoints: tuple[tuple[float, float], ...]
     altitude: float
     ramp_s: float = 3.0
+    heights: tuple[float, ...] | None = None
 
 
 @dataclass(frozen=True)
@@ -88,6 +94,16 @@ class Trajectory:
         self._ramp = ramp
 
     @property
+    def parameter_range(self) -> tuple[float, float]:
+        """The spline parameter at the first and the last waypoint."""
+        return float(self._u[0]), float(self._u[-1])
+
+    def path_xy(self, u: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Horizontal positions (K, 2) at spline parameters ``u``."""
+        xy: NDArray[np.float64] = self._spline(np.asarray(u, dtype=np.float64))
+        return xy
+
+    @property
     def speed(self) -> float:
         """Cruise speed (m/s)."""
         return self._speed
@@ -116,6 +132,14 @@ class Trajectory:
         du = self._spline(u, 1)
         return np.unwrap(np.arctan2(du[:, 1], du[:, 0]))
 
+    def _height(self, t: NDArray[np.float64], quad: Quadrotor) -> NDArray[np.float64]:
+        """The flight height at ``t``: constant, or the quadrotor's height profile."""
+        if quad.heights is None:
+            return np.full(len(t), quad.altitude)
+        u = np.interp(self._distance(t), self._s, self._u)
+        knots = np.linspace(self._u[0], self._u[-1], len(quad.heights))
+        return np.interp(u, knots, np.asarray(quad.heights, dtype=np.float64))
+
     def pose(self, t: NDArray[np.float64]) -> tuple[NDArray[np.float64], Rotation[tuple[int, ...]]]:
         """Body position (K, 3) and body-to-inertial rotation at times ``t``."""
         t = np.atleast_1d(np.asarray(t, dtype=np.float64))
@@ -131,7 +155,7 @@ class Trajectory:
         fwd = acc[:, 0] * np.cos(yaw) + acc[:, 1] * np.sin(yaw)
         lat = -acc[:, 0] * np.sin(yaw) + acc[:, 1] * np.cos(yaw)
         pitch, roll = np.arctan(fwd / _G), -np.arctan(lat / _G)
-        pos = np.column_stack([self.xy(t), np.full(len(t), quad.altitude)])
+        pos = np.column_stack([self.xy(t), self._height(t, quad)])
         return pos, Rotation.from_euler("ZYX", np.column_stack([yaw, pitch, roll]))
 
     def _cart_pose(self, t: NDArray[np.float64], cart: Cart

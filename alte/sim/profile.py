@@ -53,7 +53,7 @@ def _positive(value: float) -> bool:
 REFLECTIVITY: dict[str, float] = {
     "ground": 0.2, "wall": 0.45, "building": 0.4, "overhang": 0.3, "beam": 0.25,
     "pillar": 0.4, "car": 0.08, "tree": 0.4, "fence": 0.3, "debris": 0.3, "buoy": 0.6,
-    "room": 0.6,
+    "room": 0.6, "vegetation": 0.4, "object": 0.3,
 }
 
 

@@ -14,7 +14,7 @@ from __future__ import annotations
 import hashlib
 import json
 import os
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -24,7 +24,7 @@ import numpy as np
 from alte.errors import AlteError, SimulationError
 from alte.fsutil import atomic_dir
 from alte.sim.groundtruth import GROUND_TRUTH_FILE, load_ground_truth, write_ground_truth
-from alte.sim.meta import MountMeta, ScenarioMeta
+from alte.sim.meta import SCENARIO_FILE, MountMeta, ScenarioMeta
 from alte.sim.mission import Simulation, simulate
 from alte.sim.profile import PROFILES, SensorProfile
 from alte.sim.scene import Scene
@@ -43,20 +43,26 @@ __all__ = ["BAG_DIR", "IMU_TOPIC", "SCENARIO_FILE", "SIM_VERSION", "MountMeta", 
 
 #: Bump when the simulator's output changes for the same spec (invalidates caches).
 SIM_VERSION = 1
-SCENARIO_FILE = "scenario.json"
 BAG_DIR = "bag"
 CLOUD_TOPIC = "/velodyne_points"
 POSE_TOPIC = "/pose"
 IMU_TOPIC = "/imu"
 
 
-def get_terrain(name: str) -> Terrain:
-    """Build the registered terrain ``name``; SimulationError lists the valid names."""
-    try:
-        builder = TERRAINS[name]
-    except KeyError as err:
-        raise SimulationError(f"unknown terrain {name!r}; valid: {', '.join(TERRAINS)}") from err
-    return builder()
+def get_terrain(name: str, data_dir: str | os.PathLike[str] | None = None) -> Terrain:
+    """Build the registered terrain ``name``, or read the terrain imported as
+    ``data_dir/NAME`` (``alte simulate TILE ...``); SimulationError lists the valid names."""
+    builder = TERRAINS.get(name)
+    if builder is not None:
+        return builder()
+    folder = Path(data_dir) / name if data_dir is not None else None
+    if folder is not None and (folder / SCENARIO_FILE).is_file():
+        from alte.sim.real.folder import imported_terrain
+
+        return imported_terrain(folder)
+    where = f" in {data_dir}" if data_dir is not None else ""
+    raise SimulationError(f"unknown terrain {name!r}; valid: {', '.join(TERRAINS)}, or a "
+                          f"terrain imported{where} (`alte simulate TILE.laz --out DIR`)")
 
 
 def profile_label(profile: SensorProfile) -> str:
@@ -123,8 +129,10 @@ def _metadata(terrain: Terrain, sim: Simulation, run: JSONDict) -> JSONDict:
 
 def write_scenario(target: str | os.PathLike[str], terrain: Terrain, sim: Simulation, *,
                    seed: int, frames: int | None, storage: str = "sqlite3",
-                   progress: bool = False) -> Path:
-    """Write bag, ground truth and scenario.json into ``target`` atomically (replacing it)."""
+                   progress: bool = False, extra: JSONDict | None = None,
+                   more: Callable[[Path], None] | None = None) -> Path:
+    """Write bag, ground truth and scenario.json into ``target`` atomically (replacing it);
+    ``extra`` adds keys to scenario.json, ``more`` writes further files into the folder."""
     from alte.io.writer import write_bag
 
     key = spec_hash(terrain, frames, storage, profile=sim.profile)
@@ -134,9 +142,11 @@ def write_scenario(target: str | os.PathLike[str], terrain: Terrain, sim: Simula
                   sim.mount, cloud_topic=CLOUD_TOPIC, pose_topic=POSE_TOPIC, storage=storage,
                   progress=progress, imu=_imu_samples(sim))
         write_ground_truth(tmp / GROUND_TRUTH_FILE, terrain.scene)
+        if more is not None:
+            more(tmp)
         run: JSONDict = {"seed": int(seed), "frames_requested": frames, "spec_hash": key,
                "storage": storage}
-        meta = _metadata(terrain, sim, run)
+        meta = {**_metadata(terrain, sim, run), **(extra or {})}
         meta["files"] = _file_table(tmp)
         (tmp / SCENARIO_FILE).write_text(json.dumps(meta, indent=2, sort_keys=True) + "\n")
     return Path(target)
@@ -204,7 +214,7 @@ def update_terrain(name: str, out_dir: str | os.PathLike[str] = "data", seed: in
                    progress: bool = False, profile: SensorProfile | None = None
                    ) -> tuple[Path, bool]:
     """As :func:`ensure_terrain`; also says whether the terrain was (re)simulated."""
-    terrain = get_terrain(name)
+    terrain = get_terrain(name, out_dir)
     target = terrain_folder(out_dir, name, frames, seed, profile)
     key = spec_hash(terrain, frames, storage, profile=profile)
     if not force and is_current(target, key, seed):

@@ -24,7 +24,7 @@ __all__ = ["CLASSES", "Scene", "SceneBuilder", "SceneObject"]
 #: Object classes of the ground truth, index = ``class_id`` stored per triangle.
 CLASSES: tuple[str, ...] = (
     "ground", "wall", "building", "overhang", "beam", "pillar", "car", "tree", "fence",
-    "debris", "buoy", "room",
+    "debris", "buoy", "room", "vegetation", "object",
 )
 
 

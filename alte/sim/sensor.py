@@ -91,7 +91,8 @@ class VLP16:
 
 @dataclass(frozen=True)
 class Hits:
-    """First-surface hits of K scans x M rays: distance (inf = miss), |cos| incidence, triangle."""
+    """First-surface hits of K scans x M rays: distance (inf = miss), ``|cos|`` incidence,
+    triangle."""
 
     distance: NDArray[np.float64]
     cos_incidence: NDArray[np.float64]

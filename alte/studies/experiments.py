@@ -21,10 +21,9 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import pandas as pd
-from tqdm.auto import tqdm
 
 from alte.errors import ParameterError
-from alte.mappers import Mapper, mapper_class
+from alte.mappers import Mapper
 from alte.metrics.maps import GroundTruth, MapMetrics, SetB, TruthOptions, measure_map
 from alte.metrics.timing import Timing
 from alte.params import Record
@@ -39,6 +38,7 @@ from alte.pipeline import (
     prepare,
     run,
 )
+from alte.progress import bar as progress_bar
 from alte.registration.odometry import OdometryParams
 from alte.studies.thesis.numbers import SWEEPS, sweep_table
 
@@ -54,7 +54,7 @@ REPEATS = 3
 #: map, seconds long, is timed once: its repeats would cost more than the rest of its row).
 REPEAT_BELOW_S = 0.5
 #: (mapper, feed) pairs this process has mapped with: their kernels are loaded.
-_WARM: set[tuple[str, str]] = set()
+_WARM: set[tuple[type[Mapper], str]] = set()
 
 
 @dataclass(eq=False)
@@ -126,7 +126,7 @@ def timed_run(data: Registered, spec: MapSpec, *, repeats: int = REPEATS,
     and the :class:`Timing` of the timed ones."""
     if repeats < 1:
         raise ParameterError(f"repeats={repeats}: expected at least 1")
-    warm = (spec.mapper, (spec.feed or mapper_class(spec.mapper).default_feed).value)
+    warm = (spec.cls, (spec.feed or spec.cls.default_feed).value)
     if warm not in _WARM:
         run(data, spec)
         _WARM.add(warm)
@@ -173,7 +173,8 @@ def sweep(data: Registered, table: int, rows: Sequence[int] | None = None, *,
         raise ParameterError(f"table 5.{table}: rows {bad or chosen} not in 0..5")
     thesis = sweep_table(table).iloc[chosen].reset_index(drop=True)
     runs = [measure(data, spec["mapper"], {**spec["rows"][r][0], **(extra or {})}, truth=truth)
-            for r in tqdm(chosen, desc=f"table 5.{table}", unit="map", disable=not progress)]
+            for r in progress_bar(chosen, desc=f"table 5.{table}", unit="map",
+                                  disable=not progress)]
     ours = pd.DataFrame([m.metrics.flat() for m in runs])
     ours.insert(0, "thesis_row", chosen)
     return pd.concat([thesis, ours], axis=1), runs

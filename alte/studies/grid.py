@@ -91,7 +91,10 @@ def tradeoff_table(rows: pd.DataFrame) -> pd.DataFrame:
     ``params`` as JSON, the terrain's ``case``, :data:`TRADEOFF_COLUMNS` first."""
     if rows.empty:
         raise ParameterError("trade-off grid: no finished runs to tabulate")
-    out = rows.assign(params=rows["params_json"], case=rows["terrain"].map(TERRAIN_CASE))
+    # An imported terrain's case is its maps' (the mappers the thesis applies to it).
+    by_mapper = {m: case for case, pair in CASE_MAPPERS.items() for m in pair}
+    case = rows["terrain"].map(TERRAIN_CASE).fillna(rows["mapper"].map(by_mapper))
+    out = rows.assign(params=rows["params_json"], case=case)
     out = out.drop(columns=[c for c in _DROP if c in out])
     first = [c for c in ("variant", *TRADEOFF_COLUMNS) if c in out]
     params = sorted(c for c in out.columns if str(c).startswith("p_"))
@@ -102,11 +105,13 @@ def tradeoff_table(rows: pd.DataFrame) -> pd.DataFrame:
 def run_grid(spec_path: str | os.PathLike[str], *, scheduler: str = "local", workers: int = 2,
              frames: int | str | None = "spec", seeds: Sequence[int] | None = None,
              data_dir: str | None = None, output: str | os.PathLike[str] | None = None,
-             progress: bool = True) -> Grid:
+             plugins: bool = False, progress: bool = True) -> Grid:
     """Run the sweep spec at ``spec_path`` (``frames``/``seeds``/``data_dir`` override the
-    spec's; ``frames="spec"`` keeps its own) into ``output`` and tabulate it."""
+    spec's; ``frames="spec"`` keeps its own; ``plugins``: add every installed plugin
+    mapper with its settings grid) into ``output`` and tabulate it."""
     spec = load_spec(spec_path)
-    changes: dict[str, object] = {"data_dir": data_dir, "seeds": list(seeds) if seeds else None}
+    changes: dict[str, object] = {"data_dir": data_dir, "seeds": list(seeds) if seeds else None,
+                                  "plugins": plugins}
     if frames != "spec":
         changes["frames"] = frames
     spec = override(spec, **changes)

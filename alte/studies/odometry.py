@@ -33,11 +33,11 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
-from tqdm.auto import tqdm
 
 from alte.errors import ParameterError
 from alte.metrics.trajectory import cloud_distance, rigid_alignment, trajectory_errors
 from alte.pipeline import FrameSpec, PoseSource, Registered, Source, open_input, prepare
+from alte.progress import bar as progress_bar
 from alte.registration.odometry import OdometryParams
 from alte.studies.analysis.tables import write_csv
 from alte.studies.experiments import CACHE_DIR
@@ -236,7 +236,7 @@ def odometry_table(inputs: Sequence[str | os.PathLike[str]] | None = None, *,
     chosen = [str(v) for v in inputs] if inputs else list(TERRAINS)
     cache = Path(data_dir) / CACHE_DIR
     tables = []
-    for what in tqdm(chosen, desc="pose benchmark", unit="input", disable=not progress):
+    for what in progress_bar(chosen, desc="pose benchmark", unit="input", disable=not progress):
         item = bench_input(what, reference=reference, voxel=voxel, frames=frames,
                            data_dir=data_dir, seed=seed)
         tables.append(pose_benchmark(item, sources, settings=settings, cache=cache,

@@ -111,8 +111,7 @@ def sensor_table(names: Sequence[str], data_dir: str | os.PathLike[str] = "data"
     ``scheduler`` and ``workers`` as for a sweep
     (:func:`~alte.studies.sweep.runner.executor`): each terrain and seed is one task and
     touches its own folders; the first failure is raised."""
-    from tqdm.auto import tqdm
-
+    from alte.progress import bar as progress_bar
     from alte.studies.sweep.runner import executor
 
     if seeds is not None and len(seeds) == 0:
@@ -123,7 +122,8 @@ def sensor_table(names: Sequence[str], data_dir: str | os.PathLike[str] = "data"
              for s in ((seed,) if seeds is None else seeds)]
     rows: list[dict[str, object]] = [{} for _ in items]
     with executor(scheduler, workers) as pool, \
-            tqdm(total=len(items), desc="sensor", unit="mission", disable=not progress) as bar:
+            progress_bar(total=len(items), desc="sensor missions", unit="mission",
+                         disable=not progress) as bar:
         for i, row, err in pool(_row, items, str(data_dir)):
             if err is not None:
                 raise err

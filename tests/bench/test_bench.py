@@ -8,8 +8,9 @@ import threading
 import numpy as np
 import pytest
 
-from alte.bench import ROWS, BenchConfig, Context, Result, run_bench, select_rows, write_outputs
-from alte.bench.output import format_value, miss_note, render_markdown
+from alte.bench.core import BenchConfig, Context, Result
+from alte.bench.output import format_value, miss_note, render_markdown, write_outputs
+from alte.bench.runner import ROWS, run_bench, select_rows
 from alte.bench.scaling import predicted_seconds, whole_scans
 from alte.bench.timing import (
     fit_exponent,
@@ -23,6 +24,7 @@ from alte.bench.wall import report_wall_time, stage_shares, thesis_total_s
 from alte.bench.workload import tile_points
 from alte.cli import main
 from alte.errors import ParameterError
+from alte.mappers import registry
 from alte.paths import realdata_dir
 from alte.report.runs import point_latest, write_record
 
@@ -118,7 +120,7 @@ def test_config_and_row_selection_errors():
         BenchConfig(budget_s=0)
     with pytest.raises(ParameterError, match=r"unknown row\(s\) \[99\]"):
         select_rows([1, 99])
-    assert select_rows(None) == sorted(ROWS) == list(range(1, 14))
+    assert select_rows(None) == sorted(ROWS) == list(range(1, 16))
     assert BenchConfig(quick=True).scaling_sizes == (3000, 6000, 12000)
     assert BenchConfig().scaling_sizes[-1] == 10**7
 
@@ -178,10 +180,14 @@ def quick_bench(tmp_path_factory):
     return run_bench(config)
 
 
+@pytest.mark.full
 @pytest.mark.slow
 def test_quick_bench_runs_every_row_and_writes_its_outputs(quick_bench):
     assert quick_bench.errors == {}
-    rows = set(range(1, 14)) if (REALDATA / "balm_seq").exists() else set(range(1, 12)) | {13}
+    rows = set(range(1, 12)) | {13}
+    rows |= {12} if (REALDATA / "balm_seq").exists() else set()
+    rows |= {14} if (REALDATA / "als").exists() else set()
+    rows |= {15} if (REALDATA / "isprs_terrain").exists() else set()
     assert {r.row for r in quick_bench.results} == rows
     for r in quick_bench.results:
         if r.row != 8:
@@ -192,11 +198,12 @@ def test_quick_bench_runs_every_row_and_writes_its_outputs(quick_bench):
     hd = [r for r in quick_bench.results if r.row == 4]
     assert all(r.detail["hd_m"] == r.detail["hd_open3d_m"] for r in hd)
     assert all(r.detail["mhd_m"] == r.detail["mhd_open3d_m"] for r in hd)
+    mappers = registry.classes()  # the thesis' four and the installed plugins
     latency = [r for r in quick_bench.results if r.row == 5]
-    assert len(latency) == 4
+    assert len(latency) == sum(cls.incremental for cls in mappers)
     assert [r.detail["same"] for r in latency if "same" in r.detail] == [True, True]
     chain = [r for r in quick_bench.results if r.row == 10]
-    assert len(chain) == 8 and all(r.detail["frames"] == 6 for r in chain)
+    assert len(chain) == 2 * len(mappers) and all(r.detail["frames"] == 6 for r in chain)
     assert all(r.detail["latency_ms"]["max"] >= r.detail["insert_ms"]["max"] for r in chain)
     assert [r.detail["frames"] for r in quick_bench.results if r.row == 11] == [3]
     poses = [r for r in quick_bench.results if r.row == 12]

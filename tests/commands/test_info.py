@@ -105,3 +105,13 @@ def test_info_refuses_a_truncated_ascii_pcd(tmp_path, capsys):
     err = capsys.readouterr().err
     assert err.count("\n") == 1
     assert f"{pcd}: truncated ascii PCD: 5 of the 10 rows its header announces" in err
+
+
+def test_info_needs_an_input_or_mappers(capsys):
+    assert main(["info"]) == 2
+    assert ("alte info: error: give INPUT (a bag, terrain folder or point file) or "
+            "--mappers") in capsys.readouterr().err
+    assert main(["info", "--mappers", "--json"]) == 0
+    rows = json.loads(capsys.readouterr().out)
+    assert [r["name"] for r in rows[:4]] == ["quadtree", "octomap", "alte2d", "alte3d"]
+    assert all(r["status"] == "ok" for r in rows)

@@ -208,3 +208,24 @@ def test_octomap_message_is_the_bt_payload(tmp_path: Path) -> None:
     assert theirs.occupied.sum() > 0
     assert np.isclose(ours.sizes[ours.occupied, 0].__pow__(3).sum(),
                       theirs.sizes[theirs.occupied, 0].__pow__(3).sum())
+
+
+def test_a_variance_layer_goes_out_in_grid_map_and_the_foxglove_grid() -> None:
+    """The cells' variance (the elevation map's) is painted like the height, becomes a
+    grid_map layer and a float32 Foxglove field after alpha (NaN where unknown)."""
+    cells = two_level_cells()
+    variance = np.arange(7, dtype=np.float64) / 100
+    cells = Cells(cells.centers, cells.sizes, cells.value, cells.occupied, cells.level,
+                  {"variance": variance})
+    grid = raster(cells, np.zeros(3))
+    assert list(grid.layers) == ["variance"] and grid.layers["variance"][0, 0] == 0.0
+    assert grid.layers["variance"][3, 3] == 0.06 and np.isnan(grid.layers["variance"][1, 3])
+    msg = grid_map(grid, 1, "map")
+    assert msg.layers == ["elevation", "occupancy", "variance"] and len(msg.data) == 3
+    fox = foxglove_grid(grid, 1, "map")
+    assert [(f.name, f.offset) for f in fox.fields][-1] == ("variance", 9)
+    assert fox.cell_stride == 13 and fox.row_stride == 4 * 13
+    raw = np.asarray(fox.data, dtype=np.uint8).reshape(4, 4, 13)
+    decoded = raw[..., 9:13].copy().view("<f4")[..., 0]
+    assert np.allclose(decoded, grid.layers["variance"], equal_nan=True)
+    assert raster(cells, np.zeros(3), dims=3).layers == {}  # 3D maps: no layer painted

@@ -29,7 +29,7 @@ def xy(size: float = 60.0) -> tuple[np.ndarray, np.ndarray]:
 @pytest.mark.parametrize(("given", "match"), [
     ({"window": 0}, r"occupancy: window=0.0 out of range \(window > 0\)"),
     ({"max_slope_deg": 90}, r"max_slope_deg=90.0 out of range \(0 < max_slope_deg < 90\)"),
-    ({"ground": "mesh"}, r"occupancy: ground='mesh' out of range \(plane\|local\)"),
+    ({"ground": "mesh"}, r"occupancy: ground='mesh' out of range \(plane\|local\|filter\)"),
     ({"ground_window": "wide"}, "ground_window='wide' is not a valid float"),
     ({"slope": 5}, r"occupancy: unknown parameter\(s\) slope; valid: ground, ground_window"),
 ])
@@ -65,6 +65,21 @@ def test_the_local_ground_follows_a_hill_that_a_plane_cannot() -> None:
     box = height.copy()
     box[(np.abs(x - 30) < 2) & (np.abs(y - 30) < 2)] += 1.0  # a 1 m box on the hilltop
     assert classify_surface(box, (0.0, 0.0), STEP).occupancy()[60, 60] == 100
+
+
+def test_the_filter_ground_follows_the_hill_and_flags_the_box() -> None:
+    """The ground stage's SMRF on the raster: the hill is landable, a 1 m box on its top
+    and a 3 m roof beside it are obstacles."""
+    x, y = xy()
+    height = 3.5 * np.exp(-((x - 30) ** 2 + (y - 30) ** 2) / (2 * 15.0**2))
+    rule = SurfaceRule(ground="filter")
+    assert classify_surface(height, (0.0, 0.0), STEP, rule).free.all()
+    box = height.copy()
+    box[(np.abs(x - 30) < 2) & (np.abs(y - 30) < 2)] += 1.0
+    box[(np.abs(x - 10) < 4) & (np.abs(y - 45) < 3)] += 3.0
+    surface = classify_surface(box, (0.0, 0.0), STEP, rule)
+    assert surface.obstacle[60, 60] and surface.obstacle[90, 20]
+    assert surface.obstacle.mean() < 0.05
 
 
 def test_local_ground_ignores_unknown_pixels_and_the_outside() -> None:

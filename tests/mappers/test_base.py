@@ -7,7 +7,6 @@ import pytest
 
 from alte.errors import MapperError
 from alte.mappers import (
-    MAPPERS,
     CellCounts,
     Cost,
     Domain,
@@ -16,9 +15,12 @@ from alte.mappers import (
     Mapper,
     check_export,
     make_mapper,
-    mapper_class,
+    registry,
 )
 from alte.mappers.base import check_points
+
+#: The thesis' four by name.
+BUILTIN = {cls.name: cls for cls in registry.BUILTIN}
 
 
 def test_check_points():
@@ -30,9 +32,9 @@ def test_check_points():
         check_points([[0, np.nan, 0]], "quadtree")
 
 
-@pytest.mark.parametrize("name", list(MAPPERS))
+@pytest.mark.parametrize("name", list(BUILTIN))
 def test_every_mapper_declares_its_capabilities(name):
-    cls = mapper_class(name)
+    cls = registry.resolve(name)
     mapper = make_mapper(name)
     assert isinstance(mapper, Mapper)
     assert cls.dims in (2, 3) and isinstance(cls.incremental, bool)
@@ -43,18 +45,18 @@ def test_every_mapper_declares_its_capabilities(name):
 
 
 def test_capabilities_of_the_four_mappers():
-    assert MAPPERS["quadtree"].default_feed is Feed.BATCH
-    assert MAPPERS["octomap"].domain_use is DomainUse.UNUSED and MAPPERS["octomap"].free_space
-    assert MAPPERS["alte3d"].domain_use is DomainUse.REQUIRED
-    assert MAPPERS["alte2d"].domain_use is DomainUse.OPTIONAL
-    assert ".bt" in MAPPERS["octomap"].exports and ".bt" not in MAPPERS["alte3d"].exports
+    assert BUILTIN["quadtree"].default_feed is Feed.BATCH
+    assert BUILTIN["octomap"].domain_use is DomainUse.UNUSED and BUILTIN["octomap"].free_space
+    assert BUILTIN["alte3d"].domain_use is DomainUse.REQUIRED
+    assert BUILTIN["alte2d"].domain_use is DomainUse.OPTIONAL
+    assert ".bt" in BUILTIN["octomap"].exports and ".bt" not in BUILTIN["alte3d"].exports
 
 
 def test_unknown_mapper_and_exports(tmp_path: Path):
     with pytest.raises(MapperError, match="unknown mapper 'octree'; valid: quadtree, octomap"):
         make_mapper("octree")
     with pytest.raises(MapperError, match=r"mapper 'alte3d' writes \.npz \(not \.bt\)"):
-        check_export(tmp_path / "map.bt", MAPPERS["alte3d"], overwrite=False)
+        check_export(tmp_path / "map.bt", BUILTIN["alte3d"], overwrite=False)
     with pytest.raises(MapperError, match="no native map format"):
         make_mapper("quadtree").write_native(tmp_path / "x.bt")
     with pytest.raises(MapperError, match="takes no domain"):
@@ -63,7 +65,7 @@ def test_unknown_mapper_and_exports(tmp_path: Path):
         make_mapper("octomap", domain=Domain(0, 0, 0, 1))
 
 
-@pytest.mark.parametrize("name", list(MAPPERS))
+@pytest.mark.parametrize("name", list(BUILTIN))
 def test_cell_counts_equal_the_cells_table(name):
     """``cell_counts`` (what ``alte map --json`` prints) counts what ``cells()`` holds."""
     rng = np.random.default_rng(3)
@@ -71,7 +73,7 @@ def test_cell_counts_equal_the_cells_table(name):
     points[:200, 2] += 4.0  # an obstacle, so some cells are occupied and some are not
     params = {"octomap": {"resolution": 2.0},
               "alte3d": {"min_pts": 2, "occupancy_level": 0}}.get(name, {})
-    text = {2: "0,0,20", 3: "0,0,-2,24"}[mapper_class(name).dims]
+    text = {2: "0,0,20", 3: "0,0,-2,24"}[registry.resolve(name).dims]
     domain = None if name == "octomap" else Domain.parse(text)
     mapper = make_mapper(name, params, domain=domain)
     mapper.build(points, np.array([10.0, 10.0, 20.0]))
@@ -100,7 +102,7 @@ def test_octomap_counts_ray_steps_and_end_voxels():
 def test_tree_maps_count_points_and_cell_updates(name):
     # 50 points in one finest cell: each is located, and one cell per level is written
     depth = {"quadtree": 12, "alte2d": 6, "alte3d": 6}[name]
-    text = {2: "0,0,64", 3: "0,0,0,64"}[mapper_class(name).dims]
+    text = {2: "0,0,64", 3: "0,0,0,64"}[registry.resolve(name).dims]
     points = np.full((50, 3), 0.1) + np.linspace(0, 0.001, 50)[:, None]
     mapper = make_mapper(name, {"max_points": 10} if name == "quadtree" else {},
                          domain=Domain.parse(text))

@@ -141,6 +141,7 @@ class Page:
         assert browser_logs(self.driver) == []
 
 
+@pytest.mark.full
 def test_chapter_notebook_runs_and_turns_in_jupyterlab(tmp_path: Path) -> None:
     before, data = _beside_notebooks(), _data_files()
     had_checkpoints = CHECKPOINTS.exists()

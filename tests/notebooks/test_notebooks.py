@@ -123,6 +123,7 @@ def _tiny_notebook(path: Path, root: Path) -> None:
     nbformat.write(nb, str(path))
 
 
+@pytest.mark.full
 @pytest.mark.slow
 def test_nbval_runs_headless_from_repo_root(tmp_path: Path) -> None:
     """notebooks/conftest.py makes nbval kernels headless and start in its parent folder."""

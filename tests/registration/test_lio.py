@@ -221,7 +221,7 @@ def uav_mission(tmp_path_factory):
 
 def test_lio_flies_the_first_five_seconds_of_the_uav_mission(uav_mission):
     """50 scans (5 s, 24 m): LiDAR-inertial ATE 5 mm, 3 mm off at the last scan, against
-    the simulator's truth (KISS-ICP over the whole mission: 34 m; README). The filter
+    the simulator's truth (KISS-ICP over the whole mission: 34 m; docs/results/lio.md). The filter
     starts from the IMU's 2 s at rest before the first scan (biases, zero velocity);
     without that start it had to learn the accelerometer bias while x and y were not
     yet seen, and was 0.95 m off here."""

@@ -59,7 +59,7 @@ def test_refine_turns_late_poses_back_and_keeps_positions(desynchronised) -> Non
     ref_m, ref_deg = _errors(out, positions, quats)
     assert rec_deg.max() > 8.0  # the late poses are far off
     assert ref_deg.mean() < 0.6 * rec_deg.mean() and ref_deg.max() < 0.6 * rec_deg.max()
-    settled = slice(6, None)  # scans 1-5 meet a map of one scan (README, "Poses")
+    settled = slice(6, None)  # scans 1-5 meet a map of one scan (docs/results/poses.md)
     assert ref_m[settled].mean() < rec_m[settled].mean() + 0.02
     assert counts.frames == SCANS and counts.corrected > SCANS // 2
     assert len(counts.scans) == SCANS and {"free", "constraint"} <= set(counts.scans[1])

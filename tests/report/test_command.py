@@ -74,6 +74,7 @@ def _kill(pid: int) -> None:
         os.kill(pid, signal.SIGKILL)
 
 
+@pytest.mark.full
 @pytest.mark.slow
 def test_killed_report_leaves_nothing_finished_and_rerun_completes(
         tmp_path: Path, notebooks: Path) -> None:

@@ -36,6 +36,7 @@ def _without_timing(path: Path) -> bytes:
     return out.getvalue().encode()
 
 
+@pytest.mark.full
 @pytest.mark.slow
 def test_ch5_tables_identical_across_runs_but_for_timing(tmp_path: Path) -> None:
     if not (ROOT / "notebooks" / "ch5_analysis.ipynb").exists():

@@ -45,6 +45,7 @@ print(json.dumps({"seconds": time.perf_counter() - start, "cells": len(cells), "
 """
 
 
+@pytest.mark.full
 @pytest.mark.slow
 @pytest.mark.parametrize("mapper", ["quadtree", "alte2d", "alte3d", "octomap"])
 def test_ten_million_points_fit_in_memory(mapper):

@@ -8,6 +8,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from alte.studies.analysis.tradeoff import mapper_title
 from alte.studies.answer import (
     USES,
     Budget,
@@ -108,3 +109,120 @@ def test_orders_count_the_equal_size_reads_each_mapper_wins():
     assert bottom_line(table).uses[1].choices == []  # no navigation rows
     single = order(table[table["seed"] == 0], LANDING, "mhd_m")
     assert single.leader == "quadtree" and single.reads == 6  # one recording: no interval
+
+
+def _fronts(first, second, terrains, case="lan"):
+    """Two mappers' fronts (five sizes), the first's truth ``first`` x the second's."""
+    pair = {"lan": ("quadtree", "alte2d"), "nav": ("octomap", "alte3d")}[case]
+    settings = {pair[0]: {f"a{i}": (100 * 3**i, first / (i + 1), 0.1, 0.9) for i in range(5)},
+                pair[1]: {f"b{i}": (100 * 3**i, second / (i + 1), 0.1, 0.9) for i in range(5)}}
+    table = grid(settings, terrains)
+    if case == "nav":
+        table = table.assign(case="nav", accuracy_mean_m=table["height_rmse_m"])
+    return table
+
+
+def test_real_terrain_classes_say_where_the_built_in_answer_holds():
+    from alte.studies.answer.classes import class_checks
+
+    builtin = _fronts(0.3, 0.2, ("sim_lan_1", "sim_lan_2"))  # 2D-ALTE leads
+    agree = _fronts(0.3, 0.2, ("ign_farmland",)).assign(terrain_class="flat open",
+                                                         evidence="flown")
+    disagree = _fronts(0.2, 0.3, ("pyfor_forest",)).assign(terrain_class="flat under forest",
+                                                           evidence="points")
+    checks = class_checks(builtin, pd.concat([agree, disagree]), LANDING)
+    assert [(c.terrain_class, c.evidence, c.verdict) for c in checks] == [
+        ("flat open", "flown", "holds"), ("flat under forest", "points", "does not hold")]
+    assert "flat open (ign_farmland; flown over the real surface" in checks[0].text()
+    assert class_checks(builtin, None, LANDING) == []
+    line = bottom_line(builtin, terrain=pd.concat([agree, disagree])).uses[0]
+    assert [c.verdict for c in line.classes] == ["holds", "does not hold"]
+
+
+def test_a_sequence_whose_landing_maps_are_metres_off_says_why_it_cannot_rank_them():
+    builtin = _fronts(0.3, 0.2, ("sim_lan_1", "sim_lan_2"))
+    far = _fronts(25.0, 21.5, ("balm_seq",)).query("seed == 0")  # best 4.3 m
+    landing = bottom_line(builtin, far).uses[0]
+    assert landing.real == []
+    assert landing.real_why.startswith("balm_seq cannot rank landing maps: its best map is 4.")
+    near = _fronts(0.3, 0.2, ("balm_seq",)).query("seed == 0")
+    ranked = bottom_line(builtin, near).uses[0]
+    assert ranked.real and not ranked.real_why
+
+
+def test_a_completeness_need_picks_the_most_accurate_map_covering_that_much():
+    table = _fronts(0.3, 0.2, ("sim_nav_1", "sim_nav_2"), case="nav")
+    table.loc[table["mapper"] == "alte3d", "completeness"] = 0.6  # accurate, covers less
+    pool = candidates(table, NAVIGATION, "simulated")
+    found = budgets(pool, NAVIGATION, cover=(0.8,))
+    # read off the candidates: the median (0.75) and the best third (0.9) of 0.6 and 0.9
+    assert [b.limit for b in found if b.kind == "cover"] == [0.75, 0.8, 0.9]
+    need = choose(pool, NAVIGATION, "simulated", ("sim_nav_1", "sim_nav_2"), Budget("cover", 0.8))
+    assert need.best.mapper == "octomap" and need.rival is None
+    loose = choose(pool, NAVIGATION, "simulated", ("sim_nav_1", "sim_nav_2"), Budget("cover", 0.6))
+    assert loose.best.mapper == "alte3d"
+    assert Budget("cover", 0.8).text(NAVIGATION) == "completeness >= 0.8 on every terrain"
+    assert [b.kind for b in budgets(candidates(grid(), LANDING, "simulated"), LANDING)].count(
+        "cover") == 0
+
+
+#: The elevation map's title: its plugin's when installed (make bootstrap installs it).
+ELEVATION = mapper_title("elevation")
+
+
+def _with_challenger(calibrated: float) -> pd.DataFrame:
+    """Quadtree and 2D-ALTE as in the orders test, and an elevation map (a 2D plugin) that
+    beats both on sim_lan_1 and loses to both on sim_lan_2, claiming a height sigma whose
+    2-sigma share is ``calibrated``; a 3D map in the same table is no challenger."""
+    fronts = {"quadtree": 0.3, "alte2d": 0.2, "elevation": 0.25, "octomap": 0.2}
+    table = grid({m: {f"{m}{i}": (100 * 3**i, k / (i + 1), k / (i + 1), 0.9)
+                      for i in range(5)} for m, k in fronts.items()})
+    table["dims"] = np.where(table["mapper"] == "octomap", 3, 2)
+    elevation = table["mapper"] == "elevation"
+    better = elevation & (table["terrain"] == "sim_lan_1")
+    table.loc[better, "height_rmse_m"] *= 0.2
+    table.loc[elevation & ~better, "height_rmse_m"] *= 1.3
+    table["within_2sigma"] = np.where(elevation, calibrated, np.nan)
+    table["sigma_mean_m"] = np.where(elevation, 0.01, np.nan)
+    return table
+
+
+def test_a_challenger_joins_the_candidates_and_is_read_terrain_by_terrain():
+    answer = bottom_line(_with_challenger(0.9)).uses[0]
+    assert answer.use.mappers == ("quadtree", "alte2d")
+    assert {d.rival for d in answer.duels} == {"quadtree", "alte2d"}
+    assert all(d.challenger == "elevation" for d in answer.duels)
+    text = answer.duels[0].text()
+    assert text == (f"{ELEVATION} against Quadtree, height RMSE at equal size: leads on "
+                    "sim_lan_1 (3 of 3 reads); loses on sim_lan_2 (3 of 3)")
+    assert any(c.best is not None and c.best.mapper == "elevation" for c in answer.choices)
+    (calibration,) = answer.calibration
+    assert calibration.median == 0.9 and calibration.maps == 30
+    assert calibration.text().startswith(
+        f"{ELEVATION} on the simulated terrains (sim_lan_1, sim_lan_2): the true height lies "
+        "within 2 claimed sigma on 90.0 % of the mapped area (median of 30 maps")
+    assert "over-confident" in calibration.text()
+    assert "cautious" in bottom_line(_with_challenger(0.99)).uses[0].calibration[0].text()
+    assert "): calibrated" in bottom_line(_with_challenger(0.95)).uses[0].calibration[0].text()
+
+
+def test_without_a_dims_column_there_is_no_challenger():
+    table = _with_challenger(0.9).drop(columns=["dims", "within_2sigma"])
+    answer = bottom_line(table).uses[0]
+    assert answer.duels == [] and answer.calibration == []
+
+
+def test_a_challenger_is_read_per_class_of_real_terrain():
+    """The real-terrain evidence with the challenger's rows: read against each of the
+    thesis' two per class and kind of evidence, and its flown maps' calibration per class."""
+    real = _with_challenger(0.9)
+    real = real[real["mapper"] != "octomap"].assign(
+        evidence="flown", terrain_class=lambda t: t["terrain"].map(
+            {"sim_lan_1": "flat open", "sim_lan_2": "slope"}))
+    answer = bottom_line(_with_challenger(0.9), terrain=real).uses[0]
+    (vs_quadtree,) = [d for d in answer.duels if d.where and d.rival == "quadtree"]
+    assert vs_quadtree.text() == (
+        f"{ELEVATION} against Quadtree on real terrain, height RMSE at equal size: leads on "
+        "flat open (flown) (3 of 3 reads); loses on slope (flown) (3 of 3)")
+    classes = [c.group for c in answer.calibration]
+    assert classes == ["simulated", "real flat open", "real slope"]

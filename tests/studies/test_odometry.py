@@ -58,14 +58,15 @@ def test_benchmark_errors_are_typed(tmp_path: Path, capsys) -> None:
     assert "--reference" in capsys.readouterr().err
 
 
+@pytest.mark.full
 @pytest.mark.slow
 @pytest.mark.realdata
 def test_balm_seq_figures(tmp_path: Path) -> None:
     """The real sequence with its BALM poses: KISS-ICP's defaults within 35 mm (median) of
     the reference-pose cloud as placed from the first reference pose (measured 31.6 mm),
     25 mm after the rigid alignment (measured 21.2 mm; the 20 mm goal is not met yet),
-    refinement within 1.1x of the recorded poses (measured: every scan kept, 1.0x; README,
-    "Poses")."""
+    refinement within 1.1x of the recorded poses (measured: every scan kept, 1.0x;
+    docs/results/poses.md)."""
     if not BALM.exists():
         pytest.skip("../shared/realdata/balm_seq absent")
     item = bench_input(BALM / "bag")  # its /lidar_pose topic as the reference

@@ -25,13 +25,13 @@ def skip_ray(okey: NDArray[np.int64], k: NDArray[np.int64]) -> bool:
 
 @numba.njit(cache=True, inline="always")
 def walk_limit(okey: NDArray[np.int64], k: NDArray[np.int64]) -> int:
-    """The most voxels a ray to key ``k`` steps through (|dk|_1 and a margin)."""
+    """The most voxels a ray to key ``k`` steps through (``|dk|_1`` and a margin)."""
     return int(abs(k[0] - okey[0]) + abs(k[1] - okey[1]) + abs(k[2] - okey[2]) + 5)
 
 
 @numba.njit(cache=True)
 def _steps(okey: NDArray[np.int64], ekeys: NDArray[np.int64]) -> int:
-    """Voxel steps of the scan's walks (|dk|_1 of the valid ray ends)."""
+    """Voxel steps of the scan's walks (``|dk|_1`` of the valid ray ends)."""
     steps = 0
     for i in range(ekeys.shape[0]):
         if ekeys[i, 0] >= 0:

@@ -12,7 +12,7 @@ frames can be inserted one at a time with no ``domain`` parameter.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import ClassVar, Literal, Protocol
@@ -24,6 +24,7 @@ from alte.errors import MapperError, ParameterError
 from alte.fsutil import atomic_path
 from alte.mappers._rows import unique_rows
 from alte.mappers.base import (
+    API_VERSION,
     CellCounts,
     Cells,
     Cost,
@@ -130,7 +131,9 @@ class Octomap:
     point voxels occupied once with no ray casting (no free space).
     """
 
+    api_version: ClassVar[int] = API_VERSION
     name: ClassVar[str] = "octomap"
+    title: ClassVar[str] = "Octomap"
     dims: ClassVar[int] = 3
     incremental: ClassVar[bool] = True
     domain_use: ClassVar[DomainUse] = DomainUse.UNUSED
@@ -140,6 +143,9 @@ class Octomap:
     #: Every parameter changes the log-odds the tree stores.
     view_params: ClassVar[frozenset[str]] = frozenset()
     cost_unit: ClassVar[Cost] = Cost.RAY_STEPS
+    layers: ClassVar[frozenset[str]] = frozenset()
+    settings_grid: ClassVar[Mapping[str, tuple[object, ...]]] = {
+        "resolution": (0.5, 0.75, 1.0, 1.5, 2.0, 2.5, 3.0, 4.0, 5.0, 6.0)}
     Params: ClassVar[type[Record]] = OctomapParams
 
     def __init__(self, domain: Domain | None = None, *, record: Record | None = None,

@@ -11,9 +11,9 @@ range like ``computeUpdate``. Keys are 48-bit Morton codes (x in the lowest bit 
 each triple), so sorting them puts the eight children of every octree node next to
 each other. ``_scan`` drives the walks over a scan and de-duplicates the keys.
 
-The key can equal the end key only after exactly |dk|_1 steps (each axis moves
+The key can equal the end key only after exactly ``|dk|_1`` steps (each axis moves
 monotonically), so :func:`walk_hashed` compares it then alone. The step limit
-|dk|_1 + 5 only stops a ray that float round-off carries past its end voxel, so a walk
+``|dk|_1`` + 5 only stops a ray that float round-off carries past its end voxel, so a walk
 strays at most 4 voxels from the box of its origin and end keys.
 """
 
@@ -191,7 +191,7 @@ def flat_starts(rays: Ray, res: float, grid: NDArray[np.int64],
         ints[m, 0], ints[m, 1], ints[m, 2], ints[m, 3] = first, sx, sy * grid[3], sz * grid[4]
         ints[m, 4] = first + (k[0] - okey[0]) + (k[1] - okey[1]) * grid[3] \
             + (k[2] - okey[2]) * grid[4]
-        ints[m, 5] = last + 4  # the step limit |dk|_1 + 5, less the origin's voxel
+        ints[m, 5] = last + 4  # the step limit ``|dk|_1`` + 5, less the origin's voxel
         m += 1
     return floats[:m], ints[:m]
 

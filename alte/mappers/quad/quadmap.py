@@ -18,6 +18,7 @@ a batch build with ``domain`` set to the grown root (:attr:`QuadMap.square`).
 from __future__ import annotations
 
 import copy
+from collections.abc import Mapping
 from pathlib import Path
 from typing import ClassVar, Self, TypeAlias
 
@@ -27,6 +28,7 @@ from numpy.typing import NDArray
 from alte.errors import MapperError
 from alte.mappers._rows import unique_rows
 from alte.mappers.base import (
+    API_VERSION,
     CellCounts,
     Cells,
     Cost,
@@ -74,7 +76,9 @@ def rectangle_corners(cells: Cells, mask: NDArray[np.bool_]) -> NDArray[np.float
 class QuadMap:
     """Base of the 2D mappers (Quadtree, 2D-ALTE); see the module docstring."""
 
+    api_version: ClassVar[int] = API_VERSION
     name: ClassVar[str] = "quadmap"
+    title: ClassVar[str] = "quadmap"
     dims: ClassVar[int] = 2
     incremental: ClassVar[bool] = True
     domain_use: ClassVar[DomainUse] = DomainUse.OPTIONAL
@@ -84,6 +88,8 @@ class QuadMap:
     cost_unit: ClassVar[Cost] = Cost.CELL_UPDATES
     Params: ClassVar[type[Record]] = Record
     view_params: ClassVar[frozenset[str]] = frozenset()
+    layers: ClassVar[frozenset[str]] = frozenset()
+    settings_grid: ClassVar[Mapping[str, tuple[object, ...]]] = {}
     _NVALUES: ClassVar[int] = 1
 
     def __init__(self, domain: Domain | None = None, *, record: Record | None = None,

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import pandas as pd
 
 from alte.errors import ParameterError
-from alte.studies.analysis.tradeoff import MAPPER_NAMES, METRICS
+from alte.studies.analysis.tradeoff import METRICS, mapper_title
 from alte.studies.thesis.numbers import TERRAIN_CASE
 
 __all__ = ["ELAPSED", "STAT_COLUMNS", "CheckValues", "NoDataError", "case_rows", "name",
@@ -58,7 +58,7 @@ class CheckValues:
 
 def name(mapper: str) -> str:
     """A mapper's display name."""
-    return MAPPER_NAMES.get(mapper, mapper)
+    return mapper_title(mapper)
 
 
 def unit(metric: str) -> str:

@@ -20,7 +20,7 @@ from collections.abc import Sequence
 import pandas as pd
 
 from alte.studies.analysis.evidence import Finding
-from alte.studies.analysis.tradeoff import MAPPER_NAMES, METRICS, label
+from alte.studies.analysis.tradeoff import METRICS, label, mapper_title
 from alte.studies.thesis.claims.types import (
     Agreement,
     AllOf,
@@ -46,7 +46,7 @@ def _pair(check: Check) -> str:
     better, other = getattr(check, "better", None), getattr(check, "other", None)
     if not (isinstance(better, str) and isinstance(other, str)):
         return ""
-    return f" ({MAPPER_NAMES.get(better, better)} vs {MAPPER_NAMES.get(other, other)})"
+    return f" ({mapper_title(better)} vs {mapper_title(other)})"
 
 
 def part_label(check: Check, pair: bool = False) -> str:
@@ -55,7 +55,7 @@ def part_label(check: Check, pair: bool = False) -> str:
     if isinstance(check, Compare):
         return f"{label(check.metric, False)} {_VIEWS[check.at]}" + (_pair(check) if pair
                                                                      else "")
-    mapper = MAPPER_NAMES.get(getattr(check, "mapper", ""), getattr(check, "mapper", ""))
+    mapper = mapper_title(getattr(check, "mapper", ""))
     if isinstance(check, Trend):
         return f"{label(check.metric, False)} with {label(check.x, False)} ({mapper})"
     if isinstance(check, Agreement):

@@ -35,7 +35,7 @@ import numpy as np
 import pandas as pd
 
 from alte.studies.analysis.measures import CheckValues, NoDataError, measure_check
-from alte.studies.analysis.tradeoff import MAPPER_NAMES, prepare
+from alte.studies.analysis.tradeoff import mapper_title, prepare
 from alte.studies.analysis.uncertainty import (
     CONFIDENCE,
     Interval,
@@ -149,11 +149,11 @@ def _cell_verdict(cells: pd.DataFrame, level_kind: str) -> tuple[str, str]:
 
 
 def _property(p: Property) -> tuple[str, str]:
-    from alte.mappers import MAPPERS
+    from alte.mappers import registry
 
-    values = {m: bool(getattr(MAPPERS[m], p.attribute)) for m in (*p.true, *p.false)}
+    values = {m: bool(getattr(registry.resolve(m), p.attribute)) for m in (*p.true, *p.false)}
     wrong = [m for m in p.true if not values[m]] + [m for m in p.false if values[m]]
-    text = ", ".join(f"{MAPPER_NAMES.get(m, m)}: {p.attribute} = {values[m]}" for m in values)
+    text = ", ".join(f"{mapper_title(m)}: {p.attribute} = {values[m]}" for m in values)
     return (_FAILS if wrong else _HOLDS), f"our implementations: {text}"
 
 

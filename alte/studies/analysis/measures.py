@@ -30,7 +30,6 @@ from numpy.typing import ArrayLike
 from scipy.stats import spearmanr
 
 from alte.errors import ParameterError
-from alte.mappers import mapper_class
 from alte.studies.analysis.checks import (
     ELAPSED,
     STAT_COLUMNS,
@@ -268,9 +267,10 @@ def _by_cost(check: Check, table: pd.DataFrame) -> CheckValues:
     if "cost" not in mine or mine.empty or mine["cost"].isna().any():
         return replace(_measure(timed, table), time="cpu")
     found = _measure(renamed(check, ELAPSED, "cost"), table)
-    units = ", ".join(dict.fromkeys(mapper_class(m).cost_unit.value for m in _mappers(check)))
-    return replace(found, what=f"{found.what}; cost in {units}", time="cost",
-                   crosscheck=_measure(timed, table))
+    units = ", ".join(dict.fromkeys(str(u) for u in mine["cost_unit"].dropna())
+                      if "cost_unit" in mine else ())  # the rows carry their cost's unit
+    return replace(found, what=f"{found.what}; cost in {units}" if units else found.what,
+                   time="cost", crosscheck=_measure(timed, table))
 
 
 def measure_check(check: Check, table: pd.DataFrame) -> CheckValues:

@@ -27,7 +27,7 @@ from alte.errors import ParameterError
 from alte.studies.analysis.uncertainty import CONFIDENCE, bootstrap_ci
 from alte.studies.thesis.numbers import COMPARISONS, SWEEPS
 
-__all__ = ["MAPPER_NAMES", "METRICS", "OPTIONAL_COLUMNS", "REQUIRED_COLUMNS", "equal_fidelity",
+__all__ = ["METRICS", "OPTIONAL_COLUMNS", "REQUIRED_COLUMNS", "equal_fidelity",
            "equal_size", "fronts", "interval_table", "label", "matching", "pareto_front",
            "parse_params", "prepare", "read_at_size", "size_for_fidelity", "thesis_setting"]
 
@@ -42,9 +42,16 @@ REQUIRED_COLUMNS = ("terrain", "mapper", "params", "seed", "basis_functions", "o
 OPTIONAL_COLUMNS = ("mh_ab_m", "mh_ba_m", "height_rmse_m", "size_octaves", "hd_minus_mhd_m",
                     "elapsed_spread", "map_cpu_s", "map_cpu_spread", "time_repeats", "cost",
                     "cost_unit")
-#: Display names of the mappers.
-MAPPER_NAMES = {"quadtree": "Quadtree", "octomap": "Octomap", "alte2d": "2D-ALTE",
-                "alte3d": "3D-ALTE"}
+
+
+def mapper_title(name: str) -> str:
+    """The display name of a mapper by its name in a table: its class's ``title``, found by
+    the registry (:func:`alte.mappers.registry.title`; imported on first use, the mappers'
+    kernels being heavy), or the name itself for a mapper this process does not know."""
+    from alte.mappers import registry
+
+    return registry.title(name)
+
 #: Metric -> (label, unit) for text, tables and axes.
 METRICS: dict[str, tuple[str, str]] = {
     "basis_functions": ("basis functions", ""), "occupied_cells": ("occupied cells", ""),

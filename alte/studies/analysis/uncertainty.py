@@ -32,13 +32,14 @@ __all__ = ["CONFIDENCE", "RUN_TIME_SPREAD", "TIME_SPREAD_FLOOR", "Interval", "bo
 #: Confidence level of every interval in the report.
 CONFIDENCE = 0.95
 #: Least spread of a map's time (half the log of max/min; 0.25: within a factor 1.28 of
-#: the middle), from the run-to-run differences of the grid's CPU times (README, "Time").
+#: the middle), from the run-to-run differences of the grid's CPU times
+#: (docs/explanation/verdicts.md).
 TIME_SPREAD_FLOOR = 0.25
 #: Spread of a time compared between mappers (a claim on two mappers' times): the
 #: run-to-run spread of the same maps' CPU times between four whole chapter 5 grids run at
 #: load averages 1 to 16 (95 % of 1,344 maps within exp(2 x 0.16-0.32) between any two),
 #: for every map alike: a map's own repeats say how loaded the machine was in that second,
-#: and verdicts that followed them moved between runs (README, "Time").
+#: and verdicts that followed them moved between runs (docs/explanation/verdicts.md).
 RUN_TIME_SPREAD = 0.35
 
 

@@ -1,13 +1,15 @@
 """Which map to build under a budget, read off the trade-off grid.
 
 A *use* is one of the thesis' cases with its two mappers and the ground-truth metric that
-ranks their maps (:data:`USES`): landing (Quadtree or 2D-ALTE, ranked by the true height
-RMSE, obstacle recall shown beside it) and urban navigation (Octomap or 3D-ALTE, ranked
-by mean accuracy, the distance of the occupied cells to the true surface, completeness
-shown beside it). A map covering less than half of the true surface
-(:data:`MIN_COMPLETENESS`) is never chosen: few cells are accurate cheaply, and a
-planner cannot use a map that misses most surfaces. Terrains are taken in two groups of
-one scale (:data:`GROUPS`): the simulated urban-scale terrains and the lab terrains.
+ranks their maps (:data:`USES`; further mappers of the use's dimension in the grid, e.g. a
+plugin, join its candidates: :mod:`~alte.studies.answer.challengers`): landing (Quadtree
+or 2D-ALTE, ranked by the true height RMSE, obstacle recall shown beside it) and urban
+navigation (Octomap or 3D-ALTE, ranked by mean accuracy, the distance of the occupied
+cells to the true surface, completeness shown beside it). A map covering less than half
+of the true surface (:data:`MIN_COMPLETENESS`) is never chosen: few cells are accurate
+cheaply, and a planner cannot use a map that misses most surfaces. Terrains are taken in
+two groups of one scale (:data:`GROUPS`): the simulated urban-scale terrains and the lab
+terrains.
 
 A *candidate* is one mapper setting; on a group its size and time per scan are the
 worst (largest) of its terrains' means over seeds, so a budget met holds on every terrain,
@@ -17,7 +19,12 @@ bootstrap interval over seeds. Under a :class:`Budget`:
 * ``size``: the best truth among candidates of at most that many basis functions;
 * ``time``: the best truth among candidates mapping a scan in at most that many ms
   (the mapper's CPU time over the grid's scans);
-* ``need``: the smallest candidate whose truth meets the need on every terrain.
+* ``need``: the smallest candidate whose truth meets the need on every terrain;
+* ``cover`` (navigation): the best truth among candidates covering at least that share
+  of the true surface on every terrain (completeness): ranked by mean accuracy alone, the
+  pick may cover little more than :data:`MIN_COMPLETENESS`, so a planner that needs most
+  surfaces states its need. Two needs are read off the candidates (the median and the
+  best third of their worst-terrain completeness); others are the reader's (``cover``).
 
 Time budgets and the need are read off the candidates (:func:`budgets`), so they sit
 where the choice is a real one. A :class:`Choice` holds the pick, the other mapper's
@@ -34,7 +41,7 @@ from typing import Literal
 import numpy as np
 import pandas as pd
 
-from alte.studies.analysis.tradeoff import MAPPER_NAMES, METRICS
+from alte.studies.analysis.tradeoff import METRICS, mapper_title
 from alte.studies.analysis.uncertainty import Interval, bootstrap_ci
 from alte.studies.obstacles import setting_text
 
@@ -44,19 +51,23 @@ __all__ = ["GROUPS", "MIN_COMPLETENESS", "SIZE_BUDGETS", "USES", "Budget", "Choi
 
 @dataclass(frozen=True)
 class Use:
-    """A case of the thesis: its mappers, the truth that ranks them, a second one shown."""
+    """A case of the thesis: its mappers (the thesis' two first), the truth that ranks them,
+    a second one shown, and the dimension of its maps (``dims``)."""
 
     name: str
     case: str
-    mappers: tuple[str, str]
+    mappers: tuple[str, ...]
     truth: str
     second: str
     truth_higher: bool = False
+    dims: int | None = None
 
 
 #: The two uses the thesis studies.
-USES = (Use("landing", "lan", ("quadtree", "alte2d"), "height_rmse_m", "obstacle_recall"),
-        Use("navigation", "nav", ("octomap", "alte3d"), "accuracy_mean_m", "completeness"))
+USES = (Use("landing", "lan", ("quadtree", "alte2d"), "height_rmse_m", "obstacle_recall",
+            dims=2),
+        Use("navigation", "nav", ("octomap", "alte3d"), "accuracy_mean_m", "completeness",
+            dims=3))
 #: The least completeness of a map that may be chosen.
 MIN_COMPLETENESS = 0.5
 #: Terrain groups of one scale: name -> terrain-name prefix.
@@ -69,7 +80,7 @@ SIZE_BUDGETS = (1_000.0, 5_000.0, 20_000.0)
 class Budget:
     """A limit on size (basis functions), time (ms per scan), or a need on the truth."""
 
-    kind: Literal["size", "time", "need"]
+    kind: Literal["size", "time", "need", "cover"]
     limit: float
 
     def text(self, use: Use) -> str:
@@ -78,6 +89,8 @@ class Budget:
             return f"at most {self.limit:,.0f} basis functions"
         if self.kind == "time":
             return f"at most {self.limit:g} ms per scan"
+        if self.kind == "cover":
+            return f"completeness >= {self.limit:.2g} on every terrain"
         name, unit = METRICS.get(use.truth, (use.truth, ""))
         sign = ">=" if use.truth_higher else "<="
         return f"{name} {sign} {self.limit:.3g}{' ' + unit if unit else ''}"
@@ -98,7 +111,7 @@ class Pick:
     @property
     def name(self) -> str:
         """The mapper's display name."""
-        return MAPPER_NAMES.get(self.mapper, self.mapper)
+        return mapper_title(self.mapper)
 
 
 @dataclass(frozen=True)
@@ -149,6 +162,7 @@ def candidates(table: pd.DataFrame, use: Use, group: str) -> pd.DataFrame:
                                       if np.isfinite(values).any() else np.nan)
         by_terrain = mine.groupby("terrain")[[use.truth, "completeness"]].mean()
         item["worst"] = float(by_terrain[use.truth].agg("min" if use.truth_higher else "max"))
+        item["worst_completeness"] = float(by_terrain["completeness"].min())
         item["covers"] = bool((by_terrain["completeness"] >= MIN_COMPLETENESS).all())
         out.append(item)
     pool = pd.DataFrame(out)
@@ -159,10 +173,12 @@ def _round(value: float, digits: int) -> float:
     return float(f"{value:.{digits}g}")
 
 
-def budgets(pool: pd.DataFrame, use: Use) -> list[Budget]:
+def budgets(pool: pd.DataFrame, use: Use, cover: Sequence[float] = ()) -> list[Budget]:
     """The size budgets, two time budgets (the fastest quarter and three quarters of the
-    candidates fit, one significant digit) and a need met by the best third of the
-    candidates on their worst terrain (two significant digits)."""
+    candidates fit, one significant digit), a need met by the best third of the
+    candidates on their worst terrain (two significant digits) and, where the use shows
+    completeness beside its truth, completeness needs: ``cover`` and two read off the
+    candidates (module docstring)."""
     out = [Budget("size", b) for b in SIZE_BUDGETS]
     if pool.empty:
         return out
@@ -173,6 +189,11 @@ def budgets(pool: pd.DataFrame, use: Use) -> list[Budget]:
     if len(worst):
         level = float(np.quantile(worst, 2 / 3 if use.truth_higher else 1 / 3))
         out.append(Budget("need", _round(level, 2)))
+    if use.second == "completeness" and "worst_completeness" in pool:
+        cover_of = pool["worst_completeness"].dropna()
+        read = [_round(float(np.quantile(cover_of, q)), 2) for q in (0.5, 2 / 3)
+                if len(cover_of)]
+        out += [Budget("cover", c) for c in sorted({*read, *cover})]
     return list(dict.fromkeys(out))
 
 
@@ -198,6 +219,8 @@ def _feasible(pool: pd.DataFrame, budget: Budget, use: Use) -> pd.DataFrame:
         return pool[pool["size"] <= budget.limit]
     if budget.kind == "time":
         return pool[pool["ms"] <= budget.limit]
+    if budget.kind == "cover":
+        return pool[pool["worst_completeness"] >= budget.limit]
     met = pool["worst"] >= budget.limit if use.truth_higher else pool["worst"] <= budget.limit
     return pool[met]
 

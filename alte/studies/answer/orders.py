@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 
 import pandas as pd
 
-from alte.studies.analysis.tradeoff import MAPPER_NAMES, equal_size, label, prepare
+from alte.studies.analysis.tradeoff import equal_size, label, mapper_title, prepare
 from alte.studies.analysis.uncertainty import bootstrap_ci
 from alte.studies.answer.choose import Use
 
@@ -60,7 +60,7 @@ class Order:
         for mapper, n in sorted(self.leads.items(), key=lambda kv: -kv[1]):
             if n:
                 places = ", ".join(self.where.get(mapper, ())) if where else ""
-                parts.append(f"{MAPPER_NAMES.get(mapper, mapper)} on {n} of {self.reads} "
+                parts.append(f"{mapper_title(mapper)} on {n} of {self.reads} "
                              f"read{'s' if self.reads != 1 else ''}"
                              + (f" ({places})" if places and not parts else ""))
         if self.undecided:
@@ -70,15 +70,16 @@ class Order:
 
 def _reads(table: pd.DataFrame, use: Use, metric: str) -> pd.DataFrame:
     """(terrain, level, seed, difference first minus second mapper) at equal size."""
-    rows = table[table["mapper"].isin(use.mappers)]
-    if metric not in rows or rows[metric].isna().all() or set(use.mappers) - set(rows["mapper"]):
+    pair = use.mappers[:2]
+    rows = table[table["mapper"].isin(pair)]
+    if metric not in rows or rows[metric].isna().all() or set(pair) - set(rows["mapper"]):
         return pd.DataFrame(columns=["terrain", "level", "seed", "diff"])
-    reads = equal_size(prepare(rows), use.mappers, metric, higher_is_better=metric in HIGHER)
+    reads = equal_size(prepare(rows), pair, metric, higher_is_better=metric in HIGHER)
     wide = reads.pivot_table(index=["terrain", "level", "seed"], columns="mapper",
                              values="value").dropna()
-    if wide.empty or set(use.mappers) - set(wide.columns):
+    if wide.empty or set(pair) - set(wide.columns):
         return pd.DataFrame(columns=["terrain", "level", "seed", "diff"])
-    first, second = use.mappers
+    first, second = use.mappers[:2]
     return (wide[first] - wide[second]).rename("diff").reset_index()
 
 
@@ -86,8 +87,9 @@ def order(table: pd.DataFrame, use: Use, metric: str) -> Order:
     """The equal-size reads of ``metric`` for ``use``'s mappers on ``table``'s terrains."""
     diffs = _reads(table, use, metric)
     sign = 1.0 if metric in HIGHER else -1.0  # a positive signed difference: first leads
-    leads = dict.fromkeys(use.mappers, 0)
-    where: dict[str, list[str]] = {m: [] for m in use.mappers}
+    pair = use.mappers[:2]
+    leads = dict.fromkeys(pair, 0)
+    where: dict[str, list[str]] = {m: [] for m in pair}
     reads = 0
     for (terrain, _), group in diffs.groupby(["terrain", "level"], sort=True):
         ci = bootstrap_ci(sign * group["diff"].to_numpy(float))
@@ -95,7 +97,7 @@ def order(table: pd.DataFrame, use: Use, metric: str) -> Order:
             continue
         reads += 1
         low, high = (ci.estimate, ci.estimate) if ci.seeds == 1 else (ci.low, ci.high)
-        winner = use.mappers[0] if low > 0 else use.mappers[1] if high < 0 else ""
+        winner = pair[0] if low > 0 else pair[1] if high < 0 else ""
         if winner:
             leads[winner] += 1
             where[winner].append(str(terrain))

@@ -1,4 +1,4 @@
-"""Landing-zone detection on 2D maps (Quadtree, 2D-ALTE), scored against ground truth.
+"""Landing-zone detection on 2D maps (Quadtree, 2D-ALTE, 2D plugins), scored against truth.
 
 Thesis 1.2 defines a landing zone as "any planar site, free of obstacles, with a clear
 approach path, and with an area big enough for the vehicle to land". Here a 2D map is
@@ -19,7 +19,7 @@ from alte.studies.landing.detect import (
     rank_sites,
 )
 from alte.studies.landing.experiment import (
-    LANDING_MAPPERS,
+    GRID_ROWS,
     SWEEP_ROWS,
     LandingRun,
     evaluate_landing,
@@ -32,8 +32,20 @@ from alte.studies.landing.experiment import (
     score_landing,
     write_landing_table,
 )
-from alte.studies.landing.params import LAB, QUADROTOR, LandingParams, landing_params
-from alte.studies.landing.raster import Grid, PlaneFeatures, plane_features, rasterise
+from alte.studies.landing.params import (
+    LAB,
+    QUADROTOR,
+    SIGMA_OF_OBSTACLE,
+    LandingParams,
+    landing_params,
+)
+from alte.studies.landing.raster import (
+    Grid,
+    PlaneFeatures,
+    plane_features,
+    rasterise,
+    rasterise_sigma,
+)
 from alte.studies.landing.truth import (
     GROUND_CLASSES,
     object_footprints,
@@ -43,10 +55,11 @@ from alte.studies.landing.truth import (
 )
 
 __all__ = [
+    "GRID_ROWS",
     "GROUND_CLASSES",
     "LAB",
-    "LANDING_MAPPERS",
     "QUADROTOR",
+    "SIGMA_OF_OBSTACLE",
     "SITE_COLUMNS",
     "SWEEP_ROWS",
     "Centres",
@@ -70,6 +83,7 @@ __all__ = [
     "plane_features",
     "rank_sites",
     "rasterise",
+    "rasterise_sigma",
     "score_detection",
     "score_landing",
     "top_surface",

@@ -9,7 +9,11 @@ centre on a raster of the 2D map:
   standard deviation of at most ``max_roughness`` (m);
 * no obstacle lies closer than ``radius + clearance`` to the centre (and none inside
   the disk), an obstacle being a raster pixel more than ``obstacle_height`` above or
-  below the ground plane.
+  below the ground plane;
+* with ``max_height_sigma`` set (a map whose cells carry a height variance, e.g. the
+  elevation map), every pixel of the disk is known to within that standard deviation: a
+  pixel the map is less sure of counts as unknown, so a flat patch the map has barely
+  seen is not a site. :data:`SIGMA_OF_OBSTACLE` is the bound the landing study tries.
 
 Defaults fit the thesis' quadrotor over the simulated urban-scale terrains; the
 experimental terrains live in an 8 m x 6 m lab, where the same vehicle would not fit
@@ -25,7 +29,12 @@ from alte.errors import ParameterError
 from alte.ground.surface import SurfaceRule
 from alte.params import Record, param
 
-__all__ = ["LAB", "QUADROTOR", "LandingParams", "landing_params"]
+__all__ = ["LAB", "QUADROTOR", "SIGMA_OF_OBSTACLE", "LandingParams", "landing_params"]
+
+#: The height sigma bound the landing study tries, as a share of the obstacle height:
+#: 2 sigma of a quarter of the step that makes an obstacle leaves a known pixel's height
+#: within half that step, so no obstacle hides in the map's uncertainty.
+SIGMA_OF_OBSTACLE = 0.25
 
 
 @dataclass(frozen=True)
@@ -49,6 +58,10 @@ class LandingParams(Record):
     step: float = param(0.25, lambda v: v > 0, "0 < step <= radius", "raster pixel (m)")
     max_sites: int = param(5, lambda v: v >= 1, "max_sites >= 1",
                            "best ranked sites chosen and scored")
+    max_height_sigma: float | None = param(
+        None, lambda v: v > 0, "max_height_sigma > 0",
+        "largest height standard deviation of a pixel a site may hold (m; None: no bound; "
+        "needs a map with a height variance)")
 
     def __post_init__(self) -> None:
         super().__post_init__()

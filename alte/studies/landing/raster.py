@@ -4,8 +4,9 @@ Landing tests need the same question answered at every candidate centre ("is the
 disk around here known, planar, free?"), which is cheap on a regular grid with
 image filters. :func:`rasterise` samples a map's cells at the pixel centres (each
 pixel takes the height of the cell holding it; NaN where no cell with a height
-does: unknown). :func:`plane_features` (the local plane fit of the landing
-criterion) lives in :mod:`alte.ground.surface`, shared with the map export.
+does: unknown), :func:`rasterise_sigma` the height standard deviation of a map whose
+cells carry a ``variance`` layer. :func:`plane_features` (the local plane fit of the
+landing criterion) lives in :mod:`alte.ground.surface`, shared with the map export.
 """
 
 from __future__ import annotations
@@ -17,10 +18,10 @@ from numpy.typing import NDArray
 
 from alte.errors import ParameterError
 from alte.ground.surface import PlaneFeatures, pixel_centres, plane_features
-from alte.mappers.base import Cells
+from alte.mappers.base import VARIANCE, Cells
 from alte.metrics import cell_at_xy
 
-__all__ = ["Grid", "PlaneFeatures", "plane_features", "rasterise"]
+__all__ = ["Grid", "PlaneFeatures", "plane_features", "rasterise", "rasterise_sigma"]
 
 
 @dataclass(frozen=True)
@@ -69,11 +70,24 @@ class Grid:
         return (x0, x0 + nx * self.step, y0, y0 + ny * self.step)
 
 
+def _sample(cells: Cells, grid: Grid, values: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``values`` (one per cell) of the known cell holding each pixel centre; NaN elsewhere."""
+    known = np.isfinite(cells.centers[:, 2])
+    idx = cell_at_xy(grid.centers(), cells.centers[known], cells.sizes[known])
+    mine = values[known]
+    out = np.where(idx >= 0, mine[np.maximum(idx, 0)] if len(mine) else np.nan, np.nan)
+    return out.reshape(grid.shape)
+
+
 def rasterise(cells: Cells, grid: Grid) -> NDArray[np.float64]:
     """Height (ny, nx) of the cell holding each pixel centre; NaN where unknown."""
-    known = np.isfinite(cells.centers[:, 2])
-    centers, sizes = cells.centers[known], cells.sizes[known]
-    idx = cell_at_xy(grid.centers(), centers, sizes)
-    height = np.where(idx >= 0, centers[np.maximum(idx, 0), 2] if len(centers) else np.nan,
-                      np.nan)
-    return height.reshape(grid.shape)
+    return _sample(cells, grid, cells.centers[:, 2])
+
+
+def rasterise_sigma(cells: Cells, grid: Grid) -> NDArray[np.float64]:
+    """Height standard deviation (ny, nx) of the cell holding each pixel centre (the square
+    root of its ``variance`` layer); NaN where unknown. A map without the layer raises."""
+    variance = cells.layer(VARIANCE)
+    if variance is None:
+        raise ParameterError("landing: the map's cells carry no height variance")
+    return _sample(cells, grid, np.sqrt(np.maximum(np.asarray(variance, np.float64), 0.0)))

@@ -170,7 +170,7 @@ def identify(raster: MapRaster, truth: TrueObstacles) -> ObstacleScores:
     labels, count = ndimage.label(obstacle, structure=_EIGHT)
     there = np.unique(labels.ravel()[truth.objects & obstacle.ravel()])
     objects = _object_rows(truth, height, obstacle.ravel(), ground)
-    found = objects[objects["found"]]
+    found = objects[objects["found"].astype(bool)]  # an empty column is of object dtype
     errors = found["height_error_m"].to_numpy(float)
     errors = errors[np.isfinite(errors)]
     return ObstacleScores(

@@ -17,11 +17,11 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
-from tqdm.auto import tqdm
 
 from alte.errors import ParameterError
 from alte.metrics import TrueSurface
 from alte.pipeline import MapSpec, Registered, run
+from alte.progress import bar as progress_bar
 from alte.studies.analysis.tables import write_csv
 from alte.studies.experiments import ground_truth, terrain
 from alte.studies.planning.lattice import POLICIES, PlanningMap, planning_map
@@ -150,7 +150,7 @@ def planning_experiment(terrains: Sequence[str], data_dir: str | os.PathLike[str
     if bad or not policies:
         raise ParameterError(f"unknown policies {bad or list(policies)}; valid: {POLICIES}")
     plans = []
-    for name in tqdm(terrains, desc="planning", unit="terrain", disable=not progress):
+    for name in progress_bar(terrains, desc="planning", unit="terrain", disable=not progress):
         data = terrain(name, data_dir, seed, frames)
         maps = _terrain_maps(data, name, mappers, params)
         truth = ground_truth(data)

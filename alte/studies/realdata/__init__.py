@@ -2,10 +2,12 @@
 
 :mod:`~alte.studies.realdata.data` locates the folder (skipping cleanly when it is absent),
 loads the ISPRS airborne samples, the OctoMap scan and the VLP-16 packet bag, runs
-the mappers and tabulates them; :mod:`~alte.studies.realdata.ground` is the map-based ground
-filter and its Sithole & Vosselman (2004) scores; :mod:`~alte.studies.realdata.fronts`
-maps a real sequence with reference poses over a grid of settings (the trade-off fronts on
-real data); :mod:`~alte.plot.realdata` draws them.
+the mappers and tabulates them; :mod:`~alte.studies.realdata.ground` is the map-based
+ground and its Sithole & Vosselman (2004) scores; :mod:`~alte.studies.realdata.filters`
+scores the ground filters on the ISPRS samples and the ALS tiles (how the default was
+chosen); :mod:`~alte.studies.realdata.fronts` maps a real sequence with reference poses
+over a grid of settings (the trade-off fronts on real data); :mod:`~alte.plot.realdata`
+draws them.
 """
 
 from alte.studies.realdata.data import (
@@ -28,6 +30,19 @@ from alte.studies.realdata.data import (
     vlp16_dataset,
     write_csv,
 )
+from alte.studies.realdata.filters import (
+    ALS_FOLDER,
+    CANDIDATES,
+    PUBLISHED,
+    LabelledCloud,
+    als_tile,
+    als_tiles,
+    choose,
+    filter_table,
+    labelled_clouds,
+    mean_table,
+    reference_gaps,
+)
 from alte.studies.realdata.fronts import (
     FRONT_COLUMNS,
     FRONT_GRID,
@@ -46,29 +61,40 @@ from alte.studies.realdata.ground import (
 )
 
 __all__ = [
+    "ALS_FOLDER",
     "BASELINE",
+    "CANDIDATES",
     "FRONT_COLUMNS",
     "FRONT_GRID",
     "ISPRS_FOLDER",
+    "PUBLISHED",
     "SEQUENCE",
     "GroundRun",
     "IsprsSample",
+    "LabelledCloud",
     "RealData",
     "RealSequence",
+    "als_tile",
+    "als_tiles",
+    "choose",
     "classify_ground",
     "dataset_summary",
     "default_dir",
+    "filter_table",
     "front_table",
     "ground_errors",
     "ground_runs",
     "ground_table",
     "isprs_sample",
     "isprs_samples",
+    "labelled_clouds",
     "locate",
     "map_heights",
     "map_runs",
     "map_table",
+    "mean_table",
     "opened_surface",
+    "reference_gaps",
     "reference_labels",
     "reference_metrics",
     "results",

@@ -21,11 +21,11 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
-from tqdm.auto import tqdm
 
 from alte.errors import ParameterError
+from alte.ground.filters import MIN_POINTS, filter_ground
+from alte.ground.settings import GroundSettings, ground_settings
 from alte.io.pointfiles import local_origin, read_points
-from alte.mappers import make_mapper
 from alte.paths import realdata_dir
 from alte.pipeline import (
     DomainPolicy,
@@ -36,15 +36,10 @@ from alte.pipeline import (
     open_input,
     prepare,
 )
+from alte.progress import bar as progress_bar
 from alte.studies.analysis.tables import write_csv as write_tables_csv
 from alte.studies.experiments import Measured, measure
-from alte.studies.realdata.ground import (
-    classify_ground,
-    ground_errors,
-    map_heights,
-    opened_surface,
-    reference_labels,
-)
+from alte.studies.realdata.ground import ground_errors, map_heights, reference_labels
 
 __all__ = [
     "BASELINE",
@@ -70,7 +65,7 @@ __all__ = [
 #: The folder of the ISPRS filter-test samples: ``<name>-utm.pcd`` with its reference
 #: bare earth ``<name>-utm-ground.pcd`` (today samp11, samp21, samp31 of the fifteen).
 ISPRS_FOLDER = "isprs_terrain"
-#: Name of the map-free filter (raw point heights) in the ground runs and table.
+#: Name of the map-free side (the filter on raw point heights) in the ground runs and table.
 BASELINE = "points"
 
 
@@ -156,44 +151,59 @@ class GroundRun:
     metrics: dict[str, float] = field(default_factory=dict)
 
 
+def _map_ground(points: NDArray[np.float64], heights: NDArray[np.float64],
+                method: str | None, settings: GroundSettings | None) -> NDArray[np.bool_]:
+    """The filter run on the map's heights (each point at its leaf's height), then every
+    raw point judged against that bare earth with the filter's own tolerance; points of
+    unknown leaves are not ground."""
+    known = np.isfinite(heights)
+    ground = np.zeros(len(points), bool)
+    if known.sum() >= MIN_POINTS:
+        seen = filter_ground(np.column_stack([points[known, :2], heights[known]]), method,
+                             settings)
+        ground[known] = seen.classify(points[known, 2])
+    return ground
+
+
 def _ground_run(sample: IsprsSample, name: str, params: Mapping[str, object],
-                options: Mapping[str, float]) -> GroundRun:
+                method: str | None, settings: GroundSettings | None) -> GroundRun:
     pts, extra = sample.points, {"basis_functions": 0, "map_s": 0.0}
     if name == BASELINE:
-        heights = pts[:, 2]
+        ground = filter_ground(pts, method, settings).ground
     else:
-        mapper = make_mapper(name, params)
+        spec = MapSpec(name, dict(params))
+        mapper = spec.cls(None, record=spec.record)
         start = time.perf_counter()
         mapper.build(pts)
         extra = {"basis_functions": int(mapper.basis_functions),
                  "map_s": time.perf_counter() - start}
-        heights = map_heights(mapper.cells(), pts)
-    surface = opened_surface(pts, heights, options["step"], options["window"])
-    ground = classify_ground(pts, surface, options["tolerance"])
+        ground = _map_ground(pts, map_heights(mapper.cells(), pts), method, settings)
     metrics = {**extra, "points": len(pts), **ground_errors(ground, sample.reference)}
     return GroundRun(sample.name, name, dict(params), pts, ground, sample.reference, metrics)
 
 
 def ground_runs(data: RealData, samples: Sequence[str] | None,
-                mappers: Mapping[str, Mapping[str, object]], *, step: float = 1.0,
-                window: float = 20.0, tolerance: float = 1.0, baseline: bool = True,
+                mappers: Mapping[str, Mapping[str, object]], *, method: str | None = None,
+                settings: Mapping[str, object] | None = None, baseline: bool = True,
                 progress: bool = True) -> list[GroundRun]:
     """Filter the named samples (None: every sample present, :func:`isprs_samples`) with
-    every 2D mapper (and the map-free baseline); [] if the folder is absent."""
+    the ground filter ``method`` and ``settings`` over its published ones (neither: the
+    ground stage's default) on the raw points (the baseline) and on every 2D mapper's
+    heights, the same filter on both sides; [] if the folder is absent."""
     if not data.available:
         return []
+    chosen = ground_settings(method, settings)
     present = isprs_samples(data)
     samples = present if samples is None else tuple(samples)
     bad = sorted(set(samples) - set(present))
     if bad:
         raise ParameterError(f"ISPRS samples {bad} unknown; samples present in "
                              f"{data.file(ISPRS_FOLDER)}: {list(present)}")
-    options = {"step": step, "window": window, "tolerance": tolerance}
     sources = {**({BASELINE: {}} if baseline else {}), **mappers}
     runs = []
-    for name in tqdm(samples, desc="ISPRS samples", disable=not progress):
+    for name in progress_bar(samples, desc="ISPRS samples", disable=not progress):
         sample = isprs_sample(data, name)
-        runs += [_ground_run(sample, m, p, options) for m, p in sources.items()]
+        runs += [_ground_run(sample, m, p, method, chosen) for m, p in sources.items()]
     return runs
 
 
@@ -230,7 +240,7 @@ def map_runs(dataset: Registered | None, mappers: Mapping[str, Mapping[str, obje
         return []
     name = dataset.source.name
     return [measure(dataset, m, spec=MapSpec(m, dict(p), domain=DomainPolicy.DATA))
-            for m, p in tqdm(mappers.items(), desc=name, disable=not progress)]
+            for m, p in progress_bar(mappers.items(), desc=name, disable=not progress)]
 
 
 def map_table(runs: Sequence[Measured]) -> pd.DataFrame:

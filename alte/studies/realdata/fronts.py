@@ -31,12 +31,12 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 from scipy.spatial import cKDTree
-from tqdm.auto import tqdm
 
 from alte.mappers.base import Cells
 from alte.metrics.truth import distance_to_boxes
 from alte.pipeline import DomainPolicy, FrameSpec, MapSpec, PoseSource, Registered, open_input
 from alte.pipeline import prepare as register
+from alte.progress import bar as progress_bar
 from alte.studies.experiments import measure
 from alte.studies.landing import Grid
 from alte.studies.obstacles import map_raster
@@ -141,7 +141,7 @@ def front_table(sequence: RealSequence | None,
         return pd.DataFrame(columns=list(FRONT_COLUMNS))
     runs = [(m, dict(p)) for m, rows in (grid or FRONT_GRID).items() for p in rows]
     rows = []
-    for mapper, params in tqdm(runs, desc=sequence.name, unit="map", disable=not progress):
+    for mapper, params in progress_bar(runs, desc=sequence.name, unit="map", disable=not progress):
         spec = MapSpec(mapper, params, domain=DomainPolicy.DATA)
         found = measure(sequence.data, mapper, spec=spec)
         cells = found.mapper.cells()

@@ -31,6 +31,7 @@ from alte.studies.sweep.spec import (
     SweepSpec,
     load_spec,
     parse_spec,
+    with_plugins,
 )
 from alte.studies.sweep.store import (
     KEY_COLUMNS,
@@ -69,5 +70,6 @@ __all__ = [
     "sensitivity_ranking",
     "sensitivity_table",
     "variant_table",
+    "with_plugins",
     "write_row",
 ]

@@ -21,11 +21,11 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Protocol, TypeVar
 
 import pandas as pd
-from tqdm.auto import tqdm
 
 from alte.errors import ParameterError, SimulationError
+from alte.progress import bar as progress_bar
 from alte.studies.sweep.runs import SweepRun, plan_runs, plan_variants
-from alte.studies.sweep.spec import SweepSettings, SweepSpec
+from alte.studies.sweep.spec import SweepSettings, SweepSpec, with_plugins
 from alte.studies.sweep.store import finished_ids, load_results, write_row
 from alte.studies.sweep.work import MapGroup, group_runs, input_data, run_group, run_one
 
@@ -137,7 +137,8 @@ def _ensure_all(pool: MapUnordered, runs: Sequence[SweepRun], data_dir: str,
                 progress: bool) -> None:
     inputs = {r.input_key(): r for r in runs}
     items = [inputs[key] for key in sorted(inputs, key=str)]
-    bar = tqdm(total=len(items), desc="terrains", unit="terrain", disable=not progress)
+    bar = progress_bar(total=len(items), desc="sweep terrains", unit="terrain",
+                       disable=not progress)
     with bar:
         for i, _, err in pool(_ensure, items, data_dir):
             if err is not None:
@@ -159,7 +160,7 @@ def _map_all(pool: MapUnordered, runs: Sequence[SweepRun], data_dir: str, out: P
     groups = _by_input(runs)
     by_id = {r.run_id: r for r in runs}
     # smoothing 0: the ETA from the mean rate so far (maps of one input differ widely)
-    with tqdm(total=len(runs), desc="runs", unit="run", disable=not progress,
+    with progress_bar(total=len(runs), desc="sweep runs", unit="run", disable=not progress,
               smoothing=0) as bar:
         for i, done, err in pool(run_group, groups, data_dir):
             # err: the task itself failed (e.g. a lost worker), so did each of its runs
@@ -201,11 +202,15 @@ def run_sweep(spec: SweepSpec, *, scheduler: str = "local", workers: int = 2,
 def override(spec: SweepSpec, **changes: object) -> SweepSpec:
     """``spec`` with other ``frames``/``data_dir``/``output``/``seed``/``seeds`` (CLI and
     notebook), checked as :class:`SweepSettings`; ``None`` keeps the spec's value, except
-    for ``frames`` (the whole mission)."""
-    allowed = ("frames", "data_dir", "output", "seed", "seeds")
+    for ``frames`` (the whole mission). ``plugins=True`` adds the installed plugin mappers
+    (:func:`~alte.studies.sweep.spec.with_plugins`)."""
+    allowed = ("frames", "data_dir", "output", "seed", "seeds", "plugins")
     unknown = sorted(set(changes) - set(allowed))
     if unknown:
         raise ParameterError(f"sweep override {', '.join(unknown)}: valid: {', '.join(allowed)}")
+    if changes.pop("plugins", None):
+        spec = with_plugins(dataclasses.replace(
+            spec, settings=spec.settings.replace(plugins=True)))
     given = {k: v for k, v in changes.items() if k == "frames" or v is not None}
     new = SweepSettings.parse(given)  # checked alone first: errors name only what was given
     kept = {**spec.settings.as_dict(), "output": spec.output}

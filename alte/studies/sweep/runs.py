@@ -13,6 +13,7 @@ import json
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
+from alte.mappers import Mapper
 from alte.metrics.maps import SetB, TruthOptions
 from alte.studies.sweep.spec import SweepSpec
 from alte.studies.sweep.variants import Variant
@@ -22,12 +23,13 @@ __all__ = ["SweepRun", "plan_runs", "plan_variants"]
 
 @dataclass(frozen=True)
 class SweepRun:
-    """One map to make and measure; ``params`` are as the spec gives them (type-coerced)."""
+    """One map to make and measure: the mapper's class and its ``params`` as the spec gives
+    them (type-coerced)."""
 
     terrain: str
     frames: int | None
     seed: int
-    mapper: str
+    cls: type[Mapper]
     params: Mapping[str, object]
     voxel: float | None = None
     truth: TruthOptions = field(default_factory=TruthOptions)
@@ -37,6 +39,11 @@ class SweepRun:
     deskew: bool = True
     obstacles: bool = False
     poses: str = "recorded"
+
+    @property
+    def mapper(self) -> str:
+        """The mapper's name."""
+        return self.cls.name
 
     def key(self) -> dict[str, object]:
         """Everything that determines the run's result, JSON-ready (``domain``, ``set_b``,
@@ -75,9 +82,9 @@ class SweepRun:
 def _variant_runs(spec: SweepSpec, variant: Variant) -> list[SweepRun]:
     """The runs of one variant in grid order (seed, terrain, mapper, row)."""
     terrains = variant.terrains or spec.terrains
-    return [SweepRun(terrain, spec.frames, seed, grid.mapper,
-                     variant.params_for(grid.mapper, params), spec.voxel, spec.truth,
-                     variant.domain_for(grid.mapper), variant.set_b_for(grid.mapper),
+    return [SweepRun(terrain, spec.frames, seed, grid.cls,
+                     variant.params_for(grid.cls, params), spec.voxel, spec.truth,
+                     variant.domain_for(grid.cls), variant.set_b_for(grid.cls),
                      variant.sensor, variant.deskew, spec.obstacles, variant.poses)
             for seed in spec.seeds for terrain in spec.terrains if terrain in terrains
             for grid in spec.mappers if terrain in grid.terrains for params in grid.rows]

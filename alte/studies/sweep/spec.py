@@ -3,7 +3,10 @@
 A spec names terrains, the scans kept per terrain (``frames``), the simulation
 ``seeds`` (or one ``seed``), where results go (``output``), per mapper a ``grid`` of
 parameter lists (their cartesian product) and/or explicit ``rows``, and optionally
-ablation ``variants`` (:mod:`alte.studies.sweep.variants`). The top-level scalars are a
+ablation ``variants`` (:mod:`alte.studies.sweep.variants`). With ``plugins: true`` (or
+:func:`with_plugins`) every installed plugin mapper the spec does not list joins the
+grid with its own ``settings_grid`` on every terrain (a plugin the spec lists keeps the
+spec's rows). The top-level scalars are a
 :class:`SweepSettings` parameter record, checked and coerced like mapper parameters
 (:mod:`alte.params`); errors name the spec and the key. The runs a spec plans are in
 :mod:`~alte.studies.sweep.runs`.
@@ -11,6 +14,7 @@ ablation ``variants`` (:mod:`alte.studies.sweep.variants`). The top-level scalar
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import os
 from collections.abc import Mapping, Sequence
@@ -19,13 +23,13 @@ from pathlib import Path
 from typing import ClassVar, TypeVar
 
 from alte.errors import AlteError, ParameterError
-from alte.mappers import make_mapper
+from alte.mappers import Mapper, registry
 from alte.metrics.maps import TruthOptions
 from alte.params import Record, param
 from alte.sim import TERRAINS
 from alte.studies.sweep.variants import Variant, parse_variants, spec_error
 
-__all__ = ["MapperGrid", "SweepSettings", "SweepSpec", "load_spec", "parse_spec"]
+__all__ = ["MapperGrid", "SweepSettings", "SweepSpec", "load_spec", "parse_spec", "with_plugins"]
 
 _MAPPER_KEYS = ("grid", "rows", "terrains")
 _SCALARS = (bool, int, float, str)
@@ -37,7 +41,14 @@ def _seed_list(value: tuple[int, ...]) -> bool:
 
 
 def _known(names: tuple[str, ...]) -> bool:
-    return bool(names) and all(n in TERRAINS for n in names)
+    """Non-empty names (built-in, or imported into the data folder: :func:`_terrains`
+    checks which when the spec is read)."""
+    return bool(names) and all(isinstance(n, str) and n for n in names)
+
+
+def _imported(name: str, data_dir: str) -> bool:
+    """Whether ``data_dir/NAME`` is a terrain imported with ``alte simulate TILE ...``."""
+    return (Path(data_dir) / name / "scenario.json").is_file()
 
 
 @dataclass(frozen=True)
@@ -57,6 +68,8 @@ class SweepSettings(Record):
     output: str | None = param(None, help="results folder (default: reports/sweeps/NAME)")
     obstacles: bool = param(False, help="also score each map's obstacle identification "
                                         "against the simulator's objects")
+    plugins: bool = param(False, help="add every installed plugin mapper the spec does not "
+                                      "list, with its own settings grid")
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -78,13 +91,18 @@ _TOP_KEYS = (*SweepSettings.names(), "terrains", "truth", "mappers", "variants")
 
 @dataclass(frozen=True)
 class MapperGrid(Record):
-    """A mapper's parameter rows (grid product and explicit rows, coerced by the mapper's
-    own record) and its terrains."""
+    """A mapper (its class) with its parameter rows (grid product and explicit rows,
+    coerced by the mapper's own record) and its terrains."""
 
     OWNER: ClassVar[str] = "mapper grid"
-    mapper: str = param("", help="the mapper's name")
+    cls: type[Mapper]
     rows: tuple[Mapping[str, object], ...] = param((), help="its parameter rows")
     terrains: tuple[str, ...] = param((), _known, "known terrain names", "its terrains")
+
+    @property
+    def mapper(self) -> str:
+        """The mapper's name."""
+        return self.cls.name
 
 
 @dataclass(frozen=True)
@@ -146,13 +164,14 @@ def _check_keys(source: str, where: str, given: Mapping[object, object],
                          f"{', '.join(valid)}")
 
 
-def _terrains(source: str, key: str, value: object) -> tuple[str, ...]:
+def _terrains(source: str, key: str, value: object, data_dir: str = "data") -> tuple[str, ...]:
     names = [value] if isinstance(value, str) else value
     if not isinstance(names, list) or not names:
         raise spec_error(source, key, f"{value!r} must be a terrain name or a non-empty list")
-    bad = [n for n in names if n not in TERRAINS]
+    bad = [n for n in names if n not in TERRAINS and not _imported(str(n), data_dir)]
     if bad:
-        raise spec_error(source, key, f"unknown terrain(s) {bad}; valid: {', '.join(TERRAINS)}")
+        raise spec_error(source, key, f"unknown terrain(s) {bad}; valid: {', '.join(TERRAINS)}, "
+                         f"or a terrain imported into {data_dir} (alte simulate TILE.laz)")
     return tuple(dict.fromkeys(names))
 
 
@@ -185,8 +204,8 @@ def _grid_rows(source: str, key: str, grid: object) -> list[dict[str, object]]:
     return [dict(zip(lists, combo, strict=True)) for combo in itertools.product(*lists.values())]
 
 
-def _coerce_row(source: str, key: str, mapper: str, row: object) -> dict[str, object]:
-    """Validate one parameter row by constructing the mapper; values come back coerced."""
+def _coerce_row(source: str, key: str, mapper: type[Mapper], row: object) -> dict[str, object]:
+    """Validate one parameter row by the mapper's record; values come back coerced."""
     if not isinstance(row, Mapping):
         raise spec_error(source, key, f"{row!r} must map parameter names to values")
     for name, value in row.items():
@@ -194,7 +213,7 @@ def _coerce_row(source: str, key: str, mapper: str, row: object) -> dict[str, ob
             raise spec_error(source, f"{key}.{name}", f"{value!r} must be a number, string or "
                              "bool")
     try:
-        resolved = make_mapper(mapper, dict(row)).params.as_dict()
+        resolved = mapper.Params.parse({str(k): v for k, v in row.items()}).as_dict()
     except AlteError as err:
         raise spec_error(source, key, str(err)) from err
     return {str(name): resolved[str(name)] for name in row}
@@ -202,6 +221,10 @@ def _coerce_row(source: str, key: str, mapper: str, row: object) -> dict[str, ob
 
 def _mapper(source: str, name: str, body: object, terrains: tuple[str, ...]) -> MapperGrid:
     key = f"mappers.{name}"
+    try:
+        cls = registry.resolve(name)  # the spec's names become classes here, once
+    except AlteError as err:
+        raise spec_error(source, key, str(err)) from err
     if not isinstance(body, Mapping) or not ({"grid", "rows"} & set(body)):
         raise spec_error(source, key, "needs a 'grid' of parameter lists and/or explicit "
                          "'rows'")
@@ -213,12 +236,28 @@ def _mapper(source: str, name: str, body: object, terrains: tuple[str, ...]) -> 
         raise spec_error(source, f"{key}.rows", f"{explicit!r} must be a list of parameter "
                          "mappings")
     rows += explicit
-    coerced = tuple(_coerce_row(source, key, name, row) for row in rows)
+    coerced = tuple(_coerce_row(source, key, cls, row) for row in rows)
     own = _terrains(source, f"{key}.terrains", body["terrains"]) if "terrains" in body else terrains
     outside = sorted(set(own) - set(terrains))
     if outside:
         raise spec_error(source, f"{key}.terrains", f"{outside} not in the top-level terrains")
-    return MapperGrid(name, coerced, own)
+    return MapperGrid(cls, coerced, own)
+
+
+def with_plugins(spec: SweepSpec) -> SweepSpec:
+    """``spec`` with a grid for every installed plugin mapper it does not list: the rows of
+    the plugin's ``settings_grid`` (its defaults when empty) on every terrain of the spec."""
+    listed = {g.cls for g in spec.mappers}
+    grids = []
+    for cls in registry.plugins():
+        if cls in listed:
+            continue
+        key = f"plugin {cls.name} settings_grid"
+        lists = {k: list(v) for k, v in cls.settings_grid.items()}
+        rows = _grid_rows(spec.source, key, lists) if lists else [{}]
+        grids.append(MapperGrid(cls, tuple(_coerce_row(spec.source, key, cls, r) for r in rows),
+                                spec.terrains))
+    return dataclasses.replace(spec, mappers=spec.mappers + tuple(grids))
 
 
 def parse_spec(raw: object, source: str = "spec") -> SweepSpec:
@@ -229,17 +268,18 @@ def parse_spec(raw: object, source: str = "spec") -> SweepSpec:
     for key in ("terrains", "mappers"):
         if key not in raw:
             raise spec_error(source, key, "missing (required)")
-    terrains = _terrains(source, "terrains", raw["terrains"])
+    terrains = _terrains(source, "terrains", raw["terrains"], str(raw.get("data_dir", "data")))
     if not isinstance(raw["mappers"], Mapping) or not raw["mappers"]:
         raise spec_error(source, "mappers", "must map mapper names to their grids")
     settings = _record(source, SweepSettings,
                        {k: raw[k] for k in SweepSettings.names() if k in raw})
     mappers = tuple(_mapper(source, str(m), body, terrains) for m, body in raw["mappers"].items())
-    return SweepSpec(
+    spec = SweepSpec(
         terrains=terrains, mappers=mappers, settings=settings,
         truth=_truth(source, raw.get("truth")), source=source,
         variants=parse_variants(source, raw.get("variants"), terrains,
-                                tuple(g.mapper for g in mappers)))
+                                tuple(g.cls for g in mappers)))
+    return with_plugins(spec) if settings.plugins else spec
 
 
 def load_spec(path: str | os.PathLike[str]) -> SweepSpec:

@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 from typing import ClassVar, Literal, get_args
 
 from alte.errors import AlteError, ParameterError
-from alte.mappers import DomainUse, make_mapper, mapper_class
+from alte.mappers import DomainUse, Mapper
 from alte.metrics.maps import SetB
 from alte.params import Record, param
 from alte.sim.profile import PROFILES
@@ -57,18 +57,18 @@ class Variant(Record):
     deskew: bool = param(True, help="deskew swept scans")
     poses: PosesName = param("recorded", help="recorded poses or the odometry's")
 
-    def domain_for(self, mapper: str) -> str:
+    def domain_for(self, mapper: type[Mapper]) -> str:
         """The domain policy a run of ``mapper`` gets (``auto`` where it uses none)."""
-        return "auto" if mapper_class(mapper).domain_use is DomainUse.UNUSED else self.domain
+        return "auto" if mapper.domain_use is DomainUse.UNUSED else self.domain
 
-    def set_b_for(self, mapper: str) -> SetB:
+    def set_b_for(self, mapper: type[Mapper]) -> SetB:
         """The set B a run of ``mapper`` gets (``occupied`` is ``corners`` in 3D)."""
-        return (SetB.CORNERS if self.set_b is SetB.OCCUPIED and mapper_class(mapper).dims == 3
+        return (SetB.CORNERS if self.set_b is SetB.OCCUPIED and mapper.dims == 3
                 else self.set_b)
 
-    def params_for(self, mapper: str, row: Mapping[str, object]) -> dict[str, object]:
+    def params_for(self, mapper: type[Mapper], row: Mapping[str, object]) -> dict[str, object]:
         """``row`` with this variant's parameter changes for ``mapper``."""
-        return {**row, **self.params.get(mapper, {})}
+        return {**row, **self.params.get(mapper.name, {})}
 
 
 def spec_error(source: str, key: str, message: str) -> ParameterError:
@@ -76,19 +76,21 @@ def spec_error(source: str, key: str, message: str) -> ParameterError:
     return ParameterError(f"{source}: {key}: {message}")
 
 
-def _params(source: str, key: str, value: object, mappers: tuple[str, ...]
+def _params(source: str, key: str, value: object, mappers: tuple[type[Mapper], ...]
             ) -> dict[str, dict[str, object]]:
     if not isinstance(value, Mapping):
         raise spec_error(source, key, f"{value!r} must map mapper names to parameter changes")
     out = {}
+    ours = {cls.name: cls for cls in mappers}
     for mapper, changes in value.items():
         where = f"{key}.{mapper}"
-        if mapper not in mappers:
-            raise spec_error(source, where, f"not a mapper of this sweep ({', '.join(mappers)})")
+        if mapper not in ours:
+            raise spec_error(source, where, f"not a mapper of this sweep ({', '.join(ours)})")
         if not isinstance(changes, Mapping) or not changes:
             raise spec_error(source, where, f"{changes!r} must map parameter names to values")
         try:
-            resolved = make_mapper(str(mapper), dict(changes)).params.as_dict()
+            resolved = ours[mapper].Params.parse({str(k): v for k, v in changes.items()}
+                                                 ).as_dict()
         except AlteError as err:
             raise spec_error(source, where, str(err)) from err
         out[str(mapper)] = {str(k): resolved[str(k)] for k in changes}
@@ -96,7 +98,7 @@ def _params(source: str, key: str, value: object, mappers: tuple[str, ...]
 
 
 def _variant(source: str, name: str, body: object, terrains: tuple[str, ...],
-             mappers: tuple[str, ...]) -> Variant:
+             mappers: tuple[type[Mapper], ...]) -> Variant:
     key = f"variants.{name}"
     if name == BASE:
         raise spec_error(source, key, f"{BASE!r} is the grid as written; name the variant "
@@ -124,7 +126,7 @@ def _variant(source: str, name: str, body: object, terrains: tuple[str, ...],
 
 
 def parse_variants(source: str, raw: object, terrains: tuple[str, ...],
-                   mappers: tuple[str, ...]) -> tuple[Variant, ...]:
+                   mappers: tuple[type[Mapper], ...]) -> tuple[Variant, ...]:
     """The spec's ``variants`` mapping, validated (errors name the key)."""
     if raw is None:
         return ()

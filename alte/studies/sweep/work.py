@@ -23,7 +23,6 @@ import time
 from collections.abc import Iterable
 from dataclasses import dataclass
 
-from alte.mappers import mapper_class
 from alte.metrics.maps import TruthOptions, measure_map
 from alte.metrics.reference import Reference
 from alte.metrics.timing import Timing
@@ -52,12 +51,12 @@ class MapGroup:
 
 def _resolved(run: SweepRun) -> dict[str, object]:
     """The run's mapper parameters, defaults filled in."""
-    return mapper_class(run.mapper).Params.parse(run.params).as_dict()
+    return run.cls.Params.parse(run.params).as_dict()
 
 
 def map_key(run: SweepRun) -> str:
     """What decides a run's stored map: everything but its view parameters and set B."""
-    view = mapper_class(run.mapper).view_params
+    view = run.cls.view_params
     key = run.key()
     key["params"] = {k: v for k, v in _resolved(run).items() if k not in view}
     key.pop("truth")
@@ -119,7 +118,7 @@ def _row(run: SweepRun, data: Registered, measured: tuple[dict[str, float], JSON
         "poses": run.poses,
         "frames": len(data), "points": len(data.cloud),
         **{k: v for k, v in metrics.items() if k != "elapsed_s"}, **obstacles,
-        "cost_unit": mapper_class(run.mapper).cost_unit.value,
+        "cost_unit": run.cls.cost_unit.value, "dims": run.cls.dims,
         "elapsed_s": float(metrics["elapsed_s"]), "wall_s": cost[0], "cpu_s": cost[1],
     }
 
@@ -130,7 +129,7 @@ def _measure(made: tuple[MapRun, Timing], run: SweepRun, data: Registered,
     its obstacle columns."""
     result, timing = made
     fed, mine = result.mapper.params.as_dict(), _resolved(run)
-    changes = {k: mine[k] for k in mapper_class(run.mapper).view_params if mine[k] != fed[k]}
+    changes = {k: mine[k] for k in run.cls.view_params if mine[k] != fed[k]}
     mapper = result.mapper.reread(**changes) if changes else result.mapper
     cells = mapper.cells()  # listed once for every metric
     metrics = measure_map(mapper, data.cloud, elapsed_s=timing, truth=reference.truth,
@@ -147,7 +146,7 @@ def run_group(group: MapGroup, data_dir: str) -> list[RunOutcome]:
     first = group.runs[0]
     try:
         data, reference = _inputs(first, data_dir)
-        made = timed_run(data, MapSpec(first.mapper, dict(first.params),
+        made = timed_run(data, MapSpec(first.cls, dict(first.params),
                                        domain=DomainPolicy(first.domain)))
     except Exception as err:  # a failed map fails its runs; the sweep goes on
         return [(r.run_id, None, err) for r in group.runs]

@@ -62,6 +62,7 @@ def test_the_grid_is_the_full_report_with_measured_times(grid: pd.DataFrame) -> 
     assert grid["cost"].gt(0).all() and set(grid["cost_unit"]) == {"cell updates", "ray steps"}
 
 
+@pytest.mark.full
 @pytest.mark.slow
 @pytest.mark.parametrize("seed", [11, 12])
 def test_times_moved_within_their_spread_move_no_verdict(grid: pd.DataFrame,

@@ -12,6 +12,7 @@ import numpy as np
 import pandas as pd
 import pytest
 from matplotlib.collections import EllipseCollection
+from support.example import NoisyGrid
 
 from alte.errors import AlteError, MetricsError, ParameterError
 from alte.mappers.base import Cells
@@ -37,6 +38,7 @@ from alte.studies.landing import (
     object_footprints,
     plane_features,
     rasterise,
+    rasterise_sigma,
     score_detection,
     score_landing,
     truth_centres,
@@ -319,3 +321,35 @@ def test_sites_are_drawn_one_panel_per_run(tiny_table):
                                                            for r in runs[:2])
     with pytest.raises(ParameterError, match="no runs to draw"):
         plot_landing_runs(runs, only="nothing")
+
+
+def test_rasterise_sigma_and_its_refusal():
+    cells = Cells(np.array([[1.0, 1.0, 0.0], [3.0, 1.0, 2.0]]), np.array([[2.0, 2.0, 0.0]] * 2),
+                  np.zeros(2), np.ones(2, bool), np.zeros(2, np.int64),
+                  {"variance": np.array([0.04, 0.01])})
+    grid = Grid.from_bounds(np.array([[0.0, 0.0], [4.0, 2.0]]), 1.0)
+    assert rasterise_sigma(cells, grid).tolist() == [[0.2, 0.2, 0.1, 0.1]] * 2
+    with pytest.raises(ParameterError, match="carry no height variance"):
+        rasterise_sigma(dataclasses.replace(cells, layers={}), grid)
+
+
+def test_a_height_sigma_bound_makes_unsure_pixels_unknown(tiny_lan):
+    """The example grid with a (5 cm)^2 / count variance: a bound under the sigma of every
+    cell leaves no site; one over all of them changes nothing; a map without variance is
+    refused; further mappers' settings rows join the parameter sets."""
+    params = landing_params("sim_lan_1", step=0.5)
+    free = evaluate_landing(tiny_lan, NoisyGrid, {"cell": 1.0}, params)
+    loose = evaluate_landing(tiny_lan, NoisyGrid, {"cell": 1.0},
+                             params.replace(max_height_sigma=0.06))
+    tight = evaluate_landing(tiny_lan, NoisyGrid, {"cell": 1.0},
+                             params.replace(max_height_sigma=0.001))
+    assert free.scores["chosen"] >= 1 and loose.scores == free.scores
+    assert tight.scores["sites"] == 0 and tight.detection.height.size > 0
+    with pytest.raises(ParameterError, match=r"max_height_sigma=0\.1 needs a map whose cells "
+                                             r"carry a height variance; 'quadtree' has none"):
+        evaluate_landing(tiny_lan, "quadtree", {}, params.replace(max_height_sigma=0.1))
+    sets = landing_param_sets("sim_lan_1", extra=(NoisyGrid,))
+    assert [(label, p) for label, m, p in sets if m is NoisyGrid] == [
+        (f"grid row {i}", {"cell": c}) for i, c in enumerate((0.25, 0.5, 1.0, 2.0))]
+    with pytest.raises(ParameterError, match=r"max_height_sigma=0\.0 out of range"):
+        params.replace(max_height_sigma=0.0)

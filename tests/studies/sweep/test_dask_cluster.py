@@ -1,6 +1,7 @@
 """A sweep on a real Dask cluster: ``dask scheduler`` and ``dask worker`` processes on
-loopback, started as a user would start them on other machines (README), give the rows
-of a serial run; the processes are stopped whatever happens."""
+loopback, started as a user would start them on other machines
+(docs/how-to/dask-cluster.md), give the rows of a serial run; the processes are stopped
+whatever happens."""
 
 from __future__ import annotations
 

@@ -6,6 +6,7 @@ import pandas as pd
 import pytest
 
 from alte.errors import ParameterError
+from alte.mappers import Alte2D, Alte3D, Octomap, Quadtree
 from alte.metrics.maps import SetB
 from alte.studies.sweep import (
     BASE,
@@ -72,10 +73,10 @@ def test_variants_run_only_what_they_change():
 
 def test_variant_helpers():
     v = Variant("v", domain="data", set_b=SetB.OCCUPIED, params={"alte2d": {"kappa": 2.0}})
-    assert v.domain_for("octomap") == "auto" and v.domain_for("alte2d") == "data"
-    assert v.set_b_for("alte3d") is SetB.CORNERS and v.set_b_for("quadtree") is SetB.OCCUPIED
-    assert v.params_for("alte2d", {"kappa": 1.0, "max_res": 3}) == {"kappa": 2.0, "max_res": 3}
-    assert v.params_for("quadtree", {"max_points": 9}) == {"max_points": 9}
+    assert v.domain_for(Octomap) == "auto" and v.domain_for(Alte2D) == "data"
+    assert v.set_b_for(Alte3D) is SetB.CORNERS and v.set_b_for(Quadtree) is SetB.OCCUPIED
+    assert v.params_for(Alte2D, {"kappa": 1.0, "max_res": 3}) == {"kappa": 2.0, "max_res": 3}
+    assert v.params_for(Quadtree, {"max_points": 9}) == {"max_points": 9}
 
 
 @pytest.mark.parametrize(("variants", "match"), [

@@ -8,7 +8,7 @@ from dataclasses import fields
 import pytest
 
 from alte.errors import ParameterError
-from alte.mappers import MAPPERS, make_mapper
+from alte.mappers import make_mapper, registry
 from alte.paths import realdata_dir
 from alte.studies.analysis.tradeoff import METRICS, OPTIONAL_COLUMNS, REQUIRED_COLUMNS
 from alte.studies.thesis.claims import (
@@ -28,6 +28,9 @@ THESIS = realdata_dir().parent / "thesis" / "alte-thesis.txt"  # ../shared/thesi
 _MAPPER_FIELDS = ("better", "other", "mapper")
 _COLUMN_FIELDS = ("metric", "size", "fidelity", "reference", "reference_other", "column")
 _PARAM_FIELDS = ("param", "x", "other_param")
+
+#: The thesis' four by name.
+BUILTIN = {cls.name: cls for cls in registry.BUILTIN}
 
 
 def _parts(item):
@@ -79,7 +82,7 @@ def test_checks_name_known_mappers_columns_and_parameters():
                 assert len(part.reason) > 30
                 continue
             if isinstance(part, Property):
-                assert set(part.true) | set(part.false) <= set(MAPPERS)
+                assert set(part.true) | set(part.false) <= set(BUILTIN)
                 continue
             values = {f.name: getattr(part, f.name) for f in fields(part)}
             if isinstance(part, Agreement):  # its ``other`` is a metric, not a mapper
@@ -88,7 +91,7 @@ def test_checks_name_known_mappers_columns_and_parameters():
                 values["other_param"] = values.pop("other")
             assert values["case"] in CASES, item.id
             mappers = [values[k] for k in _MAPPER_FIELDS if values.get(k)]
-            assert mappers and set(mappers) <= set(MAPPERS), item.id
+            assert mappers and set(mappers) <= set(BUILTIN), item.id
             assert {values[k] for k in _COLUMN_FIELDS if values.get(k)} <= columns, item.id
             for key in _PARAM_FIELDS:
                 if values.get(key) and values[key] not in columns:

@@ -1,0 +1,341 @@
+"""Sphinx extension of alte's documentation: pages and tables generated from the code.
+
+- **API pages** (``reference/api/``): one page per package of ``alte``, with every public
+  module below it (a module whose name does not start with ``_``), written when the build
+  starts from what :func:`public_modules` finds. A new module appears without anyone
+  editing the docs; the tests check that every one of them reached the built site.
+- ``{alte-record} dotted.path.Record``: the settings of a :class:`alte.params.Record` as a
+  table (name, type, default, rule, meaning), read from its fields.
+- ``{alte-mappers}``: the settings of every mapper of the registry
+  (:func:`alte.mappers.registry.classes`: the thesis' four and the installed plugins),
+  one table each.
+
+The pages are written only when their text changes, through a temporary file and a
+rename, so two builds of the same tree at once (``make docs`` beside ``make test``) never
+read a half-written page.
+"""
+
+from __future__ import annotations
+
+import ast
+import dataclasses
+import enum
+import importlib
+import importlib.util
+import os
+import pkgutil
+import tempfile
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any, ClassVar
+
+from docutils import nodes
+from docutils.statemachine import StringList
+from sphinx.application import Sphinx
+from sphinx.util.docutils import SphinxDirective
+
+REPO = Path(__file__).resolve().parents[2]
+API_DIR = REPO / "docs" / "reference" / "api"
+
+
+def public_modules(package: str = "alte") -> list[str]:
+    """Every importable public module and package of ``package``, sorted."""
+    root = importlib.import_module(package)
+    found = [package]
+    for info in pkgutil.walk_packages(root.__path__, prefix=f"{package}."):
+        if not any(part.startswith("_") for part in info.name.split(".")[1:]):
+            found.append(info.name)
+    return sorted(found)
+
+
+def _packages(modules: list[str]) -> dict[str, list[str]]:
+    """Each package with the plain modules directly below it (a package is its own page)."""
+    packages = [m for m in modules if _is_package(m)]
+    pages: dict[str, list[str]] = {p: [] for p in packages}
+    for module in modules:
+        if module in pages:
+            continue
+        parent = module.rsplit(".", 1)[0]
+        pages[parent].append(module)
+    return pages
+
+
+def _is_package(name: str) -> bool:
+    spec = importlib.util.find_spec(name)
+    return bool(spec and spec.submodule_search_locations is not None)
+
+
+def _write_if_changed(path: Path, text: str) -> None:
+    if path.is_file() and path.read_text() == text:
+        return
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.")
+    with os.fdopen(fd, "w") as out:
+        out.write(text)
+    os.replace(tmp, path)
+
+
+def owned_names(module: str) -> list[str]:
+    """The public names ``module`` defines itself (not imports), in ``__all__`` order.
+
+    Read from the module's source (top-level ``def``, ``class`` and assignments), so a
+    name a package or module re-exports is documented once, where it is defined.
+    """
+    spec = importlib.util.find_spec(module)
+    origin = Path(spec.origin) if spec and spec.origin else None
+    tree = ast.parse(origin.read_text()) if origin and origin.suffix == ".py" else ast.Module()
+    bound: set[str] = set()
+    for node in tree.body:
+        if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef | ast.ClassDef):
+            bound.add(node.name)
+        elif isinstance(node, ast.Assign):
+            bound |= {t.id for t in node.targets if isinstance(t, ast.Name)}
+        elif isinstance(node, ast.AnnAssign) and isinstance(node.target, ast.Name):
+            bound.add(node.target.id)
+    listed = getattr(importlib.import_module(module), "__all__", None)
+    names = list(listed) if listed is not None else sorted(bound)
+    return [n for n in names if n in bound and not n.startswith("_")]
+
+
+def _owner(module: str, name: str, modules: list[str]) -> str | None:
+    """The module below ``module`` that defines ``name`` (``None``: none does)."""
+    obj = getattr(importlib.import_module(module), name, None)
+    home = getattr(obj, "__module__", None)
+    if isinstance(home, str) and home in modules and name in owned_names(home):
+        return home
+    for candidate in modules:
+        if candidate.startswith(module + ".") and name in owned_names(candidate):
+            return candidate
+    return None
+
+
+def _automodule(module: str) -> list[str]:
+    names = owned_names(module)
+    lines = [f".. automodule:: {module}"]
+    if names:
+        lines += [f"   :members: {', '.join(names)}", "   :show-inheritance:"]
+    return [*lines, ""]
+
+
+def _reexports(package: str, modules: list[str]) -> list[str]:
+    """A line per defining module: the names ``package`` re-exports from it, linked."""
+    own = set(owned_names(package))
+    by_owner: dict[str, list[str]] = {}
+    for name in getattr(importlib.import_module(package), "__all__", []):
+        if name in own or name.startswith("_"):
+            continue
+        home = _owner(package, name, modules)
+        if home is not None:
+            by_owner.setdefault(home, []).append(name)
+    if not by_owner:
+        return []
+    lines = ["Public names of the package, documented where they are defined:", ""]
+    for home, names in by_owner.items():
+        refs = ", ".join(f":py:obj:`~{home}.{n}`" for n in names)
+        lines += [f"- from :py:mod:`{home}`: {refs}"]
+    return [*lines, ""]
+
+
+def _api_page(package: str, modules: list[str], everything: list[str]) -> str:
+    lines = [f"# `{package}`", "", "```{eval-rst}", *_automodule(package),
+             *_reexports(package, everything)]
+    for module in modules:
+        lines += _automodule(module)
+    lines += ["```", ""]
+    return "\n".join(lines)
+
+
+def write_api_pages(_app: Sphinx) -> None:
+    """The API reference: an index and one page per package (module docstring)."""
+    everything = public_modules()
+    pages = _packages(everything)
+    wanted = {f"{package}.md" for package in pages} | {"index.md"}
+    for package, modules in pages.items():
+        _write_if_changed(API_DIR / f"{package}.md", _api_page(package, modules, everything))
+    toc = "\n".join(sorted(pages))
+    index = ("# Python API\n\nGenerated from the docstrings: one page per package of `alte`, "
+             "with every public module inside it. The library's wing (`io`, `registration`, "
+             "`ground`, `mappers`, `metrics`, `pipeline`, `sim`, `export`) never imports the "
+             "lab's (`studies`, `plot`, `report`, `bench`); the command line sits on both.\n\n"
+             f"```{{toctree}}\n:maxdepth: 1\n\n{toc}\n```\n")
+    _write_if_changed(API_DIR / "index.md", index)
+    for stale in API_DIR.glob("*.md"):
+        if stale.name not in wanted:
+            stale.unlink(missing_ok=True)
+
+
+def _type_name(kind: object) -> str:
+    if isinstance(kind, type):
+        return kind.__name__
+    text = str(kind).replace("typing.", "")
+    for module in ("alte.types.", "alte.pipeline.spec.", "alte.mappers.", "pathlib.",
+                   "alte.registration.settings."):
+        text = text.replace(module, "")
+    return text
+
+
+def _default(spec: dataclasses.Field[Any]) -> str:
+    if spec.default is not dataclasses.MISSING:
+        value = spec.default
+    elif spec.default_factory is not dataclasses.MISSING:
+        value = spec.default_factory()
+    else:
+        return "(required)"
+    if isinstance(value, enum.Enum):
+        value = value.value
+    if dataclasses.is_dataclass(value):
+        return f"{type(value).__name__}()"
+    return repr(value) if isinstance(value, str) else str(value)
+
+
+def record_rows(record: type[Any]) -> list[tuple[str, str, str, str, str]]:
+    """(name, type, default, rule, meaning) of each field a user sets."""
+    from alte.params import Rule, _choices, _hints
+
+    hints = _hints(record)
+    rows = []
+    for spec in dataclasses.fields(record):
+        if not spec.init:
+            continue
+        rule = spec.metadata.get("rule")
+        rule = rule if isinstance(rule, Rule) else Rule()
+        kind = hints[spec.name]
+        rows.append((spec.name, _type_name(kind), _default(spec),
+                     rule.rule or _choices(kind), rule.help))
+    return rows
+
+
+def _cell(text: str) -> str:
+    return text.replace("|", "\\|").replace("\n", " ") or "-"
+
+
+def record_table(record: type[Any]) -> list[str]:
+    """An RST list-table of the record's settings."""
+    lines = [".. list-table::", "   :header-rows: 1", "   :widths: 15 15 12 18 40", "",
+             "   * - setting", "     - type", "     - default", "     - rule", "     - meaning"]
+    for row in record_rows(record):
+        first, *rest = (f"``{row[0]}``", *(_literal(v) for v in row[1:3]), *row[3:])
+        lines.append(f"   * - {first}")
+        lines += [f"     - {_escape(v)}" if not v.startswith("``") else f"     - {v}"
+                  for v in rest]
+    return lines
+
+
+def _literal(text: str) -> str:
+    return f"``{text}``" if text and text != "-" else "-"
+
+
+def _escape(text: str) -> str:
+    if not text:
+        return "-"
+    for char in ("\\", "*", "`", "|", "_"):
+        text = text.replace(char, "\\" + char)
+    return text
+
+
+class RecordDirective(SphinxDirective):
+    """``{alte-record} module.Class``: a settings table (module docstring)."""
+
+    required_arguments = 1
+
+    def run(self) -> list[nodes.Node]:
+        module, _, name = self.arguments[0].rpartition(".")
+        record = getattr(importlib.import_module(module), name)
+        return self._parse(record_table(record))
+
+    def _parse(self, lines: list[str]) -> list[nodes.Node]:
+        """The reST ``lines`` as nodes. In a MyST page a nested parse reads Markdown, so
+        the lines go through MyST's ``eval-rst`` block there (reST pages parse them as is)."""
+        if "myst" in type(self.state).__module__.lower():
+            lines = ["````{eval-rst}", *lines, "````"]
+        node = nodes.section()
+        node.document = self.state.document
+        self.state.nested_parse(StringList(lines, source="alte-record"), 0, node)
+        return list(node.children)
+
+
+class MappersDirective(RecordDirective):
+    """``{alte-mappers}``: every registered mapper's settings, one table each."""
+
+    required_arguments = 0
+
+    def run(self) -> list[nodes.Node]:
+        from alte.mappers import registry
+
+        lines: list[str] = []
+        for cls in registry.classes():
+            said = (cls.__doc__ or "").strip().splitlines()[0]
+            lines += [f"**{cls.name}** (:class:`{cls.__module__}.{cls.__name__}`): {said}",
+                      "", *record_table(cls.Params), ""]
+        return self._parse(lines)
+
+
+class CsvDirective(RecordDirective):
+    """``{alte-csv} path.csv`` (from the repository root) with ``:columns: a, b`` and an
+    optional ``:where: column=value``: a committed table, as a list-table, with the row
+    count and the file named under it, so a page quotes the numbers from their file."""
+
+    option_spec: ClassVar[dict[str, Callable[[str], object]]] = {
+        "columns": lambda text: [c.strip() for c in text.split(",")],
+        "where": str, "caption": str}
+
+    def run(self) -> list[nodes.Node]:
+        import csv
+
+        path = REPO / self.arguments[0]
+        self.env.note_dependency(str(path))
+        with path.open(newline="") as handle:
+            rows = list(csv.DictReader(handle))
+        if "where" in self.options:
+            key, _, value = self.options["where"].partition("=")
+            rows = [r for r in rows if r.get(key.strip()) == value.strip()]
+        columns = self.options.get("columns") or (list(rows[0]) if rows else [])
+        missing = [c for c in columns if rows and c not in rows[0]]
+        if missing:
+            raise self.error(f"{path.name} has no column(s) {missing}")
+        lines = [".. list-table:: " + self.options.get("caption", ""), "   :header-rows: 1", "",
+                 "   * - " + columns[0], *(f"     - {c}" for c in columns[1:])]
+        for row in rows:
+            cells = [_escape(row[c]) for c in columns]
+            lines += [f"   * - {cells[0]}", *(f"     - {c}" for c in cells[1:])]
+        lines += ["", f"{len(rows)} rows, read from ``{self.arguments[0]}``."]
+        return self._parse(lines)
+
+
+class ProvenanceDirective(RecordDirective):
+    """``{alte-provenance} path.json``: the command, commit, dates and cost a committed
+    result was written with (a sweep's ``provenance.json``)."""
+
+    def run(self) -> list[nodes.Node]:
+        import json
+
+        path = REPO / self.arguments[0]
+        self.env.note_dependency(str(path))
+        said = json.loads(path.read_text())
+        machine = said.get("machine", {})
+        lines = [".. list-table::", "   :stub-columns: 1", ""]
+        items = [("command", f"``{said.get('command', '-')}``"),
+                 ("commit", f"``{str(said.get('commit', '-'))[:10]}``"),
+                 ("started", said.get("started", "-")), ("finished", said.get("finished", "-")),
+                 ("runs", f"{said.get('runs', '-'):,}" if isinstance(said.get("runs"), int)
+                  else "-"),
+                 ("CPU", f"{said['cpu_s'] / 3600:.2f} h" if "cpu_s" in said else "-"),
+                 ("machine", f"{machine.get('cpu', '-')}, {machine.get('cores', '-')} cores"),
+                 ("file", f"``{self.arguments[0]}``")]
+        for key, value in items:
+            lines += [f"   * - {key}", f"     - {value}"]
+        return self._parse(lines)
+
+
+def setup(app: Sphinx) -> dict[str, object]:
+    """Register the page generator and the two directives."""
+    app.connect("builder-inited", write_api_pages)
+    app.add_directive("alte-record", RecordDirective)
+    app.add_directive("alte-mappers", MappersDirective)
+    app.add_directive("alte-csv", CsvDirective)
+    app.add_directive("alte-provenance", ProvenanceDirective)
+    return {"parallel_read_safe": True, "parallel_write_safe": True}
+
+
+__all__ = ["owned_names", "public_modules", "record_rows", "record_table", "setup",
+           "write_api_pages"]
