@@ -3,11 +3,10 @@
 :func:`align` is point-to-plane Gauss-Newton (correspondences from the map's k-d tree,
 normals from the map, :class:`~alte.registration.refmap.DenseMap`) that moves a pose
 only along the directions the scan constrains, first its rotation alone, then all six
-directions. Each step is reweighted (IRLS) with a Cauchy kernel :data:`KERNEL` times the
-scan's own residual noise wide (:func:`noise`, re-estimated at every step): a point
-that falls between two surfaces, or on a surface the map does not hold, no longer pulls
-the pose as hard as the thousands that lie on one. small_gicp's own alignment needs the
-target's normals in its point cloud, which it can only estimate for the whole cloud.
+directions. small_gicp's own alignment needs the target's normals in its point cloud,
+which it can only estimate for the whole cloud. (A Cauchy-reweighted alignment was
+tried and not kept: on the simulated ``exp_nav_2`` it leaves more late poses
+uncorrected, 35 mm from the true mesh against 31.7 mm; docs/design-notes/poses.md.)
 
 :func:`evidence` measures what a correction is worth, on the scan's own terms:
 
@@ -19,7 +18,7 @@ target's normals in its point cloud, which it can only estimate for the whole cl
     them onto a surface gains little);
 ``information``
     how strongly the scan's points see the corrected direction: the Hessian along it per
-    unit weight (1: every residual moves as much as the pose; 0: none). A correction
+    matched point (1: every residual moves as much as the pose; 0: none). A correction
     along a direction the scan barely sees (a slide over flat ground) is what noise and
     a map of sparse rings produce.
 """
@@ -36,11 +35,9 @@ from scipy.spatial.transform import Rotation
 if TYPE_CHECKING:
     from alte.registration.refmap import DenseMap
 
-__all__ = ["KERNEL", "MAX_ITERATIONS", "TRUNCATE", "Alignment", "Evidence", "align",
+__all__ = ["MAX_ITERATIONS", "TRUNCATE", "Alignment", "Evidence", "align",
            "evidence", "noise"]
 
-#: Cauchy kernel width, in residual-noise sigmas (:func:`noise`).
-KERNEL = 3.0
 #: Truncation of the cost :func:`evidence` compares, in residual-noise sigmas.
 TRUNCATE = 3.0
 #: Least residual noise (m): a scan whose residuals are all near zero fits already.
@@ -61,9 +58,9 @@ def noise(residuals: NDArray[np.float64]) -> float:
 
 @dataclass(frozen=True)
 class Alignment:
-    """Where the scan was aligned to (sensor pose, 4x4), the weighted Gauss-Newton Hessian
-    at that pose (6x6, rotation first, rotation in radians), the sum of the weights it
-    was built from and how many of its six directions were left at the guess (too weakly
+    """Where the scan was aligned to (sensor pose, 4x4), the Gauss-Newton Hessian at that
+    pose (6x6, rotation first, rotation in radians), the number of matched points it was
+    built from and how many of its six directions were left at the guess (too weakly
     constrained to move)."""
 
     pose: NDArray[np.float64]
@@ -103,20 +100,17 @@ def _step(hessian: NDArray[np.float64], gradient: NDArray[np.float64], length: f
 
 def _solve(local: DenseMap, points: NDArray[np.float64], pose: NDArray[np.float64], *,
            length: float, ratio: float, turn_only: bool) -> Alignment:
-    """Reweighted Gauss-Newton iterations from ``pose`` (:func:`align`)."""
+    """Gauss-Newton iterations from ``pose`` (:func:`align`)."""
     hessian, weight, free = np.zeros((6, 6)), 0.0, 0
     for _ in range(MAX_ITERATIONS):
         rot = pose[:3, :3]
         inlier, index, residual = local.matches(points @ rot.T + pose[:3, 3])
         if not inlier.any():
             break
-        kept = residual[inlier]
-        weights = np.ones(len(kept)) if turn_only else \
-            1.0 / (1.0 + (kept / (KERNEL * noise(kept))) ** 2)
         turned = local.normals[index[inlier]] @ rot
         jacobian = np.hstack([np.cross(points[inlier], turned), turned])
-        hessian, weight = jacobian.T @ (jacobian * weights[:, None]), float(weights.sum())
-        step, free = _step(hessian, jacobian.T @ (weights * kept), length, ratio, turn_only)
+        hessian, weight = jacobian.T @ jacobian, float(inlier.sum())
+        step, free = _step(hessian, jacobian.T @ residual[inlier], length, ratio, turn_only)
         pose = pose @ _exp(step)
         if np.linalg.norm(step[:3]) < _CONVERGED[0] and np.linalg.norm(step[3:]) < _CONVERGED[1]:
             break
@@ -149,7 +143,7 @@ class Evidence:
 
 def _information(found: Alignment, guess: NDArray[np.float64], length: float) -> float:
     """Hessian along the correction ``guess -> found.pose`` (rotation in metres at
-    ``length``) per unit of squared correction and of weight."""
+    ``length``) per unit of squared correction and per matched point."""
     delta = np.linalg.inv(guess) @ found.pose
     step = np.concatenate([Rotation.from_matrix(delta[:3, :3]).as_rotvec(), delta[:3, 3]])
     metres = np.linalg.solve(_scaling(length), step)

@@ -1,6 +1,6 @@
 """Refinement of recorded poses that moves them only on evidence.
 
-Each scan is aligned point-to-plane (reweighted Gauss-Newton,
+Each scan is aligned point-to-plane (Gauss-Newton,
 :func:`~alte.registration.refalign.align`) to a map of the scans before it, placed with
 their refined poses (:class:`~alte.registration.refmap.DenseMap`, updated
 incrementally), starting from its recorded pose. The alignment moves the pose only
@@ -27,7 +27,7 @@ and the scan counted as kept with the first reason that failed:
 This corrects desynchronised poses (thesis fig. 4.34) and leaves good ones alone. The
 two evidence thresholds were chosen on the real ``balm_seq`` and ``balm_seq2``
 recordings, whose reference poses no alignment should move, and the simulated
-``exp_nav_2``, whose late poses it should (README, "Poses").
+``exp_nav_2``, whose late poses it should (docs/results/poses.md, "Cross-validation").
 Every scan has a :class:`ScanDecision` in ``PoseCounts.scans``.
 """
 

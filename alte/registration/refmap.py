@@ -1,8 +1,7 @@
 """The map refinement aligns each scan to, updated incrementally.
 
 :class:`DenseMap` holds one point per ``voxel`` cell with a normal from its
-:data:`NEIGHBOURS` nearest map neighbours, used only where they spread over a plane
-(:data:`PLANARITY`). Scans are queued (on a ``voxel / 2`` grid) and join every
+:data:`NEIGHBOURS` nearest map neighbours. Scans are queued (on a ``voxel / 2`` grid) and join every
 ``rebuild`` scans: cells the map does not hold yet are appended (the mean of the queued
 points in them); the points of a scan whose recorded pose was *confirmed* (kept for
 lack of evidence against it, or the first) are also averaged into the cells already
@@ -24,7 +23,7 @@ from typing import Protocol
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["MAX_SOURCE", "NEIGHBOURS", "PLANARITY", "REACH", "DenseMap"]
+__all__ = ["MAX_SOURCE", "NEIGHBOURS", "REACH", "DenseMap"]
 
 #: Correspondence reach, in map voxels.
 REACH = 4.0
@@ -36,10 +35,6 @@ NEIGHBOURS = 20
 #: A new map point's nearest neighbours whose normals are estimated again (their
 #: neighbourhood changed): the frontier of what the map saw.
 REFRESH = 5
-#: Least ratio of the middle to the largest spread of a map point's neighbours for its
-#: normal to be used: the neighbours of a point on one scan ring lie on a line (or a
-#: shallow arc), whose least-spread direction is any direction across it.
-PLANARITY = 0.05
 #: Cell index range (each axis) packed into one int64 key: +-2^20 cells.
 _HALF = 1 << 20
 
@@ -73,15 +68,14 @@ def _codes(points: NDArray[np.float64], voxel: float) -> NDArray[np.int64]:
 
 
 def _normals(points: NDArray[np.float64], neighbours: NDArray[np.int64],
-             ) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
+             ) -> NDArray[np.float64]:
     """Unit normals: the least-spread direction of each point's neighbours (rows of
-    indices into ``points``), and whether the neighbours spread over a plane (their
-    middle spread at least :data:`PLANARITY` of the largest) rather than along a line."""
+    indices into ``points``)."""
     near = points[neighbours]
     centred = near - near.mean(axis=1, keepdims=True)
-    values, vectors = np.linalg.eigh(np.matmul(centred.transpose(0, 2, 1), centred))
+    _, vectors = np.linalg.eigh(np.matmul(centred.transpose(0, 2, 1), centred))
     normals: NDArray[np.float64] = vectors[:, :, 0]
-    return normals, values[:, 1] >= PLANARITY * values[:, 2]
+    return normals
 
 
 class DenseMap:
@@ -93,7 +87,6 @@ class DenseMap:
         self.threads = _threads(threads)
         self.points = np.empty((0, 3))
         self.normals = np.empty((0, 3))
-        self.planar = np.empty(0, bool)
         self.sums = np.empty((0, 3))  # per cell: sum and number of the points in it
         self.counts = np.empty(0)
         self.codes = np.empty(0, np.int64)  # sorted cell codes; ``rows``: their rows
@@ -133,7 +126,7 @@ class DenseMap:
                               axis=1) <= self.radius
         first = int(keep[:first].sum())
         self.sums, self.counts = self.sums[keep], self.counts[keep]
-        self.normals, self.planar = self.normals[keep], self.planar[keep]
+        self.normals = self.normals[keep]
         self.points = self.sums / self.counts[:, None]
         codes = _codes(self.points, self.voxel)
         self.rows = np.argsort(codes, kind="stable")
@@ -161,7 +154,6 @@ class DenseMap:
         self.sums = np.vstack([self.sums, sums[~held]])
         self.counts = np.concatenate([self.counts, counts[~held]])
         self.normals = np.vstack([self.normals, np.zeros((int((~held).sum()), 3))])
-        self.planar = np.concatenate([self.planar, np.zeros(int((~held).sum()), bool)])
         return first
 
     def _retarget(self, first: int) -> None:
@@ -174,13 +166,11 @@ class DenseMap:
         if first >= len(self.points) or k < 3:
             return
         near, _ = self.tree.batch_knn_search(self.points[first:], k, num_threads=self.threads)
-        self.normals[first:], self.planar[first:] = _normals(
-            self.points, np.asarray(near, dtype=np.int64))
+        self.normals[first:] = _normals(self.points, np.asarray(near, dtype=np.int64))
         touched = np.asarray(near, dtype=np.int64)[:, :REFRESH].ravel()
         touched = np.unique(touched[touched < first])
         around, _ = self.tree.batch_knn_search(self.points[touched], k, num_threads=self.threads)
-        self.normals[touched], self.planar[touched] = _normals(
-            self.points, np.asarray(around, dtype=np.int64))
+        self.normals[touched] = _normals(self.points, np.asarray(around, dtype=np.int64))
 
     def matches(self, placed: NDArray[np.float64],
                 ) -> tuple[NDArray[np.bool_], NDArray[np.int64], NDArray[np.float64]]:
@@ -192,7 +182,6 @@ class DenseMap:
         inlier = (np.asarray(sq) <= (REACH * self.voxel) ** 2) & (index >= 0) & (
             index < len(self.points))
         index = np.where(inlier, index, 0)
-        inlier &= self.planar[index]
         residual = np.einsum("ij,ij->i", self.normals[index], placed - self.points[index])
         return inlier, index, np.where(inlier, residual, 0.0)
 
