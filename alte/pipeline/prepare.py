@@ -37,7 +37,7 @@ from alte.types import Box, RegisteredFrame, Trajectory
 __all__ = ["Merged", "Registered", "cache_key", "merge_frames", "merged_cloud", "prepare"]
 
 #: Bump when the registered output of the same input and spec changes.
-CACHE_VERSION = 5
+CACHE_VERSION = 6
 _POINTS, _ARRAYS, _META = "points.f64", "arrays.npz", "meta.json"
 #: The odometry's pose cache inside a registration cache folder.
 POSE_DIR = "poses"

@@ -1,34 +1,29 @@
-"""The map refinement aligns each scan to, updated incrementally, and the alignment.
+"""The map refinement aligns each scan to, updated incrementally.
 
-:class:`DenseMap` holds one point per ``voxel`` cell with a normal from its 20 nearest
-map neighbours. Scans are queued (on a ``voxel / 2`` grid) and join every ``rebuild``
-scans: cells the map does not hold yet are appended (the mean of the queued points in
-them); the points of a scan whose recorded pose was *confirmed* (kept for ``no_gain``,
-or the first) are also averaged into the cells already held, while a *corrected* scan
-only extends the map: its pose came from the map, and feeding it back would let the map
-drift with the alignments' errors (on the simulated ``exp_nav_2`` the refined positions
-then wander 8 cm from the truth instead of 4.5). Normals are estimated for the new
-points and for the :data:`REFRESH` nearest map points of each (their neighbourhood
-changed); the rest keep theirs. Cells beyond ``radius`` of the sensor are dropped and
-the k-d tree (small_gicp) rebuilt. An update costs the k-d tree plus what is new, not
-grid, tree and normals of the whole map again.
-
-:func:`align` is point-to-plane Gauss-Newton (correspondences from the k-d tree, normals
-from the map) that moves a pose only along the directions the scan constrains, first
-its rotation alone, then all six directions. small_gicp's own alignment needs the
-target's normals in its point cloud, which it can only estimate for the whole cloud.
+:class:`DenseMap` holds one point per ``voxel`` cell with a normal from its
+:data:`NEIGHBOURS` nearest map neighbours. Scans are queued (on a ``voxel / 2`` grid) and join every
+``rebuild`` scans: cells the map does not hold yet are appended (the mean of the queued
+points in them); the points of a scan whose recorded pose was *confirmed* (kept for
+lack of evidence against it, or the first) are also averaged into the cells already
+held, while a *corrected* scan only extends the map: its pose came from the map, and
+feeding it back would let the map drift with the alignments' errors (on the simulated
+``exp_nav_2`` the refined positions then wander 8 cm from the truth instead of 4.5).
+Normals are estimated for the new points and for the :data:`REFRESH` nearest map points
+of each (their neighbourhood changed); the rest keep theirs. Cells beyond ``radius``
+of the sensor are dropped and the k-d tree (small_gicp) rebuilt. An update costs the
+k-d tree plus what is new, not grid, tree and normals of the whole map again. The
+alignment to it is :mod:`~alte.registration.refalign`.
 """
 
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass
 from typing import Protocol
 
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["MAX_ITERATIONS", "MAX_SOURCE", "NEIGHBOURS", "REACH", "Alignment", "DenseMap", "align"]
+__all__ = ["MAX_SOURCE", "NEIGHBOURS", "REACH", "DenseMap"]
 
 #: Correspondence reach, in map voxels.
 REACH = 4.0
@@ -40,10 +35,6 @@ NEIGHBOURS = 20
 #: A new map point's nearest neighbours whose normals are estimated again (their
 #: neighbourhood changed): the frontier of what the map saw.
 REFRESH = 5
-#: Gauss-Newton steps at most; it stops earlier once a step moves less than
-#: :data:`_CONVERGED` (radians, metres).
-MAX_ITERATIONS = 30
-_CONVERGED = (np.radians(0.1), 1e-3)
 #: Cell index range (each axis) packed into one int64 key: +-2^20 cells.
 _HALF = 1 << 20
 
@@ -82,21 +73,9 @@ def _normals(points: NDArray[np.float64], neighbours: NDArray[np.int64],
     indices into ``points``)."""
     near = points[neighbours]
     centred = near - near.mean(axis=1, keepdims=True)
-    scatter = np.einsum("nki,nkj->nij", centred, centred)
-    _, vectors = np.linalg.eigh(scatter)
+    _, vectors = np.linalg.eigh(np.matmul(centred.transpose(0, 2, 1), centred))
     normals: NDArray[np.float64] = vectors[:, :, 0]
     return normals
-
-
-@dataclass(frozen=True)
-class Alignment:
-    """Where the scan was aligned to (sensor pose, 4x4), the Gauss-Newton Hessian at that
-    pose (6x6, rotation first, rotation in radians) and how many of its six directions
-    were left at the guess (too weakly constrained to move)."""
-
-    pose: NDArray[np.float64]
-    hessian: NDArray[np.float64]
-    free: int
 
 
 class DenseMap:
@@ -206,69 +185,13 @@ class DenseMap:
         residual = np.einsum("ij,ij->i", self.normals[index], placed - self.points[index])
         return inlier, index, np.where(inlier, residual, 0.0)
 
-    def cost(self, points: NDArray[np.float64], pose: NDArray[np.float64]) -> tuple[float, float]:
-        """Inlier fraction and truncated point-to-plane cost (m^2, outliers at the reach)
-        of sensor-frame ``points`` placed at ``pose``."""
-        reach = (REACH * self.voxel) ** 2
+    def cost(self, points: NDArray[np.float64], pose: NDArray[np.float64], cap: float,
+             ) -> tuple[float, float]:
+        """Inlier fraction and truncated point-to-plane cost (m^2: residuals capped at
+        ``cap`` m, points without a match at the cap) of sensor-frame ``points`` placed
+        at ``pose``."""
         if not len(points):
-            return 0.0, reach
+            return 0.0, cap * cap
         inlier, _, residual = self.matches(points @ pose[:3, :3].T + pose[:3, 3])
-        cost = np.where(inlier, np.minimum(residual ** 2, reach), reach)
+        cost = np.where(inlier, np.minimum(residual ** 2, cap * cap), cap * cap)
         return float(inlier.mean()), float(cost.mean())
-
-
-def _exp(step: NDArray[np.float64]) -> NDArray[np.float64]:
-    """4x4 transform of a small (rotation vector, translation) step."""
-    from scipy.spatial.transform import Rotation
-
-    out = np.eye(4)
-    out[:3, :3] = Rotation.from_rotvec(step[:3]).as_matrix()
-    out[:3, 3] = step[3:]
-    return out
-
-
-def _step(hessian: NDArray[np.float64], gradient: NDArray[np.float64], length: float,
-          ratio: float, turn_only: bool) -> tuple[NDArray[np.float64], int]:
-    """Gauss-Newton step restricted to the directions whose Hessian eigenvalue (rotation
-    scaled to metres at ``length``) is at least ``ratio`` times the largest; the others
-    stay where they are (solution remapping, Zhang, Kaess and Singh, ICRA 2016).
-    ``turn_only``: the rotation block alone (position held)."""
-    size = 3 if turn_only else 6
-    scale = np.diag([1.0 / length] * 3 + [1.0] * 3)[:size, :size]
-    values, vectors = np.linalg.eigh(scale @ hessian[:size, :size] @ scale)
-    good = values >= max(ratio * values[-1], 1e-12)
-    basis = vectors[:, good]
-    step = np.zeros(6)
-    step[:size] = scale @ (-basis @ ((basis.T @ (scale @ gradient[:size])) / values[good]))
-    return step, int((~good).sum())
-
-
-def _solve(local: DenseMap, points: NDArray[np.float64], pose: NDArray[np.float64], *,
-           length: float, ratio: float, turn_only: bool) -> Alignment:
-    """Gauss-Newton iterations from ``pose`` (:func:`align`)."""
-    hessian, free = np.zeros((6, 6)), 0
-    for _ in range(MAX_ITERATIONS):
-        rot = pose[:3, :3]
-        inlier, index, residual = local.matches(points @ rot.T + pose[:3, 3])
-        if not inlier.any():
-            break
-        turned = local.normals[index[inlier]] @ rot
-        jacobian = np.hstack([np.cross(points[inlier], turned), turned])
-        hessian = jacobian.T @ jacobian
-        step, free = _step(hessian, jacobian.T @ residual[inlier], length, ratio, turn_only)
-        pose = pose @ _exp(step)
-        if np.linalg.norm(step[:3]) < _CONVERGED[0] and np.linalg.norm(step[3:]) < _CONVERGED[1]:
-            break
-    return Alignment(pose, hessian, free)
-
-
-def align(local: DenseMap, points: NDArray[np.float64], guess: NDArray[np.float64], *,
-          length: float, ratio: float) -> Alignment:
-    """Point-to-plane Gauss-Newton of sensor-frame ``points`` onto ``local`` from ``guess``
-    (poses compose on the right, rotation first), moving only along the directions
-    constrained at least ``ratio`` (:func:`_step`): first the rotation about the sensor
-    alone, then all six directions. A late pose is mostly turned (the vehicle swings
-    faster than it moves), and a turn left to the full alignment is partly taken up by
-    a shift that lands it in a wrong minimum."""
-    turned = _solve(local, points, guess, length=length, ratio=ratio, turn_only=True)
-    return _solve(local, points, turned.pose, length=length, ratio=ratio, turn_only=False)

@@ -87,8 +87,13 @@ class OdometryParams(Record):
                                "alignment to count")
     min_constraint: float = param(0.002, _fraction, "0..1",
                                   "refine: smallest / largest Hessian eigenvalue to accept")
-    min_gain: float = param(0.1, _fraction, "0..1",
-                            "refine: least drop of the alignment cost to accept a correction")
+    min_gain: float = param(0.3, _fraction, "0..1",
+                            "refine: least share of the scan's cost (truncated at 3 noise "
+                            "sigmas) a correction must remove to be applied")
+    min_information: float = param(0.0, _fraction, "0..1",
+                                   "refine: least information (Hessian per point) along "
+                                   "the corrected direction for a correction to be applied "
+                                   "(0: any)")
     max_correction: float = param(0.5, _positive, "> 0",
                                   "m; refine: a larger correction is not applied")
     max_correction_deg: float = param(20.0, _positive, "> 0",
@@ -132,7 +137,7 @@ KEYS: dict[str, tuple[str, ...]] = {
             "wide_points", "wide_reach", "least", "gyro_noise", "accel_noise", "gyro_walk",
             "accel_walk", "gyro_bias", "accel_bias", "imu_topic"),
     "refine": ("max_range", "voxel", "rebuild", "min_fitness", "min_constraint", "min_gain",
-               "max_correction", "max_correction_deg", "threads"),
+               "min_information", "max_correction", "max_correction_deg", "threads"),
 }
 KEYS["auto"] = tuple(dict.fromkeys(KEYS["kiss"] + KEYS["lio"]))
 

@@ -94,6 +94,9 @@ def _ch4(terrain: str) -> Entry:
                  {"TERRAIN": terrain, "FRAMES": None})
 
 
+#: The real sequences of table 6.4 (``alte.studies.odometry.REAL_SEQUENCES``, named here
+#: so that reading the plan imports no study).
+POSE_SEQUENCES = ("balm_seq", "balm_seq2")
 #: The report: chapters 2 and 3 once, chapter 4 once per terrain, chapter 5 once.
 #: Quick mode keeps the notebooks' small defaults except a common ``FRAMES``.
 PLAN: tuple[Entry, ...] = (
@@ -111,8 +114,10 @@ PLAN: tuple[Entry, ...] = (
           {"FRAMES": None, "SPEC": "notebooks/sweeps/report.yaml", "SCHEDULER": "local"},
           terrains=("sim_lan_2", "sim_nav_1")),
     Entry("ch6_real_data", "ch6_real_data.ipynb",
-          {"FRAMES": QUICK_FRAMES, "FRONT_FRAMES": 10, "FRONT_GRID": None},
-          {"FRAMES": None, "FRONT_FRAMES": 20, "FRONT_GRID": None}),
+          {"FRAMES": QUICK_FRAMES, "FRONT_FRAMES": 10, "FRONT_GRID": None,
+           "POSE_SEQUENCES": list(POSE_SEQUENCES)},
+          {"FRAMES": None, "FRONT_FRAMES": 20, "FRONT_GRID": None,
+           "POSE_SEQUENCES": list(POSE_SEQUENCES)}),
     Entry("ch7_landing", "ch7_landing.ipynb", {"FRAMES": QUICK_FRAMES}, {"FRAMES": None},
           terrains=("sim_lan_1", "sim_lan_2", "exp_lan_1", "exp_lan_2")),
     Entry("ch7_planning", "ch7_planning.ipynb", {"FRAMES": QUICK_FRAMES}, {"FRAMES": None},

@@ -42,7 +42,7 @@ from alte.registration.odometry import OdometryParams
 from alte.studies.analysis.tables import write_csv
 from alte.studies.experiments import CACHE_DIR
 
-__all__ = ["COLUMNS", "REAL_SEQUENCE", "SOURCES", "BenchInput", "bench_input", "odometry_table",
+__all__ = ["COLUMNS", "REAL_SEQUENCES", "SOURCES", "BenchInput", "bench_input", "odometry_table",
            "pose_benchmark", "realdata_table", "write_odometry_table"]
 
 #: Pose sources in table order: name -> (pose source, odometry backend or None).
@@ -84,6 +84,13 @@ def _terrain_input(name: str, data_dir: Path, frames: int | None, seed: int) -> 
     return BenchInput(name, source, tum, float(source.voxel or BAG_VOXEL), frames)
 
 
+def _name(path: Path, name: str) -> str:
+    """A bag's name in the table: its folder's, or its parent's when the folder is only
+    called ``bag`` (``balm_seq/bag``, a terrain folder's ``bag``)."""
+    path = path.resolve()
+    return path.parent.name if path.name == "bag" else (name or path.name)
+
+
 def bench_input(what: str | os.PathLike[str], *, reference: str | os.PathLike[str] | None = None,
                 voxel: float | None = None, frames: int | None = None,
                 data_dir: str | os.PathLike[str] = "data", seed: int = 0) -> BenchInput:
@@ -103,7 +110,7 @@ def bench_input(what: str | os.PathLike[str], *, reference: str | os.PathLike[st
     source = open_input(Path(what))
     if reference is not None and not Path(reference).is_file():
         raise ParameterError(f"--reference {reference}: no such TUM file")
-    return BenchInput(source.name or Path(what).name, source,
+    return BenchInput(_name(Path(what), source.name), source,
                       None if reference is None else Path(reference),
                       voxel or source.voxel or BAG_VOXEL, frames)
 
@@ -237,19 +244,25 @@ def odometry_table(inputs: Sequence[str | os.PathLike[str]] | None = None, *,
     return pd.concat(tables, ignore_index=True)
 
 
-#: The real sequence of the benchmark, under the real-data folder.
-REAL_SEQUENCE = ("balm_seq", "bag")
+#: The real sequences of the benchmark (folders under the real-data folder, each with a
+#: ``bag`` holding its reference poses): two non-overlapping stretches of one recording.
+REAL_SEQUENCES = ("balm_seq", "balm_seq2")
 
 
 def realdata_table(root: Path | None, terrains: Sequence[str] = (), *,
+                   sequences: Sequence[str] = REAL_SEQUENCES,
                    sources: Sequence[str] = tuple(SOURCES),
                    data_dir: str | os.PathLike[str] = "data",
                    progress: bool = False) -> pd.DataFrame:
-    """The benchmark on the real sequence under ``root`` (its pose topic as the reference),
-    then on ``terrains``; an empty table when ``root`` is None (no real data)."""
+    """The benchmark on the real ``sequences`` present under ``root`` (their pose topic as
+    the reference), then on ``terrains``; an empty table when ``root`` is None (no real
+    data)."""
     if root is None:
         return pd.DataFrame(columns=list(COLUMNS))
-    inputs = [str(Path(root).joinpath(*REAL_SEQUENCE)), *terrains]
+    bags = [Path(root) / name / "bag" for name in sequences]
+    inputs = [str(b) for b in bags if b.exists()] + list(terrains)
+    if not inputs:
+        return pd.DataFrame(columns=list(COLUMNS))
     return odometry_table(inputs, data_dir=data_dir, sources=sources, progress=progress)
 
 
