@@ -79,3 +79,14 @@ def test_no_mapper_imports_another_mappers_module() -> None:
     assert crossing == []
     assert {"alte.mappers.octomap.backends", "alte.mappers.octree.tree"} <= graph[
         "alte.mappers.octomap.mapper"]  # the family imports its own and shared modules
+
+
+def test_the_ground_settings_load_without_the_ground_stage() -> None:
+    """``alte map`` reads the ground filters' settings for its flags; importing them must not
+    load the stage (pandas through the obstacle tables: +80 MB on every ``alte map``)."""
+    code = ("import sys, json\nimport alte.commands.map, alte.ground.settings\n"
+            "print(json.dumps([m for m in ('pandas', 'alte.ground.obstacles', "
+            "'alte.ground.clustering') if m in sys.modules]))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True, timeout=600).stdout
+    assert json.loads(out) == []
