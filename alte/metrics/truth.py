@@ -41,6 +41,7 @@ from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 
 from alte.errors import MetricsError
+from alte.metrics.cellxy import cell_at_xy, size_groups
 from alte.metrics.freespace import free_space_truth
 from alte.metrics.surface import SurfaceSamples, TrueSurface
 
@@ -67,8 +68,6 @@ __all__ = [
 ]
 
 
-
-
 class TruthValues(TypedDict, total=False):
     """Ground-truth metrics by name (module docstring), as
     :class:`~alte.metrics.maps.TruthMetrics` takes them; each function gives its own."""
@@ -86,11 +85,6 @@ class TruthValues(TypedDict, total=False):
     free_truly_free_share: float
     completeness_by_class: dict[str, float]
     completeness_by_object: dict[str, float]
-
-
-def size_groups(half: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.intp]]:
-    """Distinct half sizes and, per cell, the index of its group (trees have few sizes)."""
-    return np.unique(np.round(half, 9), axis=0, return_inverse=True)
 
 
 def distance_to_boxes(points: NDArray[np.float64], centers: NDArray[np.float64],
@@ -119,50 +113,6 @@ def distance_to_boxes(points: NDArray[np.float64], centers: NDArray[np.float64],
         np.minimum.at(out, i, np.linalg.norm(gap, axis=1))
     out[out > max_distance] = np.inf
     return out
-
-
-def _lattice_keys(ij: NDArray[np.int64]) -> NDArray[np.int64]:
-    """One int64 per (i, j) lattice index pair (each shifted into 32 bits)."""
-    shifted = np.clip(ij, -(1 << 30), (1 << 30) - 1) + (1 << 30)
-    return np.asarray((shifted[:, 0] << 32) | shifted[:, 1], dtype=np.int64)
-
-
-def cell_at_xy(xy: NDArray[np.float64], centers: NDArray[np.float64], sizes: NDArray[np.float64],
-               ) -> NDArray[np.int64]:
-    """Index of the 2D cell whose x/y rectangle holds each point, -1 where none does.
-
-    Within one size group the cells of a tree lie on a lattice, so a point's lattice
-    index (floor of its offset over the cell size) names the only cell that can hold
-    it, found by a sorted-key lookup; a point on a cell edge is also tried against the
-    cells below it on that axis. Containment is then checked exactly (edges included).
-    """
-    xy = np.asarray(xy, dtype=np.float64)
-    found = np.full(len(xy), -1, dtype=np.int64)
-    if len(xy) == 0 or len(centers) == 0:
-        return found
-    half = np.asarray(sizes, dtype=np.float64)[:, :2] / 2.0
-    groups, inverse = size_groups(half)
-    for g, h in enumerate(groups):
-        sel = np.flatnonzero(inverse.reshape(-1) == g)
-        step = np.maximum(2.0 * h, 1e-12)
-        origin = centers[sel[0], :2] - h
-        keys = _lattice_keys(np.rint((centers[sel, :2] - h - origin) / step).astype(np.int64))
-        order = np.argsort(keys)
-        sorted_keys = keys[order]
-        todo = np.flatnonzero(found < 0)
-        rel = (xy[todo] - origin) / step
-        low = np.floor(rel)
-        on_edge = (low == rel).astype(np.int64)  # per axis: also try the cell below
-        for shift in ((0, 0), (1, 0), (0, 1), (1, 1)):
-            rows = np.all(on_edge >= shift, axis=1)
-            pts = todo[rows]
-            query = _lattice_keys(low[rows].astype(np.int64) - np.asarray(shift))
-            pos = np.minimum(np.searchsorted(sorted_keys, query), len(sorted_keys) - 1)
-            cand = sel[order[pos]]
-            inside = ((sorted_keys[pos] == query) & (found[pts] < 0)
-                      & np.all(np.abs(xy[pts] - centers[cand, :2]) <= h + 1e-9, axis=1))
-            found[pts[inside]] = cand[inside]
-    return found
 
 
 def accuracy(centers: NDArray[np.float64], sizes: NDArray[np.float64], surface: TrueSurface,
