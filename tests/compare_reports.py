@@ -18,8 +18,8 @@ import pandas as pd
 
 #: Parts of a column name that mark a wall-clock or CPU-time column.
 TIME_MARKS = ("elapsed", "map_cpu", "wall_s", "cpu_s", "time_repeats", "rule_score",
-              "ms_per_scan", "seconds", "latency", "time per scan", "map_s", "build_s",
-              "search_s")
+              "ms_per_scan", "seconds", "latency", "time per scan", "CPU per scan", "map_s",
+              "build_s", "search_s")
 #: Columns naming what a row reads, and the words of a time reading there.
 ROW_KEYS, TIME_ROWS = ("metric", "what"), ("elapsed", "cpu", "time")
 #: Tables whose content follows a pick made on times (any column), or quotes times (those
