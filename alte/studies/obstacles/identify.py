@@ -23,6 +23,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
@@ -67,21 +68,32 @@ def _spans(lo: NDArray[np.float64], hi: NDArray[np.float64], origin: float, step
             np.clip(last, -1, count - 1).astype(np.int64))
 
 
+@numba.njit(cache=True)
+def _max_into(
+    out: NDArray[np.float64], rows: tuple[NDArray[np.int64], NDArray[np.int64]],
+    cols: tuple[NDArray[np.int64], NDArray[np.int64]], values: NDArray[np.float64],
+    nx: int,
+) -> None:
+    """``out[r * nx + c] = max(out, value)`` over each cell's pixel block (rows and columns
+    first to last), NaN winning as in ``np.maximum``."""
+    for i in range(values.shape[0]):
+        v = values[i]
+        for r in range(rows[0][i], rows[1][i] + 1):
+            for c in range(cols[0][i], cols[1][i] + 1):
+                if v > out[r * nx + c] or np.isnan(v):
+                    out[r * nx + c] = v
+
+
 def _paint(centers: NDArray[np.float64], half: NDArray[np.float64],
            values: NDArray[np.float64], grid: RasterGeometry, centres: bool) -> NDArray[np.float64]:
     """Per pixel, the largest of ``values`` over the cells covering it (NaN: none)."""
     ny, nx = grid.shape
     out = np.full(ny * nx, -np.inf)
-    c0, c1 = _spans(centers[:, 0] - half[:, 0], centers[:, 0] + half[:, 0], grid.origin[0],
-                    grid.step, nx, centres=centres)
-    r0, r1 = _spans(centers[:, 1] - half[:, 1], centers[:, 1] + half[:, 1], grid.origin[1],
-                    grid.step, ny, centres=centres)
-    width, rows = np.maximum(c1 - c0 + 1, 0), np.maximum(r1 - r0 + 1, 0)
-    count = width * rows
-    cell = np.repeat(np.arange(len(count)), count)
-    k = np.arange(count.sum()) - np.repeat(np.cumsum(count) - count, count)
-    flat = (r0[cell] + k // width[cell]) * nx + c0[cell] + k % width[cell]
-    np.maximum.at(out, flat, values[cell])
+    cols = _spans(centers[:, 0] - half[:, 0], centers[:, 0] + half[:, 0], grid.origin[0],
+                  grid.step, nx, centres=centres)
+    rows = _spans(centers[:, 1] - half[:, 1], centers[:, 1] + half[:, 1], grid.origin[1],
+                  grid.step, ny, centres=centres)
+    _max_into(out, rows, cols, np.ascontiguousarray(values, dtype=np.float64), nx)
     return np.where(np.isfinite(out), out, np.nan).reshape(grid.shape)
 
 
