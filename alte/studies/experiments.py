@@ -25,6 +25,7 @@ import pandas as pd
 from alte.errors import ParameterError
 from alte.mappers import Mapper
 from alte.metrics.maps import GroundTruth, MapMetrics, MapPointSet, TruthOptions, measure_map
+from alte.metrics.reference import Reference
 from alte.metrics.timing import Timing
 from alte.params import Record
 from alte.pipeline import (
@@ -43,7 +44,7 @@ from alte.registration.odometry import OdometryParams
 from alte.studies.thesis.numbers import SWEEPS, sweep_table
 
 __all__ = ["CACHE_DIR", "REPEATS", "REPEAT_BELOW_S", "Measured", "ground_truth", "measure",
-           "sweep", "terrain", "timed_run"]
+           "reference_of", "sweep", "terrain", "timed_run"]
 
 #: Where registrations are cached, inside the data folder (``DATA_DIR/.cache``).
 CACHE_DIR = ".cache"
@@ -141,18 +142,30 @@ def timed_run(data: Registered, spec: MapSpec, *, repeats: int = REPEATS,
 
 def measure(data: Registered, mapper: str, params: Mapping[str, object] | None = None, *,
             truth: TruthOptions | None = None, spec: MapSpec | None = None,
-            set_b: MapPointSet = MapPointSet.CORNERS, progress: bool = False) -> Measured:
+            set_b: MapPointSet = MapPointSet.CORNERS, progress: bool = False,
+            reference: Reference | None = None) -> Measured:
     """Map ``data`` with ``mapper`` and ``params`` and measure it (``truth``: also against
     the true surface; ``set_b``: the map's points of HD/MHD, see
     :class:`alte.metrics.maps.MapPointSet`). ``spec`` replaces
-    the default map specification. The map is timed by :func:`timed_run`."""
+    the default map specification. The map is timed by :func:`timed_run`.
+    ``reference``: :func:`reference_of` ``data`` and ``truth``, prepared once for several
+    maps (the same values)."""
     chosen = spec or MapSpec(mapper, dict(params or {}))
     result, timing = timed_run(data, chosen, progress=progress)
     cells = result.mapper.cells()  # listed once for every metric
     metrics = measure_map(result.mapper, data.cloud, elapsed_s=timing,
                           truth=ground_truth(data) if truth is not None else None,
-                          options=truth, set_b=set_b, cells=cells)
+                          options=truth, set_b=set_b, cells=cells,
+                          reference=None if reference is None else reference.fresh())
     return Measured(result, metrics)
+
+
+def reference_of(data: Registered, truth: TruthOptions | None) -> Reference:
+    """The cloud of ``data`` and, with ``truth``, its true surface, prepared once for
+    every map :func:`measure` makes of it (:class:`~alte.metrics.reference.Reference`:
+    the cloud's nearest-neighbour grids, the surface samples and what the sensor saw of
+    them, the true heights under the 2D probes)."""
+    return Reference(data.cloud, ground_truth(data) if truth is not None else None, truth)
 
 
 def sweep(data: Registered, table: int, rows: Sequence[int] | None = None, *,
@@ -172,7 +185,9 @@ def sweep(data: Registered, table: int, rows: Sequence[int] | None = None, *,
     if bad or not chosen:
         raise ParameterError(f"table 5.{table}: rows {bad or chosen} not in 0..5")
     thesis = sweep_table(table).iloc[chosen].reset_index(drop=True)
-    runs = [measure(data, spec["mapper"], {**spec["rows"][r][0], **(extra or {})}, truth=truth)
+    reference = reference_of(data, truth)  # the cloud and truth prepared once
+    runs = [measure(data, spec["mapper"], {**spec["rows"][r][0], **(extra or {})}, truth=truth,
+                    reference=reference)
             for r in progress_bar(chosen, desc=f"table 5.{table}", unit="map",
                                   disable=not progress)]
     ours = pd.DataFrame([m.metrics.flat() for m in runs])

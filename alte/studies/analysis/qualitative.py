@@ -35,7 +35,7 @@ from numpy.typing import ArrayLike
 from alte.metrics.maps import TruthOptions
 from alte.pipeline import Registered
 from alte.studies.analysis.tables import rule_pick
-from alte.studies.experiments import Measured, measure
+from alte.studies.experiments import Measured, measure, reference_of
 from alte.studies.thesis.numbers import QUALITATIVE
 
 __all__ = ["MEASURES", "Inputs", "class_completeness", "qualitative_inputs", "qualitative_table"]
@@ -156,8 +156,10 @@ def class_completeness(data: Registered,
     """Map ``data`` (e.g. sim_nav_2) with each sweep's chosen parameters and return the
     completeness on objects of class ``cls`` per mapper (NaN when the terrain has none)."""
     out = {}
+    reference = reference_of(data, truth)  # the cloud and truth prepared once
     for mapper, (table, runs) in sweeps.items():
-        found = measure(data, mapper, runs[rule_pick(table)].params.as_dict(), truth=truth)
+        found = measure(data, mapper, runs[rule_pick(table)].params.as_dict(), truth=truth,
+                        reference=reference)
         by_class = found.metrics.truth.completeness_by_class if found.metrics.truth else {}
         out[mapper] = float(by_class.get(cls, np.nan))
     return out
