@@ -279,9 +279,13 @@ def test_unknown_terrain_simulation_failure_is_named(spec, tmp_path, monkeypatch
         run_sweep(spec, scheduler="serial", output=tmp_path, progress=False)
 
 
-@pytest.mark.slow
+@pytest.mark.full
 def test_local_cluster_gives_the_serial_rows(spec, serial, tmp_path):
-    """The issue's acceptance test: same grid, serial vs LocalCluster(2 workers)."""
+    """Same grid, serial vs LocalCluster(2 workers). ``make check-full``'s: its parts are
+    proven in ``make test`` by ``test_sensor.py::test_seeds_give_a_row_each...`` (the same
+    ``local`` executor, two worker processes, the serial rows), ``test_dask_cluster.py``
+    (a sweep on worker processes gives the serial rows) and
+    ``test_existing_scheduler_address`` below."""
     table = serial[0].table
     dask = run_sweep(spec, scheduler="local", workers=2, output=tmp_path / "b", progress=False)
     assert dask.ran == 6 and not dask.failed
