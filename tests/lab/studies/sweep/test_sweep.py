@@ -282,7 +282,7 @@ def test_unknown_terrain_simulation_failure_is_named(spec, tmp_path, monkeypatch
 @pytest.mark.full
 def test_local_cluster_gives_the_serial_rows(spec, serial, tmp_path):
     """Same grid, serial vs LocalCluster(2 workers). ``make check-full``'s: its parts are
-    proven in ``make test`` by ``test_sensor.py::test_seeds_give_a_row_each...`` (the same
+    proven in ``make test`` by ``sensor/test_sensor.py::test_seeds_give_a_row_each...`` (the
     ``local`` executor, two worker processes, the serial rows), ``test_dask_cluster.py``
     (a sweep on worker processes gives the serial rows) and
     ``test_existing_scheduler_address`` below."""
