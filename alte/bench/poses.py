@@ -39,7 +39,7 @@ def _scans(ctx: Context) -> list[Frame]:
 
     bag = realdata_dir() / "balm_seq" / "bag"
     limit = 20 if ctx.config.quick else None
-    return ctx.memo("balm_frames", lambda: read_frames(bag, frames=None).frames[:limit])
+    return ctx.memo("balm_frames", lambda: read_frames(bag).frames[:limit])
 
 
 class _Clock:

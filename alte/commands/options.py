@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
+from alte.commands.flags import flag_message
 from alte.errors import ParameterError
 from alte.ground.settings import (
     DEFAULT_METHOD,
@@ -135,7 +136,10 @@ def ground_spec(args: argparse.Namespace, prefix: str = "") -> tuple[str | None,
 def odometry_spec(args: argparse.Namespace) -> OdometryParams:
     """The :class:`OdometryParams` of ``--odometry`` / ``--odometry-set`` (errors name them)."""
     settings = parse_key_values(getattr(args, "odometry_sets", []) or [], "--odometry-set")
-    return odometry_params(getattr(args, "odometry", None), settings)
+    try:
+        return odometry_params(getattr(args, "odometry", None), settings)
+    except ParameterError as err:
+        raise ParameterError(flag_message(err, {"--odometry", "--odometry-set"})) from err
 
 
 def parse_box(text: str, flag: str = "--crop") -> Box:
@@ -163,15 +167,6 @@ def parse_origin(text: str) -> tuple[float, float, float]:
     return (float(values[0]), float(values[1]), float(values[2]))
 
 
-def _checked(flag: str, value: float | int | None, integer: bool = False) -> None:
-    if value is None:
-        return
-    if not (np.isfinite(value) and value > 0):
-        raise ParameterError(f"{flag} {value!r}: must be > 0")
-    if integer and int(value) != value:
-        raise ParameterError(f"{flag} {value!r}: must be a whole number")
-
-
 def _poses(args: argparse.Namespace) -> PoseSource:
     """``--poses`` (``--no-pose`` is ``--poses identity``); unset is ``auto``."""
     chosen = getattr(args, "poses", None)
@@ -183,10 +178,8 @@ def _poses(args: argparse.Namespace) -> PoseSource:
 
 
 def frame_spec(args: argparse.Namespace) -> FrameSpec:
-    """The :class:`FrameSpec` of the parsed flags (errors name the flags)."""
-    for flag, value in (("--frames", args.frames), ("--voxel", args.voxel),
-                        ("--max-rate", args.max_rate), ("--max-offset", args.max_offset)):
-        _checked(flag, value, integer=flag == "--frames")
+    """The :class:`FrameSpec` of the parsed flags (its errors name the settings; the
+    command line puts their flags in front, :mod:`alte.commands.flags`)."""
     poses = _poses(args)
     if poses is PoseSource.IDENTITY and args.pose_topic:
         raise ParameterError("--no-pose (--poses identity) and --pose-topic exclude each other")

@@ -137,7 +137,7 @@ class Quadtree(QuadMap):
         """Add one frame; needs a fixed ground plane (not ``ground=fit``)."""
         if self.plane is None:
             raise MapperError("quadtree: ground=fit needs the whole cloud (build); give "
-                              "insert a fixed plane, e.g. --set ground=0 or ground=a,b,c,d")
+                              "insert a fixed plane, e.g. ground=0 or ground=a,b,c,d")
         super().insert(points, origin)
 
     def build(self, points: NDArray[np.float64],

@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from alte.errors import BagError, ParameterError, PointFileError, TopicError
-from alte.io.bag import NO_POSE_NOTE, FrameStream, ReadCounts
+from alte.io.bag import NO_POSE_NOTE, FrameStream, ReadCounts, ReadOptions
 from alte.io.pose import POSE_TYPES
 from alte.pipeline.posing import odometry_poses
 from alte.pipeline.spec import FrameSpec, PoseSource
@@ -136,9 +136,10 @@ class StreamCounts:
 def _open(source: Source, spec: FrameSpec, pose_topic: str | None, progress: bool,
           read_all: bool = False) -> FrameStream:
     pose_file = spec.pose_file if pose_topic != "" else None
-    return FrameStream(source.bag or source.path, cloud_topic=spec.cloud_topic,
-                       pose_topic=pose_topic, mount=spec.mount, allow_no_pose=True,
-                       frames=spec.frames, progress=progress, pose_file=pose_file,
+    options = ReadOptions(cloud_topic=spec.cloud_topic, pose_topic=pose_topic,
+                          allow_no_pose=True, frames=spec.frames, progress=progress,
+                          pose_file=pose_file)
+    return FrameStream(source.bag or source.path, options, mount=spec.mount,
                        read_all=read_all)
 
 
@@ -164,10 +165,10 @@ def _posed(source: Source, spec: FrameSpec, counts: PoseCounts, progress: bool,
         return stream, iter(stream)
     probe = _open(source, spec, spec.pose_topic, progress)
     if choice in (PoseSource.RECORDED, PoseSource.REFINE) and probe.track is None:
-        raise TopicError(f"{probe.path}: --poses {choice.value} needs the bag's poses and it "
+        raise TopicError(f"{probe.path}: poses={choice.value} needs the bag's poses and it "
                          f"has no pose topic ({', '.join(POSE_TYPES)}) for "
-                         f"{probe.cloud_topic}; use --poses odometry (LiDAR odometry) or "
-                         "--poses identity (static sensor)")
+                         f"{probe.cloud_topic}; use poses=odometry (LiDAR odometry) or "
+                         "poses=identity (static sensor)", setting="frame spec.poses")
     if choice is PoseSource.RECORDED:
         return probe, _deskewed(probe, spec, deskew)
     if choice is PoseSource.REFINE:
@@ -215,8 +216,9 @@ def _file_frames(source: Source, spec: FrameSpec, counts: StreamCounts,
     from alte.io.pointfiles import read_points_info
 
     if spec.poses in (PoseSource.ODOMETRY, PoseSource.REFINE):
-        raise ParameterError(f"{source.path}: --poses {spec.poses.value} needs a bag of scans; "
-                             "a point file is one frame seen from --origin")
+        raise ParameterError(f"{source.path}: poses={spec.poses.value} needs a bag of scans; "
+                             "a point file is one frame seen from its origin",
+                             setting="frame spec.poses")
     counts.poses.source = "origin"
     info = read_points_info(source.path)
     reg = counts.registration

@@ -22,6 +22,7 @@ from alte.errors import ParameterError
 from alte.mappers.base import Feed, Mapper
 from alte.mappers.domain import Domain
 from alte.params import Record, param
+from alte.registration.grid import VOXEL
 from alte.registration.odometry import OdometryParams
 from alte.types import Box, Mount
 
@@ -102,8 +103,7 @@ class FrameSpec(Record):
     OWNER: ClassVar[str] = "frame spec"
     frames: int | None = param(None, lambda v: v >= 1, "frames >= 1",
                                "scans kept, evenly spaced (None: all)")
-    voxel: float | None = param(None, _positive, "voxel > 0, finite",
-                                "grid-average size of each frame and of the cloud (m)")
+    voxel: float | None = field(default=None, metadata={"rule": VOXEL})
     crop: Box | None = param(None, help="the control volume points are kept in")
     mount: Mount | None = param(None, help="the sensor's mount on the vehicle")
     cloud_topic: str | None = param(None, help="the bag's point cloud topic")
@@ -122,7 +122,8 @@ class FrameSpec(Record):
     def __post_init__(self) -> None:
         super().__post_init__()
         if self.pose_file is not None and self.pose_topic:
-            raise ParameterError("--pose-file and --pose-topic exclude each other")
+            raise ParameterError(f"{self.OWNER}: pose_file and pose_topic exclude each other",
+                                 setting=(f"{self.OWNER}.pose_file", f"{self.OWNER}.pose_topic"))
 
     def key(self) -> dict[str, object]:
         """Everything that decides the registered frames, JSON-ready (the cache key)."""

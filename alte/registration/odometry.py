@@ -89,8 +89,8 @@ def _lio_frames(frames: Iterable[Frame], mount: Mount, imu: ImuSamples | None, *
                 start: tuple[NDArray[np.float64], NDArray[np.float64]] | None) -> Iterator[Frame]:
     """``frames`` posed by LiDAR-inertial odometry (:mod:`alte.registration.lio`)."""
     if imu is None:
-        raise ParameterError("--odometry lio needs an IMU topic (sensor_msgs/msg/Imu) in the "
-                             "bag; use --odometry kiss")
+        raise ParameterError("odometry: method=lio needs an IMU topic (sensor_msgs/msg/Imu) "
+                             "in the bag; use method=kiss", setting="odometry.method")
     previous: Frame | None = None
     steps = lio_frames(frames, mount, imu, lio_settings(params), start, counts=counts)
     while True:

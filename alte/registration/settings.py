@@ -142,23 +142,27 @@ KEYS: dict[str, tuple[str, ...]] = {
 KEYS["auto"] = tuple(dict.fromkeys(KEYS["kiss"] + KEYS["lio"]))
 
 
-def odometry_params(method: str | None = None, settings: Mapping[str, object] | None = None,
-                    *, flag: str = "--odometry-set") -> OdometryParams:
-    """``--odometry METHOD --odometry-set KEY=VALUE ...`` checked; errors name the flag."""
+def odometry_params(method: str | None = None, settings: Mapping[str, object] | None = None
+                    ) -> OdometryParams:
+    """The backend ``method`` with its ``settings`` (text or typed) checked; an error names
+    the setting (``odometry.method``, else ``odometry.settings``: the command line's
+    ``--odometry`` / ``--odometry-set``)."""
     settings = dict(settings or {})
     if method is not None and method not in METHODS:
-        raise ParameterError(f"--odometry {method}: unknown backend; valid: "
-                             f"{', '.join(METHODS)}")
+        raise ParameterError(f"odometry: method={method!r} unknown; valid: "
+                             f"{', '.join(METHODS)}", setting="odometry.method")
     chosen = method or OdometryParams().method
     valid = set(KEYS[chosen]) | set(KEYS["refine"])
     unknown = sorted(set(settings) - valid)
     if unknown:
-        raise ParameterError(f"{flag} {', '.join(unknown)}: not a setting of --odometry "
-                             f"{chosen} or refinement; valid: {', '.join(sorted(valid))}")
+        raise ParameterError(f"odometry: {', '.join(unknown)}: not a setting of method={chosen} "
+                             f"or refinement; valid: {', '.join(sorted(valid))}",
+                             setting="odometry.settings")
     try:
         return OdometryParams.parse({"method": chosen, **settings})
     except ParameterError as err:
-        raise ParameterError(f"{flag}: {err}") from err
+        err.settings = ("odometry.settings",)
+        raise
 
 
 def odometry_label(params: OdometryParams) -> str:

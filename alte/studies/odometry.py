@@ -100,8 +100,8 @@ def bench_input(what: str | os.PathLike[str], *, reference: str | os.PathLike[st
 
     if str(what) in TERRAINS:
         if reference is not None:
-            raise ParameterError(f"--reference: {what} is a simulated terrain; its true "
-                                 "poses are the reference")
+            raise ParameterError(f"reference: {what} is a simulated terrain; its true "
+                                 "poses are the reference", setting="odometry study.reference")
         made = _terrain_input(str(what), Path(data_dir), frames, seed)
         return made if voxel is None else replace(made, voxel=voxel)
     if not Path(what).exists():
@@ -109,7 +109,8 @@ def bench_input(what: str | os.PathLike[str], *, reference: str | os.PathLike[st
                              "nor a bag or terrain folder")
     source = open_input(Path(what))
     if reference is not None and not Path(reference).is_file():
-        raise ParameterError(f"--reference {reference}: no such TUM file")
+        raise ParameterError(f"reference={reference}: no such TUM file",
+                             setting="odometry study.reference")
     return BenchInput(_name(Path(what), source.name), source,
                       None if reference is None else Path(reference),
                       voxel or source.voxel or BAG_VOXEL, frames)

@@ -10,7 +10,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from alte.errors import ParameterError, RegistrationError
-from alte.io.bag import FrameStream
+from alte.io.bag import FrameStream, ReadOptions
 from alte.io.imu import ImuSamples, read_imu
 from alte.metrics.trajectory import trajectory_errors
 from alte.registration.inertial import (
@@ -207,7 +207,7 @@ def test_auto_is_lio_with_an_imu_and_lio_without_one_is_refused():
     assert resolve_method(OdometryParams(), True).method == "lio"
     assert resolve_method(OdometryParams(), False).method == "kiss"
     assert resolve_method(odometry_params("plane"), True).method == "plane"
-    with pytest.raises(ParameterError, match="--odometry lio needs an IMU topic"):
+    with pytest.raises(ParameterError, match="odometry: method=lio needs an IMU topic"):
         list(odometry_frames([], Mount(), counts=PoseCounts(), params=odometry_params("lio")))
     with pytest.raises(ParameterError, match=r"plane_sigma=-1\.0 out of range"):
         odometry_params("lio", {"plane_sigma": "-1"})
@@ -226,7 +226,7 @@ def test_lio_flies_the_first_five_seconds_of_the_uav_mission(uav_mission):
     without that start it had to learn the accelerometer bias while x and y were not
     yet seen, and was 0.95 m off here."""
     bag = uav_mission / "bag"
-    stream = FrameStream(bag, pose_topic="", allow_no_pose=True)
+    stream = FrameStream(bag, ReadOptions(pose_topic="", allow_no_pose=True))
     imu = read_imu(bag)
     truth = true_poses(get_terrain("sim_nav_1"))
     counts = PoseCounts()
@@ -262,7 +262,7 @@ def test_lio_frames_carry_the_scan_the_imu_deskewed(uav_mission):
     from alte.sim import load_ground_truth
 
     bag = uav_mission / "bag"
-    stream = FrameStream(bag, pose_topic="", allow_no_pose=True)
+    stream = FrameStream(bag, ReadOptions(pose_topic="", allow_no_pose=True))
     truth = true_poses(get_terrain("sim_nav_1"))
     mesh = load_ground_truth(uav_mission)
     raw = next(iter(stream))
@@ -359,21 +359,18 @@ def test_the_plane_fit_across_rings_and_the_projection_are_odometry_settings():
     assert lio_settings(odometry_params("lio", {"wide_reach": "4"})).wide_reach == 4.0
 
 
-#: LIO settings refused, as ``--odometry METHOD --odometry-set KEY=VALUE``, and the message.
+#: LIO settings refused (``odometry_params(METHOD, {KEY: VALUE})``), and the message.
 REFUSED = [
-    ("lio", "wide_points", "2", r"--odometry-set: odometry: wide_points=2 out of range "
-                                r"\(0 or >= 3\)"),
-    ("lio", "least", "-1", r"--odometry-set: odometry: least=-1.0 out of range \(>= 0\)"),
-    ("kiss", "least", "5", r"--odometry-set least: not a setting of --odometry kiss"),
-    ("lio", "gyro_bias", "0", r"--odometry-set: odometry: gyro_bias=0.0 out of range "
-                              r"\(> 0\)"),
-    ("kiss", "accel_walk", "1e-3", r"--odometry-set accel_walk: not a setting of "
-                                   r"--odometry kiss"),
+    ("lio", "wide_points", "2", r"odometry: wide_points=2 out of range \(0 or >= 3\)"),
+    ("lio", "least", "-1", r"odometry: least=-1.0 out of range \(>= 0\)"),
+    ("kiss", "least", "5", r"odometry: least: not a setting of method=kiss"),
+    ("lio", "gyro_bias", "0", r"odometry: gyro_bias=0.0 out of range \(> 0\)"),
+    ("kiss", "accel_walk", "1e-3", r"odometry: accel_walk: not a setting of method=kiss"),
 ]
 
 
 @pytest.mark.parametrize(("method", "key", "value", "message"), REFUSED)
-def test_lio_settings_out_of_range_or_of_another_backend_are_refused_naming_the_flag(
+def test_lio_settings_out_of_range_or_of_another_backend_are_refused_naming_the_setting(
         method, key, value, message):
     with pytest.raises(ParameterError, match=message):
         odometry_params(method, {key: value})
@@ -453,7 +450,7 @@ def test_settling_at_rest_finds_the_biases_and_the_ground_corrects_the_accelerom
 
 def test_the_uav_mission_starts_the_filter_at_rest(uav_mission):
     bag = uav_mission / "bag"
-    stream = FrameStream(bag, pose_topic="", allow_no_pose=True)
+    stream = FrameStream(bag, ReadOptions(pose_topic="", allow_no_pose=True))
     imu = read_imu(bag)
     first = next(iter(stream))
     odometry = LioOdometry(imu, stream.mount, LioSettings(), None, first.stamp)

@@ -66,7 +66,7 @@ def test_imported_folder_is_a_terrain_every_entry_point_reads(tmp_path):
                   truth=TruthOptions())
     assert run.metrics.truth.completeness_by_class["building"] > 0.3
     assert run.metrics.truth.completeness_seen > 0.9
-    with pytest.raises(SimulationError, match=r"exists .*--force"):
+    with pytest.raises(SimulationError, match=r"exists .*force=True replaces it"):
         write_imported(imported, tmp_path / "data", frames=5)
 
 
