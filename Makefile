@@ -23,8 +23,9 @@ bootstrap:
 report: bootstrap
 	$(PY) -m alte report --jobs $(REPORT_JOBS) $(REPORT_ARGS)
 
-# The report with the sensor study over every seed (SENSOR_SEEDS_ALL of alte/report/plan.py:
-# seeds 0-2, its worst-seed columns; about 10 more minutes than `make report`).
+# The report with the sensor study over every seed (SENSOR_SEEDS_ALL of
+# alte/lab/studies/sensor/report.py: seeds 0-2, its worst-seed columns; about 10 more
+# minutes than `make report`).
 report-full: bootstrap
 	$(PY) -m alte report --jobs $(REPORT_JOBS) --param "SENSOR_SEEDS=[0, 1, 2]" $(REPORT_ARGS)
 
@@ -64,7 +65,7 @@ reference: bootstrap
 # Mutation testing of the verdict logic and the metrics (tests/README.md): mutmut, one
 # module at a time with its own tests (tests/mutation_run.py); results in mutants/<name>/,
 # a rerun retests only what changed; MODULES='checks truth' picks modules,
-# MUTANTS='alte.studies.analysis.evidence.x__outcome*' narrows them; rm -rf mutants starts afresh.
+# MUTANTS='alte.lab.studies.analysis.evidence.x__outcome*' narrows them; rm -rf mutants starts afresh.
 MUTANTS ?=
 MODULES ?=
 mutants: bootstrap

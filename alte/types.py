@@ -248,7 +248,7 @@ class Mount:
     @classmethod
     def from_string(cls, text: str) -> Mount:
         """Parse ``x,y,z,roll,pitch,yaw`` (metres, degrees; the angle convention of
-        :mod:`alte.plot.scene`: intrinsic z-y-x, equal to extrinsic x-y-z)."""
+        :mod:`alte.lab.plot.scene`: intrinsic z-y-x, equal to extrinsic x-y-z)."""
         try:
             values = [float(v) for v in text.split(",")]
         except ValueError as err:

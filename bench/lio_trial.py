@@ -29,8 +29,8 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from alte.io.bag import FrameStream, ReadOptions
-from alte.io.imu import ImuSamples, read_imu
+from alte.io.bags.bag import FrameStream, ReadOptions
+from alte.io.bags.imu import ImuSamples, read_imu
 from alte.metrics.trajectory import trajectory_errors
 from alte.registration import odometry
 from alte.registration.odometry import PoseCounts, odometry_frames, odometry_params, pose_matrix

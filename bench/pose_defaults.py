@@ -1,7 +1,7 @@
 """Cross-validation of the pose defaults on the two real sequences (balm_seq, balm_seq2),
 and table 6.4 (every pose source on both).
 
-Every setting of :data:`alte.studies.pose_defaults.CANDIDATES` is run with each of its
+Every setting of :data:`alte.lab.studies.poses.defaults.CANDIDATES` is run with each of its
 values on both sequences (``../shared/realdata``, their reference poses as the truth),
 then chosen on one and scored on the other, both ways (:func:`choices`). Registrations
 are cached under ``--data`` (a rerun only scores). Usage:
@@ -22,9 +22,9 @@ from pathlib import Path
 
 import pandas as pd
 
+from alte.lab.studies.poses.benchmark import REAL_SEQUENCES, realdata_table
+from alte.lab.studies.poses.defaults import CANDIDATES, choices, cross_validation
 from alte.paths import realdata_dir
-from alte.studies.odometry import REAL_SEQUENCES, realdata_table
-from alte.studies.pose_defaults import CANDIDATES, choices, cross_validation
 
 
 def _print(table: pd.DataFrame) -> None:

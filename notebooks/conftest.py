@@ -2,11 +2,11 @@
 
 The kernels nbval starts inherit this process' environment, so setting the
 variables here makes every notebook render statically (matplotlib Agg, pyvista
-off-screen, ``alte.notebook.setup`` in static mode) without a display. nbval starts
+off-screen, ``alte.lab.notebook.setup`` in static mode) without a display. nbval starts
 kernels in the notebook's folder; the report runner (papermill) starts them in the
 repository root, where the notebooks' relative defaults (``DATA_DIR = "data"``,
 ``OUT_DIR = "reports/scratch/..."``) are meant to resolve, so nbval is made to do
-the same. (``alte.notebook.setup()`` also moves a kernel to the repository root,
+the same. (``alte.lab.notebook.setup()`` also moves a kernel to the repository root,
 which is what JupyterLab relies on; starting there covers code run before it.)
 """
 

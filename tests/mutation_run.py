@@ -18,7 +18,7 @@ the repository::
     .venv/bin/python tests/mutation_run.py [NAME ...] [--mutants GLOB ...] [--max-children 2]
 
 with NAME among :data:`MODULES` (default: all) and GLOB a mutmut mutant name pattern,
-e.g. ``'alte.studies.analysis.evidence.x__outcome*'``.
+e.g. ``'alte.lab.studies.analysis.evidence.x__outcome*'``.
 """
 
 from __future__ import annotations
@@ -47,29 +47,37 @@ MODULES: dict[str, tuple[str, tuple[str, ...]]] = {
     "freespace": ("alte/metrics/freespace.py", (
         "tests/metrics/test_metrics.py", "tests/metrics/test_truth.py", "-k", "free")),
     "trajectory": ("alte/metrics/trajectory.py", ("tests/metrics/test_trajectory.py",)),
-    "checks": ("alte/studies/analysis/checks.py", (
-        "tests/studies/analysis/test_checks.py", "tests/studies/analysis/test_verdicts.py",
-        "tests/studies/analysis/test_measures.py", "tests/studies/analysis/test_evidence.py")),
-    "comparisons": ("alte/studies/analysis/comparisons.py", (
-        "tests/studies/analysis/test_verdicts.py", "tests/studies/analysis/test_measures.py",
-        "tests/studies/analysis/test_evidence.py",
-        "tests/studies/analysis/test_comparisons_cases.py")),
-    "measures": ("alte/studies/analysis/measures.py", (
-        "tests/studies/analysis/test_verdicts.py", "tests/studies/analysis/test_measures.py",
-        "tests/studies/analysis/test_evidence.py", "tests/studies/analysis/test_conditions.py",
-        "tests/studies/analysis/test_measures_cases.py")),
-    "evidence": ("alte/studies/analysis/evidence.py", (
-        "tests/studies/analysis/test_verdicts.py", "tests/studies/analysis/test_evidence.py",
-        "tests/studies/analysis/test_evidence_tables.py",
-        "tests/studies/analysis/test_conditions.py")),
-    "wording": ("alte/studies/analysis/wording.py", (
-        "tests/studies/analysis/test_verdicts.py", "tests/studies/analysis/test_evidence.py",
-        "tests/studies/analysis/test_evidence_tables.py")),
-    "tradeoff": ("alte/studies/analysis/tradeoff.py", (
-        "tests/studies/analysis/test_tradeoff.py", "tests/studies/analysis/test_verdicts.py",
-        "tests/studies/analysis/test_measures.py",
-        "tests/studies/analysis/test_tradeoff_cases.py")),
-    "claims": ("alte/studies/thesis/claims/__init__.py", ("tests/studies/thesis/test_claims.py",)),
+    "checks": ("alte/lab/studies/analysis/checks.py", (
+        "tests/lab/studies/analysis/test_checks.py", "tests/lab/studies/analysis/test_verdicts.py",
+        "tests/lab/studies/analysis/test_measures.py",
+        "tests/lab/studies/analysis/test_evidence.py")),
+    "comparisons": ("alte/lab/studies/analysis/comparisons.py", (
+        "tests/lab/studies/analysis/test_verdicts.py",
+        "tests/lab/studies/analysis/test_measures.py",
+        "tests/lab/studies/analysis/test_evidence.py",
+        "tests/lab/studies/analysis/test_comparisons_cases.py")),
+    "measures": ("alte/lab/studies/analysis/measures.py", (
+        "tests/lab/studies/analysis/test_verdicts.py",
+        "tests/lab/studies/analysis/test_measures.py",
+        "tests/lab/studies/analysis/test_evidence.py",
+        "tests/lab/studies/analysis/test_conditions.py",
+        "tests/lab/studies/analysis/test_measures_cases.py")),
+    "evidence": ("alte/lab/studies/analysis/evidence.py", (
+        "tests/lab/studies/analysis/test_verdicts.py",
+        "tests/lab/studies/analysis/test_evidence.py",
+        "tests/lab/studies/analysis/test_evidence_tables.py",
+        "tests/lab/studies/analysis/test_conditions.py")),
+    "wording": ("alte/lab/studies/analysis/wording.py", (
+        "tests/lab/studies/analysis/test_verdicts.py",
+        "tests/lab/studies/analysis/test_evidence.py",
+        "tests/lab/studies/analysis/test_evidence_tables.py")),
+    "tradeoff": ("alte/lab/studies/analysis/tradeoff.py", (
+        "tests/lab/studies/analysis/test_tradeoff.py",
+        "tests/lab/studies/analysis/test_verdicts.py",
+        "tests/lab/studies/analysis/test_measures.py",
+        "tests/lab/studies/analysis/test_tradeoff_cases.py")),
+    "claims": ("alte/lab/studies/thesis/claims/__init__.py",
+    ("tests/lab/studies/thesis/test_claims.py",)),
 }
 
 

@@ -14,13 +14,13 @@ from support.bagtools import TS, write_ros2
 
 from alte import __version__
 from alte.cli import COMMANDS, build_parser
-from alte.io.pointcloud2 import encode_pointcloud2
-from alte.io.writer import BagSettings, write_bag
+from alte.io.bags.pointcloud2 import encode_pointcloud2
+from alte.io.bags.writer import BagSettings, write_bag
 from alte.types import thesis_mount
 
 #: What a command that only reads or prints must not load: the lab (report, studies),
 #: the mappers' numba kernels, open3d (~200 MB), Dask and pyvista/VTK.
-HEAVY = ["alte.report", "alte.studies", "open3d", "numba", "dask", "distributed", "pyvista",
+HEAVY = ["alte.lab.report", "alte.lab.studies", "open3d", "numba", "dask", "distributed", "pyvista",
          "vtk", "pandas"]
 NS = 1_000_000_000
 
@@ -95,7 +95,7 @@ def test_an_unknown_command_lists_the_commands(capsys) -> None:
 
 
 def test_the_bench_row_of_the_light_commands(bags) -> None:
-    from alte.bench.memory import LIGHT_CEILINGS_MB, light_memory
+    from bench.memory import LIGHT_CEILINGS_MB, light_memory
 
     rows = light_memory(bags[0])
     assert [r.case.split(" peak")[0] for r in rows] == ["alte --version", "alte info BAG"]

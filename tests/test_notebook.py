@@ -3,8 +3,8 @@ import json
 import numpy as np
 import pytest
 
-from alte import notebook
 from alte.errors import ParameterError
+from alte.lab import notebook
 
 
 def test_save_results_is_json_with_numpy_values(tmp_path):
@@ -29,7 +29,7 @@ def test_save_figure(tmp_path):
     notebook.setup("static")
     import matplotlib.pyplot as plt
 
-    from alte.plot.figure import Caption, Plot
+    from alte.lab.plot.figure import Caption, Plot
 
     fig, ax = plt.subplots()
     ax.plot([0, 1], [1, 0])
@@ -41,8 +41,8 @@ def test_offscreen_pyvista_render(tmp_path):
     notebook.setup("static")
     import pyvista as pv
 
-    from alte.plot import show, view
-    from alte.plot.figure import Caption
+    from alte.lab.plot import show, view
+    from alte.lab.plot.figure import Caption
 
     cube = view(Caption("Cube", "A cube."), window_size=(160, 120))
     cube.plotter.add_mesh(pv.Cube())

@@ -10,8 +10,8 @@ import pytest
 from report.conftest import make_notebook
 
 from alte import progress
-from alte.report.plan import Entry, build_plan
-from alte.report.runner import run_report
+from alte.lab.report.plan import Entry, build_plan
+from alte.lab.report.runner import run_report
 
 
 @pytest.fixture

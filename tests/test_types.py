@@ -77,7 +77,7 @@ def test_rows_all_and_finite_rows_match_numpy() -> None:
 def test_every_counter_gives_its_counts_by_name_as_copies() -> None:
     """The four counters share ``Counts.as_dict``: every field by name, lists and dicts
     copied so that a summary does not change when the run goes on counting."""
-    from alte.io.bag import ReadCounts
+    from alte.io.bags.bag import ReadCounts
     from alte.registration.deskew import DeskewCounts
     from alte.registration.odometry import PoseCounts
     from alte.registration.register import RegistrationCounts

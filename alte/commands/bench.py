@@ -1,12 +1,31 @@
-"""``alte bench``: run the performance benchmark and write reports/bench.{md,json}."""
+"""``alte bench``: run the performance benchmark and write reports/bench.{md,json}.
+
+The benchmark lives outside the package, in the ``bench/`` folder of a source checkout
+(as rosbags keeps its benchmarks): this command finds it beside the ``alte`` it runs.
+"""
 
 from __future__ import annotations
 
 import argparse
+import sys
 import textwrap
 from pathlib import Path
 
-from alte.bench.catalog import TITLES, describe
+from alte.errors import AlteError
+from alte.paths import REPO_ROOT
+
+
+def _find_bench(checkout: Path = REPO_ROOT) -> None:
+    """Make the checkout's ``bench`` package importable, or say why it cannot be."""
+    if not (checkout / "bench" / "__init__.py").is_file():
+        raise AlteError(f"alte bench runs from a source checkout: no bench/ folder beside "
+                        f"{checkout / 'alte'} (clone the repository and run it there)")
+    if str(checkout) not in sys.path:
+        sys.path.insert(0, str(checkout))
+
+
+_find_bench()
+from bench.catalog import TITLES, describe  # noqa: E402  (after the checkout is on the path)
 
 __all__ = ["add_parser", "run"]
 
@@ -58,9 +77,9 @@ def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) 
 
 def run(args: argparse.Namespace) -> int:
     """Run the benchmark, write its outputs, print the table; 1 when a row failed."""
-    from alte.bench.core import BenchConfig
-    from alte.bench.output import render_markdown, write_outputs
-    from alte.bench.runner import run_bench, select_rows
+    from bench.core import BenchConfig
+    from bench.output import render_markdown, write_outputs
+    from bench.runner import run_bench, select_rows
 
     config = BenchConfig(quick=args.quick, repeats=args.repeats, warmup=args.warmup,
                          frames=args.frames, sizes=args.sizes, budget_s=args.budget,

@@ -3,7 +3,7 @@
 The tile (LAS/LAZ/PCD/PLY/npz/xyz, in metres) goes through one ground filter
 (:mod:`alte.ground.filters`; ``--method``, ``--set KEY=VALUE``) and is written as
 LAS/LAZ with ASPRS classes 2 (ground) and 1 (the rest), the classification's provenance
-in its header (:func:`alte.io.tiles.write_classified`). The summary gives the ground
+in its header (:func:`alte.io.points.tiles.write_classified`). The summary gives the ground
 share and the time of each step.
 """
 
@@ -19,7 +19,7 @@ from alte.errors import ParameterError
 from alte.fsutil import refuse_overwrite
 from alte.ground.filters import filter_ground
 from alte.ground.settings import DEFAULT_METHOD
-from alte.io.tiles import read_tile, tile_crs, write_classified
+from alte.io.points.tiles import read_tile, tile_crs, write_classified
 
 __all__ = ["add_parser", "run"]
 

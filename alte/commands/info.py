@@ -17,11 +17,11 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from alte.errors import ParameterError
-from alte.io.baginfo import BagInfo, inspect_bag
+from alte.io.bags.baginfo import BagInfo, inspect_bag
 from alte.pipeline.source import InputKind, Source, open_input
 
 if TYPE_CHECKING:
-    from alte.io.pointfiles import PointSummary
+    from alte.io.points.pointfiles import PointSummary
 
 __all__ = ["add_parser", "format_info", "format_mappers", "format_points", "imu_topics",
            "odometry_choice", "pose_source", "run"]
@@ -50,7 +50,7 @@ def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) 
 
 def imu_topics(info: BagInfo) -> list[str]:
     """The bag's ``sensor_msgs/msg/Imu`` topics."""
-    from alte.io.imu import IMU_TYPE
+    from alte.io.bags.imu import IMU_TYPE
 
     return [name for name, (kind, _) in info.topics.items() if kind == IMU_TYPE]
 
@@ -161,7 +161,7 @@ def run(args: argparse.Namespace) -> int:
                              "or --mappers")
     source = open_input(args.input)
     if source.kind is InputKind.POINTS:
-        from alte.io.pointfiles import describe_points  # pandas, numba: point files only
+        from alte.io.points.pointfiles import describe_points  # pandas, numba: point files only
 
         about = describe_points(source.path)
         print(json.dumps(about, sort_keys=True) if args.json else "\n".join(format_points(about)))

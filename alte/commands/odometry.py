@@ -3,7 +3,7 @@
 Inputs are simulated terrain names (the simulator's true poses are the reference) or bags
 and terrain folders (the bag's pose topic, or ``--reference FILE.tum``). Writes
 ``odometry.csv`` (ATE, RPE, cloud distance to the reference-pose cloud, ms per scan, per
-input and pose source; :mod:`alte.studies.odometry`) into ``--out`` (default
+input and pose source; :mod:`alte.lab.studies.poses.benchmark`) into ``--out`` (default
 ``reports/tables``) and prints it.
 """
 
@@ -17,9 +17,9 @@ import pandas as pd
 from alte.commands.options import parse_key_values
 from alte.errors import ParameterError
 from alte.fsutil import refuse_overwrite
+from alte.lab.studies.poses.benchmark import SOURCES, odometry_table, write_odometry_table
 from alte.paths import resolve
 from alte.registration.odometry import KEYS, METHODS, odometry_params
-from alte.studies.odometry import SOURCES, odometry_table, write_odometry_table
 
 __all__ = ["add_parser", "run"]
 

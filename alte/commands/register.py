@@ -15,8 +15,8 @@ from alte.commands.options import add_frame_options, frame_spec
 from alte.errors import ParameterError, PointFileError
 from alte.export import export_registered
 from alte.fsutil import refuse_overwrite
-from alte.io.pointfiles import WRITE_SUFFIXES, storable, write_points
-from alte.io.pointformats import Fields
+from alte.io.points.pointfiles import WRITE_SUFFIXES, storable, write_points
+from alte.io.points.pointformats import Fields
 from alte.pipeline import InputKind, StreamCounts, merge_frames, open_input, prepare
 from alte.registration import RegistrationCounts
 

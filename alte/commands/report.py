@@ -6,8 +6,8 @@ import argparse
 from pathlib import Path
 
 from alte.errors import ParameterError
+from alte.lab.report import PLAN, build_plan, load_plan, parse_param, run_report
 from alte.paths import REPO_ROOT
-from alte.report import PLAN, build_plan, load_plan, parse_param, run_report
 
 __all__ = ["add_parser", "run"]
 

@@ -10,7 +10,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from alte.studies.sweep import SweepResult, SweepSpec
+    from alte.lab.studies.sweep import SweepResult, SweepSpec
 
 __all__ = ["add_parser", "run"]
 
@@ -67,9 +67,9 @@ def _command(args: argparse.Namespace) -> str:
 
 def _evidence(args: argparse.Namespace, spec: SweepSpec, result: SweepResult, started: str,
               seconds: float) -> None:
-    from alte.bench.timing import machine_info
-    from alte.studies.grid import grid_of
-    from alte.studies.missions import Provenance, git_commit, write_mission_evidence
+    from alte.lab.machine import machine_info
+    from alte.lab.studies.missions import Provenance, git_commit, write_mission_evidence
+    from alte.lab.studies.tradeoff.grid import grid_of
 
     grid = grid_of(spec, result, seconds)
     provenance = Provenance(
@@ -83,7 +83,7 @@ def _evidence(args: argparse.Namespace, spec: SweepSpec, result: SweepResult, st
 
 def run(args: argparse.Namespace) -> int:
     """Run the sweep and print a summary; 1 when a run failed (rerun to retry it)."""
-    from alte.studies.sweep import load_spec, override, run_sweep
+    from alte.lab.studies.sweep import load_spec, override, run_sweep
 
     spec = load_spec(args.spec)
     if args.frames is not None:

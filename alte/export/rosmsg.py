@@ -20,7 +20,7 @@ from rosbags.interfaces import Nodetype
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 from rosbags.typesys.store import Typestore
 
-from alte.io.pointcloud2 import encode_pointcloud2, make_header, make_time
+from alte.io.bags.pointcloud2 import encode_pointcloud2, make_header, make_time
 
 if TYPE_CHECKING:  # rosbags declares its message classes' types for checkers only
     from rosbags.interfaces.typing import FieldDesc, Typesdict

@@ -20,7 +20,7 @@ the filter a reader of the paper would run:
   height) of it is ground.
 
 :data:`DEFAULT_METHOD` and :data:`DEFAULT_SETTINGS` are the ground stage's choice on real
-data (``alte.studies.realdata.filters``; README "Ground"); a method named without settings
+data (``alte.lab.studies.realdata.filters``; README "Ground"); a method named without settings
 runs with its published defaults.
 """
 

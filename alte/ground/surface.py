@@ -22,7 +22,7 @@ A known pixel of a height raster (NaN = unknown) is **landable** when
   allowance SMRF's own: its scaling factor times the bare earth's slope.
 
 :func:`classify_surface` applies it to every pixel at once (image filters, one
-vectorised pass); the landing study (:mod:`alte.studies.landing`) tests site centres
+vectorised pass); the landing study (:mod:`alte.lab.studies.landing`) tests site centres
 with the same functions, and the MCAP export paints its occupancy grids with it.
 :func:`plane_features` fits the window planes with ten ``uniform_filter`` passes over
 the moments ``1, x, y, z, x^2, xy, y^2, xz, yz, z^2`` of the known pixels.
@@ -50,7 +50,7 @@ _MAX_FIT_PIXELS = 50_000
 class SurfaceRule(Record):
     """The landing criterion's thresholds (module docstring); validated on creation.
 
-    Defaults are the landing study's quadrotor (:data:`alte.studies.landing.QUADROTOR`:
+    Defaults are the landing study's quadrotor (:data:`alte.lab.studies.landing.QUADROTOR`:
     a 1 m footprint radius plus 0.5 m margin as the plane window).
     """
 

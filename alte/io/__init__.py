@@ -1,4 +1,4 @@
-"""Input/output: ROS bags -> posed frames, bags from frames, point files, raw Velodyne packets.
+"""Input/output in three folders: ROS bags (`bags`), point files (`points`), poses (`poses`).
 
 ``read_frames`` is the pipeline's entry point (bag -> frames); ``write_bag`` /
 ``write_frames`` write ROS 2 bags the simulator and tests read back.

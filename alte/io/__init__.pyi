@@ -1,10 +1,10 @@
-from .bag import FrameSet, read_frames
-from .baginfo import BagInfo, inspect_bag
-from .pointcloud2 import decode_pointcloud2, encode_pointcloud2
-from .pointfiles import read_points, write_points
-from .pose import PoseSamples, PoseTrack
-from .velodyne import decode_velodyne_scan, register_velodyne_types
-from .writer import write_bag, write_frames
+from .bags.bag import FrameSet, read_frames
+from .bags.baginfo import BagInfo, inspect_bag
+from .bags.pointcloud2 import decode_pointcloud2, encode_pointcloud2
+from .bags.velodyne import decode_velodyne_scan, register_velodyne_types
+from .bags.writer import write_bag, write_frames
+from .points.pointfiles import read_points, write_points
+from .poses.pose import PoseSamples, PoseTrack
 
 __all__ = [
     "BagInfo",

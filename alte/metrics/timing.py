@@ -11,7 +11,7 @@ Each comes with its *spread*: half the natural log of the largest over the small
 reading, so readings lie within a factor ``exp(spread)`` of their geometric middle
 (0.1: about +/-10 %). With one reading the spread is unknown (NaN); the judgement of
 time-based claims then uses a floor measured between whole runs
-(:data:`alte.studies.analysis.uncertainty.TIME_SPREAD_FLOOR`).
+(:data:`alte.lab.studies.analysis.uncertainty.TIME_SPREAD_FLOOR`).
 """
 
 from __future__ import annotations

@@ -18,7 +18,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from alte.errors import ParameterError, RegistrationError
-from alte.io.pointfiles import local_origin
+from alte.io.points.pointfiles import local_origin
 from alte.mappers import Domain, DomainUse, Feed, Mapper
 from alte.pipeline.maprun import FrameLog, FrameObserver, MapRun, RunInfo, Snapshot
 from alte.pipeline.source import Source, StreamCounts

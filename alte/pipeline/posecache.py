@@ -42,7 +42,7 @@ __all__ = ["CACHE_VERSION", "PosedScans", "code_hash", "pose_key", "read_poses",
 CACHE_VERSION = 1
 _POINTS, _ARRAYS, _META = "points.bin", "arrays.npz", "meta.json"
 #: The sources whose code decides the odometry's output (hashed into every key).
-_SOURCES = ("registration", "io/imu.py", "io/bag.py", "pipeline/posing.py")
+_SOURCES = ("registration", "io/bags/imu.py", "io/bags/bag.py", "pipeline/posing.py")
 
 
 @functools.cache

@@ -1,7 +1,7 @@
 """The pipeline's odometry step: scans posed by LiDAR (or LiDAR-inertial) odometry.
 
 Odometry aligns consecutive scans, so it reads every scan of the bag even when
-``FrameSpec.frames`` keeps fewer (:attr:`alte.io.bag.FrameStream.read_all`); only the
+``FrameSpec.frames`` keeps fewer (:attr:`alte.io.bags.bag.FrameStream.read_all`); only the
 scans the selection keeps go on, posed as in a run over all of them.
 """
 
@@ -16,8 +16,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from alte.errors import PoseError
-from alte.io.bag import FrameStream
-from alte.io.imu import ImuSamples, imu_topic, read_imu
+from alte.io.bags.bag import FrameStream
+from alte.io.bags.imu import ImuSamples, imu_topic, read_imu
 from alte.pipeline.posecache import PosedScans, pose_key, read_poses, record_poses
 from alte.pipeline.spec import FrameSpec
 from alte.registration.odometry import (

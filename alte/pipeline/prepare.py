@@ -24,8 +24,8 @@ from numpy.typing import NDArray
 from alte import __version__
 from alte.errors import AlteError, RegistrationError
 from alte.fsutil import atomic_dir
-from alte.io.bag import ReadCounts
-from alte.io.pcd import Fields
+from alte.io.bags.bag import ReadCounts
+from alte.io.points.pcd import Fields
 from alte.pipeline.source import Source, StreamCounts, stream_frames
 from alte.pipeline.spec import FrameSpec
 from alte.registration.deskew import DeskewCounts

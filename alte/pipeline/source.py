@@ -22,8 +22,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from alte.errors import BagError, ParameterError, PointFileError, TopicError
-from alte.io.bag import NO_POSE_NOTE, FrameStream, ReadCounts, ReadOptions
-from alte.io.pose import POSE_TYPES
+from alte.io.bags.bag import NO_POSE_NOTE, FrameStream, ReadCounts, ReadOptions
+from alte.io.poses.pose import POSE_TYPES
 from alte.pipeline.posing import odometry_poses
 from alte.pipeline.spec import FrameSpec, PoseSource
 from alte.registration.deskew import DeskewCounts, deskew_frames
@@ -91,7 +91,7 @@ class Source:
 
 def open_input(path: str | Path) -> Source:
     """Recognise ``path``: terrain folder, ROS bag (file or folder) or point file."""
-    from alte.io.pointfiles import READ_SUFFIXES
+    from alte.io.points.pointfiles import READ_SUFFIXES
 
     where = Path(path)
     if not where.exists():
@@ -213,7 +213,7 @@ def _file_frames(source: Source, spec: FrameSpec, counts: StreamCounts,
                  merge: GridAccumulator | None) -> Iterator[RegisteredFrame]:
     """A point file as one frame: finite, cropped, grid-averaged, seen from ``spec.origin``;
     the file's other fields ride along while every point is kept (no voxel)."""
-    from alte.io.pointfiles import read_points_info
+    from alte.io.points.pointfiles import read_points_info
 
     if spec.poses in (PoseSource.ODOMETRY, PoseSource.REFINE):
         raise ParameterError(f"{source.path}: poses={spec.poses.value} needs a bag of scans; "

@@ -25,7 +25,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
-from alte.io.pose import PoseTrack
+from alte.io.poses.pose import PoseTrack
 from alte.types import Counts, Frame, Mount
 
 __all__ = ["DESKEW_STEP_S", "DeskewCounts", "deskew_constant_velocity", "deskew_frames",

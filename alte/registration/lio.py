@@ -58,7 +58,7 @@ from alte.registration.localmap import LocalMap, voxel_first
 from alte.types import Frame, Mount
 
 if TYPE_CHECKING:
-    from alte.io.imu import ImuSamples
+    from alte.io.bags.imu import ImuSamples
     from alte.registration.settings import PoseCounts
 
 __all__ = ["LioOdometry", "LioSettings", "check_overlap", "lio_frames"]

@@ -50,7 +50,7 @@ from alte.registration.window import window_poses
 from alte.types import Frame, Mount
 
 if TYPE_CHECKING:
-    from alte.io.imu import ImuSamples
+    from alte.io.bags.imu import ImuSamples
 
 __all__ = ["KEYS", "METHODS", "OdometryParams", "PoseCounts", "lio_settings", "odometry_frames",
            "odometry_label", "odometry_params", "pose_matrix", "refine_frames", "resolve_method"]

@@ -23,7 +23,7 @@ import numpy as np
 
 from alte.errors import AlteError, SimulationError
 from alte.fsutil import atomic_dir
-from alte.io.writer import BagSettings
+from alte.io.bags.writer import BagSettings
 from alte.sim.groundtruth import GROUND_TRUTH_FILE, load_ground_truth, write_ground_truth
 from alte.sim.meta import SCENARIO_FILE, MountMeta, ScenarioMeta
 from alte.sim.mission import Simulation, simulate
@@ -34,8 +34,8 @@ from alte.sim.terrains import TERRAINS, Terrain
 from alte.types import JSONDict, Mount
 
 if TYPE_CHECKING:
-    from alte.io.imu import ImuSamples
-    from alte.io.writer import Cloud
+    from alte.io.bags.imu import ImuSamples
+    from alte.io.bags.writer import Cloud
 
 __all__ = ["BAG_DIR", "IMU_TOPIC", "SCENARIO_FILE", "SIM_VERSION", "MountMeta", "Scenario",
            "ScenarioMeta", "ensure_terrain", "get_terrain", "is_current", "load_metadata",
@@ -134,7 +134,7 @@ def write_scenario(target: str | os.PathLike[str], terrain: Terrain, sim: Simula
                    more: Callable[[Path], None] | None = None) -> Path:
     """Write bag, ground truth and scenario.json into ``target`` atomically (replacing it);
     ``extra`` adds keys to scenario.json, ``more`` writes further files into the folder."""
-    from alte.io.writer import write_bag
+    from alte.io.bags.writer import write_bag
 
     key = spec_hash(terrain, frames, storage, profile=sim.profile)
     with atomic_dir(target, overwrite=True) as tmp:
@@ -168,7 +168,7 @@ def _clouds(sim: Simulation) -> Iterator[Cloud]:
 
 
 def _imu_samples(sim: Simulation) -> ImuSamples | None:
-    from alte.io.imu import ImuSamples
+    from alte.io.bags.imu import ImuSamples
 
     imu = sim.imu
     if imu is None:

@@ -10,7 +10,7 @@
   (:func:`alte.mappers.registry.classes`: the thesis' four and the installed plugins),
   one table each.
 - **Short type names** in signatures (``tiles: list[Tile]``) that two modules define
-  (``alte.io.tiles.Tile``, ``alte.sim.real.tiles.Tile``) link to the one nearest the
+  (``alte.io.points.tiles.Tile``, ``alte.sim.real.tiles.Tile``) link to the one nearest the
   signature's module (:class:`NearestTarget`), where Sphinx would warn and pick any.
 
 The pages are written only when their text changes, through a temporary file and a
@@ -27,6 +27,7 @@ import importlib
 import importlib.util
 import os
 import pkgutil
+import sys
 import tempfile
 from collections.abc import Callable
 from pathlib import Path
@@ -152,16 +153,19 @@ def _api_page(package: str, modules: list[str], everything: list[str]) -> str:
 
 def write_api_pages(_app: Sphinx) -> None:
     """The API reference: an index and one page per package (module docstring)."""
-    everything = public_modules()
+    if str(REPO) not in sys.path:
+        sys.path.insert(0, str(REPO))  # bench/ sits beside alte/, not installed
+    everything = public_modules() + public_modules("bench")
     pages = _packages(everything)
     wanted = {f"{package}.md" for package in pages} | {"index.md"}
     for package, modules in pages.items():
         _write_if_changed(API_DIR / f"{package}.md", _api_page(package, modules, everything))
     toc = "\n".join(sorted(pages))
-    index = ("# Python API\n\nGenerated from the docstrings: one page per package of `alte`, "
-             "with every public module inside it. The library's wing (`io`, `registration`, "
-             "`ground`, `mappers`, `metrics`, `pipeline`, `sim`, `export`) never imports the "
-             "lab's (`studies`, `plot`, `report`, `bench`); the command line sits on both.\n\n"
+    index = ("# Python API\n\nGenerated from the docstrings: one page per package of `alte` "
+             "and of the benchmark (`bench/`, beside the package), with every public module "
+             "inside it. The library's wing (`io`, `registration`, `ground`, `mappers`, "
+             "`metrics`, `pipeline`, `sim`, `export`) never imports the lab (`alte.lab`: "
+             "`studies`, `plot`, `report`); the command line sits on both.\n\n"
              f"```{{toctree}}\n:maxdepth: 1\n\n{toc}\n```\n")
     _write_if_changed(API_DIR / "index.md", index)
     for stale in API_DIR.glob("*.md"):

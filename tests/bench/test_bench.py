@@ -8,11 +8,16 @@ import threading
 import numpy as np
 import pytest
 
-from alte.bench.core import BenchConfig, Context, Result
-from alte.bench.output import format_value, miss_note, render_markdown, write_outputs
-from alte.bench.runner import ROWS, run_bench, select_rows
-from alte.bench.scaling import predicted_seconds, whole_scans
-from alte.bench.timing import (
+from alte.cli import main
+from alte.errors import ParameterError
+from alte.lab.report.runs import point_latest, write_record
+from alte.mappers import registry
+from alte.paths import realdata_dir
+from bench.core import BenchConfig, Context, Result
+from bench.output import format_value, miss_note, render_markdown, write_outputs
+from bench.runner import ROWS, run_bench, select_rows
+from bench.scaling import predicted_seconds, whole_scans
+from bench.timing import (
     fit_exponent,
     interleave,
     machine_info,
@@ -20,13 +25,8 @@ from alte.bench.timing import (
     nlogn_exponent,
     one_core,
 )
-from alte.bench.wall import report_wall_time, stage_shares, thesis_total_s
-from alte.bench.workload import tile_points
-from alte.cli import main
-from alte.errors import ParameterError
-from alte.mappers import registry
-from alte.paths import realdata_dir
-from alte.report.runs import point_latest, write_record
+from bench.wall import report_wall_time, stage_shares, thesis_total_s
+from bench.workload import tile_points
 
 REALDATA = realdata_dir()
 

@@ -13,7 +13,7 @@ from ground.test_filters import slope_with_objects
 
 from alte.cli import main
 from alte.io import write_points
-from alte.io.tiles import read_provenance
+from alte.io.points.tiles import read_provenance
 from alte.paths import realdata_dir
 
 REALDATA = realdata_dir()

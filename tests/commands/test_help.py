@@ -7,9 +7,9 @@ import re
 
 import pytest
 
-from alte.bench.catalog import TITLES
-from alte.bench.runner import ROWS
 from alte.cli import COMMANDS, full_parser
+from bench.catalog import TITLES
+from bench.runner import ROWS
 
 # reStructuredText / Markdown a terminal would show raw, Python reprs, tracker references.
 _MARKUP = re.compile(r"``|`|:(func|data|class|mod|meth|attr|ref|doc):|\{'|\bissue\b",
@@ -49,3 +49,11 @@ def test_bench_help_lists_the_rows_that_exist(helps: dict[str, str]) -> None:
     for number, title in TITLES.items():
         assert f"- row {number}: {title}" in text
     assert f"all, {min(TITLES)}-{max(TITLES)}" in " ".join(text.split())
+
+
+def test_bench_outside_a_checkout_says_where_the_benchmark_lives(tmp_path) -> None:
+    from alte.commands import bench as command
+    from alte.errors import AlteError
+
+    with pytest.raises(AlteError, match="alte bench runs from a source checkout: no bench/"):
+        command._find_bench(tmp_path)

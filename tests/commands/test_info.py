@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from alte.cli import main
-from alte.io.writer import BagSettings, write_bag
+from alte.io.bags.writer import BagSettings, write_bag
 from alte.types import thesis_mount
 
 NS = 1_000_000_000
@@ -58,7 +58,7 @@ def test_info_says_which_pose_source_is_used(bag, tmp_path, capsys):
     bare = tmp_path / "bare"
     from support.bagtools import TS, write_ros2
 
-    from alte.io.pointcloud2 import encode_pointcloud2
+    from alte.io.bags.pointcloud2 import encode_pointcloud2
 
     write_ros2(bare, [("/lidar", "sensor_msgs/msg/PointCloud2", s,
                        encode_pointcloud2(p, s, "lidar", TS)) for s, p in clouds])

@@ -14,8 +14,8 @@ from alte.commands.options import parse_box
 from alte.commands.register import format_counts
 from alte.errors import ParameterError
 from alte.io import read_frames, write_frames
-from alte.io.bag import ReadCounts, ReadOptions
-from alte.io.pointfiles import read_points, read_points_info
+from alte.io.bags.bag import ReadCounts, ReadOptions
+from alte.io.points.pointfiles import read_points, read_points_info
 from alte.paths import realdata_dir
 from alte.pipeline import InputKind, Source
 from alte.pipeline import source as source_module

@@ -5,8 +5,8 @@ from __future__ import annotations
 import pytest
 
 from alte.cli import main
-from alte.studies.sweep import groups as sweep_groups
-from alte.studies.sweep import load_results
+from alte.lab.studies.sweep import groups as sweep_groups
+from alte.lab.studies.sweep import load_results
 
 SPEC = """\
 name: cli

@@ -13,7 +13,7 @@ from alte.errors import AlteError, ParameterError
 from alte.export import TOPICS, ExportOptions, export_map, export_registered
 from alte.export.grids import height_colours, raster
 from alte.export.maps import shown_cells
-from alte.io.reader import open_bag, topic_table
+from alte.io.bags.reader import open_bag, topic_table
 from alte.mappers import Feed
 from alte.mappers.octomap import read_bt
 from alte.pipeline import FrameSpec, MapSpec, open_input, prepare

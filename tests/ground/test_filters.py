@@ -19,7 +19,7 @@ from alte.ground.settings import (
     SmrfSettings,
     ground_settings,
 )
-from alte.studies.realdata.ground import ground_errors
+from alte.lab.studies.realdata.ground import ground_errors
 
 UTM = np.array([513_000.0, 5_404_000.0, 0.0])
 

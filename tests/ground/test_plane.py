@@ -14,7 +14,7 @@ from alte.ground.plane import (
     obstacle_mask,
 )
 from alte.io import read_frames
-from alte.io.bag import ReadOptions
+from alte.io.bags.bag import ReadOptions
 from alte.paths import realdata_dir
 from alte.registration import grid_average
 

@@ -13,7 +13,7 @@ from alte.ground.surface import (
     pixel_centres,
     plane_features,
 )
-from alte.io.pointfiles import read_points
+from alte.io.points.pointfiles import read_points
 from alte.paths import realdata_dir
 
 STEP = 0.5

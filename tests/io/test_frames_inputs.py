@@ -9,9 +9,9 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from alte.errors import ParameterError, TopicError
-from alte.io.bag import ReadOptions, read_frames
-from alte.io.pointcloud2 import encode_pointcloud2
-from alte.io.tum import write_tum
+from alte.io.bags.bag import ReadOptions, read_frames
+from alte.io.bags.pointcloud2 import encode_pointcloud2
+from alte.io.poses.tum import write_tum
 
 
 def _chain(ros, links: list[tuple[str, str, tuple, tuple]]) -> list:

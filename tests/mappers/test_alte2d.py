@@ -220,7 +220,7 @@ def test_isprs_airborne_sample() -> None:
     path = REALDATA / "isprs_terrain" / "samp11-utm.pcd"
     if not path.is_file():
         pytest.skip(f"{path} absent")
-    from alte.io.pointfiles import read_points
+    from alte.io.points.pointfiles import read_points
 
     pts = read_points(path)
     pts = pts - pts.min(axis=0)

@@ -122,8 +122,8 @@ def test_info_lists_and_refuses(plugin_path: Path, capsys: pytest.CaptureFixture
 #: The modules where a mapper's name given by a user or by the thesis' data becomes a
 #: class, through the registry: the map specification, the sweep spec, the thesis'
 #: claims on properties of its own mappers, and display titles of table rows.
-BOUNDARIES = {"alte/mappers/registry.py", "alte/pipeline/spec.py", "alte/studies/sweep/spec.py",
-              "alte/studies/analysis/evidence.py", "alte/studies/analysis/tradeoff.py"}
+BOUNDARIES = {"alte/mappers/registry.py", "alte/pipeline/spec.py", "alte/lab/studies/sweep/spec.py",
+              "alte/lab/studies/analysis/evidence.py", "alte/lab/studies/analysis/tradeoff.py"}
 
 
 def test_names_are_resolved_in_the_registry_only() -> None:

@@ -18,7 +18,7 @@ from typing import Any
 
 import pytest
 
-from alte import notebook
+from alte.lab import notebook
 from alte.errors import ParameterError
 from alte.paths import REPO_ROOT
 
@@ -29,14 +29,14 @@ _CODE = """
 import json
 import ipywidgets
 import pyvista as pv
-import alte.notebook
-from alte.plot.figure import Caption
-from alte.plot.render import show, view
+import alte.lab.notebook
+from alte.lab.plot.figure import Caption
+from alte.lab.plot.render import show, view
 
 from IPython.display import display
 from matplotlib.figure import Figure
 
-mode = alte.notebook.setup()
+mode = alte.lab.notebook.setup()
 figure = Figure()
 figure.add_subplot().plot([0, 1], [1, 0])
 display(figure)  # a 2D figure: always a PNG
@@ -131,12 +131,12 @@ _IMPORTS = "{first}\nimport open3d\nimport dash._jupyter as dj\nprint(dj._dash_c
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("first, quiet", [("import alte.notebook", True), ("", False)],
+@pytest.mark.parametrize("first, quiet", [("import alte.lab.notebook", True), ("", False)],
                          ids=["alte-first", "control"])
 def test_importing_alte_notebook_first_keeps_the_dash_comm_and_banner_away(
         first: str, quiet: bool) -> None:
     """dash (imported by open3d) opens a ``dash`` comm nothing handles and open3d prints
-    its WebVisualizer banner; both vanish when ``alte.notebook`` is imported first."""
+    its WebVisualizer banner; both vanish when ``alte.lab.notebook`` is imported first."""
     run = KernelRun({"JPY_SESSION_NAME": "ch4_terrain.ipynb"})
     env = run.env
     env.pop("OPEN3D_DISABLE_WEB_VISUALIZER", None)

@@ -117,7 +117,7 @@ def _tiny_notebook(path: Path, root: Path) -> None:
         "assert pyvista.OFF_SCREEN\n"
         "assert os.environ['ALTE_RENDER'] == 'static'\n"
         f"assert os.getcwd() == {str(root)!r}, os.getcwd()\n"
-        "from alte.notebook import setup\n"
+        "from alte.lab.notebook import setup\n"
         "print(setup())")
     nb.cells = [params, check]
     nbformat.write(nb, str(path))

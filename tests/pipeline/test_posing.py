@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from alte.io.bag import evenly_spaced
+from alte.io.bags.bag import evenly_spaced
 from alte.pipeline import FrameSpec, PoseSource, StreamCounts, open_input, stream_frames
 
 

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from alte.errors import ParameterError
-from alte.io.pointfiles import write_points
+from alte.io.points.pointfiles import write_points
 from alte.mappers import Feed
 from alte.mappers.domain import Domain
 from alte.pipeline import (

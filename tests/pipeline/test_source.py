@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from alte.errors import BagError, PointFileError
-from alte.io.pointfiles import write_points
+from alte.io.points.pointfiles import write_points
 from alte.pipeline import FrameSpec, InputKind, StreamCounts, open_input, stream_frames
 from alte.sim.scenario import load_metadata
 from alte.types import Box

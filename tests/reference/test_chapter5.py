@@ -28,9 +28,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from alte.studies.analysis.evidence import cells_table, claims_table, evaluate_all
-from alte.studies.grid import run_grid
-from alte.studies.thesis.claims import CLAIMS, AllOf, Claim, Compare
+from alte.lab.studies.analysis.evidence import cells_table, claims_table, evaluate_all
+from alte.lab.studies.thesis.claims import CLAIMS, AllOf, Claim, Compare
+from alte.lab.studies.tradeoff.grid import run_grid
 
 HERE = Path(__file__).parent
 SPEC = HERE / "chapter5.yaml"

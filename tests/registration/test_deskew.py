@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from alte.io.pose import PoseTrack
+from alte.io.poses.pose import PoseTrack
 from alte.pipeline import FrameSpec, PoseSource, merged_cloud, open_input
 from alte.registration.deskew import DeskewCounts, deskew_constant_velocity, deskew_frames
 from alte.sim import load_ground_truth, mesh_distance

@@ -10,8 +10,8 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from alte.errors import ParameterError, RegistrationError
-from alte.io.bag import FrameStream, ReadOptions
-from alte.io.imu import ImuSamples, read_imu
+from alte.io.bags.bag import FrameStream, ReadOptions
+from alte.io.bags.imu import ImuSamples, read_imu
 from alte.metrics.trajectory import trajectory_errors
 from alte.registration.inertial import (
     GRAVITY,

@@ -252,7 +252,7 @@ def test_the_kiss_stage_is_kiss_icps_own_pipeline_on_a_real_sequence() -> None:
     from kiss_icp.config import KISSConfig
     from kiss_icp.kiss_icp import KissICP
 
-    from alte.io.bag import read_frames
+    from alte.io.bags.bag import read_frames
 
     scans = read_frames(bag).frames[:12]
     ours = [pose_matrix(f.position, f.quaternion) for f in
@@ -286,7 +286,7 @@ def test_the_window_cuts_the_real_scan_to_scan_error() -> None:
     bag = REALDATA / "balm_seq" / "bag"
     if not bag.exists():
         pytest.skip("../shared/realdata/balm_seq absent")
-    from alte.io.bag import read_frames
+    from alte.io.bags.bag import read_frames
 
     scans = read_frames(bag).frames[:24]
     reference = np.loadtxt(REALDATA / "balm_seq" / "poses_tum.txt")

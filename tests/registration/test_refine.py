@@ -9,7 +9,7 @@ from itertools import islice
 import numpy as np
 import pytest
 
-from alte.io.bag import FrameStream, read_frames
+from alte.io.bags.bag import FrameStream, read_frames
 from alte.paths import realdata_dir
 from alte.registration.odometry import OdometryParams, PoseCounts, pose_matrix, refine_frames
 from alte.registration.refalign import align

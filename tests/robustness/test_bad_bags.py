@@ -247,7 +247,7 @@ def test_non_unit_quaternions_are_normalized_with_a_warning(bags, capsys, tmp_pa
     with pytest.warns(UserWarning, match=r"/pose: 44 quaternions are not unit .*normalized"):
         out = _register(bags, capsys, bag, tmp_path)
     assert _bag_counts(out)["frames"] == 4
-    from alte.io.pointfiles import read_points
+    from alte.io.points.pointfiles import read_points
 
     cloud = read_points(tmp_path / "c.ply")
     first = bags.scan_points(0).astype(np.float32).astype(np.float64)

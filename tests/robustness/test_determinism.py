@@ -14,8 +14,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from alte.io.pointfiles import write_points
-from alte.io.writer import write_frames
+from alte.io.bags.writer import write_frames
+from alte.io.points.pointfiles import write_points
 from alte.types import Frame, thesis_mount
 
 NS = 1_000_000_000
@@ -126,8 +126,8 @@ import numpy as np
 from pathlib import Path
 from alte.fsutil import atomic_path
 from alte.mappers import make_mapper
-from alte.notebook import save_figure, save_results, setup
-from alte.plot.figure import Caption, Plot
+from alte.lab.notebook import save_figure, save_results, setup
+from alte.lab.plot.figure import Caption, Plot
 import matplotlib.pyplot as plt
 setup()
 rng = np.random.default_rng(SEED)

@@ -2,7 +2,7 @@
 
 A killed run must leave nothing that a later run takes for a finished terrain, and
 the next run must complete. (``alte report`` killed mid-way is
-tests/report/test_command.py::test_killed_report_leaves_nothing_finished_and_rerun_completes.)
+tests/lab/report/test_command.py::test_killed_report_leaves_nothing_finished_and_rerun_completes.)
 """
 
 from __future__ import annotations

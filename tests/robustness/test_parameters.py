@@ -13,9 +13,9 @@ import nbformat
 import numpy as np
 import pytest
 
-from alte.io.pointfiles import write_points
+from alte.io.points.pointfiles import write_points
+from alte.lab.report.plan import notebook_parameters
 from alte.paths import REPO_ROOT
-from alte.report.plan import notebook_parameters
 
 NOTEBOOKS = REPO_ROOT / "notebooks"
 

@@ -7,7 +7,7 @@ import re
 import numpy as np
 import pytest
 
-from alte.io.pointfiles import write_points
+from alte.io.points.pointfiles import write_points
 
 CLOUD = np.random.default_rng(0).uniform(0.0, 10.0, (2000, 3))
 

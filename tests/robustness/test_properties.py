@@ -16,8 +16,8 @@ from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 from scipy.spatial.transform import Rotation
 
-from alte.io.bag import read_frames
-from alte.io.writer import write_frames
+from alte.io.bags.bag import read_frames
+from alte.io.bags.writer import write_frames
 from alte.mappers import Domain, make_mapper, registry
 from alte.metrics.hausdorff import hausdorff
 from alte.registration import register, to_sensor

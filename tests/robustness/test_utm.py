@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from alte.io.pointfiles import local_origin, read_points, write_points
+from alte.io.points.pointfiles import local_origin, read_points, write_points
 
 SETS = {
     "quadtree": ["--set", "max_points=50", "--set", "ground=300"],
@@ -66,7 +66,7 @@ def test_utm_cloud_maps_like_the_same_cloud_near_zero(bags, capsys, tmp_path, ma
 @pytest.mark.parametrize("mapper", ["octomap", "alte2d"])
 def test_utm_bag_maps_like_the_same_bag_near_zero(bags, capsys, tmp_path, mapper):
     """Poses at UTM scale (x 513 km, y 5404 km): frame-by-frame mapping as near the origin."""
-    from alte.io.writer import write_frames
+    from alte.io.bags.writer import write_frames
     from alte.types import Frame, Mount
 
     rng = np.random.default_rng(3)

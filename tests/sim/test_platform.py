@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from alte.plot.scene import attitude_deg
+from alte.lab.plot.scene import attitude_deg
 from alte.sim.platform import Cart, Quadrotor, Trajectory, mocap_stream
 
 SQUARE = ((0.0, 0.0), (40.0, 0.0), (40.0, 30.0), (0.0, 30.0))

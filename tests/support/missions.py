@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 from rosbags.typesys import Stores, get_typestore
 
-from alte.io.pointcloud2 import encode_pointcloud2, make_header
+from alte.io.bags.pointcloud2 import encode_pointcloud2, make_header
 from alte.sim import Simulation, TruePoses, get_terrain, simulate, true_poses
 from support.bagtools import write_ros2
 

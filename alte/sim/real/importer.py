@@ -25,7 +25,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from alte.errors import SimulationError
-from alte.io.pointformats import local_origin
+from alte.io.points.pointformats import local_origin
 from alte.sim.meta import SCENARIO_FILE
 from alte.sim.real.flight import Flight, flight_plan
 from alte.sim.real.folder import BARE_EARTH_FILE

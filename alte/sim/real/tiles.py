@@ -170,7 +170,7 @@ def _read_pair(path: Path, ground_file: Path, crs: str | None) -> Tile:
     """All points plus a file of the reference ground among them (the ISPRS filter test)."""
     from scipy.spatial import cKDTree
 
-    from alte.io.pointfiles import read_points
+    from alte.io.points.pointfiles import read_points
 
     units = _crs(None, crs, str(path))
     pts, ground_pts = read_points(path), read_points(ground_file)

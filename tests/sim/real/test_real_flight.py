@@ -8,11 +8,11 @@ import pytest
 from support.tiles import X0, Y0, field, write_dem, write_las
 
 from alte.errors import ParameterError, SimulationError
+from alte.lab.studies.experiments import measure
 from alte.metrics.options import TruthOptions
 from alte.pipeline import open_input, prepare
 from alte.sim import VLP16, load_scenario, simulate, write_scenario
 from alte.sim.real import Flight, import_terrain, write_imported
-from alte.studies.experiments import measure
 
 PLANE = 250.3  # m: a flat field, off every 0.5 m voxel boundary by 0.3 m
 
@@ -83,8 +83,8 @@ def test_flight_climbs_over_objects_and_follows_the_ground(tmp_path):
 def test_the_trade_off_grid_runs_on_an_imported_terrain(tmp_path):
     """A sweep names the imported terrain like a built-in one: other seeds and scan
     counts of its mission are flown from the folder, every map is measured on its truth."""
-    from alte.studies.grid import tradeoff_table
-    from alte.studies.sweep import parse_spec, run_sweep
+    from alte.lab.studies.sweep import parse_spec, run_sweep
+    from alte.lab.studies.tradeoff.grid import tradeoff_table
 
     pts, cls = field()
     tile = write_las(tmp_path / "field.laz", pts, cls)

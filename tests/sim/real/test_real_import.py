@@ -17,7 +17,7 @@ from support.tiles import (
 
 from alte.cli import main
 from alte.errors import ParameterError, PointFileError
-from alte.io.pointfiles import write_points
+from alte.io.points.pointfiles import write_points
 from alte.paths import realdata_dir
 from alte.sim.real import Flight, grid_surfaces, import_terrain, read_tiles
 
