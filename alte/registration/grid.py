@@ -31,7 +31,7 @@ def _positive(value: float) -> bool:
     return bool(np.isfinite(value) and value > 0)
 
 
-#: The one rule of a registration voxel (the grid here, :class:`alte.pipeline.FrameSpec`).
+#: The one rule of a registration voxel (the grid here, :class:`alte.pipeline.FrameSettings`).
 VOXEL: Rule[float] = Rule(_positive, "voxel > 0, finite", "grid-average cell size (m)")
 
 

@@ -70,9 +70,9 @@ def _positive(value: float) -> bool:
 
 @dataclass(frozen=True)
 class LioSettings(Record):
-    """What the LIO reads from :class:`~alte.registration.odometry.OdometryParams`
+    """What the LIO reads from :class:`~alte.registration.odometry.OdometrySettings`
     (``noise`` from its six IMU figures; ``gate``, ``gate_sigma`` and ``iterations`` are
-    not settings of ``--odometry-set``); the rules are OdometryParams'."""
+    not settings of ``--odometry-set``); the rules are OdometrySettings'."""
 
     OWNER = "lio"
 

@@ -8,7 +8,7 @@ import pytest
 
 from alte.commands.flags import FLAGS, flag_message, flags_of
 from alte.errors import AlteError, ParameterError
-from alte.pipeline import FrameSpec
+from alte.pipeline import FrameSettings
 from alte.registration.grid import VOXEL, GridSettings, check_voxel
 
 
@@ -27,22 +27,22 @@ def test_a_setting_becomes_the_flag_the_command_has() -> None:
 
 def test_a_record_error_names_its_setting() -> None:
     with pytest.raises(ParameterError, match=r"^frame spec: frames=0 out of range") as caught:
-        FrameSpec(frames=0)
+        FrameSettings(frames=0)
     assert caught.value.settings == ("frame spec.frames",)
     with pytest.raises(ParameterError, match="must be finite") as caught:
-        FrameSpec(voxel=float("nan"))
+        FrameSettings(voxel=float("nan"))
     assert caught.value.settings == ("frame spec.voxel",)
 
 
 def test_one_voxel_rule() -> None:
-    """``FrameSpec.voxel`` and the registration grid's ``check_voxel`` apply one rule."""
+    """``FrameSettings.voxel`` and the registration grid's ``check_voxel`` apply one rule."""
     with pytest.raises(ParameterError, match=r"^grid: voxel=0.0 out of range \(voxel > 0, "
                                              r"finite\)$"):
         check_voxel(0.0)
     with pytest.raises(ParameterError, match=r"^frame spec: voxel=-1.0 out of range "
                                              r"\(voxel > 0, finite\)$"):
-        FrameSpec(voxel=-1.0)
-    spec_rule = next(f for f in FrameSpec.__dataclass_fields__.values() if f.name == "voxel")
+        FrameSettings(voxel=-1.0)
+    spec_rule = next(f for f in FrameSettings.__dataclass_fields__.values() if f.name == "voxel")
     grid_rule = GridSettings.__dataclass_fields__["voxel"]
     assert spec_rule.metadata["rule"] is VOXEL is grid_rule.metadata["rule"]
     assert check_voxel(0.25) == 0.25

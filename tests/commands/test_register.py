@@ -14,7 +14,7 @@ from alte.commands.options import parse_box
 from alte.commands.register import format_counts
 from alte.errors import ParameterError
 from alte.io import read_frames, write_frames
-from alte.io.bags.bag import ReadCounts, ReadOptions
+from alte.io.bags.bag import ReadCounts, ReadSettings
 from alte.io.points.pointfiles import read_points, read_points_info
 from alte.paths import realdata_dir
 from alte.pipeline import InputKind, Source
@@ -151,7 +151,7 @@ def test_register_real_ros1_bag_without_poses(tmp_path, capsys):
         pytest.skip(f"{bag} absent")
     out = tmp_path / "luminar.pcd"
     assert main(["register", str(bag), "--out", str(out), "--voxel", "0.5", "--no-pose"]) == 0
-    frames = read_frames(bag, ReadOptions(pose_topic="", allow_no_pose=True))
+    frames = read_frames(bag, ReadSettings(pose_topic="", allow_no_pose=True))
     raw = np.vstack([register_frame(f, frames.mount) for f in frames.frames])
     expected = grid_average(raw, 0.5)
     got = read_points(out)

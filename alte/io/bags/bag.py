@@ -29,7 +29,7 @@ from alte.params import Record, param
 from alte.progress import bar as progress_bar
 from alte.types import Counts, Frame, Mount
 
-__all__ = ["NO_POSE_NOTE", "FrameSet", "FrameStream", "ReadCounts", "ReadOptions",
+__all__ = ["NO_POSE_NOTE", "FrameSet", "FrameStream", "ReadCounts", "ReadSettings",
            "evenly_spaced", "read_frames"]
 
 _IDENTITY_Q = np.array([0.0, 0.0, 0.0, 1.0])
@@ -91,7 +91,7 @@ def evenly_spaced(total: int, limit: int | None) -> frozenset[int] | None:
 
 
 @dataclass(frozen=True)
-class ReadOptions(Record):
+class ReadSettings(Record):
     """How a bag's scans are read and posed (:class:`FrameStream`, :func:`read_frames`),
     checked before the bag is opened.
 
@@ -134,12 +134,12 @@ class FrameStream:
     ``counts`` describe the last (or current) iteration.
     """
 
-    def __init__(self, path: str | Path, options: ReadOptions | None = None, *,
+    def __init__(self, path: str | Path, options: ReadSettings | None = None, *,
                  mount: Mount | None = None, read_all: bool = False) -> None:
-        """``options``: what is read (:class:`ReadOptions`); ``mount`` overrides the bag's
+        """``options``: what is read (:class:`ReadSettings`); ``mount`` overrides the bag's
         ``/tf_static`` body -> sensor transform; ``read_all``: read every scan even when
         ``options.frames`` selects some (odometry needs them all)."""
-        options = options or ReadOptions()
+        options = options or ReadSettings()
         pose_file, pose_topic = options.pose_file, options.pose_topic
         self.path = Path(path)
         self.notes: list[str] = []
@@ -160,7 +160,7 @@ class FrameStream:
         self.counts = self._new_counts()
 
     def _use_pose_file(self, pose_file: Path) -> None:
-        """Poses from a TUM file instead of a topic (``ReadOptions.pose_file``)."""
+        """Poses from a TUM file instead of a topic (``ReadSettings.pose_file``)."""
         from alte.io.poses.tum import read_tum
 
         self.track, self.pose_topic = read_tum(pose_file), str(pose_file)
@@ -257,9 +257,9 @@ def _raise_empty(stream: FrameStream, counts: ReadCounts, stamps: _StampRange) -
         "pose_file)", setting=("frame spec.poses", "read.pose_topic", "read.pose_file"))
 
 
-def read_frames(path: str | Path, options: ReadOptions | None = None, *,
+def read_frames(path: str | Path, options: ReadSettings | None = None, *,
                 mount: Mount | None = None) -> FrameSet:
-    """Every posed scan of a bag in a list (``options``: :class:`ReadOptions`).
+    """Every posed scan of a bag in a list (``options``: :class:`ReadSettings`).
 
     ``mount`` overrides the bag's ``/tf_static`` body -> sensor transform; with neither
     the mount is identity (noted in ``notes``). Holds the whole bag: the pipeline streams

@@ -6,9 +6,9 @@ the built-in four: ``alte map BAG --mapper elevation --set resolution=0.25``.
 """
 
 from alte_elevation.fusion import CellState, Gate, fuse
-from alte_elevation.mapper import LAYERS, ElevationMap, ElevationParams
+from alte_elevation.mapper import LAYERS, ElevationMap, ElevationSettings
 from alte_elevation.noise import point_variance
 
-__all__ = ["LAYERS", "CellState", "ElevationMap", "ElevationParams", "Gate", "fuse",
+__all__ = ["LAYERS", "CellState", "ElevationMap", "ElevationSettings", "Gate", "fuse",
            "point_variance"]
 __version__ = "0.1.0"

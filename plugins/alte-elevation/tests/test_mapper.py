@@ -7,7 +7,7 @@ from alte_elevation import ElevationMap, point_variance
 from alte.errors import ParameterError
 from alte.mappers import VARIANCE, registry
 from alte.mappers.api import Domain
-from alte.pipeline import MapSpec
+from alte.pipeline import MapSettings
 from alte.testing import check_mapper, scene
 
 
@@ -18,9 +18,9 @@ def test_meets_the_contract() -> None:
 def test_found_by_its_entry_point() -> None:
     """Installed, the package's entry point makes it a mapper of the registry."""
     assert registry.resolve("elevation") is ElevationMap
-    assert MapSpec("elevation", {"resolution": "0.25"}).record.resolution == 0.25
+    assert MapSettings("elevation", {"resolution": "0.25"}).record.resolution == 0.25
     with pytest.raises(ParameterError, match=r"elevation: resolution=0\.0 out of range"):
-        MapSpec("elevation", {"resolution": 0})
+        MapSettings("elevation", {"resolution": 0})
 
 
 def test_point_variance_by_range_and_angle() -> None:

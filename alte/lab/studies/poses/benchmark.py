@@ -38,9 +38,9 @@ from alte.errors import ParameterError
 from alte.lab.studies.analysis.tables import write_csv
 from alte.lab.studies.experiments import CACHE_DIR
 from alte.metrics.trajectory import cloud_distance, rigid_alignment, trajectory_errors
-from alte.pipeline import FrameSpec, PoseSource, Registered, Source, open_input, prepare
+from alte.pipeline import FrameSettings, PoseSource, Registered, Source, open_input, prepare
 from alte.progress import bar as progress_bar
-from alte.registration.odometry import OdometryParams
+from alte.registration.odometry import OdometrySettings
 
 __all__ = ["COLUMNS", "REAL_SEQUENCES", "SOURCES", "BenchInput", "bench_input", "odometry_table",
            "pose_benchmark", "realdata_table", "write_odometry_table"]
@@ -116,12 +116,12 @@ def bench_input(what: str | os.PathLike[str], *, reference: str | os.PathLike[st
                       voxel or source.voxel or BAG_VOXEL, frames)
 
 
-def _spec(item: BenchInput, poses: PoseSource, odometry: OdometryParams) -> FrameSpec:
-    return FrameSpec(frames=item.frames, voxel=item.voxel, poses=poses, odometry=odometry)
+def _spec(item: BenchInput, poses: PoseSource, odometry: OdometrySettings) -> FrameSettings:
+    return FrameSettings(frames=item.frames, voxel=item.voxel, poses=poses, odometry=odometry)
 
 
-def _reference_spec(item: BenchInput) -> FrameSpec:
-    return FrameSpec(frames=item.frames, voxel=item.voxel / 5, poses=PoseSource.RECORDED,
+def _reference_spec(item: BenchInput) -> FrameSettings:
+    return FrameSettings(frames=item.frames, voxel=item.voxel / 5, poses=PoseSource.RECORDED,
                      pose_file=item.reference)
 
 
@@ -155,7 +155,7 @@ def _matched(reg: Registered, reference: Registered,
 
 
 def _score(item: BenchInput, key: str, reg: Registered, reference: Registered,
-           odometry: OdometryParams) -> dict[str, object]:
+           odometry: OdometrySettings) -> dict[str, object]:
     mine, theirs = _matched(reg, reference)
     est, ref = reg.trajectory, reference.trajectory
     if reg.spec.poses is PoseSource.ODOMETRY:
@@ -183,12 +183,12 @@ def _score(item: BenchInput, key: str, reg: Registered, reference: Registered,
             "kept": poses.frames - poses.corrected if key == "refine" else 0}
 
 
-def _settings(key: str, odometry: OdometryParams) -> str:
+def _settings(key: str, odometry: OdometrySettings) -> str:
     """The settings a source ran with, as ``key=value`` text (those that differ from the
     defaults), or ``-`` for recorded poses."""
     if key == "recorded":
         return "-"
-    default = OdometryParams(method=odometry.method).as_dict()
+    default = OdometrySettings(method=odometry.method).as_dict()
     changed = {k: v for k, v in odometry.as_dict().items() if v != default[k]}
     return " ".join(f"{k}={v}" for k, v in changed.items()) or "defaults"
 
@@ -206,7 +206,7 @@ def pose_benchmark(item: BenchInput, sources: Sequence[str] = tuple(SOURCES), *,
                    settings: Mapping[str, Mapping[str, object]] | None = None,
                    cache: Path | None = None, progress: bool = False) -> pd.DataFrame:
     """One row per pose source of ``item`` (module docstring); ``settings`` maps a
-    backend (``kiss``, ``plane``, ``refine``) to :class:`OdometryParams` overrides."""
+    backend (``kiss``, ``plane``, ``refine``) to :class:`OdometrySettings` overrides."""
     unknown = sorted(set(sources) - set(SOURCES))
     if unknown:
         raise ParameterError(f"unknown pose source(s) {', '.join(unknown)}; "
@@ -216,7 +216,7 @@ def pose_benchmark(item: BenchInput, sources: Sequence[str] = tuple(SOURCES), *,
     rows = []
     for key in sources:
         poses, method = SOURCES[key]
-        odometry = OdometryParams.parse({"method": method or "kiss", **settings.get(key, {})})
+        odometry = OdometrySettings.parse({"method": method or "kiss", **settings.get(key, {})})
         reg = prepare(item.source, _spec(item, poses, odometry), cache=cache,
                       progress=progress)
         rows.append(_score(item, key, reg, reference, odometry))
