@@ -65,3 +65,11 @@ def test_view_parameters_reread_the_stored_map() -> None:
     narrow = mapper.reread(spread=False)
     assert np.nanmax(narrow.cells().layers[VARIANCE]) <= np.nanmax(
         mapper.cells().layers[VARIANCE])
+
+
+def test_the_first_name_of_the_settings_record_still_imports() -> None:
+    import alte_elevation
+
+    with pytest.warns(DeprecationWarning, match="use ElevationSettings"):
+        old = alte_elevation.ElevationParams
+    assert old is alte_elevation.ElevationSettings
