@@ -145,5 +145,5 @@ class Alte2D(QuadMap):
 
 
 def __getattr__(name: str) -> object:
-    """``Alte2DSettings``: the first name of :class:`Alte2DSettings` (deprecated)."""
-    return renamed(__name__, name, {"Alte2DSettings": lambda: Alte2DSettings})
+    """``Alte2DParams``: the first name of :class:`Alte2DSettings` (deprecated)."""
+    return renamed(__name__, name, {"Alte2DParams": lambda: Alte2DSettings})

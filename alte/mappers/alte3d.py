@@ -298,5 +298,5 @@ class Alte3D:
 
 
 def __getattr__(name: str) -> object:
-    """``Alte3DSettings``: the first name of :class:`Alte3DSettings` (deprecated)."""
-    return renamed(__name__, name, {"Alte3DSettings": lambda: Alte3DSettings})
+    """``Alte3DParams``: the first name of :class:`Alte3DSettings` (deprecated)."""
+    return renamed(__name__, name, {"Alte3DParams": lambda: Alte3DSettings})

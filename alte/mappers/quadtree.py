@@ -181,5 +181,5 @@ class Quadtree(QuadMap):
 
 
 def __getattr__(name: str) -> object:
-    """``QuadtreeSettings``: the first name of :class:`QuadtreeSettings` (deprecated)."""
-    return renamed(__name__, name, {"QuadtreeSettings": lambda: QuadtreeSettings})
+    """``QuadtreeParams``: the first name of :class:`QuadtreeSettings` (deprecated)."""
+    return renamed(__name__, name, {"QuadtreeParams": lambda: QuadtreeSettings})

@@ -174,11 +174,11 @@ def test_a_v1_plugin_naming_its_record_params_still_loads(plugin_path: Path) -> 
 def test_the_first_names_of_the_settings_records_still_import() -> None:
     from alte.mappers import alte2d, quadtree
 
-    with pytest.warns(DeprecationWarning, match=r"quadtree.QuadtreeSettings is deprecated; "
+    with pytest.warns(DeprecationWarning, match=r"quadtree.QuadtreeParams is deprecated; "
                                                 r"use QuadtreeSettings"):
-        old = quadtree.QuadtreeSettings
+        old = quadtree.QuadtreeParams
     assert old is quadtree.QuadtreeSettings and quadtree.Quadtree.Params is old
     with pytest.warns(DeprecationWarning, match="Alte2DSettings"):
-        from alte.mappers.alte2d import Alte2DSettings  # noqa: F401
+        from alte.mappers.alte2d import Alte2DParams  # noqa: F401
     with pytest.raises(AttributeError, match="no attribute 'NoSuch'"):
         alte2d.NoSuch  # noqa: B018

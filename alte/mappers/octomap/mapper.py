@@ -280,5 +280,5 @@ class Octomap:
 
 
 def __getattr__(name: str) -> object:
-    """``OctomapSettings``: the first name of :class:`OctomapSettings` (deprecated)."""
-    return renamed(__name__, name, {"OctomapSettings": lambda: OctomapSettings})
+    """``OctomapParams``: the first name of :class:`OctomapSettings` (deprecated)."""
+    return renamed(__name__, name, {"OctomapParams": lambda: OctomapSettings})

@@ -17,9 +17,9 @@ __version__ = "0.1.0"
 
 
 def __getattr__(name: str) -> object:
-    """``ElevationSettings``: the first name of :class:`ElevationSettings` (deprecated)."""
-    if name == "ElevationSettings":
-        warnings.warn("alte_elevation.ElevationSettings is deprecated; use ElevationSettings",
+    """``ElevationParams``: the first name of :class:`ElevationSettings` (deprecated)."""
+    if name == "ElevationParams":
+        warnings.warn("alte_elevation.ElevationParams is deprecated; use ElevationSettings",
                       DeprecationWarning, stacklevel=2)
         return ElevationSettings
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -71,5 +71,5 @@ def test_the_first_name_of_the_settings_record_still_imports() -> None:
     import alte_elevation
 
     with pytest.warns(DeprecationWarning, match="use ElevationSettings"):
-        old = alte_elevation.ElevationSettings
+        old = alte_elevation.ElevationParams
     assert old is alte_elevation.ElevationSettings
