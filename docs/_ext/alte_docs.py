@@ -275,7 +275,7 @@ class MappersDirective(RecordDirective):
         for cls in registry.classes():
             said = (cls.__doc__ or "").strip().splitlines()[0]
             lines += [f"**{cls.name}** (:class:`{cls.__module__}.{cls.__name__}`): {said}",
-                      "", *record_table(cls.Params), ""]
+                      "", *record_table(cls.Settings), ""]
         return self._parse(lines)
 
 

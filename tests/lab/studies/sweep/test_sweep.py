@@ -261,12 +261,12 @@ def test_failed_runs_are_reported_not_written_and_retried(spec, tmp_path, monkey
 
 
 def test_scheduler_errors(spec, tmp_path, monkeypatch):
-    with pytest.raises(ParameterError, match="--scheduler 'cluster': expected serial"):
+    with pytest.raises(ParameterError, match="sweep: scheduler='cluster': expected serial"):
         run_sweep(spec, scheduler="cluster", output=tmp_path, progress=False)
-    with pytest.raises(ParameterError, match="--workers 0: must be at least 1"):
+    with pytest.raises(ParameterError, match=r"sweep: workers=0 out of range \(workers >= 1\)"):
         run_sweep(spec, scheduler="local", workers=0, output=tmp_path, progress=False)
     monkeypatch.setattr(sweep_runner, "CONNECT_TIMEOUT", "0.5s")
-    with pytest.raises(ParameterError, match=r"--scheduler tcp://127.0.0.1:9: cannot connect"):
+    with pytest.raises(ParameterError, match=r"sweep: scheduler=tcp://127.0.0.1:9: cannot connect"):
         run_sweep(spec, scheduler="tcp://127.0.0.1:9", output=tmp_path, progress=False)
 
 
