@@ -80,14 +80,25 @@ def full_parser() -> argparse.ArgumentParser:
     return build_parser("*")
 
 
+def _options(parser: argparse.ArgumentParser, args: argparse.Namespace) -> set[str]:
+    """The option strings of the command that ran (its flags, for error messages)."""
+    actions = [a for a in parser._actions if isinstance(a, argparse._SubParsersAction)]
+    command = actions[0].choices[args.command] if actions else parser
+    return set(command._option_string_actions)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the process exit code."""
     argv = sys.argv[1:] if argv is None else list(argv)
-    args = build_parser(_command(argv)).parse_args(argv)
+    parser = build_parser(_command(argv))
+    args = parser.parse_args(argv)
     try:
         return int(args.func(args) or 0)
     except AlteError as err:
-        print(f"alte {args.command}: error: {err}", file=sys.stderr)
+        from alte.commands.flags import flag_message
+
+        print(f"alte {args.command}: error: {flag_message(err, _options(parser, args))}",
+              file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print(f"alte {args.command}: interrupted", file=sys.stderr)

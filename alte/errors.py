@@ -24,7 +24,16 @@ __all__ = [
 
 
 class AlteError(Exception):
-    """Base of every error alte raises on purpose."""
+    """Base of every error alte raises on purpose.
+
+    ``setting`` names the settings at fault in the library's own terms, ``OWNER.field``
+    (``"read.pose_file"``): the command line turns them into its flags
+    (:mod:`alte.commands.flags`); the library's message never names a flag.
+    """
+
+    def __init__(self, *args: object, setting: str | tuple[str, ...] = ()) -> None:
+        super().__init__(*args)
+        self.settings: tuple[str, ...] = (setting,) if isinstance(setting, str) else setting
 
 
 class BagError(AlteError):

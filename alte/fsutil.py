@@ -19,7 +19,8 @@ __all__ = ["atomic_dir", "atomic_path", "refuse_overwrite"]
 def refuse_overwrite(path: Path, overwrite: bool) -> None:
     """Raise when ``path`` exists and the caller did not ask to overwrite it."""
     if path.exists() and not overwrite:
-        raise AlteError(f"{path} already exists; pass overwrite=True (or --force) to replace it")
+        raise AlteError(f"{path} already exists; overwrite=True replaces it",
+                        setting="output.overwrite")
 
 
 def _umask() -> int:

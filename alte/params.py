@@ -223,12 +223,17 @@ class Record:
         for spec in dataclasses.fields(self):
             if not spec.init:
                 continue  # derived in the subclass's __post_init__
-            value = coerce(self.OWNER, spec.name, hints[spec.name], getattr(self, spec.name))
+            setting = f"{self.OWNER}.{spec.name}"  # what a command line names as a flag
+            try:
+                value = coerce(self.OWNER, spec.name, hints[spec.name], getattr(self, spec.name))
+            except ParameterError as err:
+                err.settings = err.settings or (setting,)
+                raise
             rule = spec.metadata.get("rule")
             if value is not None and isinstance(rule, Rule) and not rule.check(value):
                 shown = list(value) if isinstance(value, tuple) else value  # as YAML wrote it
                 raise ParameterError(f"{self.OWNER}: {spec.name}={shown!r} out of range "
-                                     f"({rule.rule})")
+                                     f"({rule.rule})", setting=setting)
             object.__setattr__(self, spec.name, value)
 
     @classmethod

@@ -118,8 +118,8 @@ def _map_problems(cls: type[Mapper], mapper: Mapper, what: str) -> list[str]:
     corners = np.asarray(mapper.corners())
     if corners.ndim != 2 or corners.shape[1:] != (3,) or not np.isfinite(corners).all():
         out.append(f"after {what}: corners() must be finite (M, 3), got {corners.shape}")
-    if not isinstance(mapper.params, cls.Params):
-        out.append(f"params is a {type(mapper.params).__name__}, not {cls.Params.__name__}")
+    if not isinstance(mapper.params, cls.Settings):
+        out.append(f"params is a {type(mapper.params).__name__}, not {cls.Settings.__name__}")
     return out
 
 
@@ -152,8 +152,8 @@ def _refuses(out: list[str], what: str, call: Callable[[], object]) -> None:
 def _construct(cls: type[Mapper], out: list[str]) -> Domain | None:
     """Construction checks; the domain the scene is mapped in."""
     domain = None if cls.domain_use is DomainUse.UNUSED else SCENE_DOMAIN
-    made = _attempt(out, f"{cls.__name__}(domain, record=Params())",
-                    lambda: cls(domain, record=cls.Params()))
+    made = _attempt(out, f"{cls.__name__}(domain, record=Settings())",
+                    lambda: cls(domain, record=cls.Settings()))
     if made is not None and not isinstance(made, Mapper):
         missing = [p for p in PROPERTIES if not hasattr(made, p)]
         out.append(f"an instance does not meet the Mapper protocol (missing {missing})")

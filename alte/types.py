@@ -252,9 +252,11 @@ class Mount:
         try:
             values = [float(v) for v in text.split(",")]
         except ValueError as err:
-            raise PoseError(f"--mount {text!r}: expected 6 numbers x,y,z,roll,pitch,yaw") from err
+            raise PoseError(f"mount {text!r}: expected 6 numbers x,y,z,roll,pitch,yaw",
+                            setting="mount") from err
         if len(values) != 6:
-            raise PoseError(f"--mount {text!r}: expected 6 numbers x,y,z,roll,pitch,yaw")
+            raise PoseError(f"mount {text!r}: expected 6 numbers x,y,z,roll,pitch,yaw",
+                            setting="mount")
         quat = Rotation.from_euler("xyz", values[3:], degrees=True).as_quat()
         return cls(np.array(values[:3]), quat)
 

@@ -19,7 +19,7 @@ from alte.params import Record, param
 from alte.types import JSONDict
 from bench.workload import Scan, Workload, load_workload
 
-__all__ = ["LIMITS", "BenchConfig", "Context", "Result"]
+__all__ = ["LIMITS", "BenchSettings", "Context", "Result"]
 
 T = TypeVar("T")
 FULL_SIZES = (10**4, 10**5, 10**6, 10**7)
@@ -32,7 +32,7 @@ LIMITS: dict[int, float] = {1: 1 / 3, 2: 1.0, 3: 10.0, 4: 0.5, 5: 0.1, 6: 2.0, 9
 
 
 @dataclass(frozen=True)
-class BenchConfig(Record):
+class BenchSettings(Record):
     """Settings of one benchmark run (validated like every parameter record)."""
 
     OWNER = "bench"
@@ -84,7 +84,7 @@ class Result:
 class Context:
     """The run's config plus a cache of loaded terrains and shared measurements."""
 
-    def __init__(self, config: BenchConfig) -> None:
+    def __init__(self, config: BenchSettings) -> None:
         self.config = config
         self._memo: dict[str, object] = {}
 

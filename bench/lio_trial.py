@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from alte.io.bags.bag import FrameStream
+from alte.io.bags.bag import FrameStream, ReadSettings
 from alte.io.bags.imu import ImuSamples, read_imu
 from alte.metrics.trajectory import trajectory_errors
 from alte.registration import odometry
@@ -107,7 +107,7 @@ def _alte(stream: FrameStream, imu: ImuSamples, truth: TruePoses,
 def main(folder: str, name: str, package: str, *settings: str) -> None:
     """Run one package over the terrain's bag and print the scores."""
     bag = Path(folder) / "bag"
-    stream = FrameStream(bag, pose_topic="", allow_no_pose=True)
+    stream = FrameStream(bag, ReadSettings(pose_topic="", allow_no_pose=True))
     imu = read_imu(bag)
     seed = int(json.loads((Path(folder) / "scenario.json").read_text()).get("seed", 0))
     truth = true_poses(get_terrain(name), seed)

@@ -26,7 +26,7 @@ from bench.core import LIMITS, Context, Result
 from bench.timing import one_core
 
 if TYPE_CHECKING:
-    from alte.registration.odometry import OdometryParams, PoseCounts
+    from alte.registration.odometry import OdometrySettings, PoseCounts
 
 __all__ = ["pose_speed"]
 
@@ -39,7 +39,7 @@ def _scans(ctx: Context) -> list[Frame]:
 
     bag = realdata_dir() / "balm_seq" / "bag"
     limit = 20 if ctx.config.quick else None
-    return ctx.memo("balm_frames", lambda: read_frames(bag, frames=None).frames[:limit])
+    return ctx.memo("balm_frames", lambda: read_frames(bag).frames[:limit])
 
 
 class _Clock:
@@ -96,7 +96,7 @@ class _Poser(Protocol):
     """``odometry_frames`` or ``refine_frames`` as the row calls them."""
 
     def __call__(self, frames: Iterable[Frame], mount: Mount, *, counts: PoseCounts,
-                 params: OdometryParams) -> Iterator[Frame]: ...
+                 params: OdometrySettings) -> Iterator[Frame]: ...
 
 
 #: The row's streams: name -> (refinement, settings); ``kiss-stage`` is the KISS-ICP stage
@@ -107,14 +107,14 @@ STREAMS: dict[str, tuple[bool, dict[str, object]]] = {
 
 def _ours(frames: list[Frame], name: str, clock: _Clock) -> None:
     from alte.registration.odometry import (
-        OdometryParams,
+        OdometrySettings,
         PoseCounts,
         odometry_frames,
         refine_frames,
     )
     refine, settings = STREAMS[name]
     poser: _Poser = refine_frames if refine else odometry_frames
-    params = OdometryParams.parse(settings)
+    params = OdometrySettings.parse(settings)
     bare = [replace(f, times=None) for f in frames]
     clock.run(bare, lambda scans: poser(scans, Mount(), counts=PoseCounts(), params=params))
 

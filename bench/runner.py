@@ -20,7 +20,7 @@ from alte.errors import ParameterError
 from alte.types import JSONDict
 from bench.catalog import TITLES
 from bench.clouds import cloud_stages, hausdorff_speed
-from bench.core import BenchConfig, Context, Result
+from bench.core import BenchSettings, Context, Result
 from bench.ground import ground_speed
 from bench.maps import batch_builds, insert_latency, octomap_memory, octomap_speed
 from bench.memory import map_memory
@@ -51,7 +51,7 @@ ROWS: dict[int, tuple[str, Row]] = {n: (TITLES[n], fn) for n, fn in sorted(_MEAS
 class Bench:
     """Results of one run, the rows that failed, the machine and the settings."""
 
-    config: BenchConfig
+    config: BenchSettings
     results: list[Result]
     errors: dict[int, str]
     machine: JSONDict
@@ -80,7 +80,7 @@ def select_rows(only: Iterable[int] | None) -> list[int]:
     return chosen
 
 
-def run_bench(config: BenchConfig, only: Iterable[int] | None = None) -> Bench:
+def run_bench(config: BenchSettings, only: Iterable[int] | None = None) -> Bench:
     """Run the chosen rows with ``config``; failures are recorded per row, not raised."""
     rows = select_rows(only)
     ctx = Context(config)

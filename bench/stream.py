@@ -40,7 +40,7 @@ from bench.timing import interleave, one_core
 from bench.workload import QUICK_FRAMES, Points, Scan, workload_dir
 
 if TYPE_CHECKING:
-    from alte.pipeline import MapRun, MapSpec
+    from alte.pipeline import MapRun, MapSettings
 
 __all__ = ["UfoPeer", "mission_seconds", "scan_peer", "streaming_chain"]
 
@@ -64,7 +64,7 @@ def _bag(ctx: Context, terrain: str) -> Path:
     return source.bag
 
 
-def _one_run(bag: Path, spec: MapSpec) -> tuple[float, float, MapRun]:
+def _one_run(bag: Path, spec: MapSettings) -> tuple[float, float, MapRun]:
     """Wall and process CPU seconds of one ``run`` of ``spec`` on ``bag``, and the run."""
     from alte.pipeline import run
 
@@ -102,14 +102,14 @@ def streaming_chain(ctx: Context) -> list[Result]:
     registered one, plugins included), each on both terrains."""
     from alte.lab.studies.thesis.numbers import mapper_params
     from alte.mappers import Feed, registry
-    from alte.pipeline import DomainPolicy, MapSpec
+    from alte.pipeline import DomainPolicy, MapSettings
 
     cfg = ctx.config
     out: list[Result] = []
     for terrain in (NAV, LAN):
         bag = _bag(ctx, terrain)
         params = mapper_params(terrain)
-        specs = {cls.name: MapSpec(cls, dict(params.get(cls.name, {})), DomainPolicy.AUTO,
+        specs = {cls.name: MapSettings(cls, dict(params.get(cls.name, {})), DomainPolicy.AUTO,
                                    Feed.FRAMES) for cls in registry.classes()}
         times: dict[str, tuple[list[float], list[float]]] = {name: ([], []) for name in specs}
         runs: dict[str, list[MapRun]] = {name: [] for name in specs}

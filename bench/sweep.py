@@ -174,7 +174,7 @@ def _peer(sample_spec: SweepSpec, data_dir: str, seed: int, strata: int | None
     on the first run of each sampled group."""
     from alte.lab.studies.experiments import measure
     from alte.lab.studies.sweep.groups import _inputs
-    from alte.pipeline import DomainPolicy, MapSpec
+    from alte.pipeline import DomainPolicy, MapSettings
 
     runs, cpu = 0, 0.0
     for group, _ in _thinned(stratified_groups(sample_spec, seed), strata):
@@ -182,7 +182,7 @@ def _peer(sample_spec: SweepSpec, data_dir: str, seed: int, strata: int | None
         data, _ = _inputs(run, data_dir)
         start = time.process_time()
         measure(data, run.mapper, truth=run.truth, set_b=run.set_b,
-                spec=MapSpec(run.mapper, dict(run.params), domain=DomainPolicy(run.domain)))
+                spec=MapSettings(run.mapper, dict(run.params), domain=DomainPolicy(run.domain)))
         runs, cpu = runs + 1, cpu + time.process_time() - start
     return runs, cpu
 

@@ -15,7 +15,7 @@ from support.bagtools import TS, write_ros2
 from alte import __version__
 from alte.cli import COMMANDS, build_parser
 from alte.io.bags.pointcloud2 import encode_pointcloud2
-from alte.io.bags.writer import write_bag
+from alte.io.bags.writer import BagSettings, write_bag
 from alte.types import thesis_mount
 
 #: What a command that only reads or prints must not load: the lab (report, studies),
@@ -46,7 +46,7 @@ def bags(tmp_path_factory):
     stamps = NS + np.arange(21) * NS // 100
     pos, quat = np.zeros((21, 3)), np.tile([0.0, 0.0, 0.0, 1.0], (21, 1))
     posed = write_bag(root / "posed", clouds, stamps, pos, quat, thesis_mount(),
-                      cloud_topic="/lidar", pose_topic="/vicon")
+                      BagSettings(cloud_topic="/lidar", pose_topic="/vicon"))
     bare = write_ros2(root / "bare", [("/lidar", "sensor_msgs/msg/PointCloud2", s,
                                        encode_pointcloud2(p, s, "lidar", TS)) for s, p in clouds])
     return posed, bare

@@ -77,11 +77,11 @@ def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) 
 
 def run(args: argparse.Namespace) -> int:
     """Run the benchmark, write its outputs, print the table; 1 when a row failed."""
-    from bench.core import BenchConfig
+    from bench.core import BenchSettings
     from bench.output import render_markdown, write_outputs
     from bench.runner import run_bench, select_rows
 
-    config = BenchConfig(quick=args.quick, repeats=args.repeats, warmup=args.warmup,
+    config = BenchSettings(quick=args.quick, repeats=args.repeats, warmup=args.warmup,
                          frames=args.frames, sizes=args.sizes, budget_s=args.budget,
                          data_dir=args.data, reports_dir=args.reports,
                          progress=not args.no_progress)

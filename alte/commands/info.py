@@ -57,10 +57,10 @@ def imu_topics(info: BagInfo) -> list[str]:
 
 def odometry_choice(info: BagInfo) -> str:
     """Which odometry ``--poses odometry`` runs by default (``--odometry auto``)."""
-    from alte.registration.odometry import OdometryParams, odometry_label, resolve_method
+    from alte.registration.odometry import OdometrySettings, odometry_label, resolve_method
 
     imus = imu_topics(info)
-    label = odometry_label(resolve_method(OdometryParams(), bool(imus)))
+    label = odometry_label(resolve_method(OdometrySettings(), bool(imus)))
     if imus:
         return f"LiDAR-inertial odometry ({label}, IMU {imus[0]})"
     return f"LiDAR odometry ({label})"

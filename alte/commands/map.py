@@ -16,12 +16,12 @@ import numpy as np
 
 from alte.commands.options import add_frame_options, frame_spec, parse_key_values
 from alte.errors import ParameterError
-from alte.export import ExportOptions, timeline_feed
+from alte.export import ExportSettings, timeline_feed
 from alte.export import export_map as export_mcap
 from alte.fsutil import refuse_overwrite
-from alte.ground.surface import SurfaceRule
+from alte.ground.surface import OccupancySettings
 from alte.mappers import Domain, Feed, check_export, export_map
-from alte.pipeline import DomainPolicy, MapRun, MapSpec, open_input, run
+from alte.pipeline import DomainPolicy, MapRun, MapSettings, open_input, run
 
 __all__ = ["add_map_options", "add_parser", "export_options", "map_spec", "mapped",
            "parse_domain", "print_summary", "run_command"]
@@ -56,9 +56,9 @@ def add_map_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--occupancy-set", action="append", default=[], metavar="KEY=VALUE",
                    dest="occupancy_sets",
                    help="with --mcap: landing criterion of the occupancy grids (repeatable): "
-                        + "; ".join(f"{k}: {v}" for k, v in SurfaceRule.help().items())
+                        + "; ".join(f"{k}: {v}" for k, v in OccupancySettings.help().items())
                         + "; defaults: " + ", ".join(
-                            f"{k}={v}" for k, v in SurfaceRule().as_dict().items()))
+                            f"{k}={v}" for k, v in OccupancySettings().as_dict().items()))
 
 
 def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -118,14 +118,14 @@ def print_summary(summary: dict[str, object], as_json: bool) -> None:
             print(f"{key}: {summary[key]}")
 
 
-def map_spec(args: argparse.Namespace) -> MapSpec:
-    """The :class:`MapSpec` of the parsed flags, parameters checked before any read."""
-    return MapSpec(args.mapper, parse_key_values(args.sets, "--set"), parse_domain(args.domain),
+def map_spec(args: argparse.Namespace) -> MapSettings:
+    """The :class:`MapSettings` of the parsed flags, parameters checked before any read."""
+    return MapSettings(args.mapper, parse_key_values(args.sets, "--set"), parse_domain(args.domain),
                    Feed(args.feed) if args.feed else None)
 
 
-def mapped(args: argparse.Namespace, mcap: Path | None, options: ExportOptions,
-           cloud: bool = False, spec: MapSpec | None = None) -> tuple[MapRun, dict[str, int]]:
+def mapped(args: argparse.Namespace, mcap: Path | None, options: ExportSettings,
+           cloud: bool = False, spec: MapSettings | None = None) -> tuple[MapRun, dict[str, int]]:
     """Run the map as ``spec`` says (default: the flags'; and write the MCAP when ``mcap``
     is given); message counts per topic."""
     spec, frames = spec or map_spec(args), frame_spec(args)
@@ -142,7 +142,7 @@ def mapped(args: argparse.Namespace, mcap: Path | None, options: ExportOptions,
                       overwrite=args.force, progress=not args.json)
 
 
-def export_options(args: argparse.Namespace, mcap: Path | None) -> ExportOptions:
+def export_options(args: argparse.Namespace, mcap: Path | None) -> ExportSettings:
     """``--timeline``, ``--occupancy-set`` and the MCAP flags, checked (and the target
     refused) before the read."""
     if mcap is None:
@@ -150,15 +150,15 @@ def export_options(args: argparse.Namespace, mcap: Path | None) -> ExportOptions
                             ("--occupancy-set", bool(args.occupancy_sets))):
             if given:
                 raise ParameterError(f"{flag} shapes the map written into --mcap FILE; add it")
-        return ExportOptions()
+        return ExportSettings()
     if mcap.suffix.lower() != ".mcap":
         raise ParameterError(f"--mcap {mcap}: the file name must end in .mcap")
     try:
-        rule = SurfaceRule.parse(parse_key_values(args.occupancy_sets, "--occupancy-set"))
+        rule = OccupancySettings.parse(parse_key_values(args.occupancy_sets, "--occupancy-set"))
     except ParameterError as err:
         raise ParameterError(f"--occupancy-set: {err}") from err
     try:
-        options = ExportOptions(args.timeline, scans=not getattr(args, "no_scans", False),
+        options = ExportSettings(args.timeline, scans=not getattr(args, "no_scans", False),
                                 all_cells=getattr(args, "all_cells", False), surface=rule)
     except ParameterError as err:
         raise ParameterError(f"--timeline: {err}") from err

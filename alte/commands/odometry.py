@@ -71,7 +71,10 @@ def _settings(items: list[str]) -> dict[str, dict[str, str]]:
         if unknown:
             raise ParameterError(f"--odometry-set {source}:{unknown[0]}: not a setting of "
                                  f"{source}; valid: {', '.join(KEYS[source])}")
-        odometry_params(source if source in METHODS else None, given)
+        try:
+            odometry_params(source if source in METHODS else None, given)
+        except ParameterError as err:
+            raise ParameterError(f"--odometry-set {source}: {err}") from err
     return out
 
 

@@ -2,7 +2,7 @@
 and a ground filter's ``--method`` / ``--set`` (``ground``; ``simulate`` as
 ``--ground-method`` / ``--ground-set``).
 
-They map one to one onto :class:`alte.pipeline.FrameSpec` and the ground stage's settings
+They map one to one onto :class:`alte.pipeline.FrameSettings` and the ground stage's settings
 records; a bad value is a :class:`~alte.errors.ParameterError` naming the flag, raised
 before any input is read.
 """
@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
+from alte.commands.flags import flag_message
 from alte.errors import ParameterError
 from alte.ground.settings import (
     DEFAULT_METHOD,
@@ -24,8 +25,8 @@ from alte.ground.settings import (
 )
 from alte.ground.settings import METHODS as GROUND_METHODS
 from alte.params import key_values
-from alte.pipeline import FrameSpec, PoseSource
-from alte.registration.odometry import METHODS, OdometryParams, odometry_params
+from alte.pipeline import FrameSettings, PoseSource
+from alte.registration.odometry import METHODS, OdometrySettings, odometry_params
 from alte.types import Box, Mount
 
 __all__ = ["add_frame_options", "add_ground_options", "add_odometry_options", "frame_spec",
@@ -85,7 +86,7 @@ def add_odometry_options(p: argparse.ArgumentParser) -> None:
                    dest="odometry_sets",
                    help="odometry / refinement setting (repeatable), e.g. --odometry-set "
                         "voxel=0.5; the keys: " + "; ".join(
-                            f"{k}: {v}" for k, v in OdometryParams.help().items()
+                            f"{k}: {v}" for k, v in OdometrySettings.help().items()
                             if k != "method"))
 
 
@@ -132,10 +133,13 @@ def ground_spec(args: argparse.Namespace, prefix: str = "") -> tuple[str | None,
         raise ParameterError(f"{flag}: {err}") from err
 
 
-def odometry_spec(args: argparse.Namespace) -> OdometryParams:
-    """The :class:`OdometryParams` of ``--odometry`` / ``--odometry-set`` (errors name them)."""
+def odometry_spec(args: argparse.Namespace) -> OdometrySettings:
+    """The :class:`OdometrySettings` of ``--odometry`` / ``--odometry-set`` (errors name them)."""
     settings = parse_key_values(getattr(args, "odometry_sets", []) or [], "--odometry-set")
-    return odometry_params(getattr(args, "odometry", None), settings)
+    try:
+        return odometry_params(getattr(args, "odometry", None), settings)
+    except ParameterError as err:
+        raise ParameterError(flag_message(err, {"--odometry", "--odometry-set"})) from err
 
 
 def parse_box(text: str, flag: str = "--crop") -> Box:
@@ -163,15 +167,6 @@ def parse_origin(text: str) -> tuple[float, float, float]:
     return (float(values[0]), float(values[1]), float(values[2]))
 
 
-def _checked(flag: str, value: float | int | None, integer: bool = False) -> None:
-    if value is None:
-        return
-    if not (np.isfinite(value) and value > 0):
-        raise ParameterError(f"{flag} {value!r}: must be > 0")
-    if integer and int(value) != value:
-        raise ParameterError(f"{flag} {value!r}: must be a whole number")
-
-
 def _poses(args: argparse.Namespace) -> PoseSource:
     """``--poses`` (``--no-pose`` is ``--poses identity``); unset is ``auto``."""
     chosen = getattr(args, "poses", None)
@@ -182,11 +177,9 @@ def _poses(args: argparse.Namespace) -> PoseSource:
     return PoseSource(chosen) if chosen else PoseSource.AUTO
 
 
-def frame_spec(args: argparse.Namespace) -> FrameSpec:
-    """The :class:`FrameSpec` of the parsed flags (errors name the flags)."""
-    for flag, value in (("--frames", args.frames), ("--voxel", args.voxel),
-                        ("--max-rate", args.max_rate), ("--max-offset", args.max_offset)):
-        _checked(flag, value, integer=flag == "--frames")
+def frame_spec(args: argparse.Namespace) -> FrameSettings:
+    """The :class:`FrameSettings` of the parsed flags (its errors name the settings; the
+    command line puts their flags in front, :mod:`alte.commands.flags`)."""
     poses = _poses(args)
     if poses is PoseSource.IDENTITY and args.pose_topic:
         raise ParameterError("--no-pose (--poses identity) and --pose-topic exclude each other")
@@ -195,7 +188,7 @@ def frame_spec(args: argparse.Namespace) -> FrameSpec:
     pose_file = getattr(args, "pose_file", None)
     if pose_file is not None and not pose_file.is_file():
         raise ParameterError(f"--pose-file {pose_file}: no such file")
-    return FrameSpec(
+    return FrameSettings(
         frames=args.frames, voxel=args.voxel,
         crop=parse_box(args.crop) if args.crop else None, mount=mount,
         cloud_topic=args.cloud_topic, pose_topic=args.pose_topic,

@@ -62,9 +62,9 @@ def pose_line(counts: StreamCounts) -> str:
         return (f"refine ({poses.corrected} corrected, {poses.frames - poses.corrected} kept"
                 + (f": {kept})" if kept else ")"))
     if poses.method:
-        from alte.registration.odometry import OdometryParams, odometry_label
+        from alte.registration.odometry import OdometrySettings, odometry_label
 
-        label = odometry_label(OdometryParams.parse(poses.settings))
+        label = odometry_label(OdometrySettings.parse(poses.settings))
         rest = f", IMU biases from {poses.rest_s:.1f} s at rest" if poses.rest_s > 0 else ""
         swept = f", {poses.deskewed} scans deskewed" if poses.deskewed else ""
         return f"{poses.source} ({label}, {1e3 * poses.seconds / max(poses.frames, 1):.0f} " \

@@ -24,7 +24,7 @@ import numpy as np
 from alte._numba import CLOUD_MIN
 from alte.mappers import Feed, Mapper, make_mapper, registry
 from alte.metrics.hausdorff import hausdorff
-from alte.pipeline import MapSpec, run
+from alte.pipeline import MapSettings, run
 from alte.sim import ensure_terrain
 
 __all__ = ["add_parser", "run_warmup", "warm_kernels"]
@@ -61,7 +61,7 @@ def warm_kernels() -> dict[str, int]:
         folder = ensure_terrain(TERRAIN, Path(tmp), frames=SCANS)
         for kind in mappers:
             for feed in Feed:
-                result = run(folder, MapSpec(kind, feed=feed))
+                result = run(folder, MapSettings(kind, feed=feed))
                 cells[f"{kind.name}/{feed.value}"] = _touch(result.mapper)
     corners = result.mapper.corners()
     hausdorff(corners, corners[::3])

@@ -8,12 +8,12 @@ GridMap definitions rosbags lacks), :mod:`~alte.export.maps` the map messages,
 
 from alte.export.mcap import MAP_TOPICS, TOPICS, McapFile
 from alte.export.run import (
-    ExportOptions,
+    ExportSettings,
     MapExporter,
     export_map,
     export_registered,
     timeline_feed,
 )
 
-__all__ = ["MAP_TOPICS", "TOPICS", "ExportOptions", "MapExporter", "McapFile", "export_map",
+__all__ = ["MAP_TOPICS", "TOPICS", "ExportSettings", "MapExporter", "McapFile", "export_map",
            "export_registered", "timeline_feed"]

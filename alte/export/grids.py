@@ -5,7 +5,7 @@
   height of its leaf; a 3D map the top of the highest occupied leaf over it (the
   surface a descending vehicle meets), pixels under free leaves only being seen but
   surfaceless. Every known pixel is then classified by the landing criterion of
-  :mod:`alte.ground.surface` (:class:`~alte.ground.surface.SurfaceRule`): free (0)
+  :mod:`alte.ground.surface` (:class:`~alte.ground.surface.OccupancySettings`): free (0)
   where a vehicle can rest, occupied (100) where it cannot (an obstacle, a steep or
   rough patch, a column seen only as free space), unknown (-1) only where no leaf lies.
 * :func:`occupancy_grid` (``nav_msgs/msg/OccupancyGrid``), :func:`grid_map`
@@ -35,7 +35,7 @@ from numpy.typing import NDArray
 
 from alte.errors import ParameterError
 from alte.export.rosmsg import blank, header, pose, time_msg, typestore
-from alte.ground.surface import SurfaceRule, classify_surface
+from alte.ground.surface import OccupancySettings, classify_surface
 from alte.mappers import Cells
 
 if TYPE_CHECKING:  # rosbags declares its message classes' type for checkers only
@@ -117,7 +117,7 @@ def _pixels(centers: NDArray[np.float64], edge: NDArray[np.float64], lo: NDArray
 
 
 def raster(cells: Cells, shift: NDArray[np.float64], max_cells: int = 4_000_000, dims: int = 2,
-           rule: SurfaceRule | None = None) -> Raster:
+           rule: OccupancySettings | None = None) -> Raster:
     """Paint the map's leaves onto a grid and classify it (module docstring)."""
     if max_cells < 1:
         raise ParameterError(f"max_cells={max_cells}: expected >= 1")

@@ -22,13 +22,13 @@ from alte.errors import ParameterError
 from alte.export import grids, maps
 from alte.export.mcap import McapFile
 from alte.export.rosmsg import cloud_msg, path_msg, pose_stamped, tf_msg
-from alte.ground.surface import SurfaceRule
+from alte.ground.surface import OccupancySettings
 from alte.mappers import Feed, Mapper, Octomap
 from alte.params import Record, param
-from alte.pipeline import FrameSpec, MapRun, MapSpec, Registered, Source, run
+from alte.pipeline import FrameSettings, MapRun, MapSettings, Registered, Source, run
 from alte.types import RegisteredFrame
 
-__all__ = ["BODY", "LOCAL", "WORLD", "ExportOptions", "MapExporter", "export_map",
+__all__ = ["BODY", "LOCAL", "WORLD", "ExportSettings", "MapExporter", "export_map",
            "export_registered", "timeline_feed"]
 
 WORLD, BODY, LOCAL = "map", "base_link", "alte_local"
@@ -36,7 +36,7 @@ _IDENTITY = np.array([0.0, 0.0, 0.0, 1.0])
 
 
 @dataclass(frozen=True)
-class ExportOptions(Record):
+class ExportSettings(Record):
     """What an MCAP export writes besides the final map and the trajectory."""
 
     OWNER = "export"
@@ -48,14 +48,14 @@ class ExportOptions(Record):
     all_cells: bool = param(False, help="free cells of 3D maps too")
     max_grid_cells: int = param(4_000_000, lambda v: v >= 1, "max_grid_cells >= 1",
                                 "largest 2D grid (cells; coarsened by powers of two beyond it)")
-    surface: SurfaceRule = param(SurfaceRule(), help="the landing criterion that makes grid "
-                                                     "cells free or occupied")
+    surface: OccupancySettings = param(OccupancySettings(), help="the landing criterion that "
+                                       "makes grid cells free or occupied")
 
 
 class MapExporter:
     """Frame observer writing scans, poses and (on the timeline) the growing map."""
 
-    def __init__(self, out: McapFile, options: ExportOptions) -> None:
+    def __init__(self, out: McapFile, options: ExportSettings) -> None:
         self.out, self.options = out, options
         self.poses: list[RegisteredFrame] = []
         self.last_map: int | None = None
@@ -134,7 +134,7 @@ class MapExporter:
             self.out.put("/alte/cloud", first, cloud_msg(cloud, first, WORLD), opening=True)
 
 
-def timeline_feed(spec: MapSpec, options: ExportOptions) -> MapSpec:
+def timeline_feed(spec: MapSettings, options: ExportSettings) -> MapSettings:
     """``spec`` as an export with ``options`` maps: a timeline needs the map fed scan by
     scan, so a default batch feed is switched and an explicit one refused."""
     if options.timeline is None or (spec.feed or spec.cls.default_feed) \
@@ -146,13 +146,13 @@ def timeline_feed(spec: MapSpec, options: ExportOptions) -> MapSpec:
     return replace(spec, feed=Feed.FRAMES)
 
 
-def export_map(source: Source | Registered, target: Path, spec: MapSpec,
-               frames: FrameSpec | None = None, *, options: ExportOptions | None = None,
+def export_map(source: Source | Registered, target: Path, spec: MapSettings,
+               frames: FrameSettings | None = None, *, options: ExportSettings | None = None,
                cache: Path | None = None, overwrite: bool = False,
                progress: bool = False) -> tuple[MapRun, dict[str, int]]:
     """Map ``source`` as :func:`alte.pipeline.run` does and write the MCAP ``target``;
     returns the run and the message count per topic."""
-    options = options or ExportOptions()
+    options = options or ExportSettings()
     spec = timeline_feed(spec, options)
     with McapFile(target, overwrite) as out:
         exporter = MapExporter(out, options)
@@ -162,11 +162,11 @@ def export_map(source: Source | Registered, target: Path, spec: MapSpec,
     return result, dict(out.counts)
 
 
-def export_registered(reg: Registered, target: Path, *, options: ExportOptions | None = None,
+def export_registered(reg: Registered, target: Path, *, options: ExportSettings | None = None,
                       overwrite: bool = False) -> dict[str, int]:
     """Write a registration (scans, poses, trajectory, merged cloud) without a map."""
     with McapFile(target, overwrite) as out:
-        exporter = MapExporter(out, options or ExportOptions())
+        exporter = MapExporter(out, options or ExportSettings())
         for frame in reg.frames():
             exporter.frame(frame)
         exporter.finish(None, np.zeros(3), np.asarray(reg.cloud))

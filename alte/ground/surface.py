@@ -40,14 +40,23 @@ from scipy import ndimage
 from alte.ground.plane import fit_plane_msac
 from alte.params import Record, param
 
-__all__ = ["PlaneFeatures", "Surface", "SurfaceRule", "classify_surface", "ground_obstacles",
-           "local_ground", "pixel_centres", "planar", "plane_features"]
+__all__ = [
+    "OccupancySettings",
+    "PlaneFeatures",
+    "Surface",
+    "classify_surface",
+    "ground_obstacles",
+    "local_ground",
+    "pixel_centres",
+    "planar",
+    "plane_features",
+]
 
 _MAX_FIT_PIXELS = 50_000
 
 
 @dataclass(frozen=True)
-class SurfaceRule(Record):
+class OccupancySettings(Record):
     """The landing criterion's thresholds (module docstring); validated on creation.
 
     Defaults are the landing study's quadrotor (:data:`alte.lab.studies.landing.QUADROTOR`:
@@ -137,7 +146,7 @@ def plane_features(height: NDArray[np.float64], step: float, radius: float) -> P
     return PlaneFeatures(slope, np.sqrt(residual), np.rint(s1 * size * size).astype(np.int64))
 
 
-def planar(feats: PlaneFeatures, rule: SurfaceRule) -> NDArray[np.bool_]:
+def planar(feats: PlaneFeatures, rule: OccupancySettings) -> NDArray[np.bool_]:
     """Pixels whose window plane is within the slope and roughness limits (NaN: not)."""
     with np.errstate(invalid="ignore"):
         flat: NDArray[np.bool_] = (feats.slope_deg <= rule.max_slope_deg) & \
@@ -196,7 +205,7 @@ def local_ground(height: NDArray[np.float64], step: float, window: float,
 
 
 def _obstacles(height: NDArray[np.float64], origin: tuple[float, float] | NDArray[np.float64],
-               step: float, rule: SurfaceRule, slope_deg: NDArray[np.float64], *, seed: int,
+               step: float, rule: OccupancySettings, slope_deg: NDArray[np.float64], *, seed: int,
                ) -> NDArray[np.bool_]:
     """Obstacle pixels: off the MSAC plane, or above the local ground by more than
     ``obstacle_height`` plus the rise the terrain's slope explains over half the ground
@@ -228,13 +237,13 @@ def _obstacles(height: NDArray[np.float64], origin: tuple[float, float] | NDArra
 
 def classify_surface(height: NDArray[np.float64],
                      origin: tuple[float, float] | NDArray[np.float64],
-                     step: float, rule: SurfaceRule | None = None, seed: int = 0) -> Surface:
+                     step: float, rule: OccupancySettings | None = None, seed: int = 0) -> Surface:
     """Free / occupied / unknown for every pixel of a height raster (module docstring).
 
     A known pixel whose window does not fix a plane (an isolated cell) is occupied: a
     vehicle cannot tell how it would rest there.
     """
-    rule = rule or SurfaceRule()
+    rule = rule or OccupancySettings()
     height = np.asarray(height, dtype=np.float64)
     known = np.isfinite(height)
     feats = plane_features(height, step, rule.window)

@@ -40,18 +40,18 @@ from typing import ClassVar, Literal, get_args
 import numpy as np
 from numpy.typing import NDArray
 
-from alte.mappers.base import Cells
+from alte.mappers.base import Cells, renamed
 from alte.mappers.quad.quadmap import LeafValues, QuadMap, Rows, plane_height
 from alte.params import Record, param
 
-__all__ = ["Alte2D", "Alte2DParams"]
+__all__ = ["Alte2D", "Alte2DSettings"]
 
 Criterion = Literal["thesis", "binev"]
 CRITERIA: tuple[str, ...] = get_args(Criterion)
 
 
 @dataclass(frozen=True)
-class Alte2DParams(Record):
+class Alte2DSettings(Record):
     """2D-ALTE parameters (module docstring)."""
 
     OWNER: ClassVar[str] = "alte2d"
@@ -69,7 +69,9 @@ class Alte2D(QuadMap):
 
     name: ClassVar[str] = "alte2d"
     title: ClassVar[str] = "2D-ALTE"
-    Params: ClassVar[type[Record]] = Alte2DParams
+    Settings: ClassVar[type[Record]] = Alte2DSettings
+    #: Contract v1's first name of :attr:`Settings` (deprecated; still read by old code).
+    Params: ClassVar[type[Record]] = Alte2DSettings
     #: The cells' statistics do not depend on the split rule's thresholds, and neither
     #: does an insertion's work (the same touched cells get new flags).
     view_params: ClassVar[frozenset[str]] = frozenset({"kappa", "min_pts"})
@@ -140,3 +142,8 @@ class Alte2D(QuadMap):
         above = cells.centers[:, 2] - plane_height(ground, cells.centers[:, :2])
         occupied = np.isfinite(above) & (above > height_threshold)
         return Cells(cells.centers, cells.sizes, above, occupied, cells.level)
+
+
+def __getattr__(name: str) -> object:
+    """``Alte2DParams``: the first name of :class:`Alte2DSettings` (deprecated)."""
+    return renamed(__name__, name, {"Alte2DParams": lambda: Alte2DSettings})

@@ -42,6 +42,7 @@ from alte.mappers.base import (
     check_points,
     check_view,
     parsed,
+    renamed,
 )
 from alte.mappers.domain import Domain, DomainUse, check_domain
 from alte.mappers.octree.celltable import (
@@ -56,13 +57,13 @@ from alte.mappers.octree.tree import check_origin
 from alte.params import Record, param
 from alte.types import Box
 
-__all__ = ["Alte3D", "Alte3DParams"]
+__all__ = ["Alte3D", "Alte3DSettings"]
 
 
 
 
 @dataclass(frozen=True)
-class Alte3DParams(Record):
+class Alte3DSettings(Record):
     """3D-ALTE parameters (module docstring)."""
 
     OWNER: ClassVar[str] = "alte3d"
@@ -103,12 +104,14 @@ class Alte3D:
     layers: ClassVar[frozenset[str]] = frozenset()
     settings_grid: ClassVar[Mapping[str, tuple[object, ...]]] = {
         "max_res": (4, 5, 6, 7, 8), "min_pts_split": (10, 40), "min_pts": (5, 20)}
-    Params: ClassVar[type[Record]] = Alte3DParams
+    Settings: ClassVar[type[Record]] = Alte3DSettings
+    #: Contract v1's first name of :attr:`Settings` (deprecated; still read by old code).
+    Params: ClassVar[type[Record]] = Alte3DSettings
 
     def __init__(self, domain: Domain | None = None, *, record: Record | None = None,
                  **given: object) -> None:
         domain = check_domain("alte3d", domain)
-        self._record = parsed(Alte3DParams, record, given)
+        self._record = parsed(Alte3DSettings, record, given)
         self._params = self._record.as_dict()
         self._fixed = domain
         self._domain = domain
@@ -292,3 +295,8 @@ class Alte3D:
         offsets = np.array([[i >> 2 & 1, i >> 1 & 1, i & 1] for i in range(8)], dtype=np.float64)
         corners = (lo[:, None, :] + offsets[None] * size[:, None, :]).reshape(-1, 3)
         return unique_rows(corners)
+
+
+def __getattr__(name: str) -> object:
+    """``Alte3DParams``: the first name of :class:`Alte3DSettings` (deprecated)."""
+    return renamed(__name__, name, {"Alte3DParams": lambda: Alte3DSettings})

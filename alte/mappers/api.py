@@ -10,7 +10,7 @@ lists it; :func:`alte.testing.check_mapper` checks a class against all of it.
 
 * ``api_version = API_VERSION`` (1); ``name`` (lowercase identifier, the ``--mapper``
   value and the entry point's name); ``title`` (shown in tables and figures);
-* ``Params``: a frozen :class:`~alte.params.Record` dataclass whose fields are declared
+* ``Settings``: a frozen :class:`~alte.params.Record` dataclass whose fields are declared
   with :func:`~alte.params.param` (default, check, rule, help); every field has a valid
   default;
 * capabilities: ``dims`` (2: a height map, the cell height in ``centers[:, 2]`` and 0 in
@@ -29,12 +29,12 @@ from the sensor at ``origin``; ``build(points, origins=None)`` replaces the map 
 made from a whole cloud; ``cells()`` returns :class:`Cells`; ``cell_counts()``,
 ``basis_functions``, ``memory_bytes``, ``corners()`` (the occupied cells' corners,
 set B of the HD/MHD), ``cost`` (work in ``cost_unit``), ``points_outside``, ``params``
-(an instance of ``Params``), ``domain``, ``write_native(path)`` and ``reread(**view)``.
+(an instance of ``Settings``), ``domain``, ``write_native(path)`` and ``reread(**view)``.
 Bad input raises an :class:`~alte.errors.AlteError` subclass (:func:`check_points`
 gives one).
 
 :class:`MapperBase` implements everything but the map itself: a subclass sets the
-names, ``dims`` and ``Params`` and writes ``clear()``, ``_insert(points, origins)`` and
+names, ``dims`` and ``Settings`` and writes ``clear()``, ``_insert(points, origins)`` and
 ``cells()``. A class may instead implement the protocol directly (the four built-ins do).
 """
 
@@ -58,6 +58,7 @@ from alte.mappers.base import (
     Cost,
     Feed,
     Mapper,
+    adopt_v1_settings,
     check_points,
     check_view,
     parsed,
@@ -77,7 +78,7 @@ _CUBE = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)],
 
 class MapperBase(Generic[P]):
     """Everything of the contract but the map: a subclass sets ``name``, ``title``,
-    ``dims`` and ``Params`` and implements :meth:`clear`, :meth:`_insert` and
+    ``dims`` and ``Settings`` and implements :meth:`clear`, :meth:`_insert` and
     :meth:`cells`; the other capabilities default to an incremental, frame-fed map
     writing ``.npz`` with no view parameters, layers or settings grid.
 
@@ -91,7 +92,7 @@ class MapperBase(Generic[P]):
     name: ClassVar[str]
     title: ClassVar[str]
     dims: ClassVar[int]
-    Params: ClassVar[type[Record]]
+    Settings: ClassVar[type[Record]]
     incremental: ClassVar[bool] = True
     domain_use: ClassVar[DomainUse] = DomainUse.OPTIONAL
     default_feed: ClassVar[Feed] = Feed.FRAMES
@@ -102,10 +103,14 @@ class MapperBase(Generic[P]):
     layers: ClassVar[frozenset[str]] = frozenset()
     settings_grid: ClassVar[Mapping[str, tuple[object, ...]]] = {}
 
+    def __init_subclass__(cls, **kwargs: object) -> None:
+        super().__init_subclass__(**kwargs)
+        adopt_v1_settings(cls)  # a v1 class naming its record Params keeps working
+
     def __init__(self, domain: Domain | None = None, *, record: Record | None = None,
                  **given: object) -> None:
         self._domain = check_domain(self.name, domain)
-        self._record = cast(P, parsed(self.Params, record, given))
+        self._record = cast(P, parsed(self.Settings, record, given))
         self.points_outside = 0
         self._cost = 0
         self._shared = False

@@ -8,7 +8,8 @@ real-time loop does) or a whole cloud at once with :meth:`Mapper.build`.
 from __future__ import annotations
 
 import enum
-from collections.abc import Mapping
+import warnings
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import ClassVar, Protocol, TypeVar, runtime_checkable
@@ -21,8 +22,20 @@ from alte.mappers.domain import Domain, DomainUse
 from alte.params import Record
 from alte.types import as_points
 
-__all__ = ["API_VERSION", "VARIANCE", "CellCounts", "Cells", "Cost", "Feed", "Mapper",
-           "check_points", "check_view", "parsed"]
+__all__ = [
+    "API_VERSION",
+    "VARIANCE",
+    "CellCounts",
+    "Cells",
+    "Cost",
+    "Feed",
+    "Mapper",
+    "adopt_v1_settings",
+    "check_points",
+    "check_view",
+    "parsed",
+    "renamed",
+]
 
 #: The version of the mapper contract (:mod:`alte.mappers.api`); a mapper declares the one
 #: it was written against as ``api_version`` and the registry refuses another.
@@ -117,7 +130,7 @@ class Mapper(Protocol):
 
     A mapper class is constructed as ``cls(domain=None, *, record=None, **params)``: a
     :class:`~alte.mappers.domain.Domain` or None, and its parameters either as an
-    instance of its ``Params`` record or as names and values that record parses.
+    instance of its ``Settings`` record or as names and values that record parses.
 
     Capabilities are class attributes the pipeline reads (never probed with hasattr):
     ``dims``, ``incremental``, ``domain_use``, ``default_feed`` (the thesis' protocol:
@@ -136,7 +149,7 @@ class Mapper(Protocol):
     #: The name tables, figures and the report show ("2D-ALTE").
     title: ClassVar[str]
     #: The parameter record: ``--set`` values and sweep rows are validated by it.
-    Params: ClassVar[type[Record]]
+    Settings: ClassVar[type[Record]]
     #: 2 for height maps (Quadtree, 2D-ALTE), 3 for volumetric maps.
     dims: ClassVar[int]
     #: True when ``insert`` updates only what the new frame touches.
@@ -163,7 +176,7 @@ class Mapper(Protocol):
     def __init__(self, domain: Domain | None = None, *, record: Record | None = None,
                  **given: object) -> None:
         """The map over ``domain`` (None: grown from the data or a key space of its own),
-        parameters as a ``Params`` record or as names and values it parses."""
+        parameters as a ``Settings`` record or as names and values it parses."""
 
     @property
     def params(self) -> Record:
@@ -250,7 +263,7 @@ _R = TypeVar("_R", bound=Record)
 
 def parsed(params: type[_R], record: Record | None, given: Mapping[str, object]) -> _R:
     """A mapper's parameters: ``record`` when one was resolved already (a
-    :class:`~alte.pipeline.MapSpec`'s), else ``given`` parsed; never both."""
+    :class:`~alte.pipeline.MapSettings`'s), else ``given`` parsed; never both."""
     if record is None:
         return params.parse(given)
     if not isinstance(record, params):
@@ -260,3 +273,28 @@ def parsed(params: type[_R], record: Record | None, given: Mapping[str, object])
         raise MapperError(f"{params.OWNER}: parameters come as a record or as names and "
                           f"values, not both ({', '.join(sorted(given))} beside the record)")
     return record
+
+
+def adopt_v1_settings(cls: type) -> None:
+    """Contract v1 first named a mapper's settings record ``Params``; a class that still
+    does gets ``Settings`` from it, with a :class:`DeprecationWarning` (it keeps working),
+    and a class naming ``Settings`` keeps ``Params`` as an alias for code that reads it."""
+    own = vars(cls)
+    if "Settings" not in own and "Params" in own:
+        warnings.warn(f"{cls.__module__}.{cls.__qualname__}: the settings record is named "
+                      "Settings now; Params (mapper contract v1's first name) still works "
+                      "but is deprecated", DeprecationWarning, stacklevel=3)
+        cls.Settings = own["Params"]  # type: ignore[attr-defined]
+    if "Settings" in vars(cls) and "Params" not in own:
+        cls.Params = vars(cls)["Settings"]  # type: ignore[attr-defined]
+
+
+def renamed(module: str, name: str, names: Mapping[str, Callable[[], object]]) -> object:
+    """A module's ``__getattr__`` for names it renamed: the new object, with a
+    :class:`DeprecationWarning` naming the new name; other names raise AttributeError."""
+    if name not in names:
+        raise AttributeError(f"module {module!r} has no attribute {name!r}")
+    new = names[name]()
+    warnings.warn(f"{module}.{name} is deprecated; use {getattr(new, '__name__', new)}",
+                  DeprecationWarning, stacklevel=3)
+    return new

@@ -15,7 +15,7 @@ import re
 from collections.abc import Callable, Mapping
 
 from alte.errors import AlteError
-from alte.mappers.base import API_VERSION, Cost, Feed
+from alte.mappers.base import API_VERSION, Cost, Feed, adopt_v1_settings
 from alte.mappers.domain import DomainUse
 from alte.params import Record
 
@@ -69,16 +69,16 @@ def _version(cls: type) -> list[str]:
 
 
 def _params(cls: type) -> tuple[list[str], type[Record] | None]:
-    record = getattr(cls, "Params", None)
+    record = getattr(cls, "Settings", None)
     if not (isinstance(record, type) and issubclass(record, Record)
             and dataclasses.is_dataclass(record)):
-        return ["Params must be a alte.params.Record dataclass (its parameter record)"], None
+        return ["Settings must be a alte.params.Record dataclass (its parameter record)"], None
     try:
         record()
     except AlteError as err:
-        return [f"Params() must be valid with its defaults ({err})"], None
+        return [f"Settings() must be valid with its defaults ({err})"], None
     except TypeError as err:
-        return [f"every parameter of Params needs a default ({err})"], None
+        return [f"every parameter of Settings needs a default ({err})"], None
     return [], record
 
 
@@ -115,6 +115,7 @@ def contract_problems(cls: object) -> list[str]:
     """Every class-level rule of the contract ``cls`` breaks (empty: none)."""
     if not isinstance(cls, type):
         return [f"{cls!r} is not a class"]
+    adopt_v1_settings(cls)
     out = _version(cls)
     for name, test, what in _ATTRIBUTES:
         if not hasattr(cls, name):

@@ -18,8 +18,9 @@ def check_export(path: Path, mapper: type[Mapper] | Mapper, overwrite: bool) -> 
     """Fail before mapping when ``path`` cannot be written (type, support, exists)."""
     suffix = path.suffix.lower()
     if suffix not in mapper.exports:
-        raise MapperError(f"--export {path}: mapper {mapper.name!r} writes "
-                          f"{', '.join(sorted(mapper.exports))} (not {suffix or 'no suffix'})")
+        raise MapperError(f"export {path}: mapper {mapper.name!r} writes "
+                          f"{', '.join(sorted(mapper.exports))} (not {suffix or 'no suffix'})",
+                          setting="export.path")
     refuse_overwrite(path, overwrite)
 
 

@@ -47,12 +47,12 @@ from numpy.typing import NDArray
 
 from alte._numba import CLOUD_MIN, threads_for
 from alte.errors import AlteError, MapperError
-from alte.mappers.base import Feed
+from alte.mappers.base import Feed, renamed
 from alte.mappers.domain import Domain
 from alte.mappers.quad.quadmap import LeafValues, QuadMap, Rows, plane_height
 from alte.params import Record, param
 
-__all__ = ["Quadtree", "QuadtreeParams", "parse_ground"]
+__all__ = ["Quadtree", "QuadtreeSettings", "parse_ground"]
 
 Occupancy = Literal["mean", "max"]
 RULES: tuple[str, ...] = get_args(Occupancy)
@@ -92,7 +92,7 @@ def _ground_ok(text: str) -> bool:
 
 
 @dataclass(frozen=True)
-class QuadtreeParams(Record):
+class QuadtreeSettings(Record):
     """Quadtree parameters (module docstring)."""
 
     OWNER: ClassVar[str] = "quadtree"
@@ -114,7 +114,9 @@ class Quadtree(QuadMap):
     name: ClassVar[str] = "quadtree"
     title: ClassVar[str] = "Quadtree"
     default_feed: ClassVar[Feed] = Feed.BATCH
-    Params: ClassVar[type[Record]] = QuadtreeParams
+    Settings: ClassVar[type[Record]] = QuadtreeSettings
+    #: Contract v1's first name of :attr:`Settings` (deprecated; still read by old code).
+    Params: ClassVar[type[Record]] = QuadtreeSettings
     #: The leaves keep the mean and the maximum height above the plane: the rule and the
     #: threshold only read them.
     view_params: ClassVar[frozenset[str]] = frozenset({"occupancy", "height_threshold"})
@@ -137,7 +139,7 @@ class Quadtree(QuadMap):
         """Add one frame; needs a fixed ground plane (not ``ground=fit``)."""
         if self.plane is None:
             raise MapperError("quadtree: ground=fit needs the whole cloud (build); give "
-                              "insert a fixed plane, e.g. --set ground=0 or ground=a,b,c,d")
+                              "insert a fixed plane, e.g. ground=0 or ground=a,b,c,d")
         super().insert(points, origin)
 
     def build(self, points: NDArray[np.float64],
@@ -176,3 +178,8 @@ class Quadtree(QuadMap):
         value = self.leaf_stat(level, rows, self._params["occupancy"], 1)
         occupied = np.isfinite(value) & (value > self._params["height_threshold"])
         return z, value, occupied
+
+
+def __getattr__(name: str) -> object:
+    """``QuadtreeParams``: the first name of :class:`QuadtreeSettings` (deprecated)."""
+    return renamed(__name__, name, {"QuadtreeParams": lambda: QuadtreeSettings})

@@ -248,9 +248,9 @@ def create(mapper: str | type[Mapper], params: Mapping[str, object] | Record | N
            *, domain: Domain | None = None, **given: object) -> Mapper:
     """Construct ``mapper`` (a class, or a name resolved here) with validated ``params`` (a
     mapping or record, and/or keywords) and, where the mapper uses one, its ``domain``. A
-    record of the mapper's own ``Params`` with no keywords is used as it is."""
+    record of the mapper's own ``Settings`` with no keywords is used as it is."""
     cls = resolve(mapper) if isinstance(mapper, str) else mapper
-    if isinstance(params, cls.Params) and not given:
+    if isinstance(params, cls.Settings) and not given:
         made: object = cls(domain, record=params)
     else:
         merged = params.as_dict() if isinstance(params, Record) else dict(params or {})

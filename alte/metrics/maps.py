@@ -20,7 +20,7 @@ from numpy.typing import NDArray
 from alte.errors import MetricsError
 from alte.mappers.quad.quadmap import rectangle_corners
 from alte.metrics.hausdorff import hausdorff
-from alte.metrics.options import GroundTruth, TruthOptions
+from alte.metrics.options import GroundTruth, TruthSettings
 from alte.metrics.timing import Timing
 from alte.types import rows_all
 
@@ -34,7 +34,7 @@ __all__ = [
     "MapMetrics",
     "MapPointSet",
     "TruthMetrics",
-    "TruthOptions",
+    "TruthSettings",
     "measure_map",
     "set_b_points",
     "set_b_rule",
@@ -167,7 +167,7 @@ def _thesis(points: NDArray[np.float64], cloud: NDArray[np.float64],
 
 
 def measure_map(mapper: Mapper, cloud: NDArray[np.float64], *, elapsed_s: float | Timing,
-                truth: GroundTruth | None = None, options: TruthOptions | None = None,
+                truth: GroundTruth | None = None, options: TruthSettings | None = None,
                 set_b: MapPointSet = MapPointSet.CORNERS, reference: Reference | None = None,
                 cells: Cells | None = None) -> MapMetrics:
     """Every metric of ``mapper`` against the registered ``cloud`` (and ``truth``);
@@ -190,7 +190,7 @@ def measure_map(mapper: Mapper, cloud: NDArray[np.float64], *, elapsed_s: float 
     elif truth is not None:
         from alte.metrics.truth import ground_truth_metrics
 
-        opts = options or TruthOptions()
+        opts = options or TruthSettings()
         truth_metrics = TruthMetrics(**ground_truth_metrics(
             cells, truth.surface, dims=mapper.dims, cloud=cloud, bounds=truth.bounds.array(),
             tolerance=opts.tolerance, n_samples=opts.n_samples, grid_step=opts.grid_step,

@@ -15,11 +15,11 @@ if TYPE_CHECKING:
     from alte.metrics.surface import TrueSurface
     from alte.types import Box
 
-__all__ = ["GroundTruth", "TruthOptions"]
+__all__ = ["GroundTruth", "TruthSettings"]
 
 
 @dataclass(frozen=True)
-class TruthOptions(Record):
+class TruthSettings(Record):
     """Ground-truth metric settings (see :mod:`alte.metrics.truth`), a parameter record."""
 
     OWNER = "truth"

@@ -6,7 +6,7 @@ map, the work those share. A :class:`Reference` does it once:
 
 * set A of HD/MHD, the cloud, validated and bucketed into its nearest-neighbour grids
   (:class:`~alte.metrics.nearest.NearestIndex`);
-* the truth for one :class:`~alte.metrics.maps.TruthOptions`: the surface samples, which
+* the truth for one :class:`~alte.metrics.maps.TruthSettings`: the surface samples, which
   of them the sensor saw (a KD-tree query of the whole cloud) and a KD-tree over them
   (3D maps); the x/y probe grid and the true top height under each probe (2D maps);
 * per leaf geometry (the cells' centres and sizes), what the truth says of each leaf:
@@ -33,7 +33,7 @@ from scipy.spatial import cKDTree
 from alte.metrics.hausdorff import HausdorffResult, _as_set, summarise
 from alte.metrics.leaves import LeafTruth
 from alte.metrics.nearest import NearestIndex
-from alte.metrics.options import GroundTruth, TruthOptions
+from alte.metrics.options import GroundTruth, TruthSettings
 from alte.metrics.truth import (
     TruthValues,
     cell_at_xy,
@@ -59,7 +59,7 @@ class _Shared:
     :meth:`~Reference.fresh` copies share one."""
 
     def __init__(self, cloud: NDArray[np.float64], truth: GroundTruth | None,
-                 options: TruthOptions) -> None:
+                 options: TruthSettings) -> None:
         self.cloud, self.truth, self.options = cloud, truth, options
 
     def ground_truth(self) -> GroundTruth:
@@ -107,10 +107,10 @@ class Reference:
     them; :meth:`fresh` gives one sharing the prepared parts with no per-leaf memory."""
 
     def __init__(self, cloud: NDArray[np.float64], truth: GroundTruth | None = None,
-                 options: TruthOptions | None = None) -> None:
+                 options: TruthSettings | None = None) -> None:
         self.cloud = cloud
         self.truth = truth
-        self.options = options or TruthOptions()
+        self.options = options or TruthSettings()
         self._shared = _Shared(cloud, truth, self.options)  # shared with fresh() copies
         self._leaves: list[LeafTruth] = []
 
@@ -122,7 +122,7 @@ class Reference:
         return other
 
     def matches(self, cloud: NDArray[np.float64], truth: GroundTruth | None,
-                options: TruthOptions | None) -> bool:
+                options: TruthSettings | None) -> bool:
         """True when made from this ``cloud``, ``truth`` and ``options``."""
         same_cloud = cloud is self.cloud or (np.shape(cloud) == np.shape(self.cloud)
                                              and np.array_equal(cloud, self.cloud))

@@ -1,6 +1,6 @@
 """The pipeline: an input and a map specification -> a map run.
 
-``run(input, MapSpec(...), FrameSpec(...))`` is the one path from a bag, a terrain
+``run(input, MapSettings(...), FrameSettings(...))`` is the one path from a bag, a terrain
 folder or a point file to a map (:mod:`~alte.pipeline.run`); ``prepare`` registers
 an input once for several maps (:mod:`~alte.pipeline.prepare`); the specifications
 and their policies are in :mod:`~alte.pipeline.spec`.

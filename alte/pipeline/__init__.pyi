@@ -10,17 +10,17 @@ from .prepare import (
 )
 from .run import run
 from .source import InputKind, Source, StreamCounts, open_input, stream_frames
-from .spec import DomainChoice, DomainPolicy, FrameSpec, MapSpec, PoseSource
+from .spec import DomainChoice, DomainPolicy, FrameSettings, MapSettings, PoseSource
 
 __all__ = [
     "DomainChoice",
     "DomainPolicy",
     "FrameLog",
     "FrameObserver",
-    "FrameSpec",
+    "FrameSettings",
     "InputKind",
     "MapRun",
-    "MapSpec",
+    "MapSettings",
     "Merged",
     "PoseSource",
     "Registered",

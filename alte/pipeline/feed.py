@@ -22,7 +22,7 @@ from alte.io.points.pointfiles import local_origin
 from alte.mappers import Domain, DomainUse, Feed, Mapper
 from alte.pipeline.maprun import FrameLog, FrameObserver, MapRun, RunInfo, Snapshot
 from alte.pipeline.source import Source, StreamCounts
-from alte.pipeline.spec import DomainChoice, DomainPolicy, FrameSpec, MapSpec
+from alte.pipeline.spec import DomainChoice, DomainPolicy, FrameSettings, MapSettings
 from alte.progress import bar as progress_bar
 from alte.registration.register import empty_reason
 from alte.types import Box, RegisteredFrame, Trajectory
@@ -39,7 +39,7 @@ class FrameInput(Protocol):
         ...
 
     @property
-    def spec(self) -> FrameSpec:
+    def spec(self) -> FrameSettings:
         """How its frames were (or are being) registered."""
         ...
 
@@ -105,7 +105,7 @@ def local_shift(cls: type[Mapper], first: Callable[[], NDArray[np.float64]]) -> 
 class Feeder:
     """Feeds frames to a mapper, timing each, keeping snapshots (the run's inner loop)."""
 
-    def __init__(self, mapper: Mapper, spec: MapSpec, feed: Feed, shift: NDArray[np.float64],
+    def __init__(self, mapper: Mapper, spec: MapSettings, feed: Feed, shift: NDArray[np.float64],
                  total: int, *, observer: FrameObserver | None = None) -> None:
         self.mapper, self.feed, self.shift, self.total = mapper, feed, shift, total
         self.observer = observer
@@ -179,7 +179,7 @@ def _timed(frames: Iterator[RegisteredFrame]) -> Iterator[tuple[RegisteredFrame,
         yield frame, time.perf_counter() - start
 
 
-def map_frames(frames: FrameInput, spec: MapSpec, *, cloud: bool = False,
+def map_frames(frames: FrameInput, spec: MapSettings, *, cloud: bool = False,
                progress: bool = False, observer: FrameObserver | None = None) -> MapRun:
     """Map ``frames`` as ``spec`` says: the one map loop (module docstring)."""
     cls = spec.cls

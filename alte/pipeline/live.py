@@ -15,14 +15,14 @@ from numpy.typing import NDArray
 
 from alte.mappers import Feed
 from alte.pipeline.source import InputKind, Source, StreamCounts, stream_frames
-from alte.pipeline.spec import FrameSpec
+from alte.pipeline.spec import FrameSettings
 from alte.registration.grid import GridAccumulator
 from alte.types import Box, RegisteredFrame, Trajectory
 
 __all__ = ["LiveFrames", "bounds_pass"]
 
 
-def bounds_pass(source: Source, spec: FrameSpec) -> Box:
+def bounds_pass(source: Source, spec: FrameSettings) -> Box:
     """The box of every registered frame's points, streamed (the data domain's first pass)."""
     lo, hi = np.full(3, np.inf), np.full(3, -np.inf)
     for frame in stream_frames(source, spec, StreamCounts()):
@@ -57,7 +57,7 @@ class LiveFrames:
 
     key = ""
 
-    def __init__(self, source: Source, spec: FrameSpec) -> None:
+    def __init__(self, source: Source, spec: FrameSettings) -> None:
         self.source, self.spec = source, spec
         self._counts = StreamCounts()
         self._merged = _Cloud(spec.voxel, False)

@@ -18,7 +18,7 @@ from alte import __version__
 from alte.mappers import Cells, Domain, Feed, Mapper
 from alte.params import Record
 from alte.pipeline.source import InputKind, StreamCounts
-from alte.pipeline.spec import DomainChoice, FrameSpec
+from alte.pipeline.spec import DomainChoice, FrameSettings
 from alte.types import RegisteredFrame, Trajectory
 
 __all__ = ["FrameLog", "FrameObserver", "MapRun", "RunInfo", "Snapshot"]
@@ -72,7 +72,7 @@ class RunInfo:
     domain: Domain | None
     domain_policy: DomainChoice
     feed: Feed
-    frames: FrameSpec
+    frames: FrameSettings
     local_origin: tuple[float, float, float]
     cache_key: str = ""
     version: str = __version__

@@ -30,8 +30,8 @@ from numpy.typing import NDArray
 from alte import __version__
 from alte.errors import AlteError
 from alte.fsutil import atomic_dir
-from alte.pipeline.spec import FrameSpec
-from alte.registration.odometry import OdometryParams
+from alte.pipeline.spec import FrameSettings
+from alte.registration.odometry import OdometrySettings
 from alte.registration.settings import PoseCounts
 from alte.types import Frame
 
@@ -58,7 +58,7 @@ def code_hash() -> str:
     return digest.hexdigest()
 
 
-def pose_key(identity: str, spec: FrameSpec, params: OdometryParams) -> str:
+def pose_key(identity: str, spec: FrameSettings, params: OdometrySettings) -> str:
     """The cache key of an input's odometry: ``identity`` (:attr:`Source.identity`), the
     spec's fields that decide the poses (not the selection, crop or voxel) and the
     resolved odometry ``params``."""

@@ -1,7 +1,7 @@
 """The pipeline's odometry step: scans posed by LiDAR (or LiDAR-inertial) odometry.
 
 Odometry aligns consecutive scans, so it reads every scan of the bag even when
-``FrameSpec.frames`` keeps fewer (:attr:`alte.io.bags.bag.FrameStream.read_all`); only the
+``FrameSettings.frames`` keeps fewer (:attr:`alte.io.bags.bag.FrameStream.read_all`); only the
 scans the selection keeps go on, posed as in a run over all of them.
 """
 
@@ -19,9 +19,9 @@ from alte.errors import PoseError
 from alte.io.bags.bag import FrameStream
 from alte.io.bags.imu import ImuSamples, imu_topic, read_imu
 from alte.pipeline.posecache import PosedScans, pose_key, read_poses, record_poses
-from alte.pipeline.spec import FrameSpec
+from alte.pipeline.spec import FrameSettings
 from alte.registration.odometry import (
-    OdometryParams,
+    OdometrySettings,
     PoseCounts,
     odometry_frames,
     odometry_label,
@@ -47,7 +47,7 @@ def _start(probe: FrameStream, stamp: int,
     return (at.positions[0], at.quaternions[0]) if at.valid[0] else None
 
 
-def _imu(stream: FrameStream, params: OdometryParams) -> ImuSamples | None:
+def _imu(stream: FrameStream, params: OdometrySettings) -> ImuSamples | None:
     """The bag's IMU samples when LiDAR-inertial odometry will run (``auto`` with an IMU
     topic, or ``lio``), else None."""
     if params.method not in ("auto", "lio"):
@@ -58,7 +58,7 @@ def _imu(stream: FrameStream, params: OdometryParams) -> ImuSamples | None:
     return read_imu(stream.path, topic)
 
 
-def odometry_poses(stream: FrameStream, probe: FrameStream, spec: FrameSpec,
+def odometry_poses(stream: FrameStream, probe: FrameStream, spec: FrameSettings,
                    counts: PoseCounts, cache: PoseCache | None = None) -> Iterator[Frame]:
     """The selected scans of ``stream`` posed by odometry (LiDAR-inertial when the bag has
     an IMU and the method is ``auto`` or ``lio``), anchored at the recorded pose of the

@@ -1,6 +1,6 @@
 """Registered frames kept for reuse: in memory, or in an on-disk cache read back lazily.
 
-:func:`prepare` registers an input once per :class:`~alte.pipeline.spec.FrameSpec`:
+:func:`prepare` registers an input once per :class:`~alte.pipeline.spec.FrameSettings`:
 every frame's points laid end to end (``points`` and ``offsets``), the trajectory, the
 merged cloud (set A of the thesis' metrics) and the counts. With ``cache=DIR`` the
 result is written to ``DIR/<key>/`` (key: the input's identity and the frame spec)
@@ -27,7 +27,7 @@ from alte.fsutil import atomic_dir
 from alte.io.bags.bag import ReadCounts
 from alte.io.points.pcd import Fields
 from alte.pipeline.source import Source, StreamCounts, stream_frames
-from alte.pipeline.spec import FrameSpec
+from alte.pipeline.spec import FrameSettings
 from alte.registration.deskew import DeskewCounts
 from alte.registration.grid import GridAccumulator
 from alte.registration.odometry import PoseCounts
@@ -48,7 +48,7 @@ class Registered:
     """An input registered with one frame spec (module docstring)."""
 
     source: Source
-    spec: FrameSpec
+    spec: FrameSettings
     points: NDArray[np.float64]
     offsets: NDArray[np.int64]
     trajectory: Trajectory
@@ -75,14 +75,14 @@ class Registered:
         return Box.around(self.points)
 
 
-def cache_key(source: Source, spec: FrameSpec) -> str:
+def cache_key(source: Source, spec: FrameSettings) -> str:
     """sha256 of the input's identity, the resolved frame spec and the versions."""
     text = json.dumps({"input": source.identity, "spec": spec.key(), "cache": CACHE_VERSION,
                        "alte": __version__}, sort_keys=True)
     return hashlib.sha256(text.encode()).hexdigest()[:32]
 
 
-def _collect(source: Source, spec: FrameSpec, sink: BinaryIO | None, progress: bool,
+def _collect(source: Source, spec: FrameSettings, sink: BinaryIO | None, progress: bool,
              pose_cache: Path | None) -> tuple[list[NDArray[np.float64]], NDArray[np.int64],
                                                Trajectory, NDArray[np.float64], StreamCounts]:
     """Stream the frames once: points to ``sink`` (or a list), trajectory, merged cloud."""
@@ -109,11 +109,11 @@ def _collect(source: Source, spec: FrameSpec, sink: BinaryIO | None, progress: b
     return parts, offsets, Trajectory.of(poses), cloud, counts
 
 
-def _meta(source: Source, spec: FrameSpec, counts: StreamCounts) -> dict[str, object]:
+def _meta(source: Source, spec: FrameSettings, counts: StreamCounts) -> dict[str, object]:
     return {"input": str(source.path), "spec": spec.key(), "counts": counts.as_dict()}
 
 
-def _write(target: Path, source: Source, spec: FrameSpec, progress: bool,
+def _write(target: Path, source: Source, spec: FrameSettings, progress: bool,
            pose_cache: Path | None) -> None:
     with ExitStack() as stack:
         tmp = stack.enter_context(atomic_dir(target, overwrite=False))
@@ -138,7 +138,7 @@ def _counts(folder: Path) -> StreamCounts:
                         poses, deskew)
 
 
-def _load(folder: Path, source: Source, spec: FrameSpec, key: str) -> Registered:
+def _load(folder: Path, source: Source, spec: FrameSettings, key: str) -> Registered:
     counts = _counts(folder)
     with np.load(folder / _ARRAYS) as arrays:
         a = {k: arrays[k] for k in arrays.files}
@@ -150,7 +150,7 @@ def _load(folder: Path, source: Source, spec: FrameSpec, key: str) -> Registered
     return Registered(source, spec, points, a["offsets"], traj, cloud, counts, key)
 
 
-def prepare(source: Source, spec: FrameSpec | None = None, *, cache: Path | None = None,
+def prepare(source: Source, spec: FrameSettings | None = None, *, cache: Path | None = None,
             progress: bool = False, pose_cache: Path | None = None) -> Registered:
     """Register ``source`` once (module docstring); ``spec`` is resolved against the input.
 
@@ -158,7 +158,7 @@ def prepare(source: Source, spec: FrameSpec | None = None, *, cache: Path | None
     :mod:`alte.pipeline.posecache`), so another frame selection of the same input and
     pose settings reads them instead of aligning the scans again.
     """
-    resolved = source.resolve(spec or FrameSpec())
+    resolved = source.resolve(spec or FrameSettings())
     key = cache_key(source, resolved)
     if pose_cache is None and cache is not None:
         pose_cache = Path(cache) / POSE_DIR
@@ -189,12 +189,12 @@ class Merged:
     counts: StreamCounts
 
 
-def merge_frames(source: Source, spec: FrameSpec | None = None, *,
+def merge_frames(source: Source, spec: FrameSettings | None = None, *,
                  progress: bool = False) -> Merged:
     """The input's merged registered cloud (thesis 2.1.3), streamed: with a voxel only the
     box grid is held, never the frames; without one every registered point is kept, with
     its fields."""
-    resolved = source.resolve(spec or FrameSpec())
+    resolved = source.resolve(spec or FrameSettings())
     counts = StreamCounts()
     merge = GridAccumulator(resolved.voxel) if resolved.voxel is not None else None
     frames = [f for f in stream_frames(source, resolved, counts, merge=merge,
@@ -209,7 +209,7 @@ def merge_frames(source: Source, spec: FrameSpec | None = None, *,
     return Merged(cloud, fields, counts)
 
 
-def merged_cloud(source: Source, spec: FrameSpec | None = None, *,
+def merged_cloud(source: Source, spec: FrameSettings | None = None, *,
                  progress: bool = False) -> tuple[NDArray[np.float64], StreamCounts]:
     """The points and counts of :func:`merge_frames`."""
     merged = merge_frames(source, spec, progress=progress)

@@ -23,7 +23,7 @@ from alte.pipeline.live import LiveFrames
 from alte.pipeline.maprun import FrameObserver, MapRun
 from alte.pipeline.prepare import Registered, prepare
 from alte.pipeline.source import InputKind, Source, StreamCounts, open_input
-from alte.pipeline.spec import FrameSpec, MapSpec
+from alte.pipeline.spec import FrameSettings, MapSettings
 from alte.types import Box, RegisteredFrame, Trajectory
 
 __all__ = ["PreparedFrames", "run"]
@@ -42,7 +42,7 @@ class PreparedFrames:
         return self.reg.source
 
     @property
-    def spec(self) -> FrameSpec:
+    def spec(self) -> FrameSettings:
         return self.reg.spec
 
     @property
@@ -73,7 +73,7 @@ class PreparedFrames:
         return self.reg.trajectory
 
 
-def run(source: Input, spec: MapSpec, frames: FrameSpec | None = None, *,
+def run(source: Input, spec: MapSettings, frames: FrameSettings | None = None, *,
         cache: Path | None = None, cloud: bool = False, progress: bool = False,
         observer: FrameObserver | None = None) -> MapRun:
     """Map ``source`` as ``spec`` says (module docstring).
@@ -93,6 +93,6 @@ def run(source: Input, spec: MapSpec, frames: FrameSpec | None = None, *,
     if cache is not None:
         reg = prepare(src, frames, cache=cache, progress=progress)
         return map_frames(PreparedFrames(reg), spec, progress=progress, observer=observer)
-    live = LiveFrames(src, src.resolve(frames or FrameSpec()))
+    live = LiveFrames(src, src.resolve(frames or FrameSettings()))
     return map_frames(live, spec, cloud=cloud, progress=progress, observer=observer)
 

@@ -2,8 +2,8 @@
 
 An input is a ROS bag (file or folder), a simulated terrain folder (``scenario.json``
 + ``bag/`` + ``ground_truth.ply``: it brings its control volume and registration
-voxel) or a point file (one frame, sensor at ``FrameSpec.origin``).
-:func:`stream_frames` turns an input and a :class:`~alte.pipeline.spec.FrameSpec`
+voxel) or a point file (one frame, sensor at ``FrameSettings.origin``).
+:func:`stream_frames` turns an input and a :class:`~alte.pipeline.spec.FrameSettings`
 into registered frames one at a time: read -> pose -> eq. 2.2 -> crop -> grid
 average, with the merged cloud accumulated on the side when asked.
 """
@@ -22,10 +22,10 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from alte.errors import BagError, ParameterError, PointFileError, TopicError
-from alte.io.bags.bag import NO_POSE_NOTE, FrameStream, ReadCounts
+from alte.io.bags.bag import NO_POSE_NOTE, FrameStream, ReadCounts, ReadSettings
 from alte.io.poses.pose import POSE_TYPES
 from alte.pipeline.posing import odometry_poses
-from alte.pipeline.spec import FrameSpec, PoseSource
+from alte.pipeline.spec import FrameSettings, PoseSource
 from alte.registration.deskew import DeskewCounts, deskew_frames
 from alte.registration.grid import GridAccumulator, grid_average
 from alte.registration.odometry import KEYS, PoseCounts, refine_frames
@@ -60,7 +60,7 @@ class Source:
     name: str = ""
     title: str = ""
 
-    def resolve(self, spec: FrameSpec) -> FrameSpec:
+    def resolve(self, spec: FrameSettings) -> FrameSettings:
         """``spec`` with the input's own crop and voxel where it leaves them unset."""
         return replace(spec, crop=spec.crop if spec.crop is not None else self.control,
                        voxel=spec.voxel if spec.voxel is not None else self.voxel)
@@ -133,16 +133,17 @@ class StreamCounts:
                 "poses": self.poses.as_dict(), "deskew": self.deskew.as_dict()}
 
 
-def _open(source: Source, spec: FrameSpec, pose_topic: str | None, progress: bool,
+def _open(source: Source, spec: FrameSettings, pose_topic: str | None, progress: bool,
           read_all: bool = False) -> FrameStream:
     pose_file = spec.pose_file if pose_topic != "" else None
-    return FrameStream(source.bag or source.path, cloud_topic=spec.cloud_topic,
-                       pose_topic=pose_topic, mount=spec.mount, allow_no_pose=True,
-                       frames=spec.frames, progress=progress, pose_file=pose_file,
+    options = ReadSettings(cloud_topic=spec.cloud_topic, pose_topic=pose_topic,
+                          allow_no_pose=True, frames=spec.frames, progress=progress,
+                          pose_file=pose_file)
+    return FrameStream(source.bag or source.path, options, mount=spec.mount,
                        read_all=read_all)
 
 
-def _deskewed(stream: FrameStream, spec: FrameSpec, counts: DeskewCounts) -> Iterator[Frame]:
+def _deskewed(stream: FrameStream, spec: FrameSettings, counts: DeskewCounts) -> Iterator[Frame]:
     """The stream's frames, deskewed along its pose track when ``spec.deskew`` (clouds
     with per-point time), else as read (their time dropped: registered as taken)."""
     if spec.deskew and stream.track is not None:
@@ -151,7 +152,7 @@ def _deskewed(stream: FrameStream, spec: FrameSpec, counts: DeskewCounts) -> Ite
     return (replace(f, times=None) for f in stream)
 
 
-def _posed(source: Source, spec: FrameSpec, counts: PoseCounts, progress: bool,
+def _posed(source: Source, spec: FrameSettings, counts: PoseCounts, progress: bool,
            deskew: DeskewCounts | None = None, *, pose_cache: Path | None = None,
            ) -> tuple[FrameStream, Iterator[Frame]]:
     """The scan stream and its frames posed as ``spec.poses`` says (:class:`PoseSource`);
@@ -164,10 +165,10 @@ def _posed(source: Source, spec: FrameSpec, counts: PoseCounts, progress: bool,
         return stream, iter(stream)
     probe = _open(source, spec, spec.pose_topic, progress)
     if choice in (PoseSource.RECORDED, PoseSource.REFINE) and probe.track is None:
-        raise TopicError(f"{probe.path}: --poses {choice.value} needs the bag's poses and it "
+        raise TopicError(f"{probe.path}: poses={choice.value} needs the bag's poses and it "
                          f"has no pose topic ({', '.join(POSE_TYPES)}) for "
-                         f"{probe.cloud_topic}; use --poses odometry (LiDAR odometry) or "
-                         "--poses identity (static sensor)")
+                         f"{probe.cloud_topic}; use poses=odometry (LiDAR odometry) or "
+                         "poses=identity (static sensor)", setting="frame spec.poses")
     if choice is PoseSource.RECORDED:
         return probe, _deskewed(probe, spec, deskew)
     if choice is PoseSource.REFINE:
@@ -191,7 +192,7 @@ def _posed(source: Source, spec: FrameSpec, counts: PoseCounts, progress: bool,
     return stream, odometry_poses(stream, probe, spec, counts, cache)
 
 
-def _bag_frames(source: Source, spec: FrameSpec, counts: StreamCounts,
+def _bag_frames(source: Source, spec: FrameSettings, counts: StreamCounts,
                 merge: GridAccumulator | None, progress: bool, *,
                 pose_cache: Path | None) -> Iterator[RegisteredFrame]:
     stream, posed = _posed(source, spec, counts.poses, progress, counts.deskew,
@@ -208,15 +209,16 @@ def _bag_frames(source: Source, spec: FrameSpec, counts: StreamCounts,
     counts.read = stream.counts
 
 
-def _file_frames(source: Source, spec: FrameSpec, counts: StreamCounts,
+def _file_frames(source: Source, spec: FrameSettings, counts: StreamCounts,
                  merge: GridAccumulator | None) -> Iterator[RegisteredFrame]:
     """A point file as one frame: finite, cropped, grid-averaged, seen from ``spec.origin``;
     the file's other fields ride along while every point is kept (no voxel)."""
     from alte.io.points.pointfiles import read_points_info
 
     if spec.poses in (PoseSource.ODOMETRY, PoseSource.REFINE):
-        raise ParameterError(f"{source.path}: --poses {spec.poses.value} needs a bag of scans; "
-                             "a point file is one frame seen from --origin")
+        raise ParameterError(f"{source.path}: poses={spec.poses.value} needs a bag of scans; "
+                             "a point file is one frame seen from its origin",
+                             setting="frame spec.poses")
     counts.poses.source = "origin"
     info = read_points_info(source.path)
     reg = counts.registration
@@ -244,7 +246,7 @@ def _file_frames(source: Source, spec: FrameSpec, counts: StreamCounts,
                           fields if spec.voxel is None else None)
 
 
-def stream_frames(source: Source, spec: FrameSpec, counts: StreamCounts, *,
+def stream_frames(source: Source, spec: FrameSettings, counts: StreamCounts, *,
                   merge: GridAccumulator | None = None, progress: bool = False,
                   pose_cache: Path | None = None) -> Iterator[RegisteredFrame]:
     """Registered frames of ``source`` one at a time (``spec`` already resolved).

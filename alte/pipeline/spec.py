@@ -1,9 +1,9 @@
 """What a map run is asked to do: which frames and how they are registered, which map.
 
-A :class:`FrameSpec` fixes everything that decides the registered frames (frame
+A :class:`FrameSettings` fixes everything that decides the registered frames (frame
 selection, voxel, crop, mount, topics, pose source, manoeuvre filter): two runs with
 equal frame specs on one input share their registration (the cache key). A
-:class:`MapSpec` names the mapper, its parameters, the domain policy and the feed.
+:class:`MapSettings` names the mapper, its parameters, the domain policy and the feed.
 ``None`` means "the input's own": a terrain folder brings its control volume (crop
 and domain) and its registration voxel; a bag or point file brings neither.
 """
@@ -22,10 +22,11 @@ from alte.errors import ParameterError
 from alte.mappers.base import Feed, Mapper
 from alte.mappers.domain import Domain
 from alte.params import Record, param
-from alte.registration.odometry import OdometryParams
+from alte.registration.grid import VOXEL
+from alte.registration.odometry import OdometrySettings
 from alte.types import Box, Mount
 
-__all__ = ["DomainChoice", "DomainPolicy", "FrameSpec", "MapSpec", "PoseSource"]
+__all__ = ["DomainChoice", "DomainPolicy", "FrameSettings", "MapSettings", "PoseSource"]
 
 
 class DomainPolicy(enum.Enum):
@@ -86,7 +87,7 @@ def _finite(values: tuple[float, ...]) -> bool:
 
 
 @dataclass(frozen=True)
-class FrameSpec(Record):
+class FrameSettings(Record):
     """How the input becomes registered frames (module docstring).
 
     ``frames``: at most that many scans, evenly spaced over the cloud topic (None: all);
@@ -102,8 +103,7 @@ class FrameSpec(Record):
     OWNER: ClassVar[str] = "frame spec"
     frames: int | None = param(None, lambda v: v >= 1, "frames >= 1",
                                "scans kept, evenly spaced (None: all)")
-    voxel: float | None = param(None, _positive, "voxel > 0, finite",
-                                "grid-average size of each frame and of the cloud (m)")
+    voxel: float | None = field(default=None, metadata={"rule": VOXEL})
     crop: Box | None = param(None, help="the control volume points are kept in")
     mount: Mount | None = param(None, help="the sensor's mount on the vehicle")
     cloud_topic: str | None = param(None, help="the bag's point cloud topic")
@@ -115,14 +115,15 @@ class FrameSpec(Record):
                                      "fast-manoeuvre filter: pose-to-scan offset (s)")
     origin: tuple[float, float, float] = param((0.0, 0.0, 0.0), _finite, "finite x,y,z",
                                                "the sensor position of a point file (m)")
-    odometry: OdometryParams = field(default_factory=OdometryParams)
+    odometry: OdometrySettings = field(default_factory=OdometrySettings)
     deskew: bool = param(True, help="deskew clouds that carry per-point time")
     pose_file: Path | None = param(None, help="poses from a TUM file")
 
     def __post_init__(self) -> None:
         super().__post_init__()
         if self.pose_file is not None and self.pose_topic:
-            raise ParameterError("--pose-file and --pose-topic exclude each other")
+            raise ParameterError(f"{self.OWNER}: pose_file and pose_topic exclude each other",
+                                 setting=(f"{self.OWNER}.pose_file", f"{self.OWNER}.pose_topic"))
 
     def key(self) -> dict[str, object]:
         """Everything that decides the registered frames, JSON-ready (the cache key)."""
@@ -137,7 +138,7 @@ class FrameSpec(Record):
 
 
 @dataclass(frozen=True)
-class MapSpec(Record):
+class MapSettings(Record):
     """Which map: mapper and parameters, domain (or policy), feed, time-lapse.
 
     ``mapper`` is a mapper class or a name the registry resolves
@@ -166,7 +167,7 @@ class MapSpec(Record):
             object.__setattr__(self, "mapper", self.mapper.name)
         cls = self.cls
         given = self.params
-        record = given if isinstance(given, cls.Params) else cls.Params.parse(
+        record = given if isinstance(given, cls.Settings) else cls.Settings.parse(
             given.as_dict() if isinstance(given, Record) else given)
         object.__setattr__(self, "record", record)
         object.__setattr__(self, "params", given.as_dict() if isinstance(given, Record)

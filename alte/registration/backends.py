@@ -28,7 +28,7 @@ from numpy.typing import NDArray
 if TYPE_CHECKING:
     import open3d as o3d
 
-    from alte.registration.settings import OdometryParams, PoseCounts
+    from alte.registration.settings import OdometrySettings, PoseCounts
 
 __all__ = ["KISS_POINTS", "KISS_VOXEL_SCALE", "Kiss", "Plane", "PlaneMap", "kiss_config",
            "kiss_points", "kiss_voxel", "scene_scale", "window_voxel"]
@@ -55,7 +55,7 @@ class KissSettings(Protocol):
     def mapping(self) -> _KissMapping: ...
 
 
-def scene_scale(points: NDArray[np.float64], params: OdometryParams) -> tuple[float, float]:
+def scene_scale(points: NDArray[np.float64], params: OdometrySettings) -> tuple[float, float]:
     """(max range, voxel) for a scan in the sensor frame: ``max_range`` (default KISS-ICP's
     100 m for ``kiss``, 1.2 x the 99th percentile range for ``plane``) and ``voxel``
     (default :func:`kiss_voxel` for ``kiss``, the median range / 70 for ``plane``)."""
@@ -74,26 +74,26 @@ def scene_scale(points: NDArray[np.float64], params: OdometryParams) -> tuple[fl
 KISS_VOXEL_SCALE, KISS_POINTS = 1.5, 10
 
 
-def kiss_voxel(params: OdometryParams) -> float:
+def kiss_voxel(params: OdometrySettings) -> float:
     """KISS-ICP's map voxel for ``params``: ``voxel``, else ``max_range / 100`` (1 m at its
     default range of 100 m), 1.5 times that when the window follows (module docstring)."""
     scale = KISS_VOXEL_SCALE if params.window > 0 else 1.0
     return params.voxel or scale * (params.max_range or 100.0) / 100.0
 
 
-def kiss_points(params: OdometryParams) -> int:
+def kiss_points(params: OdometrySettings) -> int:
     """KISS-ICP's map points per voxel: ``max_points_per_voxel``, else its own 20, 10 when
     the window follows (module docstring)."""
     return params.max_points_per_voxel or (KISS_POINTS if params.window > 0 else 20)
 
 
-def window_voxel(params: OdometryParams) -> float:
+def window_voxel(params: OdometrySettings) -> float:
     """The window's Gaussian voxel: ``window_voxel``, else KISS-ICP's own map voxel rule,
     ``max_range / 100`` (1 m at its default range)."""
     return params.window_voxel or (params.max_range or 100.0) / 100.0
 
 
-def kiss_config(points: NDArray[np.float64], params: OdometryParams,
+def kiss_config(points: NDArray[np.float64], params: OdometrySettings,
                 timed: bool = False) -> KissSettings:
     """KISS-ICP's configuration for ``params`` (unset values: KISS-ICP's own defaults);
     deskewing only for scans with per-point time (``timed``)."""
@@ -117,7 +117,7 @@ def kiss_config(points: NDArray[np.float64], params: OdometryParams,
 class Kiss:
     """KISS-ICP's own pipeline, with the sparse-sensor switches (module docstring)."""
 
-    def __init__(self, points: NDArray[np.float64], params: OdometryParams, timed: bool) -> None:
+    def __init__(self, points: NDArray[np.float64], params: OdometrySettings, timed: bool) -> None:
         from kiss_icp.kiss_icp import KissICP
         from kiss_icp.voxelization import voxel_down_sample
 
@@ -199,7 +199,7 @@ class PlaneMap:
 class Plane:
     """Point-to-plane scan-to-map odometry from a constant-velocity guess."""
 
-    def __init__(self, points: NDArray[np.float64], params: OdometryParams,
+    def __init__(self, points: NDArray[np.float64], params: OdometrySettings,
                  counts: PoseCounts) -> None:
         max_range, voxel = scene_scale(points, params)
         self.map = PlaneMap(voxel, max_range, params.rebuild)

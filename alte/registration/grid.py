@@ -7,13 +7,19 @@ so every operation is O(n log n) and deterministic (output sorted by cell key).
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
+from typing import ClassVar
+
 import numpy as np
 from numpy.typing import NDArray
 
 from alte.errors import ParameterError
+from alte.params import Record, Rule
 
 __all__ = [
+    "VOXEL",
     "GridAccumulator",
+    "GridSettings",
     "box_grid_merge",
     "check_voxel",
     "grid_average",
@@ -21,12 +27,26 @@ __all__ = [
 ]
 
 
+def _positive(value: float) -> bool:
+    return bool(np.isfinite(value) and value > 0)
+
+
+#: The one rule of a registration voxel (the grid here, :class:`alte.pipeline.FrameSettings`).
+VOXEL: Rule[float] = Rule(_positive, "voxel > 0, finite", "grid-average cell size (m)")
+
+
+@dataclass(frozen=True)
+class GridSettings(Record):
+    """The grid's one setting, its cell ``voxel`` (m), checked by :data:`VOXEL`."""
+
+    OWNER: ClassVar[str] = "grid"
+    voxel: float = field(metadata={"rule": VOXEL})
+
+
 def check_voxel(voxel: float) -> float:
-    """Return ``voxel`` as a positive finite float or raise :class:`ParameterError`."""
-    value = float(voxel)
-    if not np.isfinite(value) or value <= 0:
-        raise ParameterError(f"voxel={voxel!r} must be a positive finite size in metres")
-    return value
+    """``voxel`` as a float checked by :data:`VOXEL`, or a :class:`ParameterError`
+    naming it (``grid: voxel=0.0 out of range (voxel > 0, finite)``)."""
+    return GridSettings(voxel).voxel
 
 
 def grid_average_with_counts(

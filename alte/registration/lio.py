@@ -70,9 +70,9 @@ def _positive(value: float) -> bool:
 
 @dataclass(frozen=True)
 class LioSettings(Record):
-    """What the LIO reads from :class:`~alte.registration.odometry.OdometryParams`
+    """What the LIO reads from :class:`~alte.registration.odometry.OdometrySettings`
     (``noise`` from its six IMU figures; ``gate``, ``gate_sigma`` and ``iterations`` are
-    not settings of ``--odometry-set``); the rules are OdometryParams'."""
+    not settings of ``--odometry-set``); the rules are OdometrySettings'."""
 
     OWNER = "lio"
 
@@ -115,8 +115,9 @@ def check_overlap(imu: ImuSamples, stamp: int) -> None:
     lo, hi = int(imu.stamps[0]), int(imu.stamps[-1])
     if not lo - 1_000_000_000 <= stamp <= hi + 1_000_000_000:
         raise RegistrationError(
-            f"--odometry lio: scan stamp {stamp} ns lies outside the IMU topic's "
-            f"{lo}..{hi} ns (another clock or unit?); use --odometry kiss")
+            f"odometry: method=lio: scan stamp {stamp} ns lies outside the IMU topic's "
+            f"{lo}..{hi} ns (another clock or unit?); use method=kiss",
+            setting="odometry.method")
 
 
 class LioOdometry:

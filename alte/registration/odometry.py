@@ -39,7 +39,7 @@ from alte.registration.refine import refine_frames
 from alte.registration.settings import (
     KEYS,
     METHODS,
-    OdometryParams,
+    OdometrySettings,
     PoseCounts,
     odometry_label,
     odometry_params,
@@ -52,10 +52,10 @@ from alte.types import Frame, Mount
 if TYPE_CHECKING:
     from alte.io.bags.imu import ImuSamples
 
-__all__ = ["KEYS", "METHODS", "OdometryParams", "PoseCounts", "lio_settings", "odometry_frames",
+__all__ = ["KEYS", "METHODS", "OdometrySettings", "PoseCounts", "lio_settings", "odometry_frames",
            "odometry_label", "odometry_params", "pose_matrix", "refine_frames", "resolve_method"]
 
-def lio_settings(params: OdometryParams) -> LioSettings:
+def lio_settings(params: OdometrySettings) -> LioSettings:
     """What :mod:`alte.registration.lio` reads of ``params`` (unset: its defaults)."""
     base = LioSettings()
     return LioSettings(voxel=params.voxel or base.voxel,
@@ -85,12 +85,12 @@ def _posed(frame: Frame, body: NDArray[np.float64], previous: Frame | None) -> F
 
 
 def _lio_frames(frames: Iterable[Frame], mount: Mount, imu: ImuSamples | None, *,
-                counts: PoseCounts, params: OdometryParams,
+                counts: PoseCounts, params: OdometrySettings,
                 start: tuple[NDArray[np.float64], NDArray[np.float64]] | None) -> Iterator[Frame]:
     """``frames`` posed by LiDAR-inertial odometry (:mod:`alte.registration.lio`)."""
     if imu is None:
-        raise ParameterError("--odometry lio needs an IMU topic (sensor_msgs/msg/Imu) in the "
-                             "bag; use --odometry kiss")
+        raise ParameterError("odometry: method=lio needs an IMU topic (sensor_msgs/msg/Imu) "
+                             "in the bag; use method=kiss", setting="odometry.method")
     previous: Frame | None = None
     steps = lio_frames(frames, mount, imu, lio_settings(params), start, counts=counts)
     while True:
@@ -111,12 +111,12 @@ def _lio_frames(frames: Iterable[Frame], mount: Mount, imu: ImuSamples | None, *
 
 
 def odometry_frames(frames: Iterable[Frame], mount: Mount, *, counts: PoseCounts,
-                    params: OdometryParams | None = None,
+                    params: OdometrySettings | None = None,
                     start: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None,
                     imu: ImuSamples | None = None) -> Iterator[Frame]:
     """``frames`` with body poses from LiDAR (or LiDAR-inertial, with ``imu``) odometry,
     anchored at ``start``."""
-    params = resolve_method(params or OdometryParams(), imu is not None)
+    params = resolve_method(params or OdometrySettings(), imu is not None)
     counts.method, counts.settings = params.method, params.as_dict()
     if params.method == "lio":
         yield from _lio_frames(frames, mount, imu, counts=counts, params=params, start=start)
@@ -150,7 +150,7 @@ def _carried(frame: Frame, pose: NDArray[np.float64],
     return replace(frame, points=points.astype(frame.points.dtype, copy=False), times=None)
 
 
-def _lidar_poses(frames: Iterable[Frame], params: OdometryParams, counts: PoseCounts,
+def _lidar_poses(frames: Iterable[Frame], params: OdometrySettings, counts: PoseCounts,
                  ) -> Iterator[tuple[Frame, NDArray[np.float64]]]:
     """Each frame with its sensor pose in the first scan's sensor frame (kiss or plane)."""
     odometry: Kiss | Plane | None = None

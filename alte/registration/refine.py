@@ -49,7 +49,7 @@ from alte.registration.settings import pose_matrix
 from alte.types import Frame, Mount
 
 if TYPE_CHECKING:
-    from alte.registration.settings import OdometryParams, PoseCounts
+    from alte.registration.settings import OdometrySettings, PoseCounts
 
 __all__ = ["REASONS", "ScanDecision", "refine_frames"]
 
@@ -100,7 +100,7 @@ def _correction(guess: NDArray[np.float64], aligned: NDArray[np.float64]) -> tup
 
 
 def _decide(local: DenseMap, points: NDArray[np.float64], guess: NDArray[np.float64],
-            length: float, params: OdometryParams, *, stamp: int,
+            length: float, params: OdometrySettings, *, stamp: int,
             ) -> tuple[NDArray[np.float64], ScanDecision]:
     """The pose to use for the scan and why (module docstring)."""
     found = align(local, points, guess, length=length, ratio=params.min_constraint)
@@ -129,7 +129,7 @@ def _count(counts: PoseCounts, decision: ScanDecision) -> None:
 
 
 def refine_frames(frames: Iterable[Frame], mount: Mount, *, counts: PoseCounts,
-                  params: OdometryParams) -> Iterator[Frame]:
+                  params: OdometrySettings) -> Iterator[Frame]:
     """``frames`` with each recorded pose refined when that is clearly better (module
     docstring)."""
     body_sensor = pose_matrix(mount.translation, mount.quaternion)

@@ -1,4 +1,4 @@
-"""What odometry and refinement are asked to do (:class:`OdometryParams`, checked as
+"""What odometry and refinement are asked to do (:class:`OdometrySettings`, checked as
 ``--odometry`` / ``--odometry-set``) and what they report (:class:`PoseCounts`).
 
 Apart from :mod:`~alte.registration.odometry` so that its backends and refinement read
@@ -20,7 +20,7 @@ from alte.params import Record, param
 from alte.registration.inertial import ImuNoise
 from alte.types import Counts
 
-__all__ = ["KEYS", "METHODS", "OdometryParams", "PoseCounts", "odometry_label",
+__all__ = ["KEYS", "METHODS", "OdometrySettings", "PoseCounts", "odometry_label",
            "odometry_params", "pose_matrix", "resolve_method"]
 
 #: Odometry backends (module docstring).
@@ -44,7 +44,7 @@ def _imu(default: float, unit: str, what: str) -> float:
 
 
 @dataclass(frozen=True)
-class OdometryParams(Record):
+class OdometrySettings(Record):
     """How scans are aligned by odometry (``method``) and refinement; unset values come
     from KISS-ICP's defaults or the first scan's ranges (:mod:`~alte.registration.backends`)."""
 
@@ -142,30 +142,34 @@ KEYS: dict[str, tuple[str, ...]] = {
 KEYS["auto"] = tuple(dict.fromkeys(KEYS["kiss"] + KEYS["lio"]))
 
 
-def odometry_params(method: str | None = None, settings: Mapping[str, object] | None = None,
-                    *, flag: str = "--odometry-set") -> OdometryParams:
-    """``--odometry METHOD --odometry-set KEY=VALUE ...`` checked; errors name the flag."""
+def odometry_params(method: str | None = None, settings: Mapping[str, object] | None = None
+                    ) -> OdometrySettings:
+    """The backend ``method`` with its ``settings`` (text or typed) checked; an error names
+    the setting (``odometry.method``, else ``odometry.settings``: the command line's
+    ``--odometry`` / ``--odometry-set``)."""
     settings = dict(settings or {})
     if method is not None and method not in METHODS:
-        raise ParameterError(f"--odometry {method}: unknown backend; valid: "
-                             f"{', '.join(METHODS)}")
-    chosen = method or OdometryParams().method
+        raise ParameterError(f"odometry: method={method!r} unknown; valid: "
+                             f"{', '.join(METHODS)}", setting="odometry.method")
+    chosen = method or OdometrySettings().method
     valid = set(KEYS[chosen]) | set(KEYS["refine"])
     unknown = sorted(set(settings) - valid)
     if unknown:
-        raise ParameterError(f"{flag} {', '.join(unknown)}: not a setting of --odometry "
-                             f"{chosen} or refinement; valid: {', '.join(sorted(valid))}")
+        raise ParameterError(f"odometry: {', '.join(unknown)}: not a setting of method={chosen} "
+                             f"or refinement; valid: {', '.join(sorted(valid))}",
+                             setting="odometry.settings")
     try:
-        return OdometryParams.parse({"method": chosen, **settings})
+        return OdometrySettings.parse({"method": chosen, **settings})
     except ParameterError as err:
-        raise ParameterError(f"{flag}: {err}") from err
+        err.settings = ("odometry.settings",)
+        raise
 
 
-def odometry_label(params: OdometryParams) -> str:
+def odometry_label(params: OdometrySettings) -> str:
     """``kiss-icp`` or ``point-to-plane``, with the settings that differ from the defaults."""
     name = {"auto": "auto", "kiss": "kiss-icp", "plane": "point-to-plane",
             "lio": "lidar-inertial"}[params.method]
-    default = OdometryParams(method=params.method).as_dict()
+    default = OdometrySettings(method=params.method).as_dict()
     changed = [f"{k}={v}" for k, v in params.as_dict().items()
                if v != default[k] and k in KEYS[params.method]]
     return f"{name} {' '.join(changed)}" if changed else name
@@ -204,7 +208,7 @@ def pose_matrix(position: NDArray[np.float64], quaternion: NDArray[np.float64],
     return out
 
 
-def resolve_method(params: OdometryParams, has_imu: bool) -> OdometryParams:
+def resolve_method(params: OdometrySettings, has_imu: bool) -> OdometrySettings:
     """``auto`` made concrete: ``lio`` when the bag has an IMU topic, else ``kiss``."""
     if params.method != "auto":
         return params

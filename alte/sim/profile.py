@@ -103,6 +103,6 @@ def get_profile(name: str, changes: dict[str, str] | None = None) -> SensorProfi
     try:
         base = PROFILES[name]
     except KeyError as err:
-        raise ParameterError(f"--profile {name!r}: unknown; valid: {', '.join(PROFILES)}") \
-            from err
+        raise ParameterError(f"sensor profile: name={name!r} unknown; valid: "
+                             f"{', '.join(PROFILES)}", setting="sensor profile.name") from err
     return base.replace(**changes) if changes else base

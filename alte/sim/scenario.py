@@ -23,6 +23,7 @@ import numpy as np
 
 from alte.errors import AlteError, SimulationError
 from alte.fsutil import atomic_dir
+from alte.io.bags.writer import BagSettings
 from alte.sim.groundtruth import GROUND_TRUTH_FILE, load_ground_truth, write_ground_truth
 from alte.sim.meta import SCENARIO_FILE, MountMeta, ScenarioMeta
 from alte.sim.mission import Simulation, simulate
@@ -62,7 +63,7 @@ def get_terrain(name: str, data_dir: str | os.PathLike[str] | None = None) -> Te
         return imported_terrain(folder)
     where = f" in {data_dir}" if data_dir is not None else ""
     raise SimulationError(f"unknown terrain {name!r}; valid: {', '.join(TERRAINS)}, or a "
-                          f"terrain imported{where} (`alte simulate TILE.laz --out DIR`)")
+                          f"terrain imported{where} (`alte simulate TILE.laz`)")
 
 
 def profile_label(profile: SensorProfile) -> str:
@@ -138,9 +139,10 @@ def write_scenario(target: str | os.PathLike[str], terrain: Terrain, sim: Simula
     key = spec_hash(terrain, frames, storage, profile=sim.profile)
     with atomic_dir(target, overwrite=True) as tmp:
         tmp.mkdir()
+        settings = BagSettings(cloud_topic=CLOUD_TOPIC, pose_topic=POSE_TOPIC, storage=storage,
+                               progress=progress)
         write_bag(tmp / BAG_DIR, _clouds(sim), sim.pose_stamps, sim.positions, sim.quaternions,
-                  sim.mount, cloud_topic=CLOUD_TOPIC, pose_topic=POSE_TOPIC, storage=storage,
-                  progress=progress, imu=_imu_samples(sim))
+                  sim.mount, settings, imu=_imu_samples(sim))
         write_ground_truth(tmp / GROUND_TRUTH_FILE, terrain.scene)
         if more is not None:
             more(tmp)
@@ -221,7 +223,7 @@ def update_terrain(name: str, out_dir: str | os.PathLike[str] = "data", seed: in
         return target, False
     if target.exists() and not force and not (target / SCENARIO_FILE).is_file():
         raise SimulationError(f"{target} exists but is not a simulated terrain folder; "
-                              "remove it or pass force=True (--force)")
+                              "remove it or pass force=True", setting="output.overwrite")
     sim = simulate(terrain, seed=seed, frames=frames, progress=progress, profile=profile)
     folder = write_scenario(target, terrain, sim, seed=seed, frames=frames, storage=storage,
                             progress=progress)

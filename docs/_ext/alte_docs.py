@@ -29,7 +29,7 @@ import os
 import pkgutil
 import sys
 import tempfile
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any, ClassVar
 
@@ -275,7 +275,7 @@ class MappersDirective(RecordDirective):
         for cls in registry.classes():
             said = (cls.__doc__ or "").strip().splitlines()[0]
             lines += [f"**{cls.name}** (:class:`{cls.__module__}.{cls.__name__}`): {said}",
-                      "", *record_table(cls.Params), ""]
+                      "", *record_table(cls.Settings), ""]
         return self._parse(lines)
 
 
@@ -358,10 +358,24 @@ def _shared_prefix(name: str, module: str) -> int:
     return count
 
 
+def _suffixes(names: Iterable[str]) -> set[str]:
+    """Every dotted tail of every name (``a.b.c``: ``c``, ``b.c``, ``a.b.c``)."""
+    tails = set()
+    for name in names:
+        parts = name.split(".")
+        tails.update(".".join(parts[i:]) for i in range(len(parts)))
+    return tails
+
+
 class NearestTarget(SphinxPostTransform):
     """A short Python name a signature refers to (``Tile``) that several documented
     objects end with: the one whose module is nearest the signature's own (the longest
-    shared dotted prefix), set before Sphinx resolves it (it would warn and pick any)."""
+    shared dotted prefix), set before Sphinx resolves it (it would warn and pick any).
+
+    A target no documented object ends with (``ndarray``, ``Path``, ``float``) resolves
+    to nothing whichever way Sphinx searches, so it is searched exactly: Sphinx marks
+    every annotation's reference "specific", and its search for one scans every object
+    of the site (once per reference and type, thousands of times a build)."""
 
     default_priority = 5  # before sphinx's ReferencesResolver (10)
 
@@ -371,11 +385,16 @@ class NearestTarget(SphinxPostTransform):
         by_last: dict[str, list[str]] = {}
         for name in objects:
             by_last.setdefault(name.rpartition(".")[2], []).append(name)
+        tails = _suffixes(objects)
         for node in self.document.findall(addnodes.pending_xref):
             target = str(node.get("reftarget", ""))
+            if node.get("refdomain") != "py":
+                continue
+            if target not in tails and node.hasattr("refspecific"):
+                del node["refspecific"]  # nothing to find: the exact search, same result
+                continue
             module = str(node.get("py:module") or "")
-            if (node.get("refdomain") != "py" or "." in target or target in objects
-                    or f"{module}.{target}" in objects):
+            if "." in target or target in objects or f"{module}.{target}" in objects:
                 continue
             found = by_last.get(target, [])
             if len(found) > 1:

@@ -11,20 +11,20 @@ from alte.mappers.api import Cells, MapperBase, Record, param
 
 
 @dataclass(frozen=True)
-class MeanGridParams(Record):
+class MeanGridSettings(Record):
     """The parameters ``--set`` and sweep specs give, validated on creation."""
 
     OWNER: ClassVar[str] = "meangrid"
     cell: float = param(1.0, lambda v: v > 0, "cell > 0", "cell edge (m)")
 
 
-class MeanGrid(MapperBase[MeanGridParams]):
+class MeanGrid(MapperBase[MeanGridSettings]):
     """A 2.5D grid of ``cell`` metres: a cell's height is the mean z of its points."""
 
     name = "meangrid"
     title = "Mean grid"
     dims = 2
-    Params = MeanGridParams
+    Settings = MeanGridSettings
     settings_grid: ClassVar[Mapping[str, tuple[object, ...]]] = {"cell": (0.25, 0.5, 1.0, 2.0)}
 
     def clear(self) -> None:

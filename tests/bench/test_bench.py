@@ -13,7 +13,7 @@ from alte.errors import ParameterError
 from alte.lab.report.runs import point_latest, write_record
 from alte.mappers import registry
 from alte.paths import realdata_dir
-from bench.core import BenchConfig, Context, Result
+from bench.core import BenchSettings, Context, Result
 from bench.output import format_value, miss_note, render_markdown, write_outputs
 from bench.runner import ROWS, run_bench, select_rows
 from bench.scaling import predicted_seconds, whole_scans
@@ -113,16 +113,16 @@ def test_whole_scans_keeps_scans_whole_and_tiles_the_mission():
 
 def test_config_and_row_selection_errors():
     with pytest.raises(ParameterError, match="frames=0"):
-        BenchConfig(frames=0)
+        BenchSettings(frames=0)
     with pytest.raises(ParameterError, match="sizes"):
-        BenchConfig(sizes=(1, 10))
+        BenchSettings(sizes=(1, 10))
     with pytest.raises(ParameterError, match="budget_s"):
-        BenchConfig(budget_s=0)
+        BenchSettings(budget_s=0)
     with pytest.raises(ParameterError, match=r"unknown row\(s\) \[99\]"):
         select_rows([1, 99])
     assert select_rows(None) == sorted(ROWS) == list(range(1, 16))
-    assert BenchConfig(quick=True).scaling_sizes == (3000, 6000, 12000)
-    assert BenchConfig().scaling_sizes[-1] == 10**7
+    assert BenchSettings(quick=True).scaling_sizes == (3000, 6000, 12000)
+    assert BenchSettings().scaling_sizes[-1] == 10**7
 
 
 def test_thesis_total_and_stage_shares():
@@ -135,7 +135,7 @@ def test_thesis_total_and_stage_shares():
 
 
 def test_row8_reads_the_latest_report_record_or_says_not_run(tmp_path):
-    ctx = Context(BenchConfig(reports_dir=tmp_path))
+    ctx = Context(BenchSettings(reports_dir=tmp_path))
     (missing,) = report_wall_time(ctx)
     assert missing.detail["status"] == "not run" and math.isnan(missing.ours)
     run_dir = tmp_path / "runs" / "20240101T000000Z"
@@ -160,7 +160,7 @@ def test_row8_holds_a_full_report_to_its_budget_in_cpu_seconds(tmp_path, mode, c
                            "cpu_s": cpu_s, "load_average": {"start": 9.0, "end": 12.0},
                            "runs": []})
     point_latest(tmp_path, run_dir)
-    wall, budget = report_wall_time(Context(BenchConfig(reports_dir=tmp_path)))
+    wall, budget = report_wall_time(Context(BenchSettings(reports_dir=tmp_path)))
     assert wall.ours == 2000.0
     assert (budget.ours, budget.peer, budget.met) == (cpu_s / 2, 600.0, met)
     assert budget.detail["load_average"] == {"start": 9.0, "end": 12.0}
@@ -171,7 +171,7 @@ def test_a_failing_row_is_recorded_and_the_others_still_run(monkeypatch, tmp_pat
         raise ValueError("boom")
 
     monkeypatch.setitem(ROWS, 99, ("broken", broken))
-    bench = run_bench(BenchConfig(reports_dir=tmp_path, progress=False), [8, 99])
+    bench = run_bench(BenchSettings(reports_dir=tmp_path, progress=False), [8, 99])
     assert "ValueError: boom" in bench.errors[99]
     assert [r.row for r in bench.results] == [8]
     assert "Rows that failed" in render_markdown(bench)
@@ -193,7 +193,7 @@ def test_formatting_and_miss_notes():
 def quick_bench(tmp_path_factory):
     """Every row on a few simulated scans, one repeat, no warm-up."""
     root = tmp_path_factory.mktemp("bench")
-    config = BenchConfig(quick=True, repeats=1, warmup=0, frames=3, sizes=(3000, 12000),
+    config = BenchSettings(quick=True, repeats=1, warmup=0, frames=3, sizes=(3000, 12000),
                          data_dir=root / "data", reports_dir=root / "reports", progress=False)
     return run_bench(config)
 

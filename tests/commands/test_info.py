@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from alte.cli import main
-from alte.io.bags.writer import write_bag
+from alte.io.bags.writer import BagSettings, write_bag
 from alte.types import thesis_mount
 
 NS = 1_000_000_000
@@ -21,7 +21,7 @@ def bag(tmp_path):
     pos = np.zeros((21, 3))
     quat = np.tile([0.0, 0.0, 0.0, 1.0], (21, 1))
     return write_bag(tmp_path / "bag", clouds, stamps, pos, quat, thesis_mount(),
-                     cloud_topic="/lidar", pose_topic="/vicon")
+                     BagSettings(cloud_topic="/lidar", pose_topic="/vicon"))
 
 
 def test_info_json(bag, capsys):

@@ -14,7 +14,7 @@ from alte.commands.options import parse_box
 from alte.commands.register import format_counts
 from alte.errors import ParameterError
 from alte.io import read_frames, write_frames
-from alte.io.bags.bag import ReadCounts, ReadOptions
+from alte.io.bags.bag import ReadCounts, ReadSettings
 from alte.io.points.pointfiles import read_points, read_points_info
 from alte.paths import realdata_dir
 from alte.pipeline import InputKind, Source
@@ -56,14 +56,14 @@ def fake_io(monkeypatch):
     calls: dict[str, object] = {}
 
     class Stream:
-        def __init__(self, path, **kwargs):
-            calls["read"] = (path, kwargs)
+        def __init__(self, path, options, **kwargs):
+            calls["read"] = (path, options, kwargs)
             self.mount = kwargs["mount"] or mount
             self.scans = self.selected = len(frames)
             self.notes: list[str] = []
             self.counts = ReadCounts(scans_read=len(frames))
             self.track = object()  # a recorded pose stream: the frames keep their poses
-            self.options = ReadOptions()  # read as FrameStream reads (deskew's gap limit)
+            self.options = options  # read as FrameStream reads (deskew's gap limit)
 
         def __iter__(self):
             return iter(frames)
@@ -84,9 +84,9 @@ def test_command_passes_options_and_prints_counts(tmp_path, capsys, fake_io):
     argv = ["register", "bag", "--out", str(out), "--max-rate", "1", "--cloud-topic", "/c",
             "--pose-topic", "/p", "--mount", "0,0,0,0,0,90"]
     assert main(argv) == 0
-    path, kwargs = fake_io["read"]
+    path, options, kwargs = fake_io["read"]
     assert str(path) == "bag"
-    assert (kwargs["cloud_topic"], kwargs["pose_topic"], kwargs["progress"]) == ("/c", "/p", True)
+    assert (options.cloud_topic, options.pose_topic, options.progress) == ("/c", "/p", True)
     np.testing.assert_allclose(kwargs["mount"].quaternion, Mount.from_string(
         "0,0,0,0,0,90").quaternion)
     written = fake_io["write"]
@@ -103,9 +103,9 @@ def test_command_passes_options_and_prints_counts(tmp_path, capsys, fake_io):
     (["--crop", "1,2,3"], "--crop '1,2,3': expected 6 numbers"),
     (["--crop", "a,b,c,d,e,f"], "expected 6 numbers"),
     (["--crop", "1,1,1,0,0,0"], "min must be <= max"),
-    (["--voxel", "0"], "--voxel 0.0: must be > 0"),
-    (["--max-offset", "-1"], "--max-offset -1.0: must be > 0"),
-    (["--mount", "1,2"], "--mount '1,2'"),
+    (["--voxel", "0"], "--voxel: frame spec: voxel=0.0 out of range (voxel > 0, finite)"),
+    (["--max-offset", "-1"], "--max-offset: frame spec: max_offset=-1.0 out of range"),
+    (["--mount", "1,2"], "--mount: mount '1,2': expected 6 numbers"),
     (["--out", "c.png"], "unknown point file type"),
 ])
 def test_bad_options_fail_before_reading(tmp_path, capsys, fake_io, extra, match):
@@ -151,7 +151,7 @@ def test_register_real_ros1_bag_without_poses(tmp_path, capsys):
         pytest.skip(f"{bag} absent")
     out = tmp_path / "luminar.pcd"
     assert main(["register", str(bag), "--out", str(out), "--voxel", "0.5", "--no-pose"]) == 0
-    frames = read_frames(bag, pose_topic="", allow_no_pose=True)
+    frames = read_frames(bag, ReadSettings(pose_topic="", allow_no_pose=True))
     raw = np.vstack([register_frame(f, frames.mount) for f in frames.frames])
     expected = grid_average(raw, 0.5)
     got = read_points(out)

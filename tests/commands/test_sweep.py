@@ -84,8 +84,8 @@ def test_evidence_is_not_written_while_runs_fail(spec_file, tmp_path, capsys, mo
 
 @pytest.mark.parametrize(("args", "message"), [
     (["--frames", "0"], "sweep: frames=0 out of range (frames >= 1)"),
-    (["--scheduler", "mars"], "--scheduler 'mars': expected serial"),
-    (["--workers", "0"], "--workers 0: must be at least 1"),
+    (["--scheduler", "mars"], "--scheduler: sweep: scheduler='mars': expected serial"),
+    (["--workers", "0"], "--workers: sweep: workers=0 out of range (workers >= 1)"),
     (["--seeds", "-1"], "sweep: seeds=[-1] out of range (a non-empty list of integers >= 0)"),
 ])
 def test_bad_options_are_one_line_errors(spec_file, capsys, args, message):

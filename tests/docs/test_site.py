@@ -156,7 +156,7 @@ def test_settings_tables_list_every_mapper_setting(site: Path) -> None:
     text = _text(site / "reference" / "settings.html")
     mappers = registry.classes()  # the thesis' four and the installed plugins
     missing = [f"{cls.name}.{field}" for cls in mappers
-               for field in cls.Params.names() if field not in text]
+               for field in cls.Settings.names() if field not in text]
     assert missing == [] and "gyro_noise" in text and "imu_hz" in text
     assert page.count("<table") >= len(mappers) + 9  # rendered tables, not reST as text
     assert "list-table" not in text and ":class:" not in text

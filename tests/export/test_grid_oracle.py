@@ -13,7 +13,7 @@ import numpy as np
 from support.mcapfiles import read_back
 
 from alte.export import McapFile
-from alte.export.run import ExportOptions, MapExporter
+from alte.export.run import ExportSettings, MapExporter
 from alte.mappers import Cells, Mapper
 from alte.types import RegisteredFrame
 
@@ -47,7 +47,7 @@ class HandMap:
 
 def _export(path: Path) -> dict[str, list[tuple[int, object]]]:
     with McapFile(path) as out:
-        exporter = MapExporter(out, ExportOptions(scans=False))
+        exporter = MapExporter(out, ExportSettings(scans=False))
         for stamp in (5_000_000_000, 6_000_000_000):
             exporter.frame(RegisteredFrame(stamp, np.empty((0, 3)), np.zeros(3),
                                            np.array([4.0, 3.0, 20.0]),

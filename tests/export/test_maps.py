@@ -20,7 +20,7 @@ from alte.export.grids import (
 )
 from alte.export.maps import CUBE_LIST, DELETEALL, cell_markers, octomap_msg, shown_cells
 from alte.export.rosmsg import typestore
-from alte.ground.surface import SurfaceRule
+from alte.ground.surface import OccupancySettings
 from alte.mappers import Cells, Octomap
 from alte.mappers.octomap import read_bt
 
@@ -68,14 +68,14 @@ def flat_with_a_box(size: int = 40) -> Cells:
 
 @pytest.mark.parametrize("ground", ["local", "plane"])
 def test_occupancy_tells_landable_ground_from_obstacles_and_slopes(ground: str) -> None:
-    grid = raster(flat_with_a_box(), np.zeros(3), rule=SurfaceRule(ground=ground))
+    grid = raster(flat_with_a_box(), np.zeros(3), rule=OccupancySettings(ground=ground))
     occ = grid.occupancy
     assert occ[20, 20] == -1 and (occ == -1).sum() == 1
     assert (occ[8:12, 8:12] == 100).all()  # the box
     assert occ[30, 20] == 0 and occ[5, 25] == 0  # open flat ground
     assert (occ[:, 34:] == 100).all()  # the 30 deg ramp
     assert (occ[20, 21:23] == 0).all()  # an unknown neighbour does not spoil flat ground
-    steep = raster(flat_with_a_box(), np.zeros(3), rule=SurfaceRule(max_slope_deg=45.0))
+    steep = raster(flat_with_a_box(), np.zeros(3), rule=OccupancySettings(max_slope_deg=45.0))
     assert (steep.occupancy[:, 34:] == 0).all()  # a steeper vehicle limit frees the ramp
 
 

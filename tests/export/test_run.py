@@ -10,13 +10,13 @@ import pytest
 from support.mcapfiles import container, read_back
 
 from alte.errors import AlteError, ParameterError
-from alte.export import TOPICS, ExportOptions, export_map, export_registered
+from alte.export import TOPICS, ExportSettings, export_map, export_registered
 from alte.export.grids import height_colours, raster
 from alte.export.maps import shown_cells
 from alte.io.bags.reader import open_bag, topic_table
 from alte.mappers import Feed
 from alte.mappers.octomap import read_bt
-from alte.pipeline import FrameSpec, MapSpec, open_input, prepare
+from alte.pipeline import FrameSettings, MapSettings, open_input, prepare
 from alte.sim import ensure_terrain
 
 FRAMES = 8
@@ -31,8 +31,8 @@ def terrains(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
 def test_octomap_run_on_sim_nav_1_reads_back(terrains: dict[str, Path], tmp_path: Path) -> None:
     target = tmp_path / "nav.mcap"
     result, counts = export_map(open_input(terrains["sim_nav_1"]), target,
-                                MapSpec("octomap", {"resolution": 1.0}),
-                                options=ExportOptions(timeline=4))
+                                MapSettings("octomap", {"resolution": 1.0}),
+                                options=ExportSettings(timeline=4))
     table, messages = read_back(target)
     expected = {"/alte/scan": FRAMES, "/alte/pose": FRAMES, "/tf": FRAMES,
                 "/alte/map/cells": 3, "/alte/map/octomap": 3, "/alte/map/occupancy": 3,
@@ -69,7 +69,7 @@ def test_octomap_run_on_sim_nav_1_reads_back(terrains: dict[str, Path], tmp_path
 def test_alte2d_run_on_sim_lan_2_reads_back(terrains: dict[str, Path], tmp_path: Path) -> None:
     target = tmp_path / "lan.mcap"
     result, _ = export_map(open_input(terrains["sim_lan_2"]), target,
-                           MapSpec("alte2d", {"max_res": 5}))
+                           MapSettings("alte2d", {"max_res": 5}))
     table, messages = read_back(target)
     start = min(stamp for topic in messages for stamp, _ in messages[topic])
     assert start == result.log.stamps[0]
@@ -113,8 +113,9 @@ def test_shifted_map_gets_a_local_frame_and_alte_reads_its_own_file(tmp_path: Pa
     cloud = tmp_path / "utm.npz"
     np.savez(cloud, points=points)
     target = tmp_path / "utm.mcap"
-    result, counts = export_map(open_input(cloud), target, MapSpec("octomap", {"resolution": 1.0}),
-                                FrameSpec(origin=(500_010.0, 5_400_010.0, 110.0)))
+    result, counts = export_map(open_input(cloud), target,
+                                MapSettings("octomap", {"resolution": 1.0}),
+                                FrameSettings(origin=(500_010.0, 5_400_010.0, 110.0)))
     assert counts["/tf_static"] == 1 and any(result.info.local_origin)
     _, messages = read_back(target)
     assert messages["/tf_static"][0][0] == messages["/alte/pose"][0][0]  # at the start
@@ -131,7 +132,7 @@ def test_shifted_map_gets_a_local_frame_and_alte_reads_its_own_file(tmp_path: Pa
 def test_registration_export_and_refusals(terrains: dict[str, Path], tmp_path: Path) -> None:
     reg = prepare(open_input(terrains["sim_lan_2"]))
     target = tmp_path / "reg.mcap"
-    counts = export_registered(reg, target, options=ExportOptions(scans=False))
+    counts = export_registered(reg, target, options=ExportSettings(scans=False))
     assert counts == {"/alte/pose": FRAMES, "/tf": FRAMES, "/alte/trajectory": 2,
                       "/alte/cloud": 2}
     size = target.stat().st_size
@@ -140,8 +141,8 @@ def test_registration_export_and_refusals(terrains: dict[str, Path], tmp_path: P
     assert target.stat().st_size == size
     assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]
     with pytest.raises(ParameterError, match=r"export: timeline=0 out of range \(timeline >= 1\)"):
-        ExportOptions(timeline=0)
+        ExportSettings(timeline=0)
     with pytest.raises(ParameterError, match="export: a timeline needs feed=frames"):
-        export_map(reg, tmp_path / "q.mcap", MapSpec("quadtree", feed=Feed.BATCH),
-                   options=ExportOptions(timeline=2))
+        export_map(reg, tmp_path / "q.mcap", MapSettings("quadtree", feed=Feed.BATCH),
+                   options=ExportSettings(timeline=2))
     assert not (tmp_path / "q.mcap").exists()

@@ -14,6 +14,7 @@ from alte.ground.plane import (
     obstacle_mask,
 )
 from alte.io import read_frames
+from alte.io.bags.bag import ReadSettings
 from alte.paths import realdata_dir
 from alte.registration import grid_average
 
@@ -152,7 +153,7 @@ def test_msac_on_real_luminar_scans_matches_open3d():
     bag = REALDATA / "ros1_bag" / "test.bag"
     if not bag.exists():
         pytest.skip(f"{bag} absent")
-    frames = read_frames(bag, pose_topic="", allow_no_pose=True)
+    frames = read_frames(bag, ReadSettings(pose_topic="", allow_no_pose=True))
     pts = grid_average(np.vstack([f.points for f in frames.frames]), 0.5)[::4]
     ours = fit_plane_msac(pts, threshold=0.15)
     theirs = fit_plane_open3d(pts, threshold=0.15)

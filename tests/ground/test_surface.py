@@ -7,7 +7,7 @@ import pytest
 
 from alte.errors import ParameterError
 from alte.ground.surface import (
-    SurfaceRule,
+    OccupancySettings,
     classify_surface,
     local_ground,
     pixel_centres,
@@ -35,7 +35,7 @@ def xy(size: float = 60.0) -> tuple[np.ndarray, np.ndarray]:
 ])
 def test_rule_is_validated(given: dict[str, object], match: str) -> None:
     with pytest.raises(ParameterError, match=match):
-        SurfaceRule.parse(given)
+        OccupancySettings.parse(given)
 
 
 def test_flat_ground_a_roof_and_a_hole() -> None:
@@ -45,7 +45,7 @@ def test_flat_ground_a_roof_and_a_hole() -> None:
     height[roof] = 5.0
     height[(np.abs(x - 45) < 1) & (np.abs(y - 45) < 1)] = np.nan
     for ground in ("plane", "local"):
-        surface = classify_surface(height, (0.0, 0.0), STEP, SurfaceRule(ground=ground))
+        surface = classify_surface(height, (0.0, 0.0), STEP, OccupancySettings(ground=ground))
         occ = surface.occupancy()
         assert (occ[np.isnan(height)] == -1).all() and (occ[~np.isnan(height)] >= 0).all()
         assert surface.obstacle[roof].all() and (occ[roof] == 100).all()
@@ -59,7 +59,7 @@ def test_the_local_ground_follows_a_hill_that_a_plane_cannot() -> None:
     height = 3.5 * np.exp(-((x - 30) ** 2 + (y - 30) ** 2) / (2 * 15.0**2))
     assert np.nanmax(plane_features(height, STEP, 1.5).slope_deg) < 10
     local = classify_surface(height, (0.0, 0.0), STEP)
-    plane = classify_surface(height, (0.0, 0.0), STEP, SurfaceRule(ground="plane"))
+    plane = classify_surface(height, (0.0, 0.0), STEP, OccupancySettings(ground="plane"))
     assert local.free.all()
     assert plane.obstacle.mean() > 0.3  # the hill's top half stands off any one plane
     box = height.copy()
@@ -72,7 +72,7 @@ def test_the_filter_ground_follows_the_hill_and_flags_the_box() -> None:
     and a 3 m roof beside it are obstacles."""
     x, y = xy()
     height = 3.5 * np.exp(-((x - 30) ** 2 + (y - 30) ** 2) / (2 * 15.0**2))
-    rule = SurfaceRule(ground="filter")
+    rule = OccupancySettings(ground="filter")
     assert classify_surface(height, (0.0, 0.0), STEP, rule).free.all()
     box = height.copy()
     box[(np.abs(x - 30) < 2) & (np.abs(y - 30) < 2)] += 1.0
@@ -106,14 +106,14 @@ def test_local_ground_on_the_isprs_samples() -> None:
     samp21 (hilly) an obstacle; the local ground a few percent, and both leave the cells
     where most returns are not ground occupied."""
     from alte.export.grids import raster
-    from alte.pipeline import MapSpec, open_input, run
+    from alte.pipeline import MapSettings, open_input, run
 
     cloud = REALDATA / "samp21-utm.pcd"
     if not cloud.exists():
         pytest.skip(f"{cloud} absent")
     pts, ground = read_points(cloud), read_points(REALDATA / "samp21-utm-ground.pcd")
     is_ground = np.isin(_rows(pts), _rows(ground))
-    grid = raster(run(open_input(cloud), MapSpec("alte2d", {"max_res": 7})).mapper.cells(),
+    grid = raster(run(open_input(cloud), MapSettings("alte2d", {"max_res": 7})).mapper.cells(),
                   np.zeros(3))
     ij = np.floor((pts[:, :2] - grid.origin) / grid.resolution).astype(int)
     flat = np.clip(ij[:, 1], 0, grid.shape[0] - 1) * grid.shape[1] + \
@@ -126,7 +126,7 @@ def test_local_ground_on_the_isprs_samples() -> None:
     assert bare.sum() > 5000 and objects.sum() > 1000
     local = classify_surface(grid.height, grid.origin, grid.resolution)
     plane = classify_surface(grid.height, grid.origin, grid.resolution,
-                             SurfaceRule(ground="plane"))
+                             OccupancySettings(ground="plane"))
     assert plane.obstacle[bare].mean() > 0.4 and local.obstacle[bare].mean() < 0.1
     assert local.occupied[objects].mean() > 0.97 and plane.occupied[objects].mean() > 0.97
     gentle = bare & (local.slope_deg <= 10)

@@ -9,7 +9,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from alte.errors import ParameterError, TopicError
-from alte.io.bags.bag import read_frames
+from alte.io.bags.bag import ReadSettings, read_frames
 from alte.io.bags.pointcloud2 import encode_pointcloud2
 from alte.io.poses.tum import write_tum
 
@@ -44,12 +44,12 @@ def test_pose_file_replaces_the_pose_topic(ros, tmp_path: Path) -> None:
     stamps = 10 * ros.NS + np.arange(0, 21) * (ros.NS // 100)
     pos, quat = ros.trajectory(stamps)
     tum = write_tum(tmp_path / "poses.txt", stamps, pos, quat)
-    fs = read_frames(bag, pose_file=tum)
+    fs = read_frames(bag, ReadSettings(pose_file=tum))
     assert fs.pose_topic == str(tum) and len(fs) == 2
     expect, _ = ros.trajectory(np.array([fs.frames[1].stamp]))
     assert np.allclose(fs.frames[1].position, expect[0], atol=1e-6)
-    with pytest.raises(ParameterError, match="--pose-file and --pose-topic exclude each other"):
-        read_frames(bag, pose_file=tum, pose_topic="/points")
+    with pytest.raises(ParameterError, match="read: pose_file and pose_topic exclude each other"):
+        read_frames(bag, ReadSettings(pose_file=tum, pose_topic="/points"))
 
 
 def test_per_point_time_reaches_the_frame(ros, tmp_path: Path) -> None:

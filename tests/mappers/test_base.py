@@ -40,7 +40,7 @@ def test_every_mapper_declares_its_capabilities(name):
     assert cls.dims in (2, 3) and isinstance(cls.incremental, bool)
     assert isinstance(cls.domain_use, DomainUse) and isinstance(cls.default_feed, Feed)
     assert ".npz" in cls.exports and isinstance(cls.free_space, bool)
-    assert mapper.points_outside == 0 and mapper.params == cls.Params()
+    assert mapper.points_outside == 0 and mapper.params == cls.Settings()
     assert isinstance(cls.cost_unit, Cost) and mapper.cost == 0
 
 

@@ -87,7 +87,7 @@ def _in_feet(self: MapperBase[_Params]) -> Cells:
     ({"settings_grid": {"cell": (0.0,)}}, r"settings_grid\['cell'\]: meangrid: cell=0\.0 "
                                           r"out of range"),
     ({"settings_grid": {"size": (1,)}}, r"settings_grid names 'size', not a parameter"),
-    ({"Params": dict}, r"Params must be a alte\.params\.Record dataclass"),
+    ({"Settings": dict}, r"Settings must be a alte\.params\.Record dataclass"),
     ({"cells": _wrong_cells}, r"cells\(\)\.centers is float64 \(\d+, 2\), expected"),
     ({"layers": frozenset({VARIANCE}), "cells": _no_layer},
      r"cells\(\)\.layers has \[\], the class declares layers=\['variance'\]"),

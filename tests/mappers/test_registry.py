@@ -12,7 +12,7 @@ import pytest
 from alte.cli import main
 from alte.errors import ContractError, MapperError
 from alte.mappers import registry
-from alte.pipeline import MapSpec
+from alte.pipeline import MapSettings
 
 ROOT = Path(__file__).parents[2]
 EXAMPLES = ROOT / "docs" / "examples"
@@ -64,7 +64,7 @@ def test_found_by_entry_point_and_loaded_on_use(plugin_path: Path) -> None:
     entry = next(e for e in registry.entries() if e.name == "fakemap")
     assert (entry.origin, entry.target, entry.builtin) == ("fake-alte-plugin 0.3",
                                                            "fakeplugin:Fake", False)
-    spec = MapSpec("fakemap", {"cell": "0.5"})
+    spec = MapSettings("fakemap", {"cell": "0.5"})
     assert spec.cls.__name__ == "Fake" and spec.record.as_dict() == {"cell": 0.5}
     assert registry.title("fakemap") == "Fake map" and registry.title("gone") == "gone"
 
@@ -134,3 +134,51 @@ def test_names_are_resolved_in_the_registry_only() -> None:
     found = {str(p.relative_to(ROOT)) for p in (ROOT / "alte").rglob("*.py")
              if lookups.search(p.read_text())}
     assert found <= BOUNDARIES, found - BOUNDARIES
+
+
+V1_MODULE = '''
+from dataclasses import dataclass
+from typing import ClassVar
+
+from mean_grid import MeanGrid
+from alte.mappers.api import Record, param
+
+
+@dataclass(frozen=True)
+class OldGridParams(Record):
+    OWNER: ClassVar[str] = "oldgrid"
+    cell: float = param(1.0, lambda v: v > 0, "cell > 0")
+
+
+class OldGrid(MeanGrid):
+    """Written against contract v1 as first documented: its record is named Params."""
+
+    name = "oldgrid"
+    title = "Old grid"
+    Params = OldGridParams
+'''
+
+
+def test_a_v1_plugin_naming_its_record_params_still_loads(plugin_path: Path) -> None:
+    (plugin_path / "oldplugin.py").write_text(V1_MODULE)
+    try:
+        with pytest.warns(DeprecationWarning, match=r"OldGrid: the settings record is named "
+                                                    r"Settings now; Params .* deprecated"):
+            cls = registry.MapperEntry("oldgrid", "oldplugin:OldGrid", "test").load()
+        assert cls.Settings is cls.Params and cls.Settings.__name__ == "OldGridParams"
+        assert registry.create(cls, {"cell": "2"}).params.cell == 2.0
+    finally:
+        sys.modules.pop("oldplugin", None)
+
+
+def test_the_first_names_of_the_settings_records_still_import() -> None:
+    from alte.mappers import alte2d, quadtree
+
+    with pytest.warns(DeprecationWarning, match=r"quadtree.QuadtreeParams is deprecated; "
+                                                r"use QuadtreeSettings"):
+        old = quadtree.QuadtreeParams
+    assert old is quadtree.QuadtreeSettings and quadtree.Quadtree.Params is old
+    with pytest.warns(DeprecationWarning, match="Alte2DSettings"):
+        from alte.mappers.alte2d import Alte2DParams  # noqa: F401
+    with pytest.raises(AttributeError, match="no attribute 'NoSuch'"):
+        alte2d.NoSuch  # noqa: B018

@@ -8,12 +8,19 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from alte.pipeline import FrameSpec, PoseSource, StreamCounts, open_input, posecache, stream_frames
-from alte.registration.odometry import OdometryParams
+from alte.pipeline import (
+    FrameSettings,
+    PoseSource,
+    StreamCounts,
+    open_input,
+    posecache,
+    stream_frames,
+)
+from alte.registration.odometry import OdometrySettings
 from alte.types import RegisteredFrame
 
 
-def _run(folder: Path, spec: FrameSpec, cache: Path | None,
+def _run(folder: Path, spec: FrameSettings, cache: Path | None,
          ) -> tuple[list[RegisteredFrame], StreamCounts]:
     source = open_input(folder)
     counts = StreamCounts()
@@ -34,7 +41,7 @@ def test_lio_poses_are_aligned_once_and_read_back_for_another_selection(
     """The first run (2 of 4 scans kept) aligns every scan and keeps them; a whole-mission
     run then reads them, and both give what an uncached run gives, counts included."""
     cache = tmp_path / "poses"
-    spec = FrameSpec(poses=PoseSource.ODOMETRY, odometry=OdometryParams(method="lio"))
+    spec = FrameSettings(poses=PoseSource.ODOMETRY, odometry=OdometrySettings(method="lio"))
     some, first = _run(uav, replace(spec, frames=2), cache)
     assert len(list(cache.iterdir())) == 1
     every, again = _run(uav, spec, cache)
@@ -54,8 +61,8 @@ def test_the_key_follows_the_settings_the_input_and_the_code(
     """Other odometry settings, another input or other odometry code: another key; the
     frame selection, crop and voxel (registration, after the poses) keep it."""
     identity = open_input(terrain).identity
-    spec = FrameSpec(poses=PoseSource.ODOMETRY)
-    params = OdometryParams(method="kiss")
+    spec = FrameSettings(poses=PoseSource.ODOMETRY)
+    params = OdometrySettings(method="kiss")
     key = posecache.pose_key(identity, spec, params)
     assert posecache.pose_key(identity, replace(spec, frames=2, voxel=0.5), params) == key
     assert posecache.pose_key(identity, spec, replace(params, window=0)) != key
@@ -69,7 +76,7 @@ def test_an_unfinished_run_leaves_no_cache(terrain: Path, tmp_path: Path) -> Non
     """A consumer that stops early (a killed run) keeps nothing: only a run that posed
     every scan is cached, and the next run aligns again."""
     cache = tmp_path / "poses"
-    spec = FrameSpec(poses=PoseSource.ODOMETRY, odometry=OdometryParams(method="kiss"))
+    spec = FrameSettings(poses=PoseSource.ODOMETRY, odometry=OdometrySettings(method="kiss"))
     source = open_input(terrain)
     frames = stream_frames(source, source.resolve(spec), StreamCounts(), pose_cache=cache)
     next(frames)
@@ -86,7 +93,7 @@ def test_a_cache_that_lacks_a_scan_is_refused(terrain: Path, tmp_path: Path) -> 
     from alte.errors import PoseError
 
     cache = tmp_path / "poses"
-    spec = FrameSpec(poses=PoseSource.ODOMETRY, odometry=OdometryParams(method="kiss"))
+    spec = FrameSettings(poses=PoseSource.ODOMETRY, odometry=OdometrySettings(method="kiss"))
     _run(terrain, spec, cache)
     (folder,) = cache.iterdir()
     with np.load(folder / "arrays.npz") as arrays:

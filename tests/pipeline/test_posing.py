@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from alte.io.bags.bag import evenly_spaced
-from alte.pipeline import FrameSpec, PoseSource, StreamCounts, open_input, stream_frames
+from alte.pipeline import FrameSettings, PoseSource, StreamCounts, open_input, stream_frames
 
 
 def test_odometry_reads_every_scan_and_registers_the_selected_ones(terrain: Path) -> None:
@@ -16,7 +16,7 @@ def test_odometry_reads_every_scan_and_registers_the_selected_ones(terrain: Path
     only the evenly spaced ones it selects go on, posed as in a run over all of them."""
     source = open_input(terrain / "bag")
     every, picked = StreamCounts(), StreamCounts()
-    spec = FrameSpec(poses=PoseSource.ODOMETRY)
+    spec = FrameSettings(poses=PoseSource.ODOMETRY)
     full = list(stream_frames(source, source.resolve(spec), every))
     some = list(stream_frames(source, source.resolve(replace(spec, frames=2)), picked))
     assert (picked.scans, picked.selected, picked.read.frames, picked.poses.frames) == (4, 2, 4, 4)
@@ -37,7 +37,7 @@ def test_odometry_keeps_scans_as_taken_with_no_deskew(uav: Path) -> None:
     first = {}
     for deskew, deskewed in ((True, 4), (False, 0)):
         counts = StreamCounts()
-        spec = FrameSpec(poses=PoseSource.ODOMETRY, deskew=deskew)
+        spec = FrameSettings(poses=PoseSource.ODOMETRY, deskew=deskew)
         frames = list(stream_frames(source, source.resolve(spec), counts))
         assert (counts.poses.method, counts.poses.deskewed, len(frames)) == ("lio", deskewed, 4)
         first[deskew] = frames[0]

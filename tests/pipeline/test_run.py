@@ -15,8 +15,8 @@ from alte.mappers.domain import Domain
 from alte.pipeline import (
     DomainChoice,
     DomainPolicy,
-    FrameSpec,
-    MapSpec,
+    FrameSettings,
+    MapSettings,
     open_input,
     prepare,
     run,
@@ -36,10 +36,10 @@ def _same_map(a, b) -> None:
 
 @pytest.mark.parametrize("mapper", sorted(PARAMS))
 def test_streamed_run_equals_the_prepared_one(terrain: Path, tmp_path: Path, mapper: str) -> None:
-    spec = MapSpec(mapper, PARAMS[mapper])
-    live = run(terrain, spec, FrameSpec(frames=3))
-    prepared = run(prepare(open_input(terrain), FrameSpec(frames=3)), spec)
-    cached = run(terrain, spec, FrameSpec(frames=3), cache=tmp_path)
+    spec = MapSettings(mapper, PARAMS[mapper])
+    live = run(terrain, spec, FrameSettings(frames=3))
+    prepared = run(prepare(open_input(terrain), FrameSettings(frames=3)), spec)
+    cached = run(terrain, spec, FrameSettings(frames=3), cache=tmp_path)
     _same_map(live, prepared)
     _same_map(live, cached)
     assert live.info.domain == prepared.info.domain
@@ -63,31 +63,31 @@ def test_domain_policies(terrain: Path, bag: Path) -> None:
     # sim_lan_1's control volume (scenario.json crop_box): x, y in [-35, 35], z in [-1, 12]
     crop = json.loads((terrain / "scenario.json").read_text())["crop_box"]
     assert crop == [-35.0, -35.0, -1.0, 35.0, 35.0, 12.0]
-    on_terrain = run(terrain, MapSpec("alte2d"), FrameSpec(frames=2))
+    on_terrain = run(terrain, MapSettings("alte2d"), FrameSettings(frames=2))
     assert on_terrain.info.domain_policy is DomainChoice.CONTROL
     assert _as_list(on_terrain.info.domain) == pytest.approx([-35.0, -35.0, -1.0, 70.0],
                                                              rel=1e-8)
-    on_bag = run(bag, MapSpec("alte2d"), FrameSpec(frames=2))
+    on_bag = run(bag, MapSettings("alte2d"), FrameSettings(frames=2))
     assert on_bag.info.domain_policy == "data"
-    reg = prepare(open_input(bag), FrameSpec(frames=2))
+    reg = prepare(open_input(bag), FrameSettings(frames=2))
     expected = _cube(reg.points.min(axis=0), reg.points.max(axis=0))
     assert _as_list(on_bag.info.domain) == pytest.approx(expected, rel=1e-8)
     assert on_bag.mapper.points_outside == 0
     explicit = Domain(-50.0, -50.0, -5.0, 100.0)
-    chosen = run(terrain, MapSpec("alte3d", domain=explicit), FrameSpec(frames=2))
+    chosen = run(terrain, MapSettings("alte3d", domain=explicit), FrameSettings(frames=2))
     assert (chosen.info.domain, chosen.info.domain_policy) == (explicit, "explicit")
-    octo = run(terrain, MapSpec("octomap", PARAMS["octomap"]), FrameSpec(frames=2))
+    octo = run(terrain, MapSettings("octomap", PARAMS["octomap"]), FrameSettings(frames=2))
     assert octo.info.domain_policy is DomainChoice.NONE
     assert octo.summary()["domain_policy"] == "none (fixed key space)"
     with pytest.raises(ParameterError, match="domain policy 'control': the input has no "
                                              "control volume"):
-        run(bag, MapSpec("alte2d", domain=DomainPolicy.CONTROL), FrameSpec(frames=2))
+        run(bag, MapSettings("alte2d", domain=DomainPolicy.CONTROL), FrameSettings(frames=2))
 
 
 def test_quadtree_fed_by_frames_equals_its_batch_build(terrain: Path) -> None:
-    reg = prepare(open_input(terrain), FrameSpec(frames=3))
-    batch = run(reg, MapSpec("quadtree", PARAMS["quadtree"], feed=Feed.BATCH))
-    frames = run(reg, MapSpec("quadtree", PARAMS["quadtree"], feed=Feed.FRAMES))
+    reg = prepare(open_input(terrain), FrameSettings(frames=3))
+    batch = run(reg, MapSettings("quadtree", PARAMS["quadtree"], feed=Feed.BATCH))
+    frames = run(reg, MapSettings("quadtree", PARAMS["quadtree"], feed=Feed.FRAMES))
     _same_map(batch, frames)
     assert batch.log.insert_s[:-1].sum() == 0 and batch.log.insert_s[-1] > 0
     assert (frames.log.insert_s > 0).all()
@@ -99,7 +99,7 @@ def test_quadtree_fed_by_frames_equals_its_batch_build(terrain: Path) -> None:
 
 
 def test_snapshots_end_with_the_final_map(terrain: Path) -> None:
-    result = run(terrain, MapSpec("alte2d", snapshots=2), FrameSpec(frames=4))
+    result = run(terrain, MapSettings("alte2d", snapshots=2), FrameSettings(frames=4))
     assert [s.frame for s in result.snapshots] == [2, 3]
     assert result.snapshots[-1].basis_functions == result.mapper.basis_functions
     assert (np.diff(result.log.basis_functions) >= 0).all()
@@ -110,18 +110,18 @@ def test_far_coordinates_get_a_local_origin(tmp_path: Path) -> None:
     rng = np.random.default_rng(3)
     points = rng.uniform(0, 20, (500, 3)) + np.array([512_345.0, 5_403_210.0, 300.0])
     path = write_points(tmp_path / "utm.npz", points)
-    above = FrameSpec(origin=(512_355.0, 5_403_220.0, 400.0))
-    result = run(path, MapSpec("octomap", {"resolution": 1.0}), above)
+    above = FrameSettings(origin=(512_355.0, 5_403_220.0, 400.0))
+    result = run(path, MapSettings("octomap", {"resolution": 1.0}), above)
     origin = np.array(result.info.local_origin)
     assert (origin % 1000 == 0).all() and origin[0] == 512_000.0
     centers = result.mapper.cells().centers
     assert len(centers) and np.abs(centers).max() < 2000  # near its local origin
     assert result.mapper.points_outside == 0
-    plain = run(path, MapSpec("alte3d", {"max_res": 4}), above)
+    plain = run(path, MapSettings("alte3d", {"max_res": 4}), above)
     assert plain.info.local_origin == (0.0, 0.0, 0.0)  # a domain of its own: no shift
 
 
 def test_a_prepared_input_fixes_its_frames(terrain: Path) -> None:
-    reg = prepare(open_input(terrain), FrameSpec(frames=2))
+    reg = prepare(open_input(terrain), FrameSettings(frames=2))
     with pytest.raises(ParameterError, match="a prepared registration already fixes"):
-        run(reg, MapSpec("alte2d"), FrameSpec(frames=1))
+        run(reg, MapSettings("alte2d"), FrameSettings(frames=1))

@@ -9,7 +9,7 @@ import pytest
 
 from alte.errors import BagError, PointFileError
 from alte.io.points.pointfiles import write_points
-from alte.pipeline import FrameSpec, InputKind, StreamCounts, open_input, stream_frames
+from alte.pipeline import FrameSettings, InputKind, StreamCounts, open_input, stream_frames
 from alte.sim.scenario import load_metadata
 from alte.types import Box
 
@@ -18,10 +18,10 @@ def test_terrain_folder_brings_its_crop_voxel_and_truth(terrain: Path) -> None:
     source = open_input(terrain)
     meta = load_metadata(terrain)
     assert source.kind is InputKind.TERRAIN and source.bag == terrain / "bag"
-    resolved = source.resolve(FrameSpec())
+    resolved = source.resolve(FrameSettings())
     assert resolved.crop == Box.of(meta["crop_box"])
     assert resolved.voxel == meta["registration_voxel"]
-    assert source.resolve(FrameSpec(voxel=0.5)).voxel == 0.5  # the caller's choice wins
+    assert source.resolve(FrameSettings(voxel=0.5)).voxel == 0.5  # the caller's choice wins
     truth = source.ground_truth()
     assert truth is not None and truth.bounds == resolved.crop
 
@@ -29,7 +29,7 @@ def test_terrain_folder_brings_its_crop_voxel_and_truth(terrain: Path) -> None:
 def test_bag_and_point_file_inputs(bag: Path, tmp_path: Path) -> None:
     source = open_input(bag)
     assert source.kind is InputKind.BAG and source.ground_truth() is None
-    assert source.resolve(FrameSpec()) == FrameSpec()  # no crop or voxel of its own
+    assert source.resolve(FrameSettings()) == FrameSettings()  # no crop or voxel of its own
     cloud = write_points(tmp_path / "c.npz", np.random.default_rng(0).normal(size=(50, 3)))
     assert open_input(cloud).kind is InputKind.POINTS
 
@@ -43,7 +43,7 @@ def test_missing_inputs_are_named(tmp_path: Path) -> None:
 
 def test_frames_stream_one_at_a_time_with_counts(terrain: Path) -> None:
     source = open_input(terrain)
-    spec = source.resolve(FrameSpec(frames=3))
+    spec = source.resolve(FrameSettings(frames=3))
     counts = StreamCounts()
     stream = stream_frames(source, spec, counts)
     first = next(stream)
@@ -61,7 +61,7 @@ def test_point_file_is_one_cropped_frame(tmp_path: Path) -> None:
     path = tmp_path / "c.xyz"
     path.write_text("0 0 0\n5 5 5\nnan 0 0\n")
     counts = StreamCounts()
-    spec = FrameSpec(crop=Box.of((-1, -1, -1, 1, 1, 1)), origin=(0.0, 0.0, 10.0))
+    spec = FrameSettings(crop=Box.of((-1, -1, -1, 1, 1, 1)), origin=(0.0, 0.0, 10.0))
     frames = list(stream_frames(open_input(path), spec, counts))
     assert len(frames) == 1 and frames[0].points.tolist() == [[0.0, 0.0, 0.0]]
     assert frames[0].origin.tolist() == [0.0, 0.0, 10.0]

@@ -5,7 +5,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from alte.io.poses.pose import PoseTrack
-from alte.pipeline import FrameSpec, PoseSource, merged_cloud, open_input
+from alte.pipeline import FrameSettings, PoseSource, merged_cloud, open_input
 from alte.registration.deskew import DeskewCounts, deskew_constant_velocity, deskew_frames
 from alte.sim import load_ground_truth, mesh_distance
 from alte.sim.profile import PROFILES
@@ -23,7 +23,8 @@ def swept(tmp_path_factory):
 
 
 def _mesh_mean(folder, **spec):
-    cloud, counts = merged_cloud(open_input(folder), FrameSpec(poses=PoseSource.RECORDED, **spec))
+    settings = FrameSettings(poses=PoseSource.RECORDED, **spec)
+    cloud, counts = merged_cloud(open_input(folder), settings)
     return float(mesh_distance(cloud, load_ground_truth(folder)).mean()), counts
 
 

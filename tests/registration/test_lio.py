@@ -10,7 +10,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from alte.errors import ParameterError, RegistrationError
-from alte.io.bags.bag import FrameStream
+from alte.io.bags.bag import FrameStream, ReadSettings
 from alte.io.bags.imu import ImuSamples, read_imu
 from alte.metrics.trajectory import trajectory_errors
 from alte.registration.inertial import (
@@ -25,7 +25,7 @@ from alte.registration.inertial import (
 from alte.registration.lio import LioOdometry, LioSettings, check_overlap
 from alte.registration.localmap import LocalMap
 from alte.registration.odometry import (
-    OdometryParams,
+    OdometrySettings,
     PoseCounts,
     lio_settings,
     odometry_frames,
@@ -203,11 +203,11 @@ def test_update_on_flat_ground_keeps_what_the_ground_cannot_see():
 
 
 def test_auto_is_lio_with_an_imu_and_lio_without_one_is_refused():
-    assert OdometryParams().method == "auto"
-    assert resolve_method(OdometryParams(), True).method == "lio"
-    assert resolve_method(OdometryParams(), False).method == "kiss"
+    assert OdometrySettings().method == "auto"
+    assert resolve_method(OdometrySettings(), True).method == "lio"
+    assert resolve_method(OdometrySettings(), False).method == "kiss"
     assert resolve_method(odometry_params("plane"), True).method == "plane"
-    with pytest.raises(ParameterError, match="--odometry lio needs an IMU topic"):
+    with pytest.raises(ParameterError, match="odometry: method=lio needs an IMU topic"):
         list(odometry_frames([], Mount(), counts=PoseCounts(), params=odometry_params("lio")))
     with pytest.raises(ParameterError, match=r"plane_sigma=-1\.0 out of range"):
         odometry_params("lio", {"plane_sigma": "-1"})
@@ -226,7 +226,7 @@ def test_lio_flies_the_first_five_seconds_of_the_uav_mission(uav_mission):
     without that start it had to learn the accelerometer bias while x and y were not
     yet seen, and was 0.95 m off here."""
     bag = uav_mission / "bag"
-    stream = FrameStream(bag, pose_topic="", allow_no_pose=True)
+    stream = FrameStream(bag, ReadSettings(pose_topic="", allow_no_pose=True))
     imu = read_imu(bag)
     truth = true_poses(get_terrain("sim_nav_1"))
     counts = PoseCounts()
@@ -262,7 +262,7 @@ def test_lio_frames_carry_the_scan_the_imu_deskewed(uav_mission):
     from alte.sim import load_ground_truth
 
     bag = uav_mission / "bag"
-    stream = FrameStream(bag, pose_topic="", allow_no_pose=True)
+    stream = FrameStream(bag, ReadSettings(pose_topic="", allow_no_pose=True))
     truth = true_poses(get_terrain("sim_nav_1"))
     mesh = load_ground_truth(uav_mission)
     raw = next(iter(stream))
@@ -278,11 +278,11 @@ def test_the_pipeline_picks_lio_for_a_bag_with_an_imu_and_says_so(tmp_path, caps
     """``--poses odometry`` on the uav profile's bag (it has /imu) runs LIO unasked; on the
     thesis profile's bag (no IMU) KISS-ICP; ``alte register`` prints which."""
     from alte.cli import main
-    from alte.pipeline import FrameSpec, PoseSource, open_input, prepare
+    from alte.pipeline import FrameSettings, PoseSource, open_input, prepare
 
     uav = ensure_terrain("sim_lan_2", tmp_path, frames=3, profile=PROFILES["uav"])
     thesis = ensure_terrain("sim_lan_2", tmp_path, frames=3)
-    spec = FrameSpec(poses=PoseSource.ODOMETRY)
+    spec = FrameSettings(poses=PoseSource.ODOMETRY)
     lio, kiss = (prepare(open_input(f), spec).counts for f in (uav, thesis))
     assert lio.poses.method == "lio" and lio.poses.deskewed == 3
     assert any("LiDAR-inertial odometry (lidar-inertial, IMU imu_link at 200 Hz)" in n
@@ -359,21 +359,18 @@ def test_the_plane_fit_across_rings_and_the_projection_are_odometry_settings():
     assert lio_settings(odometry_params("lio", {"wide_reach": "4"})).wide_reach == 4.0
 
 
-#: LIO settings refused, as ``--odometry METHOD --odometry-set KEY=VALUE``, and the message.
+#: LIO settings refused (``odometry_params(METHOD, {KEY: VALUE})``), and the message.
 REFUSED = [
-    ("lio", "wide_points", "2", r"--odometry-set: odometry: wide_points=2 out of range "
-                                r"\(0 or >= 3\)"),
-    ("lio", "least", "-1", r"--odometry-set: odometry: least=-1.0 out of range \(>= 0\)"),
-    ("kiss", "least", "5", r"--odometry-set least: not a setting of --odometry kiss"),
-    ("lio", "gyro_bias", "0", r"--odometry-set: odometry: gyro_bias=0.0 out of range "
-                              r"\(> 0\)"),
-    ("kiss", "accel_walk", "1e-3", r"--odometry-set accel_walk: not a setting of "
-                                   r"--odometry kiss"),
+    ("lio", "wide_points", "2", r"odometry: wide_points=2 out of range \(0 or >= 3\)"),
+    ("lio", "least", "-1", r"odometry: least=-1.0 out of range \(>= 0\)"),
+    ("kiss", "least", "5", r"odometry: least: not a setting of method=kiss"),
+    ("lio", "gyro_bias", "0", r"odometry: gyro_bias=0.0 out of range \(> 0\)"),
+    ("kiss", "accel_walk", "1e-3", r"odometry: accel_walk: not a setting of method=kiss"),
 ]
 
 
 @pytest.mark.parametrize(("method", "key", "value", "message"), REFUSED)
-def test_lio_settings_out_of_range_or_of_another_backend_are_refused_naming_the_flag(
+def test_lio_settings_out_of_range_or_of_another_backend_are_refused_naming_the_setting(
         method, key, value, message):
     with pytest.raises(ParameterError, match=message):
         odometry_params(method, {key: value})
@@ -453,7 +450,7 @@ def test_settling_at_rest_finds_the_biases_and_the_ground_corrects_the_accelerom
 
 def test_the_uav_mission_starts_the_filter_at_rest(uav_mission):
     bag = uav_mission / "bag"
-    stream = FrameStream(bag, pose_topic="", allow_no_pose=True)
+    stream = FrameStream(bag, ReadSettings(pose_topic="", allow_no_pose=True))
     imu = read_imu(bag)
     first = next(iter(stream))
     odometry = LioOdometry(imu, stream.mount, LioSettings(), None, first.stamp)

@@ -13,10 +13,10 @@ from support.missions import first_scans, unposed_bag
 from alte.cli import main
 from alte.errors import ParameterError, TopicError
 from alte.paths import realdata_dir
-from alte.pipeline import FrameSpec, PoseSource, merged_cloud, open_input, prepare
+from alte.pipeline import FrameSettings, PoseSource, merged_cloud, open_input, prepare
 from alte.registration.backends import kiss_config, kiss_voxel, window_voxel
 from alte.registration.odometry import (
-    OdometryParams,
+    OdometrySettings,
     PoseCounts,
     odometry_frames,
     odometry_params,
@@ -49,8 +49,8 @@ def test_bag_without_poses_maps_with_odometry(unposed, capsys) -> None:
     summary = json.loads(capsys.readouterr().out)
     assert summary["pose_source"] == "odometry" and summary["frames"] == SCANS
     voxel = get_terrain("exp_nav_1").spec.registration_voxel
-    reg = prepare(open_input(bag), FrameSpec(poses=PoseSource.ODOMETRY, voxel=voxel,
-                                             odometry=OdometryParams(method="plane")))
+    reg = prepare(open_input(bag), FrameSettings(poses=PoseSource.ODOMETRY, voxel=voxel,
+                                             odometry=OdometrySettings(method="plane")))
     assert len(reg) == SCANS and reg.counts.poses.frames == SCANS
     cloud = np.asarray(reg.cloud) @ start[:3, :3].T + start[:3, 3]  # the odometry frame is
     scene = get_terrain("exp_nav_1").scene                          # the first body frame
@@ -65,11 +65,11 @@ def test_auto_poses_fall_back_to_odometry(unposed) -> None:
     """Without a pose topic ``auto`` is odometry, over every scan even when ``frames``
     keeps five of them: their poses are those of the run over all 60."""
     bag, _, _ = unposed
-    cloud, counts = merged_cloud(open_input(bag), FrameSpec(frames=5))
+    cloud, counts = merged_cloud(open_input(bag), FrameSettings(frames=5))
     assert counts.poses.source == "odometry" and len(cloud) > 0
     assert any("anchored at the first scan's body frame" in n for n in counts.notes)
     assert (counts.scans, counts.selected, counts.poses.frames) == (SCANS, 5, SCANS)
-    some, every = (prepare(open_input(bag), FrameSpec(frames=n)) for n in (5, None))
+    some, every = (prepare(open_input(bag), FrameSettings(frames=n)) for n in (5, None))
     index = np.searchsorted(every.trajectory.stamps, some.trajectory.stamps)
     assert index.tolist() == [0, 15, 30, 44, 59]  # evenly spaced over the 60 scans
     np.testing.assert_allclose(some.trajectory.positions, every.trajectory.positions[index])
@@ -84,8 +84,8 @@ def test_refine_improves_a_desynchronised_mission(tmp_path: Path) -> None:
                             seed=0, frames=40)
     source = open_input(folder)
     scene = terrain.scene
-    recorded, plain = merged_cloud(source, FrameSpec(poses=PoseSource.RECORDED))
-    refined, counts = merged_cloud(source, FrameSpec(poses=PoseSource.REFINE))
+    recorded, plain = merged_cloud(source, FrameSettings(poses=PoseSource.RECORDED))
+    refined, counts = merged_cloud(source, FrameSettings(poses=PoseSource.REFINE))
     before = mesh_distance(recorded, scene).mean()
     after = mesh_distance(refined, scene).mean()
     assert after < 0.9 * before
@@ -103,7 +103,7 @@ def test_refine_counts_corrections_above_the_bound() -> None:
                     np.array([0.0, 0.0, 0.0, 1.0])) for k in range(4)]
     counts = PoseCounts()
     out = list(refine_frames(frames, Mount(), counts=counts,
-                             params=OdometryParams(max_correction=0.2, voxel=0.1)))
+                             params=OdometrySettings(max_correction=0.2, voxel=0.1)))
     assert counts.frames == 4 and counts.kept.get("above_bound") == 1
     assert np.allclose(out[2].position, [0.6, 0.0, 0.0])  # kept as recorded
     assert np.allclose(out[3].position, 0.0, atol=0.02)
@@ -115,37 +115,38 @@ def test_refine_counts_corrections_above_the_bound() -> None:
 
 def test_pose_errors_are_typed(unposed, tmp_path: Path) -> None:
     bag, _, _ = unposed
-    with pytest.raises(TopicError, match="--poses refine needs the bag's poses"):
-        merged_cloud(open_input(bag), FrameSpec(poses=PoseSource.REFINE))
+    with pytest.raises(TopicError, match="poses=refine needs the bag's poses"):
+        merged_cloud(open_input(bag), FrameSettings(poses=PoseSource.REFINE))
     points = tmp_path / "cloud.npz"
     np.savez(points, points=np.ones((10, 3)))
-    with pytest.raises(ParameterError, match="--poses odometry needs a bag of scans"):
-        merged_cloud(open_input(points), FrameSpec(poses=PoseSource.ODOMETRY))
+    with pytest.raises(ParameterError, match="poses=odometry needs a bag of scans"):
+        merged_cloud(open_input(points), FrameSettings(poses=PoseSource.ODOMETRY))
     with pytest.raises(ParameterError, match=r"odometry: method='icp' out of range"):
-        OdometryParams(method="icp")
+        OdometrySettings(method="icp")
 
 
-def test_odometry_settings_errors_name_the_flag() -> None:
+def test_odometry_settings_errors_name_the_setting() -> None:
     with pytest.raises(ParameterError,
-                       match=r"--odometry icp: unknown backend; valid: auto, kiss, plane, lio"):
+                       match=r"odometry: method='icp' unknown; valid: auto, kiss, plane, lio"):
         odometry_params("icp")
-    with pytest.raises(ParameterError, match=r"--odometry-set fixed_threshold: not a setting "
-                                             r"of --odometry plane"):
+    with pytest.raises(ParameterError, match=r"odometry: fixed_threshold: not a setting "
+                                             r"of method=plane") as caught:
         odometry_params("plane", {"fixed_threshold": "1"})
-    with pytest.raises(ParameterError, match=r"--odometry-set: odometry: voxel=-1.0 out of "
+    assert caught.value.settings == ("odometry.settings",)
+    with pytest.raises(ParameterError, match=r"^odometry: voxel=-1.0 out of "
                                              r"range \(> 0\)"):
         odometry_params(None, {"voxel": "-1"})
-    with pytest.raises(ParameterError, match=r"--odometry-set: odometry: window=-2 out of "
+    with pytest.raises(ParameterError, match=r"^odometry: window=-2 out of "
                                              r"range \(>= 0\)"):
         odometry_params("kiss", {"window": "-2"})
-    with pytest.raises(ParameterError, match=r"--odometry-set window: not a setting "
-                                             r"of --odometry plane"):
+    with pytest.raises(ParameterError, match=r"odometry: window: not a setting "
+                                             r"of method=plane"):
         odometry_params("plane", {"window": "5"})
-    with pytest.raises(ParameterError, match=r"--odometry-set: odometry: window_voxel=0.0 out "
+    with pytest.raises(ParameterError, match=r"^odometry: window_voxel=0.0 out "
                                              r"of range \(> 0\)"):
         odometry_params("kiss", {"window_voxel": "0"})
-    with pytest.raises(ParameterError, match=r"--odometry-set window_voxel: not a setting "
-                                             r"of --odometry plane"):
+    with pytest.raises(ParameterError, match=r"odometry: window_voxel: not a setting "
+                                             r"of method=plane"):
         odometry_params("plane", {"window_voxel": "0.5"})
     chosen = odometry_params("kiss", {"single_downsample": "true", "voxel": "0.5"})
     assert chosen.single_downsample and chosen.voxel == 0.5 and chosen.method == "kiss"
@@ -157,14 +158,14 @@ def test_kiss_map_and_window_voxels() -> None:
     on the rule itself. ``voxel`` sets KISS-ICP's alone, ``window_voxel`` the window's
     alone, ``max_range`` scales both."""
     scan = np.random.default_rng(0).uniform(-20, 20, (500, 3))
-    default = kiss_config(scan, OdometryParams(method="kiss"))
+    default = kiss_config(scan, OdometrySettings(method="kiss"))
     assert default.mapping.voxel_size == pytest.approx(1.5)
     assert default.mapping.max_points_per_voxel == 10
-    alone = kiss_config(scan, OdometryParams(method="kiss", window=0))
+    alone = kiss_config(scan, OdometrySettings(method="kiss", window=0))
     assert alone.mapping.voxel_size == pytest.approx(1.0)
     assert alone.mapping.max_points_per_voxel == 20
-    assert window_voxel(OdometryParams()) == pytest.approx(1.0)
-    near = OdometryParams(method="kiss", max_range=20.0)
+    assert window_voxel(OdometrySettings()) == pytest.approx(1.0)
+    near = OdometrySettings(method="kiss", max_range=20.0)
     assert kiss_voxel(near) == pytest.approx(0.3) and window_voxel(near) == pytest.approx(0.2)
     chosen = odometry_params("kiss", {"voxel": "1.0", "window_voxel": "0.5"})
     assert kiss_voxel(chosen) == 1.0 and window_voxel(chosen) == 0.5
@@ -185,7 +186,7 @@ def test_cli_odometry_flags(few_unposed, tmp_path: Path, capsys) -> None:
     out = tmp_path / "cloud.ply"
     assert main(["register", str(bag), "--out", str(out), "--frames", "5",
                  "--odometry-set", "kapa=1"]) == 2
-    assert "--odometry-set kapa: not a setting of --odometry auto" in capsys.readouterr().err
+    assert "--odometry-set: odometry: kapa: not a setting of method=auto" in capsys.readouterr().err
     assert main(["register", str(bag), "--out", str(out), "--frames", "5",
                  "--pose-file", str(tmp_path / "none.txt")]) == 2
     assert "--pose-file" in capsys.readouterr().err and not out.exists()
@@ -210,7 +211,7 @@ def test_kiss_deskews_scans_with_per_point_time() -> None:
     frames = [Frame(k * 100_000_000, room - [0.1 * k, 0.0, 0.0], np.zeros(3),
                     np.array([0.0, 0.0, 0.0, 1.0]), times=times) for k in range(6)]
     counts = PoseCounts()
-    params = OdometryParams(voxel=0.2, max_range=20.0)
+    params = OdometrySettings(voxel=0.2, max_range=20.0)
     out = list(odometry_frames(frames, Mount(), counts=counts, params=params))
     assert counts.deskewed == 6 and counts.method == "kiss" and counts.cpu_seconds > 0
     assert np.allclose(out[-1].position, [0.5, 0.0, 0.0], atol=0.1)
@@ -227,7 +228,7 @@ def test_real_recordings_odometry(method: str) -> None:
     still, moving = REALDATA / "vlp16_packets" / "bag", REALDATA / "ros1_bag" / "test.bag"
     if not still.exists() or not moving.exists():
         pytest.skip("../shared/realdata (vlp16_packets, ros1_bag) absent")
-    spec = FrameSpec(poses=PoseSource.ODOMETRY, odometry=OdometryParams(method=method))
+    spec = FrameSettings(poses=PoseSource.ODOMETRY, odometry=OdometrySettings(method=method))
     parked = prepare(open_input(still), spec).trajectory.positions
     assert len(parked) == 4
     assert np.linalg.norm(parked - parked[0], axis=1).max() < 0.015
@@ -235,8 +236,8 @@ def test_real_recordings_odometry(method: str) -> None:
     steps = np.linalg.norm(np.diff(driven, axis=0), axis=1)
     assert len(driven) == 5 and np.all((steps > 2.0) & (steps < 2.6))
     other = "kiss" if method == "plane" else "plane"
-    again = prepare(open_input(moving), FrameSpec(poses=PoseSource.ODOMETRY,
-                                                  odometry=OdometryParams(method=other)))
+    again = prepare(open_input(moving), FrameSettings(poses=PoseSource.ODOMETRY,
+                                                  odometry=OdometrySettings(method=other)))
     assert np.linalg.norm(again.trajectory.positions - driven, axis=1).max() < 0.35
 
 
@@ -253,10 +254,10 @@ def test_the_kiss_stage_is_kiss_icps_own_pipeline_on_a_real_sequence() -> None:
 
     from alte.io.bags.bag import read_frames
 
-    scans = read_frames(bag, frames=None).frames[:12]
+    scans = read_frames(bag).frames[:12]
     ours = [pose_matrix(f.position, f.quaternion) for f in
             odometry_frames(scans, Mount(), counts=PoseCounts(),
-                            params=OdometryParams(window=0))]
+                            params=OdometrySettings(window=0))]
     config = KISSConfig()
     config.data.deskew = False
     config.mapping.voxel_size = config.data.max_range / 100.0
@@ -287,12 +288,12 @@ def test_the_window_cuts_the_real_scan_to_scan_error() -> None:
         pytest.skip("../shared/realdata/balm_seq absent")
     from alte.io.bags.bag import read_frames
 
-    scans = read_frames(bag, frames=None).frames[:24]
+    scans = read_frames(bag).frames[:24]
     reference = np.loadtxt(REALDATA / "balm_seq" / "poses_tum.txt")
     counts = PoseCounts()
     windowed = list(odometry_frames(scans, Mount(), counts=counts))
     alone = list(odometry_frames(scans, Mount(), counts=PoseCounts(),
-                                 params=OdometryParams(window=0)))
+                                 params=OdometrySettings(window=0)))
     assert [f.stamp for f in windowed] == [f.stamp for f in scans]
     assert counts.frames == 24 and counts.realigned >= 20
     assert counts.settings["window"] == 20
@@ -312,7 +313,7 @@ def test_lidar_odometry_frames_carry_their_scans_deskewed() -> None:
     frames = [Frame(k * 100_000_000, swept[k], np.zeros(3), np.array([0.0, 0.0, 0.0, 1.0]),
                     times=times) for k in range(8)]
     out = list(odometry_frames(frames, Mount(), counts=PoseCounts(),
-                               params=OdometryParams(voxel=0.2, max_range=20.0)))
+                               params=OdometrySettings(voxel=0.2, max_range=20.0)))
     assert all(f.times is None for f in out)
     assert np.array_equal(out[0].points, swept[0])
     assert np.abs(swept[-1] - (room - [0.7, 0.0, 0.0])).max() > 0.09

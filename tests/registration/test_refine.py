@@ -11,7 +11,7 @@ import pytest
 
 from alte.io.bags.bag import FrameStream, read_frames
 from alte.paths import realdata_dir
-from alte.registration.odometry import OdometryParams, PoseCounts, pose_matrix, refine_frames
+from alte.registration.odometry import OdometrySettings, PoseCounts, pose_matrix, refine_frames
 from alte.registration.refalign import align
 from alte.registration.refmap import DenseMap
 from alte.sim import get_terrain, simulate, true_poses, write_scenario
@@ -60,7 +60,7 @@ def test_refine_turns_late_poses_back_and_keeps_positions(desynchronised) -> Non
     map of the first scan alone, are left out of the positions."""
     frames, mount, positions, quats = desynchronised
     counts = PoseCounts()
-    out = list(refine_frames(frames, mount, counts=counts, params=OdometryParams()))
+    out = list(refine_frames(frames, mount, counts=counts, params=OdometrySettings()))
     rec_m, rec_deg = _errors(frames, positions, quats)
     ref_m, ref_deg = _errors(out, positions, quats)
     assert rec_deg.max() > 8.0  # the late poses are far off
@@ -123,13 +123,13 @@ def test_refine_leaves_accurate_real_poses_alone(sequence: str) -> None:
     stream = FrameStream(bag)  # the first 12 scans only are read
     frames = list(islice(stream, 12))
     counts = PoseCounts()
-    out = list(refine_frames(frames, stream.mount, counts=counts, params=OdometryParams()))
+    out = list(refine_frames(frames, stream.mount, counts=counts, params=OdometrySettings()))
     assert counts.corrected == 0 and counts.kept == {"first": 1, "no_gain": 11}
     for mine, theirs in zip(out, frames, strict=True):
         np.testing.assert_allclose(pose_matrix(mine.position, mine.quaternion),
                                    pose_matrix(theirs.position, theirs.quaternion), atol=1e-9)
     gains = [float(str(s["gain"])) for s in counts.scans[1:]]
-    assert max(gains) < OdometryParams().min_gain
+    assert max(gains) < OdometrySettings().min_gain
 
 
 def _room(rng: np.random.Generator, noise: float) -> np.ndarray:
@@ -162,7 +162,7 @@ def test_a_correction_at_the_noise_level_is_kept_out_a_real_one_is_applied() -> 
               for k, pose in enumerate([still, still, still, off])]
     counts = PoseCounts()
     out = list(refine_frames(frames, Mount(), counts=counts,
-                             params=OdometryParams(voxel=0.1, rebuild=1)))
+                             params=OdometrySettings(voxel=0.1, rebuild=1)))
     reasons = [s["reason"] for s in counts.scans]
     assert reasons[:3] == ["first", "no_gain", "no_gain"] and reasons[3] == ""
     assert np.allclose(out[1].position, 0.0) and np.allclose(out[2].position, 0.0)
@@ -172,7 +172,7 @@ def test_a_correction_at_the_noise_level_is_kept_out_a_real_one_is_applied() -> 
     seen = float(str(counts.scans[3]["information"]))
     strict = PoseCounts()
     out = list(refine_frames(frames, Mount(), counts=strict,
-                             params=OdometryParams(voxel=0.1, rebuild=1,
+                             params=OdometrySettings(voxel=0.1, rebuild=1,
                                                    min_information=min(2 * seen, 1.0))))
     assert strict.kept.get("unobserved") == 1 and np.allclose(out[3].position, [0.08, -0.06, 0])
 
@@ -182,7 +182,7 @@ def test_refine_streams(desynchronised) -> None:
     with a decision."""
     frames, mount, _, _ = desynchronised
     counts = PoseCounts()
-    stream = refine_frames(iter(frames[:12]), mount, counts=counts, params=OdometryParams())
+    stream = refine_frames(iter(frames[:12]), mount, counts=counts, params=OdometrySettings())
     first = next(stream)
     assert first.stamp == frames[0].stamp and counts.frames == 1
     rest = list(stream)

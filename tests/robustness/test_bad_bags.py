@@ -95,8 +95,8 @@ def test_truncated_bag(bags, capsys, tmp_path, storage, fraction):
 def test_clouds_without_poses(bags, capsys, tmp_path, command, poses):
     bag = bags.write_ros2(tmp_path / "nopose", bags.mission(poses=False))
     line = _fails(bags, capsys, command, bag, tmp_path, "--poses", poses)
-    assert f"{bag}: --poses {poses} needs the bag's poses and it has no pose topic" in line
-    assert "for /points; use --poses odometry" in line
+    assert f"--poses: {bag}: poses={poses} needs the bag's poses and it has no pose topic" in line
+    assert "for /points; use poses=odometry" in line
 
 
 def test_clouds_without_poses_use_odometry_and_say_so(bags, capsys, tmp_path):
@@ -305,6 +305,6 @@ def test_pose_topic_on_another_clock_recovers_with_odometry(bags, capsys, tmp_pa
     poses = [(3600 + k) * bags.NS for k in range(6)]
     bag = bags.write_ros2(tmp_path / "clock", bags.mission(scan_stamps=scans, pose_stamps=poses))
     line = _fails(bags, capsys, "register", bag, tmp_path)
-    assert "different clocks? Use --poses odometry" in line and "--pose-file" in line
+    assert "--poses, --pose-topic, --pose-file: " in line and "different clocks?" in line
     out = _register(bags, capsys, bag, tmp_path, "--poses", "odometry", "--odometry", "plane")
     assert "poses: odometry (point-to-plane" in out

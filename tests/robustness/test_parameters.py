@@ -134,7 +134,8 @@ def test_runner_owned_notebook_parameter(bags, capsys, tmp_path, name):
     code, _, err = bags.run_cli(capsys, "report", "--quick", "--param", f"{name}=/tmp/x",
                                 "--out", tmp_path / "reports")
     assert code == 2
-    assert f"--param {name}: set by the runner" in bags.one_line_error(err, "report")
+    line = bags.one_line_error(err, "report")
+    assert f"--param: notebook parameter {name}: set by the runner" in line
 
 
 def _assigned(notebook: Path) -> set[str]:

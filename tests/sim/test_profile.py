@@ -160,7 +160,8 @@ def test_uav_terrain_folder_bag_and_scenario(tmp_path):
 
 
 def test_profile_errors_name_the_flag(tmp_path, capsys):
-    with pytest.raises(ParameterError, match="--profile 'lidar': unknown; valid: thesis, uav"):
+    with pytest.raises(ParameterError, match="sensor profile: name='lidar' unknown; "
+                                             "valid: thesis, uav"):
         get_profile("lidar")
     with pytest.raises(ParameterError, match=r"unknown parameter.*imu_rate"):
         get_profile("uav", {"imu_rate": "100"})

@@ -12,7 +12,7 @@ from __future__ import annotations
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TypedDict, Unpack, cast
+from typing import cast
 
 import numpy as np
 from numpy.typing import NDArray
@@ -29,8 +29,7 @@ from alte.params import Record, param
 from alte.progress import bar as progress_bar
 from alte.types import Counts, Frame, Mount
 
-__all__ = ["NO_POSE_NOTE", "FrameSet", "FrameStream", "ReadCounts", "ReadOptions",
-           "StreamOptions",
+__all__ = ["NO_POSE_NOTE", "FrameSet", "FrameStream", "ReadCounts", "ReadSettings",
            "evenly_spaced", "read_frames"]
 
 _IDENTITY_Q = np.array([0.0, 0.0, 0.0, 1.0])
@@ -92,9 +91,15 @@ def evenly_spaced(total: int, limit: int | None) -> frozenset[int] | None:
 
 
 @dataclass(frozen=True)
-class ReadOptions(Record):
-    """How scans are read (:class:`FrameStream` makes one from its keywords, checked before
-    the bag is opened)."""
+class ReadSettings(Record):
+    """How a bag's scans are read and posed (:class:`FrameStream`, :func:`read_frames`),
+    checked before the bag is opened.
+
+    Topics are detected by message type unless given (``pose_topic=""`` forces "no pose
+    topic"). Without a pose topic, frames get the identity pose only for raw
+    ``VelodyneScan`` packets or with ``allow_no_pose``. ``body_frame`` picks the child
+    frame of a ``/tf`` pose topic when ``/tf_static`` does not tell it.
+    """
 
     OWNER = "read"
 
@@ -104,6 +109,20 @@ class ReadOptions(Record):
                              "which returns of dual-return Velodyne packets are kept")
     select: frozenset[int] | None = param(None, help="the scans read, by index (None: all)")
     progress: bool = param(False, help="a progress bar over the scans")
+    cloud_topic: str | None = param(None, help="the PointCloud2 / VelodyneScan topic "
+                                               "(None: detected)")
+    pose_topic: str | None = param(None, help='the pose topic (None: detected; "": none)')
+    pose_file: Path | None = param(None, help="poses from a TUM file instead of a topic")
+    body_frame: str | None = param(None, help="the child frame of a /tf pose topic")
+    allow_no_pose: bool = param(False, help="identity poses when there is no pose topic")
+    frames: int | None = param(None, lambda v: v >= 1, "frames >= 1",
+                               "scans kept, evenly spaced (None: all)")
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if self.pose_file is not None and self.pose_topic:
+            raise ParameterError(f"{self.OWNER}: pose_file and pose_topic exclude each other",
+                                 setting=(f"{self.OWNER}.pose_file", f"{self.OWNER}.pose_topic"))
 
 
 class FrameStream:
@@ -115,36 +134,35 @@ class FrameStream:
     ``counts`` describe the last (or current) iteration.
     """
 
-    def __init__(self, path: str | Path, *, cloud_topic: str | None = None,
-                 pose_topic: str | None = None, mount: Mount | None = None,
-                 allow_no_pose: bool = False, body_frame: str | None = None,
-                 frames: int | None = None, max_gap_s: float = 0.5,
-                 return_mode: str = "strongest", progress: bool = False,
-                 pose_file: str | Path | None = None, read_all: bool = False) -> None:
-        options = ReadOptions(max_gap_s, return_mode, None, progress)
+    def __init__(self, path: str | Path, options: ReadSettings | None = None, *,
+                 mount: Mount | None = None, read_all: bool = False) -> None:
+        """``options``: what is read (:class:`ReadSettings`); ``mount`` overrides the bag's
+        ``/tf_static`` body -> sensor transform; ``read_all``: read every scan even when
+        ``options.frames`` selects some (odometry needs them all)."""
+        options = options or ReadSettings()
+        pose_file, pose_topic = options.pose_file, options.pose_topic
         self.path = Path(path)
         self.notes: list[str] = []
         with open_bag(self.path) as reader:
             self.cloud_topic, self.pose_topic, self.track, self.mount = bag_sources(
-                reader, self.path, (cloud_topic, "" if pose_file else pose_topic, body_frame),
-                mount=mount, allow_no_pose=allow_no_pose or pose_file is not None,
+                reader, self.path,
+                (options.cloud_topic, "" if pose_file else pose_topic, options.body_frame),
+                mount=mount, allow_no_pose=options.allow_no_pose or pose_file is not None,
                 notes=self.notes)
             self.scans = int(reader.topics[self.cloud_topic].msgcount)
         if pose_file is not None:
-            self._use_pose_file(Path(pose_file), pose_topic)
+            self._use_pose_file(pose_file)
         #: The scans ``frames`` selects (None: all); with ``read_all`` every scan is still
         #: read (odometry needs them) and :attr:`selection` only says which go on.
-        self.selection = evenly_spaced(self.scans, frames)
+        self.selection = evenly_spaced(self.scans, options.frames)
         self.read_all = read_all and self.selection is not None
         self.options = options.replace(select=None if self.read_all else self.selection)
         self.counts = self._new_counts()
 
-    def _use_pose_file(self, pose_file: Path, pose_topic: str | None) -> None:
-        """Poses from a TUM file instead of a topic (``--pose-file``)."""
+    def _use_pose_file(self, pose_file: Path) -> None:
+        """Poses from a TUM file instead of a topic (``ReadSettings.pose_file``)."""
         from alte.io.poses.tum import read_tum
 
-        if pose_topic:
-            raise ParameterError("--pose-file and --pose-topic exclude each other")
         self.track, self.pose_topic = read_tum(pose_file), str(pose_file)
         self.notes[:] = [n for n in self.notes if n != NO_POSE_NOTE]
 
@@ -234,38 +252,20 @@ def _raise_empty(stream: FrameStream, counts: ReadCounts, stamps: _StampRange) -
         f"{stamps.high} ns, pose stamps {int(track.stamps[0])}..{int(track.stamps[-1])} ns "
         f"({counts.scans_outside_poses} outside the pose track, "
         f"{counts.scans_in_pose_gap} in gaps > {stream.options.max_gap_s} s, "
-        f"{counts.scans_empty} without points): different clocks? Use --poses odometry to "
-        "pose the scans without it, or --pose-topic / --pose-file for poses on the scans' clock"
-    )
+        f"{counts.scans_empty} without points): different clocks? Pose the scans by odometry "
+        "without it (poses=odometry), or read poses on the scans' clock (pose_topic, "
+        "pose_file)", setting=("frame spec.poses", "read.pose_topic", "read.pose_file"))
 
 
-class StreamOptions(TypedDict, total=False):
-    """Keywords of :class:`FrameStream` (and :func:`read_frames`)."""
+def read_frames(path: str | Path, options: ReadSettings | None = None, *,
+                mount: Mount | None = None) -> FrameSet:
+    """Every posed scan of a bag in a list (``options``: :class:`ReadSettings`).
 
-    cloud_topic: str | None
-    pose_topic: str | None
-    mount: Mount | None
-    allow_no_pose: bool
-    body_frame: str | None
-    frames: int | None
-    max_gap_s: float
-    return_mode: str
-    progress: bool
-    pose_file: str | Path | None
-
-
-def read_frames(path: str | Path, **options: Unpack[StreamOptions]) -> FrameSet:
-    """Every posed scan of a bag in a list (see :class:`FrameStream` for ``options``).
-
-    Topics are detected by message type unless given (``pose_topic=""`` forces
-    "no pose topic"). Without a pose topic, frames get the identity pose only for raw
-    ``VelodyneScan`` packets or with ``allow_no_pose=True``. ``body_frame`` picks the
-    child frame of a ``/tf`` pose topic when ``/tf_static`` does not tell it. ``mount``
-    overrides the bag's ``/tf_static`` body -> sensor transform; with neither the
-    mount is identity (noted in ``notes``). Holds the whole bag: the pipeline streams
+    ``mount`` overrides the bag's ``/tf_static`` body -> sensor transform; with neither
+    the mount is identity (noted in ``notes``). Holds the whole bag: the pipeline streams
     a :class:`FrameStream` instead.
     """
-    stream = FrameStream(path, **options)
+    stream = FrameStream(path, options, mount=mount)
     frames = list(stream)
     return FrameSet(frames, stream.mount, stream.counts, stream.cloud_topic, stream.pose_topic,
                     stream.path, stream.notes)

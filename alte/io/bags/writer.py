@@ -14,24 +14,25 @@ from __future__ import annotations
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, TypeAlias, TypedDict, Unpack
+from typing import TYPE_CHECKING, ClassVar, TypeAlias
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from rosbags.rosbag2 import StoragePlugin, Writer
 from rosbags.typesys import Stores, get_typestore
 
-from alte.errors import BagError, ParameterError
+from alte.errors import BagError
 from alte.fsutil import atomic_dir
 from alte.io.bags.imu import IMU_TYPE, ImuSamples
 from alte.io.bags.pointcloud2 import CoordType, encode_pointcloud2, make_header
+from alte.params import Record, param
 from alte.progress import bar as progress_bar
 from alte.types import Frame, Mount
 
 if TYPE_CHECKING:  # rosbags declares MsgType (its message classes' type) for checkers only
     from rosbags.typesys.store import MsgType
 
-__all__ = ["STORAGES", "BagOptions", "write_bag", "write_frames"]
+__all__ = ["STORAGES", "BagSettings", "write_bag", "write_frames"]
 
 STORAGES = {"sqlite3": StoragePlugin.SQLITE3, "mcap": StoragePlugin.MCAP}
 _POSE = "geometry_msgs/msg/PoseStamped"
@@ -163,6 +164,27 @@ class _BagOut:
 _IMU_TOPIC = "/imu"
 
 
+def _name(value: str) -> bool:
+    return bool(value.strip())
+
+
+@dataclass(frozen=True)
+class BagSettings(Record):
+    """How :func:`write_bag` writes a bag: topics, storage, frame names, overwrite."""
+
+    OWNER: ClassVar[str] = "bag"
+    cloud_topic: str = param("/velodyne_points", _name, "a non-empty topic",
+                             "the PointCloud2 topic")
+    pose_topic: str = param("/pose", _name, "a non-empty topic", "the PoseStamped topic")
+    storage: str = param("sqlite3", lambda v: v in STORAGES, "|".join(STORAGES),
+                         "the rosbag2 storage plugin")
+    world_frame: str = param("map", _name, "a non-empty frame id", "the poses' frame")
+    body_frame: str = param("base_link", _name, "a non-empty frame id", "the vehicle's frame")
+    sensor_frame: str = param("velodyne", _name, "a non-empty frame id", "the clouds' frame")
+    overwrite: bool = param(False, help="replace an existing bag")
+    progress: bool = param(False, help="a progress bar over the scans")
+
+
 def write_bag(  # noqa: PLR0917 - positional arrays as specified for the simulator
     path: str | Path,
     clouds: Iterable[Cloud],
@@ -170,26 +192,22 @@ def write_bag(  # noqa: PLR0917 - positional arrays as specified for the simulat
     positions: NDArray[np.float64],
     quaternions: NDArray[np.float64],
     mount: Mount | None = None,
+    settings: BagSettings | None = None,
     *,
-    cloud_topic: str = "/velodyne_points",
-    pose_topic: str = "/pose",
-    storage: str = "sqlite3",
-    world_frame: str = "map",
-    body_frame: str = "base_link",
-    sensor_frame: str = "velodyne",
     dtype: CoordType = np.float32,
-    overwrite: bool = False,
-    progress: bool = False,
     imu: ImuSamples | None = None,
 ) -> Path:
-    """Write scans ``(stamp_ns, points[, fields])`` plus body poses (and mount) as a ROS 2 bag.
+    """Write scans ``(stamp_ns, points[, fields])`` plus body poses (and mount) as a ROS 2 bag
+    (``settings``: :class:`BagSettings`; ``dtype``: the clouds' coordinate type).
 
     Messages are logged at their header stamps, poses (and ``imu`` samples, on
     ``/imu`` with their mount in ``/tf_static``) interleaved in time order with the
-    scans. Refuses to replace ``path`` unless ``overwrite``.
+    scans. Refuses to replace ``path`` unless ``settings.overwrite``.
     """
-    if storage not in STORAGES:
-        raise ParameterError(f"storage={storage!r}; expected one of {sorted(STORAGES)}")
+    settings = settings or BagSettings()
+    cloud_topic, pose_topic = settings.cloud_topic, settings.pose_topic
+    world_frame, body_frame = settings.world_frame, settings.body_frame
+    sensor_frame = settings.sensor_frame
     stamps, pos, quat = _pose_arrays(pose_stamps, positions, quaternions)
     order = np.argsort(stamps, kind="stable")
     target = Path(path)
@@ -199,9 +217,9 @@ def write_bag(  # noqa: PLR0917 - positional arrays as specified for the simulat
     if mount is not None or (imu is not None and imu.mount is not None):
         topics["/tf_static"] = _TF
     names = _Names(world_frame, sensor_frame, cloud_topic, pose_topic, dtype)
-    plugin = STORAGES[storage]
+    plugin = STORAGES[settings.storage]
     with (
-        atomic_dir(target, overwrite=overwrite) as tmp,
+        atomic_dir(target, overwrite=settings.overwrite) as tmp,
         Writer(tmp, version=Writer.VERSION_LATEST, storage_plugin=plugin) as writer,
     ):
         out = _BagOut(writer, topics, names)
@@ -212,27 +230,14 @@ def write_bag(  # noqa: PLR0917 - positional arrays as specified for the simulat
             statics.append(_transform(imu.mount, first, body_frame, imu.frame_id))
         if statics:
             out.put("/tf_static", first, _TYPESTORE.types[_TF](transforms=statics))
-        out.clouds(clouds, (stamps, pos, quat, order), progress)
+        out.clouds(clouds, (stamps, pos, quat, order), settings.progress)
     return target
 
 
-class BagOptions(TypedDict, total=False):
-    """Keywords of :func:`write_bag` after its arrays (topics, storage, frames, dtype)."""
-
-    cloud_topic: str
-    pose_topic: str
-    storage: str
-    world_frame: str
-    body_frame: str
-    sensor_frame: str
-    dtype: CoordType
-    overwrite: bool
-    progress: bool
-
-
 def write_frames(path: str | Path, frames: Sequence[Frame], mount: Mount | None,
-                 **kw: Unpack[BagOptions]) -> Path:
-    """Write frames as a bag, each pose at its frame's stamp (keywords as :func:`write_bag`)."""
+                 settings: BagSettings | None = None, *, dtype: CoordType = np.float32
+                 ) -> Path:
+    """Write frames as a bag, each pose at its frame's stamp (as :func:`write_bag`)."""
     if not frames:
         raise BagError(f"{path}: no frames to write")
     return write_bag(
@@ -242,5 +247,6 @@ def write_frames(path: str | Path, frames: Sequence[Frame], mount: Mount | None,
         np.array([f.position for f in frames], dtype=np.float64),
         np.array([f.quaternion for f in frames], dtype=np.float64),
         mount,
-        **kw,
+        settings,
+        dtype=dtype,
     )

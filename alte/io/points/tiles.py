@@ -148,9 +148,11 @@ def write_classified(path: str | os.PathLike[str], tile: Tile, ground: NDArray[n
 
     path = Path(path)
     if path.suffix.lower() not in _LAS:
-        raise ParameterError(f"--out {path}: the output is LAS or LAZ (.las, .laz)")
+        raise ParameterError(f"output {path}: a classified tile is LAS or LAZ (.las, .laz)",
+                             setting="output.path")
     if path.exists() and tile.path.exists() and path.resolve() == tile.path.resolve():
-        raise ParameterError(f"--out {path}: the input itself; write to another file")
+        raise ParameterError(f"output {path}: the input itself; write to another file",
+                             setting="output.path")
     if len(ground) != len(tile.points):
         raise ParameterError(f"{len(ground)} labels for {len(tile.points)} points")
     las = tile.las if tile.las is not None else _new_las(tile.points, crs)

@@ -79,7 +79,8 @@ def parse_param(text: str) -> tuple[str, JSON]:
         if not name.isidentifier():
             raise ParameterError(f"{name!r} is not a name")
     except ParameterError as err:
-        raise ParameterError(f"--param {text!r}: expected NAME=VALUE") from err
+        raise ParameterError(f"notebook parameter {text!r}: expected NAME=VALUE",
+                             setting="report.param") from err
     try:
         value: JSON = ast.literal_eval(raw)
     except (ValueError, SyntaxError):
@@ -127,15 +128,16 @@ def _select(entries: Sequence[Entry], quick: bool, only: Iterable[str]) -> list[
     known = {e.name for e in mode} | {Path(e.notebook).stem for e in mode}
     unknown = [name for name in only if name not in known]
     if unknown:
-        raise ParameterError(f"--only {', '.join(unknown)}: no such run; valid: "
-                             f"{', '.join(sorted(known))}")
+        raise ParameterError(f"run {', '.join(unknown)}: no such run; valid: "
+                             f"{', '.join(sorted(known))}", setting="report.only")
     return [e for e in mode if e.name in only or Path(e.notebook).stem in only]
 
 
 def _check_overrides(overrides: JSONMap, declared: Mapping[str, Iterable[str]]) -> None:
     fixed = sorted(set(overrides) & set(RUNNER_PARAMETERS))
     if fixed:
-        raise ParameterError(f"--param {', '.join(fixed)}: set by the runner (use --out/--data)")
+        raise ParameterError(f"notebook parameter {', '.join(fixed)}: set by the runner (from "
+                             "its output and data folders)", setting="report.param")
     valid = set().union(*declared.values()) - set(RUNNER_PARAMETERS) if declared else set()
     unknown = sorted(set(overrides) - valid)
     if unknown:

@@ -25,15 +25,15 @@ import pandas as pd
 from alte.errors import ParameterError
 from alte.lab.studies.thesis.numbers import SWEEPS, sweep_table
 from alte.mappers import Mapper
-from alte.metrics.maps import GroundTruth, MapMetrics, MapPointSet, TruthOptions, measure_map
+from alte.metrics.maps import GroundTruth, MapMetrics, MapPointSet, TruthSettings, measure_map
 from alte.metrics.reference import Reference
 from alte.metrics.timing import Timing
 from alte.params import Record
 from alte.pipeline import (
-    FrameSpec,
+    FrameSettings,
     InputKind,
     MapRun,
-    MapSpec,
+    MapSettings,
     PoseSource,
     Registered,
     open_input,
@@ -41,7 +41,7 @@ from alte.pipeline import (
     run,
 )
 from alte.progress import bar as progress_bar
-from alte.registration.odometry import OdometryParams
+from alte.registration.odometry import OdometrySettings
 
 __all__ = ["CACHE_DIR", "REPEATS", "REPEAT_BELOW_S", "Measured", "ground_truth", "measure",
            "reference_of", "sweep", "terrain", "timed_run"]
@@ -83,7 +83,7 @@ class Measured:
 
 def terrain(name: str, data_dir: str | os.PathLike[str] = "data", seed: int = 0,
             frames: int | None = None, *, voxel: float | None = None, sensor: str = "thesis",
-            deskew: bool = True, odometry: OdometryParams | None = None,
+            deskew: bool = True, odometry: OdometrySettings | None = None,
             progress: bool = False) -> Registered:
     """Terrain ``name`` registered (simulated first when absent; cached per spec and seed
     in ``DATA_DIR/.cache``): the one way a study turns a terrain into registered frames.
@@ -101,9 +101,9 @@ def terrain(name: str, data_dir: str | os.PathLike[str] = "data", seed: int = 0,
         raise ParameterError(f"sensor {sensor!r}: expected one of {', '.join(PROFILES)}")
     folder = ensure_terrain(name, data_dir, seed, frames if odometry is None else None,
                             progress=progress, profile=PROFILES[sensor])
-    spec = FrameSpec(frames=frames, voxel=voxel, deskew=deskew,
+    spec = FrameSettings(frames=frames, voxel=voxel, deskew=deskew,
                      poses=PoseSource.AUTO if odometry is None else PoseSource.ODOMETRY,
-                     odometry=odometry or OdometryParams())
+                     odometry=odometry or OdometrySettings())
     return prepare(open_input(folder), spec, cache=Path(data_dir) / CACHE_DIR,
                    progress=progress)
 
@@ -121,7 +121,7 @@ def ground_truth(data: Registered) -> GroundTruth | None:
     return _truth(str(data.source.path))
 
 
-def timed_run(data: Registered, spec: MapSpec, *, repeats: int = REPEATS,
+def timed_run(data: Registered, spec: MapSettings, *, repeats: int = REPEATS,
               progress: bool = False) -> tuple[MapRun, Timing]:
     """Map ``data`` as ``spec`` says, timed as the module docstring says: the last run
     and the :class:`Timing` of the timed ones."""
@@ -141,7 +141,7 @@ def timed_run(data: Registered, spec: MapSpec, *, repeats: int = REPEATS,
 
 
 def measure(data: Registered, mapper: str, params: Mapping[str, object] | None = None, *,
-            truth: TruthOptions | None = None, spec: MapSpec | None = None,
+            truth: TruthSettings | None = None, spec: MapSettings | None = None,
             set_b: MapPointSet = MapPointSet.CORNERS, progress: bool = False,
             reference: Reference | None = None) -> Measured:
     """Map ``data`` with ``mapper`` and ``params`` and measure it (``truth``: also against
@@ -150,7 +150,7 @@ def measure(data: Registered, mapper: str, params: Mapping[str, object] | None =
     the default map specification. The map is timed by :func:`timed_run`.
     ``reference``: :func:`reference_of` ``data`` and ``truth``, prepared once for several
     maps (the same values)."""
-    chosen = spec or MapSpec(mapper, dict(params or {}))
+    chosen = spec or MapSettings(mapper, dict(params or {}))
     result, timing = timed_run(data, chosen, progress=progress)
     cells = result.mapper.cells()  # listed once for every metric
     metrics = measure_map(result.mapper, data.cloud, elapsed_s=timing,
@@ -160,7 +160,7 @@ def measure(data: Registered, mapper: str, params: Mapping[str, object] | None =
     return Measured(result, metrics)
 
 
-def reference_of(data: Registered, truth: TruthOptions | None) -> Reference:
+def reference_of(data: Registered, truth: TruthSettings | None) -> Reference:
     """The cloud of ``data`` and, with ``truth``, its true surface, prepared once for
     every map :func:`measure` makes of it (:class:`~alte.metrics.reference.Reference`:
     the cloud's nearest-neighbour grids, the surface samples and what the sensor saw of
@@ -169,7 +169,7 @@ def reference_of(data: Registered, truth: TruthOptions | None) -> Reference:
 
 
 def sweep(data: Registered, table: int, rows: Sequence[int] | None = None, *,
-          extra: Mapping[str, object] | None = None, truth: TruthOptions | None = None,
+          extra: Mapping[str, object] | None = None, truth: TruthSettings | None = None,
           progress: bool = True) -> tuple[pd.DataFrame, list[Measured]]:
     """Run the parameter rows of table 5.``table`` (7, 8, 9 or 12) on ``data``.
 

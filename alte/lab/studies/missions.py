@@ -154,7 +154,7 @@ def load_mission_evidence(folder: str | os.PathLike[str]) -> MissionEvidence:
         missing.append(PROVENANCE)
     if missing:
         raise ReportError(f"whole-mission evidence {root}: missing {', '.join(missing)} (made "
-                          "by alte sweep SPEC --evidence FOLDER)")
+                          "by a sweep given an evidence folder)")
     try:
         raw = json.loads((root / PROVENANCE).read_text(encoding="utf-8"))
         provenance = Provenance(**raw)

@@ -8,7 +8,7 @@ into key bits (:mod:`~alte.mappers.octomap.scan`, four rays at a time in
 
 from alte.mappers.octomap.agreement import compare_backends
 from alte.mappers.octomap.cells import occupied_voxels, read_bt
-from alte.mappers.octomap.mapper import SENSOR_MODELS, Octomap, OctomapParams
+from alte.mappers.octomap.mapper import SENSOR_MODELS, Octomap, OctomapSettings
 
-__all__ = ["SENSOR_MODELS", "Octomap", "OctomapParams", "compare_backends", "occupied_voxels",
+__all__ = ["SENSOR_MODELS", "Octomap", "OctomapSettings", "compare_backends", "occupied_voxels",
            "read_bt"]

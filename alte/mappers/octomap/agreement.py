@@ -9,7 +9,7 @@ from collections.abc import Iterable
 import numpy as np
 from numpy.typing import NDArray
 
-from alte.mappers.octomap.mapper import Octomap, OctomapParams
+from alte.mappers.octomap.mapper import Octomap, OctomapSettings
 
 __all__ = ["compare_backends"]
 
@@ -24,7 +24,7 @@ def compare_backends(
     ``getNumLeafNodes``); numba compilation is excluded by a warm-up insert.
     """
     native, reference, warm = (
-        Octomap(None, record=OctomapParams.parse({**params, "backend": backend}))
+        Octomap(None, record=OctomapSettings.parse({**params, "backend": backend}))
         for backend in ("native", "reference", "native"))  # warm: the numba kernels, untimed
     warm.insert(np.ones((1, 3)), np.zeros(3))
     _ = warm.basis_functions

@@ -32,6 +32,7 @@ from alte.mappers.base import (
     check_points,
     check_view,
     parsed,
+    renamed,
 )
 from alte.mappers.domain import Domain, DomainUse
 from alte.mappers.octomap.backends import NativeTree, ReferenceTree, SensorModel
@@ -41,7 +42,7 @@ from alte.mappers.octree.tree import Leaves, check_origin, leaf_geometry
 from alte.params import Record, param
 from alte.types import rows_all
 
-__all__ = ["SENSOR_MODELS", "Octomap", "OctomapParams"]
+__all__ = ["SENSOR_MODELS", "Octomap", "OctomapSettings"]
 
 #: Sensor models: MATLAB occupancyMap3D (its free threshold 0.2 only affects MATLAB's
 #: ``checkOccupancy`` queries, not the map) and OctoMap's library defaults.
@@ -80,7 +81,7 @@ def _prob(low: float, high: float) -> Callable[[float], bool]:
 
 
 @dataclass(frozen=True)
-class OctomapParams(Record):
+class OctomapSettings(Record):
     """Octomap parameters; unset probabilities come from ``sensor_model``."""
 
     OWNER: ClassVar[str] = "octomap"
@@ -146,14 +147,16 @@ class Octomap:
     layers: ClassVar[frozenset[str]] = frozenset()
     settings_grid: ClassVar[Mapping[str, tuple[object, ...]]] = {
         "resolution": (0.5, 0.75, 1.0, 1.5, 2.0, 2.5, 3.0, 4.0, 5.0, 6.0)}
-    Params: ClassVar[type[Record]] = OctomapParams
+    Settings: ClassVar[type[Record]] = OctomapSettings
+    #: Contract v1's first name of :attr:`Settings` (deprecated; still read by old code).
+    Params: ClassVar[type[Record]] = OctomapSettings
 
     def __init__(self, domain: Domain | None = None, *, record: Record | None = None,
                  **given: object) -> None:
         if domain is not None:
             raise MapperError("octomap: its domain is the fixed key space of 2^16 voxels per "
                               "axis around 0; it takes no domain")
-        self._record = parsed(OctomapParams, record, given)
+        self._record = parsed(OctomapSettings, record, given)
         self._tree = self._new_tree()
         self.points_outside = 0
         self._cells: tuple[Leaves[np.float32], Cells] | None = None  # the cells of those leaves
@@ -274,3 +277,8 @@ class Octomap:
         with atomic_path(target, overwrite=overwrite) as tmp:
             self._tree.write_bt(tmp)
         return target
+
+
+def __getattr__(name: str) -> object:
+    """``OctomapParams``: the first name of :class:`OctomapSettings` (deprecated)."""
+    return renamed(__name__, name, {"OctomapParams": lambda: OctomapSettings})

@@ -86,7 +86,7 @@ class QuadMap:
     exports: ClassVar[frozenset[str]] = frozenset({".npz"})
     free_space: ClassVar[bool] = False
     cost_unit: ClassVar[Cost] = Cost.CELL_UPDATES
-    Params: ClassVar[type[Record]] = Record
+    Settings: ClassVar[type[Record]] = Record
     view_params: ClassVar[frozenset[str]] = frozenset()
     layers: ClassVar[frozenset[str]] = frozenset()
     settings_grid: ClassVar[Mapping[str, tuple[object, ...]]] = {}
@@ -95,7 +95,7 @@ class QuadMap:
     def __init__(self, domain: Domain | None = None, *, record: Record | None = None,
                  **given: object) -> None:
         domain = check_domain(self.name, domain)
-        self._record = parsed(self.Params, record, given)
+        self._record = parsed(self.Settings, record, given)
         self._params = self._record.as_dict()
         self._zmin = 0.0 if domain is None else domain.zmin
         self._fixed = None if domain is None else Square(domain.xmin, domain.ymin, domain.size)

@@ -48,19 +48,22 @@ class GroundChoice:
 
     def __post_init__(self) -> None:
         if self.ground_class is not None and not 0 <= self.ground_class <= 255:
-            raise ParameterError(f"--ground-class {self.ground_class}: an ASPRS class is "
-                                 "0 to 255 (ground is 2)")
+            raise ParameterError(f"import: ground_class={self.ground_class}: an ASPRS class "
+                                 "is 0 to 255 (ground is 2)", setting="import.ground_class")
         if self.ground_class is not None and self.uses_filter:
-            raise ParameterError("--ground-class and --ground-method/--ground-set exclude each "
-                                 "other: the named class is the tiles' ground, the filter "
-                                 "replaces it")
+            raise ParameterError("import: ground_class and a ground filter (method, "
+                                 "settings) exclude each other: the named class is the "
+                                 "tiles' ground, the filter replaces it",
+                                 setting=("import.ground_class", "import.ground_method",
+                                          "import.ground_settings"))
         if self.method is not None and self.method not in METHODS:
-            raise ParameterError(f"--ground-method {self.method!r}: unknown; valid: "
-                                 f"{', '.join(METHODS)}")
+            raise ParameterError(f"import: ground method {self.method!r} unknown; valid: "
+                                 f"{', '.join(METHODS)}", setting="import.ground_method")
         if self.method is not None and self.settings is not None and \
                 not isinstance(self.settings, METHODS[self.method]):
-            raise ParameterError(f"--ground-set: {type(self.settings).__name__} are not the "
-                                 f"settings of --ground-method {self.method}")
+            raise ParameterError(f"import: {type(self.settings).__name__} are not the "
+                                 f"settings of the ground method {self.method}",
+                                 setting="import.ground_settings")
 
     @property
     def uses_filter(self) -> bool:
@@ -89,9 +92,10 @@ def _no_class(tile: Tile, ground_class: int) -> PointFileError:
     present = ", ".join(f"{c} ({n:,} points)" for c, n in zip(*held, strict=True))
     return PointFileError(
         f"{tile.path}: no point of ground class {ground_class} (classes present: "
-        f"{present or 'none'}); name the class its ground is with --ground-class N, give "
-        "its bare-earth points with --ground FILE, or leave --ground-class out to classify "
-        f"it with the ground filter ({DEFAULT_METHOD}, or --ground-method)")
+        f"{present or 'none'}); name the class its ground is (ground_class), give its "
+        "bare-earth points (a ground file), or leave ground_class out to classify it with "
+        f"the ground filter ({DEFAULT_METHOD}, or another ground method)",
+        setting="import.ground_class")
 
 
 def _filtered(tile: Tile, choice: GroundChoice) -> bool:
@@ -117,11 +121,12 @@ def _classify(tiles: list[Tile], pending: list[int], choice: GroundChoice
         result = filter_ground(np.vstack([t.points for t in chosen]), method, settings)
     except GroundError as err:
         raise GroundError(f"{names}: the ground filter cannot classify it ({err}); if "
-                          "every point is bare earth, name their class with --ground-class "
-                          "N") from err
+                          "every point is bare earth, name their class (ground_class)",
+                          setting="import.ground_class") from err
     if not result.ground.any():
         raise GroundError(f"{names}: the {method} filter calls no point ground; check the "
-                          "tile's units and noise, or try another --ground-method")
+                          "tile's units and noise, or try another ground method",
+                          setting="import.ground_method")
     parts = np.split(result.ground, np.cumsum([len(t.points) for t in chosen])[:-1])
     out = list(tiles)
     for i, mask in zip(pending, parts, strict=True):
@@ -137,8 +142,8 @@ def crop_tiles(tiles: list[Tile], region: Sequence[float] | None) -> list[Tile]:
         return tiles
     x0, y0, x1, y1 = (float(region[i]) for i in range(4))
     if not (x1 > x0 and y1 > y0):
-        raise ParameterError(f"--region {list(region)}: expected XMIN,YMIN,XMAX,YMAX with "
-                             "XMIN < XMAX and YMIN < YMAX")
+        raise ParameterError(f"import: region={list(region)}: expected XMIN,YMIN,XMAX,YMAX "
+                             "with XMIN < XMAX and YMIN < YMAX", setting="import.region")
     out = []
     for t in tiles:
         f = t.units.horizontal_m
@@ -147,11 +152,11 @@ def crop_tiles(tiles: list[Tile], region: Sequence[float] | None) -> list[Tile]:
         if keep.any():
             out.append(replace(t, points=t.points[keep], classes=t.classes[keep],
                                first=t.first[keep], ground=t.ground[keep],
-                               notes=[*t.notes, f"cropped to --region {x0:g},{y0:g},{x1:g},"
+                               notes=[*t.notes, f"cropped to the region {x0:g},{y0:g},{x1:g},"
                                       f"{y1:g}"]))
     if not out:
-        raise ParameterError(f"--region {list(region)}: no tile has points inside it (the "
-                             "region is in the tiles' CRS units)")
+        raise ParameterError(f"import: region={list(region)}: no tile has points inside it "
+                             "(the region is in the tiles' CRS units)", setting="import.region")
     return out
 
 
@@ -163,22 +168,26 @@ def terrain_tiles(paths: Sequence[str | os.PathLike[str]], *, crs: str | None = 
     docstring); with the record of how, for scenario.json."""
     choice = choice or GroundChoice()
     if ground is not None and choice.uses_filter:
-        raise ParameterError("--ground FILE and --ground-method/--ground-set exclude each "
-                             "other: the file is the tile's ground")
+        raise ParameterError("import: a ground file and a ground filter (method, settings) "
+                             "exclude each other: the file is the tile's ground",
+                             setting=("import.ground_file", "import.ground_method",
+                                      "import.ground_settings"))
     named = choice.ground_class if choice.ground_class is not None else GROUND_CLASS
     tiles = crop_tiles(read_tiles(list(paths), crs=crs, ground=ground, ground_class=named),
                        region)
     pending = [i for i, t in enumerate(tiles) if _filtered(t, choice)]
-    record: JSONDict = {"policy": choice.policy() if ground is None else "the --ground file",
+    record: JSONDict = {"policy": choice.policy() if ground is None else "the ground file",
                         "class": named if ground is None else None,
                         "file": str(ground) if ground is not None else None, "filter": None}
     if pending:
         tiles, record["filter"] = _classify(tiles, pending, choice)
     elif choice.method is not None:
-        raise ParameterError(f"--ground-method {choice.method}: no LAS/LAZ tile to classify "
-                             "(a DEM is bare earth already); leave it out")
+        raise ParameterError(f"import: ground method {choice.method}: no LAS/LAZ tile to "
+                             "classify (a DEM is bare earth already); leave it out",
+                             setting="import.ground_method")
     elif choice.uses_filter:
-        raise ParameterError(f"--ground-set: every tile has ground class {GROUND_CLASS} or is "
-                             "a DEM, so no filter runs; add --ground-method METHOD to "
-                             "reclassify the LAS/LAZ tiles with it")
+        raise ParameterError(f"import: ground settings: every tile has ground class "
+                             f"{GROUND_CLASS} or is a DEM, so no filter runs; name the ground "
+                             "method to reclassify the LAS/LAZ tiles with it",
+                             setting="import.ground_settings")
     return tiles, record

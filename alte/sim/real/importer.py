@@ -124,8 +124,8 @@ def write_imported(imported: Imported, out_dir: str | os.PathLike[str] = "data",
     target = terrain_folder(out_dir, name, frames, seed, chosen)
     if target.exists() and not force:
         kind = "an imported terrain" if (target / SCENARIO_FILE).is_file() else "a folder"
-        raise SimulationError(f"{target} exists ({kind}); pass --force to replace it, or "
-                              "--name to import under another name")
+        raise SimulationError(f"{target} exists ({kind}); force=True replaces it, or import "
+                              "it under another name", setting="output.overwrite")
     sim = simulate(imported.terrain, seed=seed, frames=frames, progress=progress,
                    profile=chosen)
     extra: JSONDict = {"source": imported.source, "bare_earth": BARE_EARTH_FILE}

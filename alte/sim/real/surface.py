@@ -99,8 +99,8 @@ def _index(tiles: list[Tile], step: float) -> tuple[float, float, tuple[int, int
     hi = np.max([t.points[:, :2].max(axis=0) for t in tiles], axis=0)
     nx, ny = (np.floor((hi - lo) / step).astype(int) + 1).tolist()
     if nx * ny > 25_000_000:
-        raise ParameterError(f"a {nx} x {ny} grid of {step:g} m cells is too large; pass a "
-                             "coarser --cell or import fewer tiles")
+        raise ParameterError(f"a {nx} x {ny} grid of {step:g} m cells is too large; use a "
+                             "coarser cell or import fewer tiles", setting="import.cell")
     return float(lo[0]), float(lo[1]), (ny, nx)
 
 
@@ -168,7 +168,8 @@ def grid_surfaces(tiles: list[Tile], step: float | None = None,
     metres (None: :func:`grid_step`)."""
     step = grid_step(tiles) if step is None else float(step)
     if not (np.isfinite(step) and step > 0):
-        raise ParameterError(f"--cell {step}: expected a positive number of metres")
+        raise ParameterError(f"import: cell={step}: expected a positive number of metres",
+                             setting="import.cell")
     x0, y0, shape = _index(tiles, step)
     pts = np.vstack([t.points for t in tiles])
     ground = np.concatenate([t.ground for t in tiles])

@@ -92,7 +92,8 @@ def units_of(crs: pyproj.CRS, where: str) -> Units:
                              "zone) first")
     horizontal = crs.axis_info[0] if crs.axis_info else None
     if horizontal is None or not horizontal.unit_conversion_factor:
-        raise ParameterError(f"{where}: CRS {crs.name} states no axis unit; pass --crs")
+        raise ParameterError(f"{where}: CRS {crs.name} states no axis unit; name the CRS",
+                             setting="import.crs")
     vertical = horizontal
     if crs.is_compound and len(crs.sub_crs_list) > 1 and crs.sub_crs_list[1].axis_info:
         vertical = crs.sub_crs_list[1].axis_info[0]
@@ -110,14 +111,16 @@ def _crs(found: pyproj.CRS | None, given: str | None, where: str) -> Units:
         try:
             chosen = pyproj.CRS.from_user_input(given)
         except pyproj.exceptions.CRSError as err:
-            raise ParameterError(f"--crs {given!r}: not a CRS pyproj knows ({err})") from err
+            raise ParameterError(f"import: crs={given!r}: not a CRS pyproj knows ({err})",
+                                 setting="import.crs") from err
         if found is not None and not found.equals(chosen, ignore_axis_order=True):
-            raise ParameterError(f"{where}: the file's CRS is {found.name}, not --crs "
-                                 f"{given!r}; leave --crs out for this tile")
+            raise ParameterError(f"{where}: the file's CRS is {found.name}, not crs="
+                                 f"{given!r}; leave crs out for this tile",
+                                 setting="import.crs")
         return units_of(chosen, where)
     if found is None:
-        raise ParameterError(f"{where}: no CRS in the file; pass --crs (e.g. --crs "
-                             "EPSG:32632) to say which CRS and units its coordinates are in")
+        raise ParameterError(f"{where}: no CRS in the file; name the CRS (e.g. EPSG:32632) "
+                             "its coordinates and units are in", setting="import.crs")
     return units_of(found, where)
 
 
@@ -174,8 +177,9 @@ def _read_pair(path: Path, ground_file: Path, crs: str | None) -> Tile:
     dist, _ = cKDTree(ground_pts).query(pts, distance_upper_bound=1e-3, workers=-1)
     ground = np.isfinite(dist)
     if not ground.any():
-        raise PointFileError(f"--ground {ground_file}: none of its points is in {path}; give "
-                             "the bare-earth subset of that tile's points")
+        raise PointFileError(f"ground file {ground_file}: none of its points is in {path}; "
+                             "give the bare-earth subset of that tile's points",
+                             setting="import.ground_file")
     classes = np.where(ground, GROUND_CLASS, 1).astype(np.uint8)
     notes = [f"ground: the {int(ground.sum()):,} points also in {ground_file.name}"]
     return Tile(path, "pair", units, _scaled(pts, units), classes, np.ones(len(pts), bool),
@@ -219,8 +223,8 @@ def read_tiles(paths: list[str | os.PathLike[str]], *, crs: str | None = None,
     if not paths:
         raise ParameterError("no tile given: name one or more LAS/LAZ, PCD or DEM files")
     if ground is not None and len(paths) != 1:
-        raise ParameterError("--ground pairs one tile with its bare-earth points; import "
-                             "one tile at a time with it")
+        raise ParameterError("a ground file pairs one tile with its bare-earth points; "
+                             "import one tile at a time with it", setting="import.ground_file")
     tiles = [_read_one(Path(p), crs, ground, ground_class) for p in paths]
     crss = {t.units.crs for t in tiles}
     if len(crss) > 1:
@@ -242,7 +246,8 @@ def _read_one(path: Path, crs: str | None, ground: str | os.PathLike[str] | None
     if suffix in RASTER_SUFFIXES:
         return _read_raster(path, crs)
     if suffix == ".pcd":
-        raise ParameterError(f"{path}: a PCD has no classes; pass --ground FILE with its "
-                             "bare-earth points (an ISPRS-style pair)")
+        raise ParameterError(f"{path}: a PCD has no classes; give a ground file with its "
+                             "bare-earth points (an ISPRS-style pair)",
+                             setting="import.ground_file")
     raise ParameterError(f"{path}: not a terrain tile; expected LAS/LAZ "
                          f"({', '.join(POINT_SUFFIXES)}) or a DEM ({', '.join(RASTER_SUFFIXES)})")

@@ -43,7 +43,7 @@ from alte.mappers.api import VARIANCE, Cells, MapperBase, Record, param
 from alte_elevation.fusion import CellState, Gate, fuse
 from alte_elevation.noise import point_variance
 
-__all__ = ["LAYERS", "ElevationMap", "ElevationParams"]
+__all__ = ["LAYERS", "ElevationMap", "ElevationSettings"]
 
 #: The per-cell layers of :meth:`ElevationMap.cells`.
 LAYERS = frozenset({VARIANCE, "min", "max", "count"})
@@ -60,7 +60,7 @@ def _non_negative(value: float) -> bool:
 
 
 @dataclass(frozen=True)
-class ElevationParams(Record):
+class ElevationSettings(Record):
     """Elevation map parameters (module docstring; the noise model's in
     :mod:`alte_elevation.noise`)."""
 
@@ -85,13 +85,13 @@ class ElevationParams(Record):
                                     "to its variance")
 
 
-class ElevationMap(MapperBase[ElevationParams]):
+class ElevationMap(MapperBase[ElevationSettings]):
     """A 2.5D grid of Kalman-fused heights with per-cell variance (module docstring)."""
 
     name: ClassVar[str] = "elevation"
     title: ClassVar[str] = "Elevation map"
     dims: ClassVar[int] = 2
-    Params: ClassVar[type[Record]] = ElevationParams
+    Settings: ClassVar[type[Record]] = ElevationSettings
     view_params: ClassVar[frozenset[str]] = frozenset({"min_variance", "max_variance",
                                                        "spread"})
     layers: ClassVar[frozenset[str]] = LAYERS

@@ -7,7 +7,7 @@ from alte_elevation import ElevationMap, point_variance
 from alte.errors import ParameterError
 from alte.mappers import VARIANCE, registry
 from alte.mappers.api import Domain
-from alte.pipeline import MapSpec
+from alte.pipeline import MapSettings
 from alte.testing import check_mapper, scene
 
 
@@ -18,9 +18,9 @@ def test_meets_the_contract() -> None:
 def test_found_by_its_entry_point() -> None:
     """Installed, the package's entry point makes it a mapper of the registry."""
     assert registry.resolve("elevation") is ElevationMap
-    assert MapSpec("elevation", {"resolution": "0.25"}).record.resolution == 0.25
+    assert MapSettings("elevation", {"resolution": "0.25"}).record.resolution == 0.25
     with pytest.raises(ParameterError, match=r"elevation: resolution=0\.0 out of range"):
-        MapSpec("elevation", {"resolution": 0})
+        MapSettings("elevation", {"resolution": 0})
 
 
 def test_point_variance_by_range_and_angle() -> None:
@@ -65,3 +65,11 @@ def test_view_parameters_reread_the_stored_map() -> None:
     narrow = mapper.reread(spread=False)
     assert np.nanmax(narrow.cells().layers[VARIANCE]) <= np.nanmax(
         mapper.cells().layers[VARIANCE])
+
+
+def test_the_first_name_of_the_settings_record_still_imports() -> None:
+    import alte_elevation
+
+    with pytest.warns(DeprecationWarning, match="use ElevationSettings"):
+        old = alte_elevation.ElevationParams
+    assert old is alte_elevation.ElevationSettings

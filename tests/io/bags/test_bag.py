@@ -10,7 +10,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from alte.errors import BagError, ParameterError, PoseError, TopicError
-from alte.io.bags.bag import read_frames
+from alte.io.bags.bag import ReadSettings, read_frames
 from alte.io.bags.baginfo import inspect_bag
 from alte.types import Mount
 
@@ -62,8 +62,8 @@ def test_scans_outside_poses_and_in_gaps_are_dropped_and_counted(ros, tmp_path):
     pos, quat = ros.trajectory(t)
     msgs += [("/pose", ros.POSE, int(s), ros.pose_msg(int(s), p, q))
              for s, p, q in zip(t, pos, quat, strict=True)]
-    fs = read_frames(ros.write_ros2(tmp_path / "bag", sorted(msgs, key=lambda m: m[2])),
-                     max_gap_s=0.3)
+    bag = ros.write_ros2(tmp_path / "bag", sorted(msgs, key=lambda m: m[2]))
+    fs = read_frames(bag, ReadSettings(max_gap_s=0.3))
     assert [f.stamp for f in fs.frames] == [int(10.1 * ros.NS), int(10.2 * ros.NS)]
     c = fs.counts
     assert (c.scans_read, c.scans_outside_poses, c.scans_in_pose_gap) == (6, 1, 3)
@@ -136,7 +136,7 @@ def test_tf_poses_pick_the_body_leaf(ros, tmp_path):
     assert fs.pose_topic == "/tf" and len(fs) == 2
     np.testing.assert_allclose(fs.frames[1].position, pos[10])
     assert np.array_equal(fs.mount.translation, np.zeros(3)) and "identity mount" in fs.notes[0]
-    fs = read_frames(ros.write_ros2(tmp_path / "bag2", msgs), body_frame="odom")
+    fs = read_frames(ros.write_ros2(tmp_path / "bag2", msgs), ReadSettings(body_frame="odom"))
     np.testing.assert_allclose(fs.frames[1].position, [100, 0, 0])
 
 
@@ -155,11 +155,11 @@ def test_topic_ambiguity_absence_and_bad_overrides(ros, tmp_path):
     listing = r"topics in the bag: /other \[sensor_msgs/msg/PointCloud2\], /points"
     with pytest.raises(TopicError, match=rf"several cloud topics \(/other, /points\).*{listing}"):
         read_frames(bag)
-    assert len(read_frames(bag, cloud_topic="/other")) == 2
+    assert len(read_frames(bag, ReadSettings(cloud_topic="/other"))) == 2
     with pytest.raises(TopicError, match=r"cloud topic /nope is not in the bag; topics in"):
-        read_frames(bag, cloud_topic="/nope")
+        read_frames(bag, ReadSettings(cloud_topic="/nope"))
     with pytest.raises(TopicError, match=r"pose topic /points has type sensor_msgs/msg/Point"):
-        read_frames(bag, cloud_topic="/points", pose_topic="/points")
+        read_frames(bag, ReadSettings(cloud_topic="/points", pose_topic="/points"))
     poses = msgs + [("/pose2", ros.POSE, m[2], m[3]) for m in msgs if m[0] == "/pose"]
     with pytest.raises(TopicError, match=r"several pose topics \(/pose, /pose2\)"):
         read_frames(ros.write_ros2(tmp_path / "poses", poses))
@@ -173,14 +173,14 @@ def test_missing_pose_topic(ros, tmp_path):
     bag = ros.write_ros2(tmp_path / "bag", msgs)
     with pytest.raises(TopicError, match=r"no pose topic .*allow_no_pose.*/points \["):
         read_frames(bag)
-    fs = read_frames(bag, allow_no_pose=True)
+    fs = read_frames(bag, ReadSettings(allow_no_pose=True))
     assert len(fs) == 2 and np.array_equal(fs.frames[0].quaternion, [0, 0, 0, 1])
     assert fs.pose_topic is None and "identity pose" in fs.notes[-1]
 
 
 def test_progress_bar_runs(ros, tmp_path, capsys):
     bag = ros.write_ros2(tmp_path / "bag", ros.standard_messages(2))
-    assert len(read_frames(bag, progress=True)) == 2
+    assert len(read_frames(bag, ReadSettings(progress=True))) == 2
     assert "/points" in capsys.readouterr().err
 
 
@@ -206,10 +206,10 @@ def test_empty_bag(ros, tmp_path):
 def test_bad_max_gap(ros, tmp_path):
     """Read options are checked before the bag is opened (``tmp_path`` is none)."""
     with pytest.raises(ParameterError, match=r"read: max_gap_s=0.0 out of range \(max_gap_s > 0\)"):
-        read_frames(tmp_path, max_gap_s=0)
+        read_frames(tmp_path, ReadSettings(max_gap_s=0))
     with pytest.raises(ParameterError, match=r"read: return_mode='first' out of range "
                                              r"\(strongest\|last\|dual\)"):
-        read_frames(tmp_path, return_mode="first")
+        read_frames(tmp_path, ReadSettings(return_mode="first"))
 
 
 @pytest.mark.parametrize("storage", ["sqlite3", "mcap"])
@@ -265,7 +265,7 @@ def test_real_ros1_bag(ros):
     # its Odometry runs on simulated time (60 s) and the clouds on wall time (2020)
     with pytest.raises(PoseError, match=r"different clocks"):
         read_frames(path)
-    fs = read_frames(path, pose_topic="", allow_no_pose=True)
+    fs = read_frames(path, ReadSettings(pose_topic="", allow_no_pose=True))
     sizes = [len(f.points) for f in fs.frames]
     assert sizes == [35707, 36055, 36267, 36457, 36336]
     assert fs.frames[0].stamp == 1583971570015299642
@@ -282,7 +282,7 @@ def test_real_velodyne_packets_need_no_pose(ros, tmp_path):
     assert len(fs) == 4 and fs.pose_topic is None
     assert all(len(f.points) > 10000 for f in fs.frames)
     assert np.array_equal(fs.frames[0].position, np.zeros(3))
-    dual = read_frames(path, return_mode="dual")
+    dual = read_frames(path, ReadSettings(return_mode="dual"))
     assert len(dual.frames[0].points) > len(fs.frames[0].points)
     copy = tmp_path / "bag"
     shutil.copytree(path, copy)

@@ -12,7 +12,7 @@ from scipy.spatial.transform import Rotation
 
 from alte.errors import AlteError, BagError, ParameterError
 from alte.io.bags.bag import read_frames
-from alte.io.bags.writer import write_bag, write_frames
+from alte.io.bags.writer import BagSettings, write_bag, write_frames
 from alte.types import Frame, thesis_mount
 
 NS = 1_000_000_000
@@ -35,7 +35,7 @@ def digest(folder: Path) -> dict[str, str]:
 @pytest.mark.parametrize("storage", ["sqlite3", "mcap"])
 def test_round_trip_float64_is_exact(tmp_path, storage):
     frames = make_frames()
-    bag = write_frames(tmp_path / "bag", frames, thesis_mount(), storage=storage,
+    bag = write_frames(tmp_path / "bag", frames, thesis_mount(), BagSettings(storage=storage),
                        dtype=np.float64)
     fs = read_frames(bag)
     assert fs.frames == frames
@@ -57,11 +57,12 @@ def test_round_trip_float32_within_1e6(tmp_path):
 @pytest.mark.parametrize("storage", ["sqlite3", "mcap"])
 def test_same_input_gives_identical_bytes(tmp_path, storage):
     frames = make_frames()
-    first = digest(write_frames(tmp_path / "a" / "bag", frames, thesis_mount(), storage=storage))
-    second = digest(write_frames(tmp_path / "b" / "bag", frames, thesis_mount(), storage=storage))
+    settings = BagSettings(storage=storage)
+    first = digest(write_frames(tmp_path / "a" / "bag", frames, thesis_mount(), settings))
+    second = digest(write_frames(tmp_path / "b" / "bag", frames, thesis_mount(), settings))
     assert first == second and len(first) == 2
     frames[2].points[0, 0] += 1.0
-    third = digest(write_frames(tmp_path / "c" / "bag", frames, thesis_mount(), storage=storage))
+    third = digest(write_frames(tmp_path / "c" / "bag", frames, thesis_mount(), settings))
     assert third != first
 
 
@@ -71,7 +72,7 @@ def test_poses_at_their_own_rate(tmp_path):
     pos = np.column_stack([3.0 * t, 0 * t, 1 + 0 * t])
     quat = Rotation.from_euler("z", 2.0 * t[:, None]).as_quat()
     clouds = [(20 * NS + k * NS // 10 + NS // 200, np.ones((5, 3)) * k) for k in range(5)]
-    bag = write_bag(tmp_path / "bag", clouds, stamps, pos, quat, storage="mcap")
+    bag = write_bag(tmp_path / "bag", clouds, stamps, pos, quat, None, BagSettings(storage="mcap"))
     with AnyReader([bag]) as reader:
         log = [t for _, t, _ in reader.messages()]
         assert reader.topics["/pose"].msgcount == 51 and "/tf_static" not in reader.topics
@@ -93,7 +94,7 @@ def test_refuses_to_overwrite(tmp_path):
     with pytest.raises(AlteError, match=r"bag already exists"):
         write_frames(tmp_path / "bag", make_frames(3), None)
     assert digest(bag) == before
-    write_frames(tmp_path / "bag", make_frames(3), None, overwrite=True)
+    write_frames(tmp_path / "bag", make_frames(3), None, BagSettings(overwrite=True))
     assert len(read_frames(bag)) == 3
     assert sorted(p.name for p in tmp_path.iterdir()) == ["bag"]
 
@@ -110,7 +111,7 @@ def test_failed_write_leaves_nothing(tmp_path):
 
 def test_argument_errors(tmp_path):
     with pytest.raises(ParameterError, match=r"storage='zip'"):
-        write_frames(tmp_path / "b", make_frames(1), None, storage="zip")
+        write_frames(tmp_path / "b", make_frames(1), None, BagSettings(storage="zip"))
     with pytest.raises(BagError, match=r"poses: 2 stamps but 1 positions"):
         write_bag(tmp_path / "b", [], [1, 2], [[0, 0, 0]], [[0, 0, 0, 1]] * 2)
     with pytest.raises(BagError, match=r"poses: positions and quaternions must be finite"):

@@ -40,7 +40,7 @@ def test_misspelt_param_is_an_error(tmp_path: Path, notebooks: Path,
 def test_bad_only_is_an_error(tmp_path: Path, notebooks: Path,
                               capsys: pytest.CaptureFixture[str]) -> None:
     assert main(_args(tmp_path, notebooks, "--only", "slo")) == 2
-    assert "--only slo: no such run; valid: bad, slow" in capsys.readouterr().err
+    assert "--only: run slo: no such run; valid: bad, slow" in capsys.readouterr().err
 
 
 def test_jobs_must_be_positive(tmp_path: Path, notebooks: Path,

@@ -74,7 +74,7 @@ def test_modes_select_entries(notebooks: Path) -> None:
 def test_only_selects_by_run_or_notebook(notebooks: Path) -> None:
     runs = build_plan(ENTRIES, quick=False, notebooks_dir=notebooks, only=["bad"])
     assert [r.name for r in runs] == ["bad"]
-    with pytest.raises(ParameterError, match=r"--only badd: no such run; valid: bad, good"):
+    with pytest.raises(ParameterError, match=r"run badd: no such run; valid: bad, good"):
         build_plan(ENTRIES, quick=False, notebooks_dir=notebooks, only=["badd"])
 
 

@@ -15,11 +15,11 @@ from alte.errors import ParameterError
 from alte.lab.studies import experiments
 from alte.lab.studies.experiments import CACHE_DIR, ground_truth, measure, sweep, terrain, timed_run
 from alte.mappers.domain import Domain
-from alte.metrics.maps import TruthOptions
-from alte.pipeline import MapSpec
+from alte.metrics.maps import TruthSettings
+from alte.pipeline import MapSettings
 
 FRAMES = 4
-TRUTH = TruthOptions(n_samples=5000, grid_step=0.5)
+TRUTH = TruthSettings(n_samples=5000, grid_step=0.5)
 
 
 @pytest.fixture(scope="module")
@@ -62,17 +62,17 @@ def test_measure_times_and_measures_2d_maps(lan, mapper: str, params: dict) -> N
 
 
 def test_a_cheap_map_is_timed_as_the_least_of_repeated_runs(lan, monkeypatch) -> None:
-    result, timing = timed_run(lan, MapSpec("alte2d", {"max_res": 5}))
+    result, timing = timed_run(lan, MapSettings("alte2d", {"max_res": 5}))
     assert timing.repeats == experiments.REPEATS == 3
     assert timing.cpu_s > 0 and timing.elapsed_s > 0 and timing.cpu_spread >= 0
     m = measure(lan, "alte2d", {"max_res": 5}).metrics
     assert (m.time_repeats, m.cost) == (3, result.mapper.cost) and m.map_cpu_s > 0
     # a map dearer than the threshold is timed once: no spread measured
     monkeypatch.setattr(experiments, "REPEAT_BELOW_S", 0.0)
-    once = timed_run(lan, MapSpec("alte2d", {"max_res": 5}))[1]
+    once = timed_run(lan, MapSettings("alte2d", {"max_res": 5}))[1]
     assert once.repeats == 1 and np.isnan(once.cpu_spread)
     with pytest.raises(ParameterError, match="repeats=0: expected at least 1"):
-        timed_run(lan, MapSpec("alte2d"), repeats=0)
+        timed_run(lan, MapSettings("alte2d"), repeats=0)
 
 
 def test_measure_without_truth_has_only_thesis_metrics(lan) -> None:
@@ -140,7 +140,7 @@ def test_cli_on_the_terrain_folder_reproduces_the_table_row(
         capsys: pytest.CaptureFixture[str], request: pytest.FixtureRequest, name: str,
         mapper: str, params: dict) -> None:
     data = request.getfixturevalue("lan" if name == "sim_lan_2" else "nav")
-    row = measure(data, mapper, params, truth=TruthOptions())
+    row = measure(data, mapper, params, truth=TruthSettings())
     sets = [a for k, v in params.items() for a in ("--set", f"{k}={v}")]
     assert main(["map", str(data.source.path), "--mapper", mapper, *sets, "--metrics",
                  "--json"]) == 0

@@ -118,7 +118,8 @@ def test_compare_verdicts_joins_on_the_claim_id() -> None:
 
 def test_incomplete_evidence_is_named(evidence: Path, tmp_path) -> None:
     with pytest.raises(ReportError, match=r"missing claims.csv, equal_size.csv, .*"
-                                          r"provenance.json \(made by alte sweep"):
+                                          r"provenance.json \(made by a sweep given an evidence "
+                                          r"folder\)"):
         load_mission_evidence(tmp_path)
     copy = tmp_path / "copy"
     copy.mkdir()

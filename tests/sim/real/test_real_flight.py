@@ -9,7 +9,7 @@ from support.tiles import X0, Y0, field, write_dem, write_las
 
 from alte.errors import ParameterError, SimulationError
 from alte.lab.studies.experiments import measure
-from alte.metrics.options import TruthOptions
+from alte.metrics.options import TruthSettings
 from alte.pipeline import open_input, prepare
 from alte.sim import VLP16, load_scenario, simulate, write_scenario
 from alte.sim.real import Flight, import_terrain, write_imported
@@ -34,13 +34,13 @@ def test_dem_round_trip_measures_the_error_known_by_construction(flat_flight):
     assert datum == 200.0 and imported.source["origin_m"][2] == 200.0
     assert np.allclose(data.cloud[:, 2] + datum, PLANE, atol=1e-4)  # the sensor saw the DEM
     # A 2D map's cells hold the mean height of noise-free points on a plane: no error.
-    heights = measure(data, "alte2d", {"max_res": 5, "min_pts": 10}, truth=TruthOptions())
+    heights = measure(data, "alte2d", {"max_res": 5, "min_pts": 10}, truth=TruthSettings())
     assert heights.metrics.truth.height_rmse_m == pytest.approx(0.0, abs=1e-4)
     assert heights.metrics.truth.accuracy_mean_m == pytest.approx(0.0, abs=1e-4)
     assert heights.metrics.truth.completeness == pytest.approx(1.0)
     # Octomap's leaves sit where its key grid puts them: each is off the plane by the
     # distance of its centre to 250.3 m, which the truth must measure exactly.
-    voxels = measure(data, "octomap", {"resolution": 0.5}, truth=TruthOptions())
+    voxels = measure(data, "octomap", {"resolution": 0.5}, truth=TruthSettings())
     cells = voxels.mapper.cells()
     centres = cells.centers[cells.occupied.astype(bool)]
     assert voxels.metrics.truth.accuracy_mean_m == pytest.approx(
@@ -63,10 +63,10 @@ def test_imported_folder_is_a_terrain_every_entry_point_reads(tmp_path):
     scenario = load_scenario(folder)
     assert scenario.case == "nav" and len(scenario.ground_truth.objects) == 2
     run = measure(prepare(open_input(folder)), "octomap", {"resolution": 1.0},
-                  truth=TruthOptions())
+                  truth=TruthSettings())
     assert run.metrics.truth.completeness_by_class["building"] > 0.3
     assert run.metrics.truth.completeness_seen > 0.9
-    with pytest.raises(SimulationError, match=r"exists .*--force"):
+    with pytest.raises(SimulationError, match=r"exists .*force=True replaces it"):
         write_imported(imported, tmp_path / "data", frames=5)
 
 

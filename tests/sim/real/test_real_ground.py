@@ -108,24 +108,26 @@ def test_cli_help_says_the_policy(capsys):
     assert "replacing the producer's ground class" in text and "--ground-set KEY=VALUE" in text
 
 
-def test_bad_ground_choices_name_the_flags(tiles, tmp_path):
+def test_bad_ground_choices_name_the_settings(tiles, tmp_path):
     classed, stripped, _, _ = tiles
-    with pytest.raises(ParameterError, match="--ground-class and --ground-method"):
+    with pytest.raises(ParameterError, match="import: ground_class and a ground filter"):
         GroundChoice(ground_class=3, method="smrf")
-    with pytest.raises(ParameterError, match=r"--ground-method 'nope': unknown; valid: smrf, "
+    with pytest.raises(ParameterError, match=r"import: ground method 'nope' unknown; valid: smrf, "
                                              r"csf, morph, plane"):
         GroundChoice(method="nope")
-    with pytest.raises(ParameterError, match="--ground-set: SmrfSettings are not the "
-                                             "settings of --ground-method csf"):
+    with pytest.raises(ParameterError, match="import: SmrfSettings are not the "
+                                             "settings of the ground method csf"):
         GroundChoice(method="csf", settings=SmrfSettings())
-    with pytest.raises(ParameterError, match="--ground-class 300: an ASPRS class is 0 to 255"):
+    with pytest.raises(ParameterError, match="import: ground_class=300: an ASPRS class is 0 "
+                                             "to 255"):
         GroundChoice(ground_class=300)
-    with pytest.raises(ParameterError, match="--ground-set: every tile has ground class 2"):
+    with pytest.raises(ParameterError, match="import: ground settings: every tile has "
+                                             "ground class 2"):
         terrain_tiles([classed], choice=GroundChoice(settings=SmrfSettings(slope=0.2)))
-    with pytest.raises(ParameterError, match="--ground FILE and --ground-method"):
+    with pytest.raises(ParameterError, match="import: a ground file and a ground filter"):
         terrain_tiles([stripped], ground=classed, choice=GroundChoice(method="smrf"))
     dem = write_dem(tmp_path / "dem.tif", np.full((8, 8), 100.0))
-    with pytest.raises(ParameterError, match="--ground-method csf: no LAS/LAZ tile"):
+    with pytest.raises(ParameterError, match="import: ground method csf: no LAS/LAZ tile"):
         terrain_tiles([dem], choice=GroundChoice(method="csf"))
 
 
@@ -133,13 +135,13 @@ def test_a_named_class_no_point_holds_is_refused(tmp_path):
     pts, _ = field()
     tile = write_las(tmp_path / "raw.las", pts, np.ones(len(pts), np.uint8))
     with pytest.raises(PointFileError, match=r"no point of ground class 9 .*classes present: "
-                                             r"1 .*--ground-class N.*--ground FILE.*leave "
-                                             r"--ground-class out"):
+                                             r"1 .*\(ground_class\).*a ground file.*leave "
+                                             r"ground_class out"):
         terrain_tiles([tile], choice=GroundChoice(ground_class=9))
     assert terrain_tiles([tile], choice=GroundChoice(ground_class=1))[0][0].ground.all()
     # a regular grid of points with no class is a DEM to the filter: named as such
     with pytest.raises(GroundError, match=r"raw.las: the ground filter cannot classify it "
-                                          r"\(.*regular 0.5 m grid.*--ground-class N"):
+                                          r"\(.*regular 0.5 m grid.*\(ground_class\)"):
         terrain_tiles([tile])
 
 
@@ -151,7 +153,8 @@ def test_cli_ground_flag_errors_are_one_line(tiles, tmp_path, capsys):
               "--ground-set: ground csf: rigidness=7 out of range"),
              (["--ground-set", "slope"], "--ground-set 'slope': expected KEY=VALUE"),
              (["--ground-class", "2", "--ground-method", "smrf"],
-              "--ground-class and --ground-method")]
+              "--ground-class, --ground-method, --ground-set: import: ground_class and a "
+              "ground filter")]
     for extra, message in cases:
         assert main(["simulate", str(stripped), "--out", str(tmp_path / "out"), *extra]) == 2
         err = capsys.readouterr().err.strip()

@@ -123,10 +123,10 @@ def test_dem_of_only_nodata_is_refused(tmp_path):
 def test_no_crs_and_no_crs_flag_is_refused_naming_it(tmp_path):
     pts, cls = field()
     tile = write_las(tmp_path / "nocrs.las", pts, cls, crs=None)
-    with pytest.raises(ParameterError, match="no CRS in the file; pass --crs"):
+    with pytest.raises(ParameterError, match="no CRS in the file; name the CRS"):
         read_tiles([tile])
     assert read_tiles([tile], crs="EPSG:32632")[0].units.horizontal == "metre"
-    with pytest.raises(ParameterError, match="--crs 'EPSG:0'"):
+    with pytest.raises(ParameterError, match="import: crs='EPSG:0'"):
         read_tiles([tile], crs="EPSG:0")
 
 
@@ -137,9 +137,9 @@ def test_cli_errors_are_one_line_naming_the_flag(tmp_path, capsys):
     dem = write_dem(tmp_path / "empty.asc", np.full((5, 5), np.nan))
     degrees = write_las(tmp_path / "degrees.las", pts, cls, crs="EPSG:4326")
     pcd = write_points(tmp_path / "all.pcd", pts)
-    cases = [([str(nocrs)], "--crs"), ([str(raw), "--ground-class", "9"], "--ground-class N"),
+    cases = [([str(nocrs)], "--crs"), ([str(raw), "--ground-class", "9"], "--ground-class: "),
              ([str(dem)], "nodata"),
-             ([str(degrees)], "geographic (degrees)"), ([str(pcd)], "--ground FILE"),
+             ([str(degrees)], "geographic (degrees)"), ([str(pcd)], "--ground: "),
              ([str(raw), "--ground-class", "1", "--altitude", "-2"], "--altitude -2.0"),
              ([str(raw), "--ground-class", "1", "--region", "1,2,3"], "--region")]
     for args, flag in cases:
@@ -184,4 +184,4 @@ def test_real_tile_crop_in_its_crs():
     imported = import_terrain([tile], Flight(), region=(484900, 6632900, 484960, 6632960))
     assert imported.surfaces.shape == (61, 61)
     assert imported.source["units"]["crs"] == "EPSG:2154"
-    assert "cropped to --region" in imported.source["tiles"][0]["notes"][-1]
+    assert "cropped to the region" in imported.source["tiles"][0]["notes"][-1]

@@ -58,7 +58,7 @@ from alte.lab.studies.thesis.claims.types import (
 )
 from alte.params import Record, param
 
-__all__ = ["CELL_COLUMNS", "CLAIM_COLUMNS", "VERDICTS", "EvidenceOptions", "Finding",
+__all__ = ["CELL_COLUMNS", "CLAIM_COLUMNS", "VERDICTS", "EvidenceSettings", "Finding",
            "cells_table", "claims_table", "evaluate", "evaluate_all"]
 
 #: Every verdict a claim can get.
@@ -76,7 +76,7 @@ _PRIORITY = ("metric", "view", "mapper", "case", "parameter")
 
 
 @dataclass(frozen=True)
-class EvidenceOptions(Record):
+class EvidenceSettings(Record):
     """How a claim's cells are judged: the interval and the seeds it needs (module docstring)."""
 
     OWNER = "evidence"
@@ -117,7 +117,7 @@ def _outcome(low: float, high: float, seeds: int, m: CheckValues, min_seeds: int
     return _HOLDS if low > m.threshold else _FAILS if high < m.threshold else "inconclusive"
 
 
-def _interval(group: pd.DataFrame, options: EvidenceOptions) -> Interval:
+def _interval(group: pd.DataFrame, options: EvidenceSettings) -> Interval:
     """The bootstrap interval of one cell's seeds (of their bounds, where they have them)."""
     if "low" in group:
         return bootstrap_bounds(group["value"].to_numpy(), group["low"].to_numpy(),
@@ -127,7 +127,7 @@ def _interval(group: pd.DataFrame, options: EvidenceOptions) -> Interval:
                         options.seed)
 
 
-def _cells(m: CheckValues, options: EvidenceOptions) -> pd.DataFrame:
+def _cells(m: CheckValues, options: EvidenceSettings) -> pd.DataFrame:
     rows = []
     for (terrain, level), group in m.stats.groupby(["terrain", "level"], dropna=False,
                                                    sort=True):
@@ -166,7 +166,7 @@ def _property(p: Property) -> tuple[str, str]:
 Result = tuple[str, str, str, pd.DataFrame, str]
 
 
-def _crosscheck_text(m: CheckValues, cells: pd.DataFrame, options: EvidenceOptions) -> str:
+def _crosscheck_text(m: CheckValues, cells: pd.DataFrame, options: EvidenceSettings) -> str:
     """The cost's statistic measured again on the CPU time: its verdict and the cells where
     the two decide opposite ways (readings of one run, not judged within their spread)."""
     if m.crosscheck is None:
@@ -187,7 +187,7 @@ def _crosscheck_text(m: CheckValues, cells: pd.DataFrame, options: EvidenceOptio
     return f" Cross-check on the CPU time: {text} -> {verdict}; {contra}."
 
 
-def _one(check: Check, table: pd.DataFrame, options: EvidenceOptions,
+def _one(check: Check, table: pd.DataFrame, options: EvidenceSettings,
          variants: pd.DataFrame | None = None) -> Result:
     """(verdict, depends_on, evidence, cells, time check) of one check (``variants``: the
     grid's rows of every ablation variant, which a :class:`Contrast` reads)."""
@@ -255,7 +255,7 @@ def _resized(check: Check | AllOf, size: str | None) -> Check | AllOf:
     return renamed(check, "basis_functions", size)
 
 
-def _evaluate(claim: Claim, table: pd.DataFrame, options: EvidenceOptions,
+def _evaluate(claim: Claim, table: pd.DataFrame, options: EvidenceSettings,
               cache: dict[Check, Result] | None = None,
               variants: pd.DataFrame | None = None) -> Finding:
     check = _resized(claim.check, options.size)
@@ -284,23 +284,23 @@ def _evaluate(claim: Claim, table: pd.DataFrame, options: EvidenceOptions,
     return Finding(claim, verdict, depends, text, cells.reindex(columns=CELL_COLUMNS), checks)
 
 
-def evaluate(claim: Claim, table: pd.DataFrame, options: EvidenceOptions | None = None,
+def evaluate(claim: Claim, table: pd.DataFrame, options: EvidenceSettings | None = None,
              variants: pd.DataFrame | None = None) -> Finding:
     """The verdict on ``claim`` from a trade-off table (see the module docstring);
     ``variants``: the grid's rows of every ablation variant (a ``variant`` column, the
     base grid as ``base``), for the claims that contrast them."""
     ready = prepare(variants) if variants is not None else None
-    return _evaluate(claim, prepare(table), options or EvidenceOptions(), variants=ready)
+    return _evaluate(claim, prepare(table), options or EvidenceSettings(), variants=ready)
 
 
 def evaluate_all(claims: Sequence[Claim], table: pd.DataFrame,
-                 options: EvidenceOptions | None = None,
+                 options: EvidenceSettings | None = None,
                  variants: pd.DataFrame | None = None) -> list[Finding]:
     """:func:`evaluate` for every claim (the tables are checked and prepared once)."""
     prepared = prepare(table)
     ready = prepare(variants) if variants is not None else None
     cache: dict[Check, Result] = {}
-    return [_evaluate(c, prepared, options or EvidenceOptions(), cache, ready) for c in claims]
+    return [_evaluate(c, prepared, options or EvidenceSettings(), cache, ready) for c in claims]
 
 
 def claims_table(findings: Sequence[Finding]) -> pd.DataFrame:

@@ -24,7 +24,7 @@ import pandas as pd
 from alte.lab.studies.analysis.conditions import conditions
 from alte.lab.studies.analysis.evidence import (
     CLAIM_COLUMNS,
-    EvidenceOptions,
+    EvidenceSettings,
     Finding,
     cells_table,
     claims_table,
@@ -84,13 +84,13 @@ def _case_table(table: pd.DataFrame, case: str) -> pd.DataFrame:
 
 def comparison_tables(table: pd.DataFrame, *, sizes: Sequence[float] = SIZES,
                       fidelities: Sequence[float] | None = None,
-                      options: EvidenceOptions | None = None
+                      options: EvidenceSettings | None = None
                       ) -> tuple[pd.DataFrame, pd.DataFrame]:
     """Each case's two mappers at equal size (``sizes`` basis functions; reads outside a
     front are left out) and at equal MHD (``fidelities``, default three levels inside
     the fronts' overlap per terrain): (case, terrain, metric, level, mapper, mean, low,
     high, seeds)."""
-    options = options or EvidenceOptions()
+    options = options or EvidenceSettings()
     prepared = prepare(table)
     at_size, at_fidelity = [], []
     for case, pair in CASE_MAPPERS.items():
@@ -108,7 +108,7 @@ def comparison_tables(table: pd.DataFrame, *, sizes: Sequence[float] = SIZES,
 
 
 def _summary(reads: pd.DataFrame, case: str, metric: str,
-             options: EvidenceOptions) -> pd.DataFrame:
+             options: EvidenceSettings) -> pd.DataFrame:
     out = interval_table(reads.dropna(subset=["value"]), options.level, options.seed)
     return out.assign(case=case, metric=metric)
 
@@ -133,7 +133,7 @@ def key_table(summary: pd.DataFrame, metric: str, level: str, value: str) -> pd.
 
 
 def write_evidence(table: pd.DataFrame, tables_dir: str | os.PathLike[str], *,
-                   claims: Sequence[Claim] = CLAIMS, options: EvidenceOptions | None = None,
+                   claims: Sequence[Claim] = CLAIMS, options: EvidenceSettings | None = None,
                    variants: pd.DataFrame | None = None,
                    overwrite: bool = True) -> EvidenceFiles:
     """Evaluate ``claims`` on the trade-off ``table`` (and the ablation ``variants``' rows,
@@ -154,7 +154,7 @@ def write_evidence(table: pd.DataFrame, tables_dir: str | os.PathLike[str], *,
 
 
 def ablation_table(claims: Sequence[Claim],
-                   variants: Mapping[str, tuple[pd.DataFrame, EvidenceOptions]]
+                   variants: Mapping[str, tuple[pd.DataFrame, EvidenceSettings]]
                    ) -> pd.DataFrame:
     """One row per claim, one verdict column per variant (a table and its options, e.g.
     another domain or occupancy rule, or ``size="occupied_cells"``), and ``moves``: the

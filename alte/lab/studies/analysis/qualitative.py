@@ -35,7 +35,7 @@ from numpy.typing import ArrayLike
 from alte.lab.studies.analysis.tables import rule_pick
 from alte.lab.studies.experiments import Measured, measure, reference_of
 from alte.lab.studies.thesis.numbers import QUALITATIVE
-from alte.metrics.maps import TruthOptions
+from alte.metrics.maps import TruthSettings
 from alte.pipeline import Registered
 
 __all__ = ["MEASURES", "Inputs", "class_completeness", "qualitative_inputs", "qualitative_table"]
@@ -152,7 +152,7 @@ def qualitative_inputs(sweeps: Mapping[str, tuple[pd.DataFrame, Sequence[Measure
 
 def class_completeness(data: Registered,
                        sweeps: Mapping[str, tuple[pd.DataFrame, Sequence[Measured]]],
-                       truth: TruthOptions, cls: str = "overhang") -> dict[str, float]:
+                       truth: TruthSettings, cls: str = "overhang") -> dict[str, float]:
     """Map ``data`` (e.g. sim_nav_2) with each sweep's chosen parameters and return the
     completeness on objects of class ``cls`` per mapper (NaN when the terrain has none)."""
     out = {}

@@ -36,7 +36,7 @@ from alte.lab.studies.landing.params import (
     LAB,
     QUADROTOR,
     SIGMA_OF_OBSTACLE,
-    LandingParams,
+    LandingSettings,
     landing_params,
 )
 from alte.lab.studies.landing.raster import (
@@ -64,8 +64,8 @@ __all__ = [
     "SWEEP_ROWS",
     "Centres",
     "Detection",
-    "LandingParams",
     "LandingRun",
+    "LandingSettings",
     "PlaneFeatures",
     "RasterGeometry",
     "detect_sites",

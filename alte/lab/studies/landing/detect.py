@@ -22,7 +22,7 @@ from scipy import ndimage
 
 from alte.errors import ParameterError
 from alte.ground.surface import ground_obstacles, planar, plane_features
-from alte.lab.studies.landing.params import LandingParams
+from alte.lab.studies.landing.params import LandingSettings
 from alte.lab.studies.landing.raster import RasterGeometry
 
 __all__ = ["SITE_COLUMNS", "Centres", "Detection", "detect_sites", "feasible_centres",
@@ -73,7 +73,7 @@ def _distance_to(mask: NDArray[np.bool_], step: float, pad_true: bool) -> NDArra
     return dist[1:-1, 1:-1] if pad_true else dist
 
 
-def map_obstacles(height: NDArray[np.float64], grid: RasterGeometry, params: LandingParams,
+def map_obstacles(height: NDArray[np.float64], grid: RasterGeometry, params: LandingSettings,
                   ground: float | None = None, seed: int = 0) -> NDArray[np.bool_]:
     """Known pixels more than ``obstacle_height`` above or below the ground.
 
@@ -84,7 +84,7 @@ def map_obstacles(height: NDArray[np.float64], grid: RasterGeometry, params: Lan
 
 
 def feasible_centres(height: NDArray[np.float64], obstacle: NDArray[np.bool_], step: float,
-                     params: LandingParams) -> Centres:
+                     params: LandingSettings) -> Centres:
     """Test every pixel as a site centre (module docstring); NaN heights are unknown."""
     height = np.asarray(height, dtype=np.float64)
     obstacle = np.asarray(obstacle, dtype=bool)
@@ -101,7 +101,7 @@ def feasible_centres(height: NDArray[np.float64], obstacle: NDArray[np.bool_], s
                    obstacle & known)
 
 
-def _pixel_terms(centres: Centres, params: LandingParams,
+def _pixel_terms(centres: Centres, params: LandingSettings,
                  ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Room (gap from the footprint to the nearest obstacle or unknown pixel, over twice
     ``keep_out``; not capped) and flatness in [0, 1] per pixel."""
@@ -112,7 +112,7 @@ def _pixel_terms(centres: Centres, params: LandingParams,
 
 
 def rank_sites(centres: Centres, height: NDArray[np.float64], grid: RasterGeometry,
-               params: LandingParams) -> pd.DataFrame:
+               params: LandingSettings) -> pd.DataFrame:
     """Sites = 8-connected components of feasible centres, best first (:data:`SITE_COLUMNS`).
 
     Per site the centre is the pixel maximising room + flatness (room: gap from the
@@ -144,7 +144,7 @@ def rank_sites(centres: Centres, height: NDArray[np.float64], grid: RasterGeomet
     return table.reset_index(drop=True)[list(SITE_COLUMNS)]
 
 
-def detect_sites(height: NDArray[np.float64], grid: RasterGeometry, params: LandingParams,
+def detect_sites(height: NDArray[np.float64], grid: RasterGeometry, params: LandingSettings,
                  ground: float | None = None, seed: int = 0) -> Detection:
     """Landing sites on a height raster (NaN = unknown); ``ground`` as in :func:`map_obstacles`."""
     height = np.asarray(height, dtype=np.float64)

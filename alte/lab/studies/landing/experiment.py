@@ -27,12 +27,12 @@ from alte.errors import MetricsError, ParameterError
 from alte.lab.studies.analysis.tables import write_csv
 from alte.lab.studies.experiments import ground_truth, terrain
 from alte.lab.studies.landing.detect import Centres, Detection, detect_sites
-from alte.lab.studies.landing.params import SIGMA_OF_OBSTACLE, LandingParams, landing_params
+from alte.lab.studies.landing.params import SIGMA_OF_OBSTACLE, LandingSettings, landing_params
 from alte.lab.studies.landing.raster import RasterGeometry, rasterise, rasterise_sigma
 from alte.lab.studies.landing.truth import score_detection, truth_centres
 from alte.lab.studies.thesis.numbers import SWEEPS, mapper_params
 from alte.mappers import VARIANCE, Mapper, registry
-from alte.pipeline import MapRun, MapSpec, Registered, run
+from alte.pipeline import MapRun, MapSettings, Registered, run
 from alte.progress import bar as progress_bar
 from alte.types import JSONDict
 
@@ -56,20 +56,20 @@ class LandingRun:
 
     terrain: str
     label: str
-    landing: LandingParams
+    landing: LandingSettings
     map_run: MapRun
     detection: Detection
     truth: Centres | None
     scores: dict[str, float]
 
 
-def landing_grid(data: Registered, params: LandingParams) -> RasterGeometry:
+def landing_grid(data: Registered, params: LandingSettings) -> RasterGeometry:
     """The raster over the input's control volume (its points' extent when it has none)."""
     box = data.spec.crop if data.spec.crop is not None else data.bounds()
     return RasterGeometry.from_bounds(box.array(), params.step)
 
 
-def landing_truth(data: Registered, params: LandingParams) -> Centres:
+def landing_truth(data: Registered, params: LandingSettings) -> Centres:
     """Truly safe centres of a simulated terrain on :func:`landing_grid`."""
     truth = ground_truth(data)
     if truth is None:
@@ -80,9 +80,9 @@ def landing_truth(data: Registered, params: LandingParams) -> Centres:
 
 
 def _landing_spec(mapper: str | type[Mapper], params: Mapping[str, object] | None,
-                  landing: LandingParams) -> MapSpec:
+                  landing: LandingSettings) -> MapSettings:
     """The map to make, refused when it cannot carry the landing test."""
-    spec = MapSpec(mapper, dict(params or {}))
+    spec = MapSettings(mapper, dict(params or {}))
     if spec.cls.dims != 2:
         usable = ", ".join(c.name for c in registry.classes() if c.dims == 2)
         raise ParameterError(f"landing: mapper {spec.cls.name!r} is not a 2D mapper; use one "
@@ -94,7 +94,7 @@ def _landing_spec(mapper: str | type[Mapper], params: Mapping[str, object] | Non
     return spec
 
 
-def _detect(data: Registered, result: MapRun, landing: LandingParams, truth: Centres | None,
+def _detect(data: Registered, result: MapRun, landing: LandingSettings, truth: Centres | None,
             label: str) -> LandingRun:
     """Sites on the map of ``result`` (pixels over the sigma bound unknown), scored."""
     grid = landing_grid(data, landing)
@@ -113,7 +113,7 @@ def _detect(data: Registered, result: MapRun, landing: LandingParams, truth: Cen
 
 
 def evaluate_landing(data: Registered, mapper: str | type[Mapper],
-                     params: Mapping[str, object] | None, landing: LandingParams, *,
+                     params: Mapping[str, object] | None, landing: LandingSettings, *,
                      truth: Centres | None = None, label: str = "") -> LandingRun:
     """Map ``data`` with ``mapper``/``params``, detect sites and score them when truth exists.
 
@@ -127,7 +127,7 @@ def evaluate_landing(data: Registered, mapper: str | type[Mapper],
 
 def score_landing(dataset: Registered, mapper: str | type[Mapper],
                   params: Mapping[str, object] | None,
-                  landing_params: LandingParams) -> dict[str, float]:
+                  landing_params: LandingSettings) -> dict[str, float]:
     """Scores of :func:`evaluate_landing` (precision, recall, ...) as a flat dict."""
     return evaluate_landing(dataset, mapper, params, landing_params).scores
 
@@ -168,7 +168,7 @@ def _row(run: LandingRun, params: Mapping[str, object]) -> JSONDict:
                       else f"sigma <= {landing.max_height_sigma:.3g} m")}
 
 
-def _evaluations(data: Registered, job: ParamSet, landing: LandingParams, *,
+def _evaluations(data: Registered, job: ParamSet, landing: LandingSettings, *,
                  truth: Centres | None, sigma: bool) -> list[LandingRun]:
     """The map of one parameter set, and with ``sigma`` (a map with a height variance) the
     same map again under the sigma bound :data:`SIGMA_OF_OBSTACLE` of the obstacle height."""
@@ -182,7 +182,7 @@ def _evaluations(data: Registered, job: ParamSet, landing: LandingParams, *,
 
 
 def landing_table(datasets: Sequence[Registered],
-                  landing: Mapping[str, LandingParams] | None = None, *,
+                  landing: Mapping[str, LandingSettings] | None = None, *,
                   plugins: bool = False, extra: Sequence[type[Mapper]] = (),
                   sigma: bool = True, progress: bool = True
                   ) -> tuple[pd.DataFrame, list[LandingRun]]:

@@ -19,7 +19,7 @@ from alte.lab.plot.arrays import Floats
 from alte.lab.plot.figure import Caption, Plot
 from alte.lab.studies.landing.detect import Centres, Detection
 from alte.lab.studies.landing.experiment import LandingRun
-from alte.lab.studies.landing.params import LandingParams
+from alte.lab.studies.landing.params import LandingSettings
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -45,7 +45,7 @@ def _site_colours(detection: Detection, truth: Centres | None) -> Floats:
     return np.where(safe[:, None], [0.0, 0.6, 0.0, 1.0], [0.85, 0.0, 0.0, 1.0])
 
 
-def plot_landing(detection: Detection, params: LandingParams, ax: Axes, *,
+def plot_landing(detection: Detection, params: LandingSettings, ax: Axes, *,
                  truth: Centres | None = None, title: str | None = None) -> AxesImage:
     """Draw one detection on ``ax``: heights, obstacles (red), detected feasible centres
     (blue outline), truly feasible centres (green dashed) and the chosen sites."""

@@ -26,10 +26,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from alte.errors import ParameterError
-from alte.ground.surface import SurfaceRule
+from alte.ground.surface import OccupancySettings
 from alte.params import Record, param
 
-__all__ = ["LAB", "QUADROTOR", "SIGMA_OF_OBSTACLE", "LandingParams", "landing_params"]
+__all__ = ["LAB", "QUADROTOR", "SIGMA_OF_OBSTACLE", "LandingSettings", "landing_params"]
 
 #: The height sigma bound the landing study tries, as a share of the obstacle height:
 #: 2 sigma of a quarter of the step that makes an obstacle leaves a known pixel's height
@@ -38,7 +38,7 @@ SIGMA_OF_OBSTACLE = 0.25
 
 
 @dataclass(frozen=True)
-class LandingParams(Record):
+class LandingSettings(Record):
     """What makes a safe landing site (module docstring); validated on creation."""
 
     OWNER = "landing"
@@ -75,10 +75,10 @@ class LandingParams(Record):
         return self.radius + self.margin
 
     @property
-    def surface(self) -> SurfaceRule:
+    def surface(self) -> OccupancySettings:
         """The landing criterion of :mod:`alte.ground.surface` these limits give (window:
         the disk; ground: the MSAC plane)."""
-        return SurfaceRule(window=self.disk, max_slope_deg=self.max_slope_deg,
+        return OccupancySettings(window=self.disk, max_slope_deg=self.max_slope_deg,
                            max_roughness=self.max_roughness,
                            obstacle_height=self.obstacle_height, ground="plane")
 
@@ -89,13 +89,13 @@ class LandingParams(Record):
 
 
 #: The thesis' quadrotor over the simulated terrains (the defaults).
-QUADROTOR = LandingParams()
+QUADROTOR = LandingSettings()
 #: A vehicle scaled to the 8 m x 6 m lab of the experimental terrains (thesis 2.2.4).
-LAB = LandingParams(radius=0.25, margin=0.1, clearance=0.15, max_slope_deg=10.0,
+LAB = LandingSettings(radius=0.25, margin=0.1, clearance=0.15, max_slope_deg=10.0,
                     max_roughness=0.03, obstacle_height=0.06, step=0.05)
 
 
-def landing_params(terrain: str, **overrides: object) -> LandingParams:
+def landing_params(terrain: str, **overrides: object) -> LandingSettings:
     """The preset for ``terrain`` (``exp_*``: :data:`LAB`, else :data:`QUADROTOR`), overridden."""
     base = LAB if terrain.startswith("exp_") else QUADROTOR
     return base.replace(**overrides)

@@ -27,7 +27,7 @@ from scipy.spatial import ConvexHull, QhullError
 
 from alte.errors import MetricsError
 from alte.lab.studies.landing.detect import Centres, Detection, feasible_centres
-from alte.lab.studies.landing.params import LandingParams
+from alte.lab.studies.landing.params import LandingSettings
 from alte.lab.studies.landing.raster import RasterGeometry
 from alte.metrics import TrueSurface
 from alte.tensors import to_array, to_tensor
@@ -104,7 +104,7 @@ def top_surface(surface: TrueSurface, xy: NDArray[np.float64], z_start: float,
     return np.where(found, z_start - t_hit, np.nan), ids
 
 
-def truth_centres(surface: TrueSurface, grid: RasterGeometry, params: LandingParams,
+def truth_centres(surface: TrueSurface, grid: RasterGeometry, params: LandingSettings,
                   z_start: float) -> Centres:
     """Truly safe centres on ``grid`` (module docstring); rays start at ``z_start``."""
     if not surface.classes:
@@ -121,7 +121,7 @@ def _share(num: int, den: int) -> float:
     return float(num / den) if den else float("nan")
 
 
-def score_detection(detection: Detection, truth: Centres, params: LandingParams,
+def score_detection(detection: Detection, truth: Centres, params: LandingSettings,
                     ) -> dict[str, float]:
     """Precision of the chosen sites, area precision and recall (module docstring)."""
     true = truth.feasible

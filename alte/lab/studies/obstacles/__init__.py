@@ -29,7 +29,7 @@ from alte.lab.studies.obstacles.tables import (
     write_obstacle_tables,
 )
 from alte.lab.studies.obstacles.truth import (
-    ObstacleOptions,
+    ObstacleSettings,
     TrueObstacles,
     obstacle_options,
     terrain_obstacles,
@@ -42,8 +42,8 @@ __all__ = [
     "OBSTACLE_COLUMNS",
     "SCORE_COLUMNS",
     "MapRaster",
-    "ObstacleOptions",
     "ObstacleScores",
+    "ObstacleSettings",
     "TrueObstacles",
     "identify",
     "map_raster",

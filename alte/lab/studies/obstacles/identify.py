@@ -31,7 +31,7 @@ from scipy import ndimage
 
 from alte.lab.studies.experiments import ground_truth
 from alte.lab.studies.landing.raster import RasterGeometry
-from alte.lab.studies.obstacles.truth import ObstacleOptions, TrueObstacles, terrain_obstacles
+from alte.lab.studies.obstacles.truth import ObstacleSettings, TrueObstacles, terrain_obstacles
 from alte.mappers.base import Cells
 from alte.pipeline import Registered
 
@@ -198,7 +198,7 @@ def identify(raster: MapRaster, truth: TrueObstacles) -> ObstacleScores:
 
 
 def obstacle_scores(data: Registered, cells: Cells, dims: int,
-                    options: ObstacleOptions | None) -> ObstacleScores | None:
+                    options: ObstacleSettings | None) -> ObstacleScores | None:
     """The map ``cells``' identification of the terrain's true obstacles
     (:mod:`alte.lab.studies.obstacles`); None without ``options`` or off a simulated terrain."""
     if options is None or ground_truth(data) is None:

@@ -13,7 +13,7 @@ obstacle. The ground is the median top height of the pixels whose top surface is
 ground.
 
 ``min_height`` defaults to the landing study's obstacle step for the terrain
-(:attr:`~alte.lab.studies.landing.LandingParams.obstacle_height`: 0.3 m for the
+(:attr:`~alte.lab.studies.landing.LandingSettings.obstacle_height`: 0.3 m for the
 thesis-scale quadrotor, about its landing-gear clearance, so a taller object under
 its frame strikes it; 0.06 m for the lab-scale vehicle), and the raster to the
 landing study's pixel (0.25 m, 0.05 m), so both studies call the same things
@@ -42,12 +42,12 @@ from alte.metrics import TrueSurface
 from alte.params import Record, param
 from alte.types import Box
 
-__all__ = ["ObstacleOptions", "TrueObstacles", "obstacle_options", "terrain_obstacles",
+__all__ = ["ObstacleSettings", "TrueObstacles", "obstacle_options", "terrain_obstacles",
            "true_obstacles"]
 
 
 @dataclass(frozen=True)
-class ObstacleOptions(Record):
+class ObstacleSettings(Record):
     """How obstacles are told and matched (see the module docstring)."""
 
     OWNER: ClassVar[str] = "obstacles"
@@ -58,10 +58,10 @@ class ObstacleOptions(Record):
                        "pixels a map obstacle may lie off a true footprint and still match it")
 
 
-def obstacle_options(terrain: str) -> ObstacleOptions:
+def obstacle_options(terrain: str) -> ObstacleSettings:
     """The options for ``terrain``: the landing study's obstacle step and pixel."""
     landing = landing_params(terrain)
-    return ObstacleOptions(min_height=landing.obstacle_height, step=landing.step)
+    return ObstacleSettings(min_height=landing.obstacle_height, step=landing.step)
 
 
 @dataclass(frozen=True, eq=False)
@@ -76,7 +76,7 @@ class TrueObstacles:
     """
 
     grid: RasterGeometry
-    options: ObstacleOptions
+    options: ObstacleSettings
     ground: float
     ids: NDArray[np.int64]
     names: tuple[str, ...]
@@ -112,7 +112,7 @@ def _object_tops(surface: TrueSurface, ids: NDArray[np.int64]) -> NDArray[np.flo
                      for i in ids], dtype=np.float64)
 
 
-def true_obstacles(surface: TrueSurface, bounds: Box, options: ObstacleOptions) -> TrueObstacles:
+def true_obstacles(surface: TrueSurface, bounds: Box, options: ObstacleSettings) -> TrueObstacles:
     """The true obstacles of ``surface`` inside the control volume ``bounds``."""
     if not surface.classes:
         raise MetricsError("obstacle truth: the true surface has no object classes, so the "
@@ -151,7 +151,7 @@ def true_obstacles(surface: TrueSurface, bounds: Box, options: ObstacleOptions) 
 
 
 @functools.lru_cache(maxsize=4)
-def _cached(folder: str, options: ObstacleOptions) -> TrueObstacles:
+def _cached(folder: str, options: ObstacleSettings) -> TrueObstacles:
     from alte.pipeline import open_input
 
     truth = open_input(folder).ground_truth()
@@ -160,6 +160,6 @@ def _cached(folder: str, options: ObstacleOptions) -> TrueObstacles:
     return true_obstacles(truth.surface, truth.bounds, options)
 
 
-def terrain_obstacles(folder: str, options: ObstacleOptions) -> TrueObstacles:
+def terrain_obstacles(folder: str, options: ObstacleSettings) -> TrueObstacles:
     """:func:`true_obstacles` of the simulated terrain in ``folder`` (once per process)."""
     return _cached(str(folder), options)

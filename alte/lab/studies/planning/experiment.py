@@ -27,7 +27,7 @@ from alte.lab.studies.planning.score import PathScore, score_path
 from alte.lab.studies.planning.search import PlanResult, plan_path
 from alte.lab.studies.thesis.numbers import mapper_params
 from alte.metrics import TrueSurface
-from alte.pipeline import MapSpec, Registered, run
+from alte.pipeline import MapSettings, Registered, run
 from alte.progress import bar as progress_bar
 from alte.types import JSONDict
 
@@ -132,7 +132,7 @@ def planning_rows(plans: TerrainPlans) -> list[JSONDict]:
 def _terrain_maps(data: Registered, name: str, mappers: Iterable[str],
                   params: Mapping[str, Mapping[str, object]] | None) -> dict[str, PlanningMap]:
     chosen: dict[str, Mapping[str, object]] = {**mapper_params(name), **(params or {})}
-    return {m: planning_map(run(data, MapSpec(m, chosen.get(m, {}))).mapper) for m in mappers}
+    return {m: planning_map(run(data, MapSettings(m, chosen.get(m, {}))).mapper) for m in mappers}
 
 
 def planning_experiment(terrains: Sequence[str], data_dir: str | os.PathLike[str] = "data",

@@ -38,9 +38,9 @@ from alte.errors import ParameterError
 from alte.lab.studies.analysis.tables import write_csv
 from alte.lab.studies.experiments import CACHE_DIR
 from alte.metrics.trajectory import cloud_distance, rigid_alignment, trajectory_errors
-from alte.pipeline import FrameSpec, PoseSource, Registered, Source, open_input, prepare
+from alte.pipeline import FrameSettings, PoseSource, Registered, Source, open_input, prepare
 from alte.progress import bar as progress_bar
-from alte.registration.odometry import OdometryParams
+from alte.registration.odometry import OdometrySettings
 
 __all__ = ["COLUMNS", "REAL_SEQUENCES", "SOURCES", "BenchInput", "bench_input", "odometry_table",
            "pose_benchmark", "realdata_table", "write_odometry_table"]
@@ -100,8 +100,8 @@ def bench_input(what: str | os.PathLike[str], *, reference: str | os.PathLike[st
 
     if str(what) in TERRAINS:
         if reference is not None:
-            raise ParameterError(f"--reference: {what} is a simulated terrain; its true "
-                                 "poses are the reference")
+            raise ParameterError(f"reference: {what} is a simulated terrain; its true "
+                                 "poses are the reference", setting="odometry study.reference")
         made = _terrain_input(str(what), Path(data_dir), frames, seed)
         return made if voxel is None else replace(made, voxel=voxel)
     if not Path(what).exists():
@@ -109,18 +109,19 @@ def bench_input(what: str | os.PathLike[str], *, reference: str | os.PathLike[st
                              "nor a bag or terrain folder")
     source = open_input(Path(what))
     if reference is not None and not Path(reference).is_file():
-        raise ParameterError(f"--reference {reference}: no such TUM file")
+        raise ParameterError(f"reference={reference}: no such TUM file",
+                             setting="odometry study.reference")
     return BenchInput(_name(Path(what), source.name), source,
                       None if reference is None else Path(reference),
                       voxel or source.voxel or BAG_VOXEL, frames)
 
 
-def _spec(item: BenchInput, poses: PoseSource, odometry: OdometryParams) -> FrameSpec:
-    return FrameSpec(frames=item.frames, voxel=item.voxel, poses=poses, odometry=odometry)
+def _spec(item: BenchInput, poses: PoseSource, odometry: OdometrySettings) -> FrameSettings:
+    return FrameSettings(frames=item.frames, voxel=item.voxel, poses=poses, odometry=odometry)
 
 
-def _reference_spec(item: BenchInput) -> FrameSpec:
-    return FrameSpec(frames=item.frames, voxel=item.voxel / 5, poses=PoseSource.RECORDED,
+def _reference_spec(item: BenchInput) -> FrameSettings:
+    return FrameSettings(frames=item.frames, voxel=item.voxel / 5, poses=PoseSource.RECORDED,
                      pose_file=item.reference)
 
 
@@ -154,7 +155,7 @@ def _matched(reg: Registered, reference: Registered,
 
 
 def _score(item: BenchInput, key: str, reg: Registered, reference: Registered,
-           odometry: OdometryParams) -> dict[str, object]:
+           odometry: OdometrySettings) -> dict[str, object]:
     mine, theirs = _matched(reg, reference)
     est, ref = reg.trajectory, reference.trajectory
     if reg.spec.poses is PoseSource.ODOMETRY:
@@ -182,12 +183,12 @@ def _score(item: BenchInput, key: str, reg: Registered, reference: Registered,
             "kept": poses.frames - poses.corrected if key == "refine" else 0}
 
 
-def _settings(key: str, odometry: OdometryParams) -> str:
+def _settings(key: str, odometry: OdometrySettings) -> str:
     """The settings a source ran with, as ``key=value`` text (those that differ from the
     defaults), or ``-`` for recorded poses."""
     if key == "recorded":
         return "-"
-    default = OdometryParams(method=odometry.method).as_dict()
+    default = OdometrySettings(method=odometry.method).as_dict()
     changed = {k: v for k, v in odometry.as_dict().items() if v != default[k]}
     return " ".join(f"{k}={v}" for k, v in changed.items()) or "defaults"
 
@@ -205,7 +206,7 @@ def pose_benchmark(item: BenchInput, sources: Sequence[str] = tuple(SOURCES), *,
                    settings: Mapping[str, Mapping[str, object]] | None = None,
                    cache: Path | None = None, progress: bool = False) -> pd.DataFrame:
     """One row per pose source of ``item`` (module docstring); ``settings`` maps a
-    backend (``kiss``, ``plane``, ``refine``) to :class:`OdometryParams` overrides."""
+    backend (``kiss``, ``plane``, ``refine``) to :class:`OdometrySettings` overrides."""
     unknown = sorted(set(sources) - set(SOURCES))
     if unknown:
         raise ParameterError(f"unknown pose source(s) {', '.join(unknown)}; "
@@ -215,7 +216,7 @@ def pose_benchmark(item: BenchInput, sources: Sequence[str] = tuple(SOURCES), *,
     rows = []
     for key in sources:
         poses, method = SOURCES[key]
-        odometry = OdometryParams.parse({"method": method or "kiss", **settings.get(key, {})})
+        odometry = OdometrySettings.parse({"method": method or "kiss", **settings.get(key, {})})
         reg = prepare(item.source, _spec(item, poses, odometry), cache=cache,
                       progress=progress)
         rows.append(_score(item, key, reg, reference, odometry))

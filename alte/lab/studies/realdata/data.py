@@ -32,8 +32,8 @@ from alte.lab.studies.realdata.ground import ground_errors, map_heights, referen
 from alte.paths import realdata_dir
 from alte.pipeline import (
     DomainPolicy,
-    FrameSpec,
-    MapSpec,
+    FrameSettings,
+    MapSettings,
     PoseSource,
     Registered,
     open_input,
@@ -171,7 +171,7 @@ def _ground_run(sample: IsprsSample, name: str, params: Mapping[str, object],
     if name == BASELINE:
         ground = filter_ground(pts, method, settings).ground
     else:
-        spec = MapSpec(name, dict(params))
+        spec = MapSettings(name, dict(params))
         mapper = spec.cls(None, record=spec.record)
         start = time.perf_counter()
         mapper.build(pts)
@@ -228,7 +228,7 @@ def vlp16_dataset(data: RealData, voxel: float | None = None,
     ``frames`` keeps at most that many rotations, evenly spaced (None: all)."""
     if not data.available:
         return None
-    spec = FrameSpec(frames=frames, voxel=voxel, poses=PoseSource.IDENTITY)
+    spec = FrameSettings(frames=frames, voxel=voxel, poses=PoseSource.IDENTITY)
     return prepare(open_input(data.file("vlp16_packets", "bag")), spec)
 
 
@@ -239,7 +239,7 @@ def map_runs(dataset: Registered | None, mappers: Mapping[str, Mapping[str, obje
     if dataset is None:
         return []
     name = dataset.source.name
-    return [measure(dataset, m, spec=MapSpec(m, dict(p), domain=DomainPolicy.DATA))
+    return [measure(dataset, m, spec=MapSettings(m, dict(p), domain=DomainPolicy.DATA))
             for m, p in progress_bar(mappers.items(), desc=name, disable=not progress)]
 
 

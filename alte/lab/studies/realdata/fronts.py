@@ -39,7 +39,14 @@ from alte.lab.studies.realdata.data import RealData
 from alte.lab.studies.thesis.numbers import CASE_MAPPERS
 from alte.mappers.base import Cells
 from alte.metrics.truth import distance_to_boxes
-from alte.pipeline import DomainPolicy, FrameSpec, MapSpec, PoseSource, Registered, open_input
+from alte.pipeline import (
+    DomainPolicy,
+    FrameSettings,
+    MapSettings,
+    PoseSource,
+    Registered,
+    open_input,
+)
 from alte.pipeline import prepare as register
 from alte.progress import bar as progress_bar
 
@@ -85,8 +92,8 @@ def sequence_data(data: RealData, *, frames: int = 20, voxel: float = 0.2,
         return None
     source = open_input(data.file(name, "bag"))
     where = Path(cache) if cache is not None else None
-    every = register(source, FrameSpec(voxel=voxel, poses=PoseSource.RECORDED), cache=where)
-    some = register(source, FrameSpec(frames=frames, voxel=voxel, poses=PoseSource.RECORDED),
+    every = register(source, FrameSettings(voxel=voxel, poses=PoseSource.RECORDED), cache=where)
+    some = register(source, FrameSettings(frames=frames, voxel=voxel, poses=PoseSource.RECORDED),
                     cache=where)
     return RealSequence(name, some, np.asarray(every.cloud, dtype=np.float64))
 
@@ -142,7 +149,7 @@ def front_table(sequence: RealSequence | None,
     runs = [(m, dict(p)) for m, rows in (grid or FRONT_GRID).items() for p in rows]
     rows = []
     for mapper, params in progress_bar(runs, desc=sequence.name, unit="map", disable=not progress):
-        spec = MapSpec(mapper, params, domain=DomainPolicy.DATA)
+        spec = MapSettings(mapper, params, domain=DomainPolicy.DATA)
         found = measure(sequence.data, mapper, spec=spec)
         cells = found.mapper.cells()
         m = found.metrics

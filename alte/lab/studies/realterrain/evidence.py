@@ -52,8 +52,8 @@ from alte.lab.studies.realdata.ground import map_heights
 from alte.lab.studies.realterrain.sites import SITES, Site, surface_figures, terrain_class
 from alte.lab.studies.thesis.numbers import CASE_MAPPERS
 from alte.mappers.base import Cells
-from alte.metrics.options import TruthOptions
-from alte.pipeline import DomainPolicy, FrameSpec, MapSpec, open_input, prepare
+from alte.metrics.options import TruthSettings
+from alte.pipeline import DomainPolicy, FrameSettings, MapSettings, open_input, prepare
 from alte.progress import bar as progress_bar
 from alte.sim.real import Flight, Imported, import_terrain, terrain_tiles, write_imported
 
@@ -76,7 +76,7 @@ COLUMNS = ("terrain", "terrain_class", "evidence", "case", "mapper", "params", "
            "mhd_m", "hd_m", "accuracy_mean_m", "completeness", "height_rmse_m",
            "ground_rmse_m", "obstacle_recall", "obstacle_precision", "frames", "points",
            "reference_points", "slope_deg", "building_share", "cover_share")
-_TRUTH = TruthOptions(tolerance=0.2, n_samples=20_000, grid_step=0.25)
+_TRUTH = TruthSettings(tolerance=0.2, n_samples=20_000, grid_step=0.25)
 _MISSION = {"lan": "landing", "nav": "navigation"}
 _Grid = Mapping[str, Sequence[Mapping[str, float]]]
 
@@ -193,13 +193,13 @@ def _points(site: Site, root: Path, case: str, seed: int, *, grid: _Grid,
     with tempfile.TemporaryDirectory() as tmp:
         path = write_points(Path(tmp) / "kept.npz", kept)
         above = (*np.mean(kept[:, :2], axis=0).tolist(), float(kept[:, 2].max()) + 100.0)
-        data = prepare(open_input(path), FrameSpec(origin=above))
+        data = prepare(open_input(path), FrameSettings(origin=above))
         for mapper, setting in _grid(case, grid, mappers):
             # An airborne sensor: Octomap's rays longer than a VLP-16's.
             if mapper == "octomap" and float(str(setting["resolution"])) > 2.0:
                 continue  # 0.25 m voxels along 100 m rays: millions of free leaves
             params = {**setting, "max_range": -1.0} if mapper == "octomap" else setting
-            found = measure(data, mapper, spec=MapSpec(mapper, params,
+            found = measure(data, mapper, spec=MapSettings(mapper, params,
                                                        domain=DomainPolicy.DATA))
             cells = found.mapper.cells()
             scores = reference_metrics(cells, found.mapper.dims, reference, step=1.0)

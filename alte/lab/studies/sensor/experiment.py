@@ -26,7 +26,7 @@ import pandas as pd
 from alte.errors import ParameterError
 from alte.lab.studies.experiments import CACHE_DIR
 from alte.metrics.trajectory import trajectory_errors
-from alte.pipeline import FrameSpec, PoseSource, open_input, prepare
+from alte.pipeline import FrameSettings, PoseSource, open_input, prepare
 from alte.pipeline.prepare import POSE_DIR
 from alte.registration.odometry import odometry_params
 
@@ -50,7 +50,7 @@ class _Score:
     cpu_ms_per_scan: float
 
 
-def _score(folder: Path, name: str, spec: FrameSpec, seed: int, *,
+def _score(folder: Path, name: str, spec: FrameSettings, seed: int, *,
            cache: Path | None, poses: Path) -> _Score:
     from alte.sim import get_terrain, load_ground_truth, mesh_distance, true_poses
 
@@ -94,7 +94,7 @@ def sensor_row(name: str, data_dir: str | os.PathLike[str] = "data", seed: int =
         whole = pose is PoseSource.ODOMETRY
         folder = ensure_terrain(name, data_dir, seed, None if whole else frames,
                                 profile=PROFILES[profile])
-        spec = FrameSpec(frames=frames, poses=pose, deskew=deskew,
+        spec = FrameSettings(frames=frames, poses=pose, deskew=deskew,
                          odometry=odometry_params(method))
         score = _score(folder, name, spec, seed, cache=cache, poses=poses)
         row |= {f"ate_{key}_m": score.ate_m, f"rpe_{key}_pct": score.rpe_pct,

@@ -26,11 +26,11 @@ from dataclasses import dataclass
 from alte.lab.studies.experiments import ground_truth, terrain, timed_run
 from alte.lab.studies.obstacles import obstacle_columns, obstacle_options, obstacle_scores
 from alte.lab.studies.sweep.runs import SweepRun
-from alte.metrics.maps import TruthOptions, measure_map
+from alte.metrics.maps import TruthSettings, measure_map
 from alte.metrics.reference import Reference
 from alte.metrics.timing import Timing
-from alte.pipeline import DomainPolicy, MapRun, MapSpec, Registered
-from alte.registration.odometry import OdometryParams
+from alte.pipeline import DomainPolicy, MapRun, MapSettings, Registered
+from alte.registration.odometry import OdometrySettings
 from alte.types import JSONDict
 
 __all__ = ["MapGroup", "RunOutcome", "group_runs", "input_data", "run_group", "run_one"]
@@ -51,7 +51,7 @@ class MapGroup:
 
 def _resolved(run: SweepRun) -> dict[str, object]:
     """The run's mapper parameters, defaults filled in."""
-    return run.cls.Params.parse(run.params).as_dict()
+    return run.cls.Settings.parse(run.params).as_dict()
 
 
 def map_key(run: SweepRun) -> str:
@@ -79,7 +79,7 @@ InputKey = tuple[str, int | None, int, float | None, str, bool, str]
 def _registered(key: InputKey, data_dir: str) -> Registered:
     name, frames, seed, voxel, sensor, deskew, poses = key
     return terrain(name, data_dir, seed, frames, voxel=voxel, sensor=sensor, deskew=deskew,
-                   odometry=OdometryParams() if poses == "odometry" else None)
+                   odometry=OdometrySettings() if poses == "odometry" else None)
 
 
 @functools.lru_cache(maxsize=2)
@@ -95,7 +95,7 @@ def input_data(run: SweepRun, data_dir: str) -> Registered:
 
 
 @functools.lru_cache(maxsize=2)
-def _reference(key: InputKey, data_dir: str, truth: TruthOptions) -> Reference:
+def _reference(key: InputKey, data_dir: str, truth: TruthSettings) -> Reference:
     """Per-process memo of the input's prepared cloud and truth (one per truth options)."""
     data = _dataset(key, data_dir)
     return Reference(data.cloud, ground_truth(data), truth)
@@ -146,7 +146,7 @@ def run_group(group: MapGroup, data_dir: str) -> list[RunOutcome]:
     first = group.runs[0]
     try:
         data, reference = _inputs(first, data_dir)
-        made = timed_run(data, MapSpec(first.cls, dict(first.params),
+        made = timed_run(data, MapSettings(first.cls, dict(first.params),
                                        domain=DomainPolicy(first.domain)))
     except Exception as err:  # a failed map fails its runs; the sweep goes on
         return [(r.run_id, None, err) for r in group.runs]

@@ -115,7 +115,8 @@ def executor(scheduler: str, workers: int) -> Iterator[MapUnordered]:
 
     if scheduler == "local":
         if workers < 1:
-            raise ParameterError(f"--workers {workers}: must be at least 1")
+            raise ParameterError(f"sweep: workers={workers} out of range (workers >= 1)",
+                                 setting="sweep.workers")
         # One thread per worker, numba's kernels included: the workers are the parallelism.
         with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
                           dashboard_address=None, env={"NUMBA_NUM_THREADS": "1"},
@@ -123,12 +124,13 @@ def executor(scheduler: str, workers: int) -> Iterator[MapUnordered]:
             yield _dask_map(client)
         return
     if "://" not in scheduler:
-        raise ParameterError(f"--scheduler {scheduler!r}: expected serial, none, local or an "
-                             "address like tcp://host:8786")
+        raise ParameterError(f"sweep: scheduler={scheduler!r}: expected serial, none, local "
+                             "or an address like tcp://host:8786", setting="sweep.scheduler")
     try:
         client = Client(scheduler, timeout=CONNECT_TIMEOUT)
     except (OSError, TimeoutError) as err:
-        raise ParameterError(f"--scheduler {scheduler}: cannot connect ({err})") from err
+        raise ParameterError(f"sweep: scheduler={scheduler}: cannot connect ({err})",
+                             setting="sweep.scheduler") from err
     with client:
         yield _dask_map(client)
 

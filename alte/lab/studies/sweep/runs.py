@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 from alte.lab.studies.sweep.spec import SweepSpec
 from alte.lab.studies.sweep.variants import Variant
 from alte.mappers import Mapper
-from alte.metrics.maps import MapPointSet, TruthOptions
+from alte.metrics.maps import MapPointSet, TruthSettings
 
 __all__ = ["SweepRun", "plan_runs", "plan_variants"]
 
@@ -32,7 +32,7 @@ class SweepRun:
     cls: type[Mapper]
     params: Mapping[str, object]
     voxel: float | None = None
-    truth: TruthOptions = field(default_factory=TruthOptions)
+    truth: TruthSettings = field(default_factory=TruthSettings)
     domain: str = "auto"
     set_b: MapPointSet = MapPointSet.CORNERS
     sensor: str = "thesis"

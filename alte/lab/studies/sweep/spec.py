@@ -25,7 +25,7 @@ from typing import ClassVar, TypeVar
 from alte.errors import AlteError, ParameterError
 from alte.lab.studies.sweep.variants import Variant, parse_variants, spec_error
 from alte.mappers import Mapper, registry
-from alte.metrics.maps import TruthOptions
+from alte.metrics.maps import TruthSettings
 from alte.params import Record, param
 from alte.sim import TERRAINS
 
@@ -116,7 +116,7 @@ class SweepSpec(Record):
     terrains: tuple[str, ...] = param((), _known, "known terrain names", "the terrains")
     mappers: tuple[MapperGrid, ...] = param((), help="each mapper's grid")
     settings: SweepSettings = field(default_factory=SweepSettings)
-    truth: TruthOptions = field(default_factory=TruthOptions)
+    truth: TruthSettings = field(default_factory=TruthSettings)
     source: str = param("spec", help="where the spec came from (its file)")
     variants: tuple[Variant, ...] = param((), help="the ablation variants")
 
@@ -184,12 +184,12 @@ def _record(source: str, record: type[_R], given: Mapping[object, object]) -> _R
         raise ParameterError(f"{source}: {err}") from err
 
 
-def _truth(source: str, value: object) -> TruthOptions:
+def _truth(source: str, value: object) -> TruthSettings:
     if value is None:
-        return TruthOptions()
+        return TruthSettings()
     if not isinstance(value, Mapping):
         raise spec_error(source, "truth", f"{value!r} must be a mapping")
-    return _record(source, TruthOptions, value)
+    return _record(source, TruthSettings, value)
 
 
 def _grid_rows(source: str, key: str, grid: object) -> list[dict[str, object]]:
@@ -213,7 +213,7 @@ def _coerce_row(source: str, key: str, mapper: type[Mapper], row: object) -> dic
             raise spec_error(source, f"{key}.{name}", f"{value!r} must be a number, string or "
                              "bool")
     try:
-        resolved = mapper.Params.parse({str(k): v for k, v in row.items()}).as_dict()
+        resolved = mapper.Settings.parse({str(k): v for k, v in row.items()}).as_dict()
     except AlteError as err:
         raise spec_error(source, key, str(err)) from err
     return {str(name): resolved[str(name)] for name in row}

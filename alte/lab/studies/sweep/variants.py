@@ -89,7 +89,7 @@ def _params(source: str, key: str, value: object, mappers: tuple[type[Mapper], .
         if not isinstance(changes, Mapping) or not changes:
             raise spec_error(source, where, f"{changes!r} must map parameter names to values")
         try:
-            resolved = ours[mapper].Params.parse({str(k): v for k, v in changes.items()}
+            resolved = ours[mapper].Settings.parse({str(k): v for k, v in changes.items()}
                                                  ).as_dict()
         except AlteError as err:
             raise spec_error(source, where, str(err)) from err

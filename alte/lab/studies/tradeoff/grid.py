@@ -28,7 +28,7 @@ import numpy as np
 import pandas as pd
 
 from alte.errors import ParameterError
-from alte.lab.studies.analysis.evidence import EvidenceOptions, cells_table, evaluate_all
+from alte.lab.studies.analysis.evidence import EvidenceSettings, cells_table, evaluate_all
 from alte.lab.studies.analysis.evidence_tables import EQUAL_SIZE, SIZES, ablation_verdicts
 from alte.lab.studies.analysis.tables import write_csv
 from alte.lab.studies.analysis.tradeoff import equal_size, matching, prepare
@@ -146,11 +146,11 @@ def thesis_rows(table: pd.DataFrame) -> pd.DataFrame:
 
 
 def ablations(grid: Grid, claims: Sequence[Claim] = CLAIMS,
-              options: EvidenceOptions | None = None) -> tuple[pd.DataFrame, pd.DataFrame]:
+              options: EvidenceSettings | None = None) -> tuple[pd.DataFrame, pd.DataFrame]:
     """Every claim's verdict under each variant, on the variants' terrains: (one row per
     claim with a verdict column per variant and ``moves``; every measured cell with a
     ``variant`` column). The first column, ``base``, is the base grid on those terrains."""
-    options = options or EvidenceOptions()
+    options = options or EvidenceSettings()
     rows = grid.variants
     places = sorted(set(rows.loc[rows["variant"] != BASE, "terrain"]))
     if not places:

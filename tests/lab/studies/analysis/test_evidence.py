@@ -12,7 +12,7 @@ from alte.errors import ParameterError
 from alte.lab.studies.analysis.evidence import (
     CELL_COLUMNS,
     VERDICTS,
-    EvidenceOptions,
+    EvidenceSettings,
     Finding,
     _cell_verdict,
     _combine,
@@ -89,7 +89,7 @@ def test_seeds_that_disagree_or_a_single_seed_leave_it_uncertain():
     assert "one seed, no interval" in one.evidence
     lenient = evaluate(_claim(MHD_AT_SIZE), synthetic_tradeoff({"alte2d": Curve(scale=0.5)},
                                                                seeds=(0,)),
-                       EvidenceOptions(min_seeds=1))
+                       EvidenceSettings(min_seeds=1))
     assert lenient.verdict == "holds"
 
 
@@ -182,7 +182,7 @@ def test_the_whole_catalogue_gets_verdicts_and_a_table_with_the_report_schema():
 @pytest.mark.parametrize("level", [0.5, 0.99])
 def test_the_interval_level_is_stated(level):
     table = synthetic_tradeoff({"alte2d": Curve(scale=0.5)})
-    found = evaluate(_claim(MHD_AT_SIZE), table, EvidenceOptions(level=level))
+    found = evaluate(_claim(MHD_AT_SIZE), table, EvidenceSettings(level=level))
     assert f"{level:.0%} percentile-bootstrap" in found.evidence
 
 
@@ -254,8 +254,8 @@ def test_intervals_are_reproducible_and_widen_with_the_level():
     table = synthetic_tradeoff({"alte2d": Curve(scale=0.8, noise=0.2)})
     first, again = (evaluate(_claim(MHD_AT_SIZE), table) for _ in range(2))
     pd.testing.assert_frame_equal(first.cells, again.cells)
-    narrow = evaluate(_claim(MHD_AT_SIZE), table, EvidenceOptions(level=0.5)).cells
-    wide = evaluate(_claim(MHD_AT_SIZE), table, EvidenceOptions(level=0.99)).cells
+    narrow = evaluate(_claim(MHD_AT_SIZE), table, EvidenceSettings(level=0.5)).cells
+    wide = evaluate(_claim(MHD_AT_SIZE), table, EvidenceSettings(level=0.99)).cells
     assert (wide["low"] < narrow["low"]).all() and (wide["high"] > narrow["high"]).all()
     assert (first.cells["low"] <= wide["high"]).all()
 
@@ -348,5 +348,5 @@ def test_a_single_checks_cells_say_what_they_read_in_which_unit(check, what, uni
 ])
 def test_evidence_options_name_the_bad_setting(given, message):
     with pytest.raises(ParameterError, match=message):
-        EvidenceOptions.parse(given)
-    assert EvidenceOptions.parse({"level": "0.9"}).level == 0.9
+        EvidenceSettings.parse(given)
+    assert EvidenceSettings.parse({"level": "0.9"}).level == 0.9

@@ -5,7 +5,7 @@ from __future__ import annotations
 import pandas as pd
 from support.tradeoff import Curve, synthetic_tradeoff
 
-from alte.lab.studies.analysis.evidence import CELL_COLUMNS, EvidenceOptions
+from alte.lab.studies.analysis.evidence import CELL_COLUMNS, EvidenceSettings
 from alte.lab.studies.analysis.evidence_tables import (
     CLAIMS_CSV_COLUMNS,
     ablation_table,
@@ -21,8 +21,8 @@ def test_ablation_shows_what_moves_when_free_space_is_not_counted():
     table = synthetic_tradeoff({"alte3d": Curve(scale=0.8)})
     size = claim("t5.4-size")
     out = ablation_table([size, claim("5.2.2-3d-mhd")], {
-        "basis functions": (table, EvidenceOptions()),
-        "occupied cells": (table, EvidenceOptions(size="occupied_cells"))})
+        "basis functions": (table, EvidenceSettings()),
+        "occupied cells": (table, EvidenceSettings(size="occupied_cells"))})
     row = out.set_index("id").loc["t5.4-size"]
     assert row["basis functions"] == "holds" and row["occupied cells"] == "does not hold"
     assert row["moves"] == "occupied cells"
@@ -71,5 +71,5 @@ def test_write_evidence_writes_the_six_tables(tmp_path):
     fid = pd.read_csv(files.key_equal_fidelity)
     assert list(fid.columns[2:5]) == ["mhd_m", "mapper", "basis_functions"]
     assert "ci_low" in fid.columns and fid["basis_functions"].gt(0).all()
-    again = write_evidence(table, tmp_path, claims=CLAIMS[:5], options=EvidenceOptions(seed=1))
+    again = write_evidence(table, tmp_path, claims=CLAIMS[:5], options=EvidenceSettings(seed=1))
     assert again.claims == files.claims

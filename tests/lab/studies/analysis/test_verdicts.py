@@ -21,7 +21,7 @@ from support.tradeoff import Curve, sweep_rows, synthetic_tradeoff
 
 from alte.lab.studies.analysis.checks import NoDataError
 from alte.lab.studies.analysis.comparisons import measure_compare
-from alte.lab.studies.analysis.evidence import EvidenceOptions, evaluate, evaluate_all
+from alte.lab.studies.analysis.evidence import EvidenceSettings, evaluate, evaluate_all
 from alte.lab.studies.analysis.measures import measure_check
 from alte.lab.studies.analysis.tradeoff import prepare
 from alte.lab.studies.thesis.claims import (
@@ -55,7 +55,7 @@ def _claim(check, claim_id: str = "test") -> Claim:
 
 
 def _verdict(check, table: pd.DataFrame, **options) -> str:
-    return evaluate(_claim(check), table, EvidenceOptions(**options)).verdict
+    return evaluate(_claim(check), table, EvidenceSettings(**options)).verdict
 
 
 @pytest.fixture(scope="module")
@@ -393,7 +393,7 @@ def test_too_few_seeds_are_inconclusive_whatever_the_values():
     table = _flat(1.0, seeds=2)
     check = Trend("lan", "quadtree", "max_points", "mhd_m", +1)
     assert evaluate(_claim(check), table).cells["outcome"].tolist() == ["holds"]
-    strict = evaluate(_claim(check), table, EvidenceOptions(min_seeds=3))
+    strict = evaluate(_claim(check), table, EvidenceSettings(min_seeds=3))
     assert strict.cells["outcome"].tolist() == ["inconclusive"]
     assert (strict.verdict, strict.depends_on) == ("depends", "uncertainty")
 
@@ -472,7 +472,7 @@ def test_a_size_option_replaces_basis_functions_in_every_part(win):
     check = AllOf((Compare("lan", "alte2d", "quadtree", "basis_functions", "equal_fidelity"),
                    Compare("lan", "alte2d", "quadtree", "mhd_m", "equal_size")))
     plain = evaluate(_claim(check), win)
-    occupied = evaluate(_claim(check), win, EvidenceOptions(size="occupied_cells"))
+    occupied = evaluate(_claim(check), win, EvidenceSettings(size="occupied_cells"))
     assert "basis functions, Quadtree / 2D-ALTE" in plain.evidence
     assert "occupied cells, Quadtree / 2D-ALTE" in occupied.evidence
     assert "at equal occupied cells" in occupied.evidence

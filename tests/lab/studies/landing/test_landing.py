@@ -19,7 +19,7 @@ from alte.lab.studies.landing import (
     SITE_COLUMNS,
     Centres,
     Detection,
-    LandingParams,
+    LandingSettings,
     RasterGeometry,
     detect_sites,
     evaluate_landing,
@@ -45,7 +45,7 @@ from alte.metrics import TrueSurface
 from alte.pipeline import InputKind
 from alte.sim import SceneBuilder
 
-PARAMS = LandingParams(radius=1.0, margin=0.5, clearance=1.0, step=0.25, max_sites=3)
+PARAMS = LandingSettings(radius=1.0, margin=0.5, clearance=1.0, step=0.25, max_sites=3)
 
 
 def _flat(size: float = 20.0, step: float = 0.25) -> tuple[RasterGeometry, np.ndarray]:
@@ -71,7 +71,7 @@ def _box_edge_distance(xy: np.ndarray, lo: float, hi: float) -> np.ndarray:
 ])
 def test_landing_params_are_validated(field, value, match):
     with pytest.raises(ParameterError, match=match):
-        LandingParams(**{field: value})
+        LandingSettings(**{field: value})
 
 
 def test_presets_per_terrain_and_overrides():
@@ -163,7 +163,7 @@ def test_a_slope_above_the_threshold_is_rejected(slope, accepted):
     height = np.tile(np.tan(np.radians(slope)) * xs, (grid.shape[0], 1))
     # a ground height of the slope's middle: obstacles are judged against it, so give a
     # generous step and test the slope alone
-    params = LandingParams(obstacle_height=50.0, max_slope_deg=10.0)
+    params = LandingSettings(obstacle_height=50.0, max_slope_deg=10.0)
     det = detect_sites(height, grid, params, ground=float(np.median(height)))
     assert bool(det.centres.feasible.any()) is accepted
     assert (len(det.sites) > 0) is accepted
@@ -174,7 +174,7 @@ def test_rough_ground_is_rejected_and_sites_are_ranked():
     rng = np.random.default_rng(1)
     height[:, :40] = rng.normal(0.0, 0.2, (grid.shape[0], 40))  # x < 10 m: rubble
     height[:, 44:48] = 1.0  # a wall between the rubble and the smooth part
-    det = detect_sites(height, grid, LandingParams(obstacle_height=0.8, max_sites=1),
+    det = detect_sites(height, grid, LandingSettings(obstacle_height=0.8, max_sites=1),
                        ground=0.0)
     xs, _ = grid.axes()
     assert not det.centres.feasible[:, xs < 10.0].any()
@@ -197,7 +197,7 @@ def test_detection_errors():
     with pytest.raises(ParameterError, match=r"height raster \(3, 3\) does not match"):
         detect_sites(np.zeros((3, 3)), grid, PARAMS)
     with pytest.raises(ParameterError, match=r"grid step 0\.25 m differs from the parameter"):
-        detect_sites(height, grid, LandingParams(step=0.5))
+        detect_sites(height, grid, LandingSettings(step=0.5))
     with pytest.raises(ParameterError, match="must be 2D arrays of one shape"):
         feasible_centres(height, np.zeros((2, 2), bool), 0.25, PARAMS)
 
@@ -235,7 +235,7 @@ def _centres(feasible: np.ndarray) -> Centres:
 
 def test_scores_count_chosen_sites_and_areas():
     grid = RasterGeometry((0.0, 0.0), 1.0, (4, 4))
-    params = LandingParams(radius=1.0, step=1.0, max_sites=2)
+    params = LandingSettings(radius=1.0, step=1.0, max_sites=2)
     detected = np.zeros((4, 4), bool)
     detected[0, :] = True
     true = np.zeros((4, 4), bool)

@@ -11,7 +11,7 @@ import pytest
 from alte.errors import MetricsError, ParameterError
 from alte.lab.studies.obstacles import (
     OBSTACLE_COLUMNS,
-    ObstacleOptions,
+    ObstacleSettings,
     identify,
     map_raster,
     object_table,
@@ -26,7 +26,7 @@ from alte.metrics import TrueSurface
 from alte.sim import SceneBuilder
 from alte.types import Box
 
-OPTIONS = ObstacleOptions(min_height=0.3, step=0.25, slack=1)
+OPTIONS = ObstacleSettings(min_height=0.3, step=0.25, slack=1)
 BOUNDS = Box.of((-10.0, -10.0, -1.0, 10.0, 10.0, 8.0))
 
 
@@ -83,9 +83,9 @@ def test_truth_needs_classes_and_checks_its_options():
     with pytest.raises(MetricsError, match="no pixel sees the ground"):
         true_obstacles(roofed, BOUNDS, OPTIONS)
     with pytest.raises(ParameterError, match="min_height=0"):
-        ObstacleOptions(min_height=0.0)
-    assert obstacle_options("exp_lan_1") == ObstacleOptions(min_height=0.06, step=0.05)
-    assert obstacle_options("sim_nav_1") == ObstacleOptions(min_height=0.3, step=0.25)
+        ObstacleSettings(min_height=0.0)
+    assert obstacle_options("exp_lan_1") == ObstacleSettings(min_height=0.06, step=0.05)
+    assert obstacle_options("sim_nav_1") == ObstacleSettings(min_height=0.3, step=0.25)
 
 
 def test_a_2d_map_finds_what_stands_up_and_pays_for_what_is_not_there(truth):

@@ -47,7 +47,7 @@ def test_table_on_a_small_mission(tmp_path: Path) -> None:
 def test_benchmark_errors_are_typed(tmp_path: Path, capsys) -> None:
     with pytest.raises(ParameterError, match="moon: neither a simulated terrain"):
         odometry_table(["moon"], data_dir=tmp_path / "data", progress=False)
-    with pytest.raises(ParameterError, match="--reference: exp_nav_2 is a simulated terrain"):
+    with pytest.raises(ParameterError, match="reference: exp_nav_2 is a simulated terrain"):
         bench_input("exp_nav_2", reference=tmp_path / "poses.txt", data_dir=tmp_path)
     assert main(["odometry", "exp_nav_2", "--sources", "kiss,icp"]) == 2
     assert "--sources 'kiss,icp': valid sources are recorded, kiss" in capsys.readouterr().err

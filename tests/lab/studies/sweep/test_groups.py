@@ -15,7 +15,7 @@ from alte.lab.studies.experiments import measure
 from alte.lab.studies.sweep import TIMING_COLUMNS, parse_spec, plan_runs, run_sweep
 from alte.lab.studies.sweep.groups import _dataset, group_runs, map_key, run_group, run_one
 from alte.metrics import freespace as freespace_module
-from alte.pipeline import DomainPolicy, MapSpec
+from alte.pipeline import DomainPolicy, MapSettings
 from alte.sim import ensure_terrain, terrain_folder
 
 RAW = {
@@ -46,7 +46,7 @@ def spec(tmp_path_factory):
 def _slow_row(run, data_dir: str) -> dict:
     """Today's path: a fresh map for the run alone, every metric computed from scratch."""
     data = _dataset(run.input_key(), data_dir)
-    spec = MapSpec(run.mapper, dict(run.params), domain=DomainPolicy(run.domain))
+    spec = MapSettings(run.mapper, dict(run.params), domain=DomainPolicy(run.domain))
     return measure(data, run.mapper, truth=run.truth, spec=spec, set_b=run.set_b).metrics.flat()
 
 

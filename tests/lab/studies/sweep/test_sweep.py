@@ -261,12 +261,12 @@ def test_failed_runs_are_reported_not_written_and_retried(spec, tmp_path, monkey
 
 
 def test_scheduler_errors(spec, tmp_path, monkeypatch):
-    with pytest.raises(ParameterError, match="--scheduler 'cluster': expected serial"):
+    with pytest.raises(ParameterError, match="sweep: scheduler='cluster': expected serial"):
         run_sweep(spec, scheduler="cluster", output=tmp_path, progress=False)
-    with pytest.raises(ParameterError, match="--workers 0: must be at least 1"):
+    with pytest.raises(ParameterError, match=r"sweep: workers=0 out of range \(workers >= 1\)"):
         run_sweep(spec, scheduler="local", workers=0, output=tmp_path, progress=False)
     monkeypatch.setattr(sweep_runner, "CONNECT_TIMEOUT", "0.5s")
-    with pytest.raises(ParameterError, match=r"--scheduler tcp://127.0.0.1:9: cannot connect"):
+    with pytest.raises(ParameterError, match=r"sweep: scheduler=tcp://127.0.0.1:9: cannot connect"):
         run_sweep(spec, scheduler="tcp://127.0.0.1:9", output=tmp_path, progress=False)
 
 
@@ -279,9 +279,13 @@ def test_unknown_terrain_simulation_failure_is_named(spec, tmp_path, monkeypatch
         run_sweep(spec, scheduler="serial", output=tmp_path, progress=False)
 
 
-@pytest.mark.slow
+@pytest.mark.full
 def test_local_cluster_gives_the_serial_rows(spec, serial, tmp_path):
-    """The issue's acceptance test: same grid, serial vs LocalCluster(2 workers)."""
+    """Same grid, serial vs LocalCluster(2 workers). ``make check-full``'s: its parts are
+    proven in ``make test`` by ``sensor/test_sensor.py::test_seeds_give_a_row_each...`` (the
+    ``local`` executor, two worker processes, the serial rows), ``test_dask_cluster.py``
+    (a sweep on worker processes gives the serial rows) and
+    ``test_existing_scheduler_address`` below."""
     table = serial[0].table
     dask = run_sweep(spec, scheduler="local", workers=2, output=tmp_path / "b", progress=False)
     assert dask.ran == 6 and not dask.failed
