@@ -87,7 +87,8 @@ def read_ground_truth(path: str | os.PathLike[str]) -> Scene:
     if any(o.cls not in CLASSES for o in objects):
         raise PointFileError(f"{path}: unknown object class in header")
     vertices = np.column_stack([verts["x"], verts["y"], verts["z"]])
-    return Scene(vertices, faces["v"].astype(np.int32), ids, tuple(objects))
+    triangles: NDArray[np.int32] = faces["v"].astype(np.int32)
+    return Scene(vertices, triangles, ids, tuple(objects))
 
 
 def load_ground_truth(directory: str | os.PathLike[str]) -> Scene:

@@ -197,9 +197,10 @@ def near_boxes(points: NDArray[np.float64], centers: NDArray[np.float64],
         if band.size == 0:
             continue
         pairs = cKDTree(points[band]).sparse_distance_matrix(tree, reach, output_type="ndarray")
-        gap = np.maximum(np.abs(points[band[pairs["i"]]] - centers[members[pairs["j"]]]) - half,
-                         0.0)
-        hit[band[pairs["i"][np.linalg.norm(gap, axis=1) <= radius]]] = True
+        near: NDArray[np.intp] = band[pairs["i"]]
+        offset: NDArray[np.float64] = points[near] - centers[members[pairs["j"]]]
+        gap = np.maximum(np.abs(offset) - half, 0.0)
+        hit[near[np.linalg.norm(gap, axis=1) <= radius]] = True
     return hit
 
 

@@ -74,8 +74,9 @@ def _panel(ax: Axes, rows: pd.DataFrame, mappers: Sequence[str], axes: tuple[str
 
 def _same_maps(rows: pd.DataFrame, first: str, other: str, metric: str) -> bool:
     """Whether variant ``other`` gave the same maps as ``first`` (it changed nothing here)."""
-    values = [np.sort(rows.loc[rows["variant"] == n, ["basis_functions", metric]].to_numpy(
-        float), axis=0) for n in (first, other)]
+    columns = ["basis_functions", metric]
+    values = [np.sort(rows[rows["variant"] == n][columns].to_numpy(float), axis=0)
+              for n in (first, other)]
     return values[0].shape == values[1].shape and bool(np.allclose(values[0], values[1],
                                                                   equal_nan=True))
 
