@@ -7,6 +7,7 @@ from pathlib import Path
 
 from alte.errors import ParameterError
 from alte.lab.report import PLAN, build_plan, load_plan, parse_param, run_report
+from alte.lab.report.warm import start_warmup
 from alte.paths import REPO_ROOT
 
 __all__ = ["add_parser", "run"]
@@ -16,7 +17,8 @@ def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) 
     """Register ``alte report``."""
     p = subparsers.add_parser(
         "report", help="execute the notebooks and build reports/index.html",
-        description="Simulate missing terrains, execute every notebook with papermill, write "
+        description="Compile alte's numba kernels (alte warmup) while simulating missing "
+                    "terrains, execute every notebook with papermill, write "
                     "HTML and an index into reports/runs/<UTC stamp>/ and point reports/latest "
                     "at it. Exits 1 when a notebook failed.")
     p.add_argument("--quick", action="store_true",
@@ -32,6 +34,9 @@ def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) 
                    help="notebook folder (default: the repository's)")
     p.add_argument("--plan", type=Path, default=None,
                    help="JSON plan replacing the built-in one (list of Entry objects)")
+    p.add_argument("--no-warmup", action="store_true",
+                   help="do not compile alte's kernels first (alte warmup; a few seconds when "
+                        "they are cached): for notebooks that do not map")
     p.set_defaults(func=run)
 
 
@@ -43,7 +48,8 @@ def run(args: argparse.Namespace) -> int:
     overrides = dict(parse_param(text) for text in args.param)
     runs = build_plan(entries, quick=args.quick, notebooks_dir=args.notebooks, only=args.only,
                       overrides=overrides)
-    report = run_report(runs, args.out, args.data, quick=args.quick, jobs=args.jobs)
+    report = run_report(runs, args.out, args.data, quick=args.quick, jobs=args.jobs,
+                        warmup=None if args.no_warmup else start_warmup)
     for result in report.results:
         line = f"{result.status:8s} {result.seconds:7.1f} s  {result.name}"
         print(line + (f"  ({result.error})" if result.error else ""))

@@ -172,7 +172,7 @@ def test_report_tables_identical_across_runs_and_quick_full(bags, capsys, tmp_pa
     for out, mode in (("r1", ["--quick"]), ("r2", []), ("r1", ["--quick"])):
         code, text, err = bags.run_cli(capsys, "report", *mode, "--plan", plan, "--notebooks",
                                        tmp_path / "nb", "--out", tmp_path / out,
-                                       "--data", tmp_path / "data")
+                                       "--data", tmp_path / "data", "--no-warmup")
         assert code == 0, (text, err)
         run = (tmp_path / out / "latest").resolve()
         outputs.append({**_digest(run / "robust"),

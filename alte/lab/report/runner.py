@@ -26,6 +26,7 @@ from alte.errors import AlteError, ReportError
 from alte.lab.report.html import notebook_to_html, run_index_html, top_index_html, write_html
 from alte.lab.report.plan import Run
 from alte.lab.report.runs import list_runs, new_run_dir, point_latest, publish_tables, write_record
+from alte.lab.report.warm import Warmup
 from alte.paths import REPO_ROOT
 from alte.progress import Relay, Throttle
 from alte.types import JSONDict
@@ -230,15 +231,20 @@ def _publish(reports: Path, run_dir: Path) -> list[Path]:
 def run_report(runs: Sequence[Run], reports: str | os.PathLike[str],
                data_dir: str | os.PathLike[str], *, quick: bool, jobs: int = 1,
                ensure: EnsureTerrain | None = None, progress: bool = True,
-               cwd: str | os.PathLike[str] = REPO_ROOT) -> Report:
-    """Run ``runs`` into a new folder ``reports/runs/<stamp>`` and publish it as latest."""
+               cwd: str | os.PathLike[str] = REPO_ROOT, warmup: Warmup | None = None) -> Report:
+    """Run ``runs`` into a new folder ``reports/runs/<stamp>`` and publish it as latest.
+
+    ``warmup`` (:func:`~alte.lab.report.warm.start_warmup`) compiles the kernels while the
+    terrains are simulated; the notebooks start when it has finished."""
     if not runs:
         raise ReportError("nothing to run: the plan selects no notebooks")
     reports, data_dir = Path(reports).resolve(), Path(data_dir).resolve()
     started = datetime.now(UTC)
     t0, cpu0 = time.perf_counter(), cpu_seconds(False) + cpu_seconds()
     load = os.getloadavg()[0]
+    finish = warmup(progress) if warmup is not None else None
     skip = ensure_terrains(runs, data_dir, ensure, progress=progress)
+    problems = sorted(skip.values()) + [p for p in [finish and finish()] if p]
     run_dir = new_run_dir(reports, started)
     results = _execute_all(runs, run_dir, data_dir, skip, jobs=jobs, progress=progress,
                            cwd=Path(cwd))
@@ -250,8 +256,8 @@ def run_report(runs: Sequence[Run], reports: str | os.PathLike[str],
               "cpu_s": round(cpu, 1),
               "load_average": {"start": load, "end": os.getloadavg()[0]},
               "runs": [asdict(r) for r in results],
-              "problems": sorted(skip.values()), "tables": [t.name for t in tables]}
+              "problems": problems, "tables": [t.name for t in tables]}
     write_html(run_dir / "index.html", run_index_html(record, run_dir, tables))
     write_record(run_dir, record)
     _publish(reports, run_dir)
-    return Report(run_dir, results, sorted(skip.values()), seconds, tables)
+    return Report(run_dir, results, problems, seconds, tables)

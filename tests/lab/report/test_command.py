@@ -26,7 +26,8 @@ def _args(tmp_path: Path, notebooks: Path, *extra: str) -> list[str]:
     plan = write_plan(tmp_path / "plan.json", [{"name": "slow", "notebook": "slow.ipynb"},
                                               {"name": "bad", "notebook": "bad.ipynb"}])
     return ["report", "--notebooks", str(notebooks), "--plan", str(plan),
-            "--out", str(tmp_path / "reports"), "--data", str(tmp_path / "data"), *extra]
+            "--out", str(tmp_path / "reports"), "--data", str(tmp_path / "data"), "--no-warmup",
+            *extra]
 
 
 def test_misspelt_param_is_an_error(tmp_path: Path, notebooks: Path,
