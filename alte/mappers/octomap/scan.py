@@ -229,7 +229,7 @@ def _rays_hashed(rays: Ray, res: float, capacity: int) -> _Blocks:
     """Blocks and bit rows of ``rays`` (origin, its key, ends, their keys), walked into a
     hash table."""
     origin, okey, ends, ekeys = rays
-    table, n_blocks = new_table(capacity), np.int64(0)  # not Literal: see blockset.union
+    table, n_blocks = new_table(capacity), int(np.int64(0))  # no Literal: blockset.keys_to_blocks
     for i in range(ends.shape[0]):
         k = ekeys[i]
         if skip_ray(okey, k):

@@ -119,7 +119,7 @@ def set_bit(bits: NDArray[np.uint64], row: int, word0: int, key: NDArray[np.int6
 def keys_to_blocks(keys: NDArray[np.uint64], word0: int,
                    ) -> tuple[NDArray[np.uint64], NDArray[np.uint64]]:
     """Blocks and bit rows of Morton ``keys``, set in the words from ``word0``."""
-    n_blocks = np.int64(0)  # not a constant: a Literal[int](0) argument compiles a 2nd reserve
+    n_blocks = int(np.int64(0))  # not a constant: a Literal[int](0) compiles a 2nd reserve
     table = reserve(new_table(keys.size // 64), n_blocks, keys.size)
     for key in keys:
         row, n_blocks = row_of(table, key >> np.uint64(9), n_blocks)
@@ -131,7 +131,7 @@ def keys_to_blocks(keys: NDArray[np.uint64], word0: int,
 @numba.njit(cache=True)
 def union(blocks: NDArray[np.uint64], bits: NDArray[np.uint64], capacity: int) -> tuple[Table, int]:
     """Table of the rows ``bits`` (block codes ``blocks``, repeats OR-ed); (table, n_blocks)."""
-    n_blocks = np.int64(0)  # as in keys_to_blocks
+    n_blocks = int(np.int64(0))  # as in keys_to_blocks
     table = reserve(new_table(capacity), n_blocks, blocks.size)
     for r in range(blocks.size):
         row, n_blocks = row_of(table, blocks[r], n_blocks)

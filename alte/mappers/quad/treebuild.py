@@ -66,7 +66,7 @@ def _run_row(points: Sorted, span: tuple[int, int], rows: NDArray[np.float64], s
         p = r if shift == 0 else packed[r] & ((1 << shift) - 1)
         for c in range(values.shape[1]):
             run[r - i, c] = values[p, c]
-    _cell_row(run, (np.int64(0), j - i), rows, s, dev)  # cellstats' signature, not a Literal 0
+    _cell_row(run, (int(np.int64(0)), j - i), rows, s, dev)  # cellstats' signature, not a Literal 0
 
 
 @numba.njit(cache=True)
