@@ -28,10 +28,17 @@ PAGE = 2048
 _PAGE_SHIFT = 11
 
 
-def _page() -> NDArray[np.float32]:
-    """Room for PAGE blocks, untouched: a block's row is set to NaN when the block is made,
-    so the cost of fresh memory is spread over the scans that add blocks."""
-    return np.empty((PAGE, 512), dtype=np.float32)
+@numba.njit(cache=True)
+def _add_pages(pages: MutableSequence[NDArray[np.float32]] | None, count: int,
+               ) -> MutableSequence[NDArray[np.float32]]:
+    """``pages`` (None: a new typed list) with ``count`` more pages of room for PAGE blocks
+    each, untouched: a block's row is set to NaN when the block is made, so the cost of
+    fresh memory is spread over the scans that add blocks. Compiled and cached: a typed
+    list made or grown from Python compiles numba's own list functions in every process."""
+    out = numba.typed.List.empty_list(numba.float32[:, ::1]) if pages is None else pages
+    for _ in range(count):
+        out.append(np.empty((PAGE, 512), dtype=np.float32))
+    return out
 
 
 class VoxelStore:
@@ -51,7 +58,8 @@ class VoxelStore:
         self._rows = np.zeros(1 << 10, dtype=np.int64)
         self._blocks = np.zeros(PAGE, dtype=np.uint64)
         #: A numba typed list, so that the kernels take the pages as they are.
-        self._pages: MutableSequence[NDArray[np.float32]] = numba.typed.List([_page()])
+        self._pages = _add_pages(None, 1)
+        self._page_count = 1
         self._n = 0
         self._folded: tuple[NDArray[np.uint64], NDArray[np.float32]] | None = None
 
@@ -72,8 +80,10 @@ class VoxelStore:
 
     def _reserve(self, need: int) -> None:
         total = self._n + need
-        while total > len(self._pages) * PAGE:
-            self._pages.append(_page())
+        more = -(-total // PAGE) - self._page_count
+        if more > 0:
+            self._pages = _add_pages(self._pages, more)
+            self._page_count += more
         if total > self._blocks.size:
             grown = np.zeros(max(total, 2 * self._blocks.size), dtype=np.uint64)
             grown[:self._n] = self._blocks[:self._n]
