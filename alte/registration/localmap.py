@@ -6,6 +6,13 @@ uncertainty, Yuan et al. 2022, reduced to the position): a wall mapped while the
 position along it was uncertain by 0.5 m places the vehicle no better than that when it is
 matched again. Taken as exact, three such points collapsed the along-track sigma of
 sim_nav_2 from 0.56 to 0.21 m at a turn, onto a copy of the wall the drift itself had made.
+
+Cost: the update asks for the plane fits of one scan three to five times (its iterations)
+against the same map, and most scan points keep their neighbours from one iteration to
+the next; a fit depends on its neighbours alone, so the map remembers the last fits
+(:class:`_Memo`) and fits again only the rows whose neighbours changed. The map stays
+sorted by cell: new cells are inserted in place and the k-d tree rebuilt only when the
+map changed.
 """
 
 from __future__ import annotations
@@ -34,6 +41,34 @@ def voxel_first(points: NDArray[np.float64], voxel: float) -> NDArray[np.float64
     return points[np.sort(first)]
 
 
+def _within(points: NDArray[np.float64], centre: NDArray[np.float64],
+            radius: float) -> NDArray[np.bool_]:
+    """``norm(points - centre) <= radius`` per point, as :func:`numpy.linalg.norm` decides
+    it: a cheap squared distance settles all but the points within 1e-6 of the sphere."""
+    offset = points - centre
+    square = np.einsum("ij,ij->i", offset, offset)
+    near: NDArray[np.bool_] = square < (radius * (1.0 - 1e-6)) ** 2
+    edge = np.flatnonzero(~near & (square < (radius * (1.0 + 1e-6)) ** 2))
+    near[edge] = np.linalg.norm(offset[edge], axis=1) <= radius
+    return near
+
+
+def _rows(inside: NDArray[np.bool_]) -> NDArray[np.bool_]:
+    """The rows of a neighbour mask that are all inside."""
+    return np.asarray(inside.all(axis=1), dtype=np.bool_)
+
+
+def _insert_rows(array: NDArray[np.float64], where: NDArray[np.intp],
+                 rows: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``np.insert(array, where, rows, axis=0)`` for a C-ordered 2-D array, each row taken
+    as one opaque item (eight times faster than numpy's insert along an axis)."""
+    item = np.dtype((np.void, array.dtype.itemsize * array.shape[1]))
+    flat = np.insert(np.ascontiguousarray(array).view(item).ravel(), where,
+                     np.ascontiguousarray(rows, dtype=array.dtype).view(item).ravel())
+    out: NDArray[np.float64] = flat.view(array.dtype).reshape(-1, array.shape[1])
+    return out
+
+
 @dataclass(frozen=True)
 class Planes:
     """The plane fits of the query points that got one: their ``index`` among the queries,
@@ -46,6 +81,25 @@ class Planes:
     variance: NDArray[np.float64]
 
 
+@dataclass
+class _Memo:
+    """The last fits of one neighbour count against the current map: per query row its
+    neighbour indices, whether it was fitted, and the fit (flat, normal, centre)."""
+
+    idx: NDArray[np.int64]
+    done: NDArray[np.bool_]
+    flat: NDArray[np.bool_]
+    normal: NDArray[np.float64]
+    centre: NDArray[np.float64]
+
+    def reusable(self, idx: NDArray[np.int64]) -> NDArray[np.bool_]:
+        """The rows of ``idx`` fitted last time with the same neighbours, in order."""
+        if self.idx.shape != idx.shape:
+            return np.zeros(len(idx), dtype=np.bool_)
+        same: NDArray[np.bool_] = self.done & (self.idx == idx).all(axis=1)
+        return same
+
+
 class LocalMap:
     """World points near the vehicle on a grid, with a k-d tree for plane fits."""
 
@@ -55,26 +109,35 @@ class LocalMap:
         self.keys = np.empty(0, np.int64)
         self.variance = np.empty((0, 3))
         self.tree: cKDTree | None = None
+        self._memo: dict[int, _Memo] = {}
 
     def add(self, points: NDArray[np.float64], centre: NDArray[np.float64],
             variance: NDArray[np.float64] | None = None) -> None:
         """Add ``points`` (world) in cells not yet filled, with the position ``variance``
         (x, y, z; m^2; None: exact) of the pose that placed them; drop what lies beyond
-        ``radius`` of ``centre``."""
+        ``radius`` of ``centre``. The map stays sorted by cell key."""
         new = voxel_first(points, self.voxel)
         keys = _cells(new, self.voxel)
         at = np.clip(np.searchsorted(self.keys, keys), 0, max(len(self.keys) - 1, 0))
         fresh = ~(self.keys[at] == keys) if len(self.keys) else np.ones(len(keys), bool)
         placed = np.zeros(3) if variance is None else np.asarray(variance, dtype=np.float64)
-        merged = np.vstack([self.points, new[fresh]])
-        spread = np.vstack([self.variance, np.tile(placed, (int(fresh.sum()), 1))])
-        cells = np.r_[self.keys, keys[fresh]]
-        near = np.linalg.norm(merged - centre, axis=1) <= self.radius
-        order = np.argsort(cells[near], kind="stable")
-        self.points, self.keys = merged[near][order], cells[near][order]
-        self.variance = spread[near][order]
-        self.tree = cKDTree(self.points, balanced_tree=False, compact_nodes=False) \
-            if len(self.points) >= 5 else None
+        order = np.argsort(keys[fresh])
+        cells, new = keys[fresh][order], new[fresh][order]
+        where = np.searchsorted(self.keys, cells)
+        changed = len(cells) > 0
+        if changed:
+            self.points = _insert_rows(self.points, where, new)
+            self.keys = np.insert(self.keys, where, cells)
+            self.variance = _insert_rows(self.variance, where, np.tile(placed, (len(new), 1)))
+        near = _within(self.points, centre, self.radius)
+        if not near.all():
+            changed = True
+            self.points, self.keys = self.points[near], self.keys[near]
+            self.variance = self.variance[near]
+        if changed or self.tree is None:
+            self._memo.clear()
+            self.tree = cKDTree(self.points, balanced_tree=False, compact_nodes=False) \
+                if len(self.points) >= 5 else None
 
     def planes(self, query: NDArray[np.float64], max_distance: float, k: int = 5,
                wide: tuple[int, float] = (0, 0.0)) -> Planes:
@@ -92,30 +155,47 @@ class LocalMap:
                                       distance_upper_bound=max(max_distance, wide[1]))
         dist = np.asarray(dist).reshape(-1, count)
         idx = np.asarray(found, dtype=np.int64).reshape(-1, count)
-        flat, normal, centre = self._fit(idx[:, :k], dist[:, :k] <= max_distance)
-        if wide[0] > k:
-            broad, wide_normal, wide_centre = self._fit(idx, dist <= wide[1])
-            normal[broad], centre[broad] = wide_normal[broad], wide_centre[broad]
-            flat |= broad
+        small = _rows(dist[:, :k] <= max_distance)
+        if wide[0] > k:  # the small fit only where the wide one fails
+            flat, normal, centre = self._fit(idx, _rows(dist <= wide[1]))
+            few, few_normal, few_centre = self._fit(idx[:, :k], small & ~flat)
+            normal[~flat], centre[~flat] = few_normal[~flat], few_centre[~flat]
+            flat |= few
+        else:
+            flat, normal, centre = self._fit(idx[:, :k], small)
         index = np.flatnonzero(flat)
         placed = self.variance[idx[index, 0]]
         return Planes(index, normal[index], centre[index],
                       np.einsum("ij,ij->i", normal[index] ** 2, placed))
 
-    def _fit(self, idx: NDArray[np.int64], inside: NDArray[np.bool_],
+    def _fit(self, idx: NDArray[np.int64], ok: NDArray[np.bool_],
              ) -> tuple[NDArray[np.bool_], NDArray[np.float64], NDArray[np.float64]]:
-        """Per row of neighbour indices: whether all are ``inside`` and on a plane, the
-        plane's unit normal and the neighbours' centroid."""
-        ok: NDArray[np.bool_] = np.asarray(inside.all(axis=1), dtype=np.bool_)
-        normal, centre = np.zeros((len(idx), 3)), np.zeros((len(idx), 3))
-        nbrs = self.points[idx[ok]]
-        centre[ok] = nbrs.mean(axis=1)
-        centred = nbrs - centre[ok][:, None, :]
+        """For the ``ok`` rows of neighbour indices: whether they lie on a plane, its unit
+        normal and the neighbours' centroid; rows fitted last time against this map with
+        the same neighbours are taken from :class:`_Memo`."""
+        memo = self._memo.get(idx.shape[1])
+        reuse = ok & memo.reusable(idx) if memo is not None \
+            else np.zeros(len(idx), dtype=np.bool_)
+        flat, normal, centre = np.zeros(len(idx), np.bool_), np.zeros((len(idx), 3)), \
+            np.zeros((len(idx), 3))
+        if memo is not None and reuse.any():
+            flat[reuse], normal[reuse], centre[reuse] = memo.flat[reuse], \
+                memo.normal[reuse], memo.centre[reuse]
+        todo = ok & ~reuse
+        flat[todo], normal[todo], centre[todo] = self._plane(idx[todo])
+        self._memo[idx.shape[1]] = _Memo(idx, ok.copy(), flat.copy(), normal.copy(),
+                                         centre.copy())
+        return flat, normal, centre
+
+    def _plane(self, idx: NDArray[np.int64],
+               ) -> tuple[NDArray[np.bool_], NDArray[np.float64], NDArray[np.float64]]:
+        """Per row of neighbour indices: whether they lie on a plane, its unit normal and
+        their centroid (each row on its own: the same neighbours give the same fit)."""
+        nbrs = self.points[idx]
+        centre = nbrs.mean(axis=1)
+        centred = nbrs - centre[:, None, :]
         values, vectors = np.linalg.eigh(np.einsum("nki,nkj->nij", centred, centred)
                                          / idx.shape[1])
         spread = np.sqrt(np.maximum(values, 0.0))
-        good = (spread[:, 0] < self.thickness) & (spread[:, 1] > 3.0 * self.thickness)
-        normal[ok] = vectors[:, :, 0]
-        flat = ok.copy()
-        flat[ok] = good
-        return flat, normal, centre
+        flat = (spread[:, 0] < self.thickness) & (spread[:, 1] > 3.0 * self.thickness)
+        return flat, vectors[:, :, 0], centre
