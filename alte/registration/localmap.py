@@ -10,9 +10,10 @@ sim_nav_2 from 0.56 to 0.21 m at a turn, onto a copy of the wall the drift itsel
 Cost: the update asks for the plane fits of one scan three to five times (its iterations)
 against the same map, and most scan points keep their neighbours from one iteration to
 the next; a fit depends on its neighbours alone, so the map remembers the last fits
-(:class:`_Memo`) and fits again only the rows whose neighbours changed. The map stays
-sorted by cell: new cells are inserted in place and the k-d tree rebuilt only when the
-map changed.
+(:class:`_Memo`) and fits again only the rows whose neighbours changed. The map's rows
+are appended and dropped by a mask under a k-d tree split in two
+(:mod:`alte.registration.neighbours`), rather than a tree over the whole map rebuilt
+each scan.
 """
 
 from __future__ import annotations
@@ -21,7 +22,8 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.spatial import cKDTree
+
+from alte.registration.neighbours import SplitTree
 
 __all__ = ["LocalMap", "Planes", "voxel_first"]
 
@@ -58,17 +60,6 @@ def _rows(inside: NDArray[np.bool_]) -> NDArray[np.bool_]:
     return np.asarray(inside.all(axis=1), dtype=np.bool_)
 
 
-def _insert_rows(array: NDArray[np.float64], where: NDArray[np.intp],
-                 rows: NDArray[np.float64]) -> NDArray[np.float64]:
-    """``np.insert(array, where, rows, axis=0)`` for a C-ordered 2-D array, each row taken
-    as one opaque item (eight times faster than numpy's insert along an axis)."""
-    item = np.dtype((np.void, array.dtype.itemsize * array.shape[1]))
-    flat = np.insert(np.ascontiguousarray(array).view(item).ravel(), where,
-                     np.ascontiguousarray(rows, dtype=array.dtype).view(item).ravel())
-    out: NDArray[np.float64] = flat.view(array.dtype).reshape(-1, array.shape[1])
-    return out
-
-
 @dataclass(frozen=True)
 class Planes:
     """The plane fits of the query points that got one: their ``index`` among the queries,
@@ -101,43 +92,62 @@ class _Memo:
 
 
 class LocalMap:
-    """World points near the vehicle on a grid, with a k-d tree for plane fits."""
+    """World points near the vehicle on a grid, with k-d trees for plane fits. Rows are
+    appended and dropped by a mask (:class:`~alte.registration.neighbours.SplitTree`), and
+    packed when the rows added or dropped since the last packing pass ``repack`` of it."""
 
-    def __init__(self, voxel: float, radius: float, thickness: float = 0.05) -> None:
-        self.voxel, self.radius, self.thickness = voxel, radius, thickness
+    def __init__(self, voxel: float, radius: float, thickness: float = 0.05,
+                 repack: float = 0.1) -> None:
+        self.voxel, self.radius, self.thickness, self.repack = voxel, radius, thickness, repack
         self.points = np.empty((0, 3))
-        self.keys = np.empty(0, np.int64)
         self.variance = np.empty((0, 3))
-        self.tree: cKDTree | None = None
+        self.live = np.empty(0, np.bool_)
+        self.cells = np.empty(0, np.int64)  # each row's cell key
+        self.keys = np.empty(0, np.int64)  # the live rows' keys, sorted
+        self.index = SplitTree(self.points, self.live)
         self._memo: dict[int, _Memo] = {}
+
+    @property
+    def ready(self) -> bool:
+        """Whether the map holds enough points (five) to fit planes."""
+        return len(self.keys) >= 5
 
     def add(self, points: NDArray[np.float64], centre: NDArray[np.float64],
             variance: NDArray[np.float64] | None = None) -> None:
         """Add ``points`` (world) in cells not yet filled, with the position ``variance``
         (x, y, z; m^2; None: exact) of the pose that placed them; drop what lies beyond
-        ``radius`` of ``centre``. The map stays sorted by cell key."""
+        ``radius`` of ``centre``."""
         new = voxel_first(points, self.voxel)
         keys = _cells(new, self.voxel)
         at = np.clip(np.searchsorted(self.keys, keys), 0, max(len(self.keys) - 1, 0))
         fresh = ~(self.keys[at] == keys) if len(self.keys) else np.ones(len(keys), bool)
         placed = np.zeros(3) if variance is None else np.asarray(variance, dtype=np.float64)
-        order = np.argsort(keys[fresh])
-        cells, new = keys[fresh][order], new[fresh][order]
-        where = np.searchsorted(self.keys, cells)
-        changed = len(cells) > 0
-        if changed:
-            self.points = _insert_rows(self.points, where, new)
-            self.keys = np.insert(self.keys, where, cells)
-            self.variance = _insert_rows(self.variance, where, np.tile(placed, (len(new), 1)))
-        near = _within(self.points, centre, self.radius)
-        if not near.all():
-            changed = True
-            self.points, self.keys = self.points[near], self.keys[near]
-            self.variance = self.variance[near]
-        if changed or self.tree is None:
-            self._memo.clear()
-            self.tree = cKDTree(self.points, balanced_tree=False, compact_nodes=False) \
-                if len(self.points) >= 5 else None
+        new, keys = new[fresh], keys[fresh]
+        self.points = np.concatenate([self.points, new])
+        self.variance = np.concatenate([self.variance, np.tile(placed, (len(new), 1))])
+        self.cells = np.concatenate([self.cells, keys])
+        self.live = np.concatenate([self.live, np.ones(len(new), np.bool_)])
+        sort = np.sort(keys)
+        self.keys = np.insert(self.keys, np.searchsorted(self.keys, sort), sort)
+        dead = self.live & ~_within(self.points, centre, self.radius)
+        if dead.any():
+            self.live &= ~dead
+            self.keys = np.delete(self.keys, np.searchsorted(self.keys, self.cells[dead]))
+        if len(self.points) - len(self.keys) + len(self.points) - self.index.base \
+                > self.repack * self.index.base:
+            self._pack()
+        else:
+            self.index.update(self.points, self.live)
+
+    def _pack(self) -> None:
+        """Only the live rows kept, sorted by cell (neighbours close in memory too), under
+        a new k-d tree (row numbers change)."""
+        keep = np.flatnonzero(self.live)
+        keep = keep[np.argsort(self.cells[keep])]
+        self.points, self.variance = self.points[keep], self.variance[keep]
+        self.cells, self.live = self.cells[keep], self.live[keep]
+        self.index = SplitTree(self.points, self.live)
+        self._memo.clear()
 
     def planes(self, query: NDArray[np.float64], max_distance: float, k: int = 5,
                wide: tuple[int, float] = (0, 0.0)) -> Planes:
@@ -147,14 +157,11 @@ class LocalMap:
         twenty points over metres tilts far less than one fitted to five, and a tilted
         normal reads as a constraint along the ground; the five keep small objects and
         edges."""
-        if self.tree is None or len(query) == 0:
+        if not self.ready or len(query) == 0:
             return Planes(np.empty(0, np.intp), np.empty((0, 3)), np.empty((0, 3)),
                           np.empty(0))
         count = max(k, wide[0])
-        dist, found = self.tree.query(query, k=count,
-                                      distance_upper_bound=max(max_distance, wide[1]))
-        dist = np.asarray(dist).reshape(-1, count)
-        idx = np.asarray(found, dtype=np.int64).reshape(-1, count)
+        dist, idx = self.index.query(query, count, max(max_distance, wide[1]))
         small = _rows(dist[:, :k] <= max_distance)
         if wide[0] > k:  # the small fit only where the wide one fails
             flat, normal, centre = self._fit(idx, _rows(dist <= wide[1]))
