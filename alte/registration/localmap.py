@@ -19,6 +19,7 @@ each scan.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -26,6 +27,8 @@ from numpy.typing import NDArray
 from alte.registration.neighbours import SplitTree
 
 __all__ = ["LocalMap", "Planes", "voxel_first"]
+
+_T = TypeVar("_T", np.float64, np.int64, np.bool_)
 
 
 def _cells(points: NDArray[np.float64], voxel: float) -> NDArray[np.int64]:
@@ -58,6 +61,25 @@ def _within(points: NDArray[np.float64], centre: NDArray[np.float64],
 def _rows(inside: NDArray[np.bool_]) -> NDArray[np.bool_]:
     """The rows of a neighbour mask that are all inside."""
     return np.asarray(inside.all(axis=1), dtype=np.bool_)
+
+
+def _distance(points: NDArray[np.float64], centre: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Each point's distance to ``centre`` (to within rounding: a bound, not a decision)."""
+    offset = points - centre
+    out: NDArray[np.float64] = np.sqrt(np.einsum("ij,ij->i", offset, offset))
+    return out
+
+
+def _put(array: NDArray[_T], rows: int, new: NDArray[_T]) -> NDArray[_T]:
+    """``new`` written after the first ``rows`` rows of ``array``, grown (doubled) when full:
+    appending a scan's few hundred rows costs them, not the map."""
+    need = rows + len(new)
+    if need > len(array):
+        grown = np.empty((max(need, 2 * len(array)), *array.shape[1:]), array.dtype)
+        grown[:rows] = array[:rows]
+        array = grown
+    array[rows:need] = new
+    return array
 
 
 @dataclass(frozen=True)
@@ -93,19 +115,36 @@ class _Memo:
 
 class LocalMap:
     """World points near the vehicle on a grid, with k-d trees for plane fits. Rows are
-    appended and dropped by a mask (:class:`~alte.registration.neighbours.SplitTree`), and
-    packed when the rows added or dropped since the last packing pass ``repack`` of it."""
+    appended (into arrays grown by doubling) and dropped by a mask
+    (:class:`~alte.registration.neighbours.SplitTree`), and packed when the rows added or
+    dropped since the last packing pass ``repack`` of it. Each row keeps its distance to
+    an anchor, so that only the rows that may have left ``radius`` since are measured."""
 
     def __init__(self, voxel: float, radius: float, thickness: float = 0.05,
                  repack: float = 0.1) -> None:
         self.voxel, self.radius, self.thickness, self.repack = voxel, radius, thickness, repack
-        self.points = np.empty((0, 3))
-        self.variance = np.empty((0, 3))
-        self.live = np.empty(0, np.bool_)
-        self.cells = np.empty(0, np.int64)  # each row's cell key
-        self.keys = np.empty(0, np.int64)  # the live rows' keys, sorted
+        self.rows = 0
+        self._points, self._variance = np.empty((0, 3)), np.empty((0, 3))
+        self._live, self._cells = np.empty(0, np.bool_), np.empty(0, np.int64)
+        self._reach, self._anchor = np.empty(0), np.zeros(3)
+        self.keys = np.empty(0, np.int64)  # the live rows' cell keys, sorted
         self.index = SplitTree(self.points, self.live)
         self._memo: dict[int, _Memo] = {}
+
+    @property
+    def points(self) -> NDArray[np.float64]:
+        """Every row's world point (live or dropped)."""
+        return self._points[:self.rows]
+
+    @property
+    def variance(self) -> NDArray[np.float64]:
+        """Every row's position variance (x, y, z; m^2) of the pose that placed it."""
+        return self._variance[:self.rows]
+
+    @property
+    def live(self) -> NDArray[np.bool_]:
+        """Whether each row is still in the map."""
+        return self._live[:self.rows]
 
     @property
     def ready(self) -> bool:
@@ -122,30 +161,49 @@ class LocalMap:
         at = np.clip(np.searchsorted(self.keys, keys), 0, max(len(self.keys) - 1, 0))
         fresh = ~(self.keys[at] == keys) if len(self.keys) else np.ones(len(keys), bool)
         placed = np.zeros(3) if variance is None else np.asarray(variance, dtype=np.float64)
-        new, keys = new[fresh], keys[fresh]
-        self.points = np.concatenate([self.points, new])
-        self.variance = np.concatenate([self.variance, np.tile(placed, (len(new), 1))])
-        self.cells = np.concatenate([self.cells, keys])
-        self.live = np.concatenate([self.live, np.ones(len(new), np.bool_)])
-        sort = np.sort(keys)
-        self.keys = np.insert(self.keys, np.searchsorted(self.keys, sort), sort)
-        dead = self.live & ~_within(self.points, centre, self.radius)
-        if dead.any():
-            self.live &= ~dead
-            self.keys = np.delete(self.keys, np.searchsorted(self.keys, self.cells[dead]))
-        if len(self.points) - len(self.keys) + len(self.points) - self.index.base \
-                > self.repack * self.index.base:
+        self._append(new[fresh], keys[fresh], placed)
+        self._drop(centre)
+        if 2 * self.rows - len(self.keys) - self.index.base > self.repack * self.index.base:
             self._pack()
         else:
             self.index.update(self.points, self.live)
+
+    def _append(self, new: NDArray[np.float64], keys: NDArray[np.int64],
+                placed: NDArray[np.float64]) -> None:
+        """Rows for the ``new`` points of cell ``keys``, placed with variance ``placed``."""
+        n = self.rows
+        self._points = _put(self._points, n, new)
+        self._variance = _put(self._variance, n, np.tile(placed, (len(new), 1)))
+        self._cells = _put(self._cells, n, keys)
+        self._live = _put(self._live, n, np.ones(len(new), np.bool_))
+        self._reach = _put(self._reach, n, _distance(new, self._anchor))
+        self.rows = n + len(new)
+        sort = np.sort(keys)
+        self.keys = np.insert(self.keys, np.searchsorted(self.keys, sort), sort)
+
+    def _drop(self, centre: NDArray[np.float64]) -> None:
+        """Rows beyond ``radius`` of ``centre`` out of the map; measured are only those
+        whose distance to the anchor, plus how far ``centre`` moved from it, may exceed
+        it (the anchor moves to ``centre`` when that is 2 % of the radius)."""
+        moved = float(np.linalg.norm(centre - self._anchor))
+        if moved > 0.02 * self.radius:
+            self._anchor, moved = np.array(centre, dtype=np.float64), 0.0
+            self._reach[:self.rows] = _distance(self.points, self._anchor)
+        maybe = np.flatnonzero(self.live & (self._reach[:self.rows]
+                                            > self.radius * (1.0 - 1e-6) - moved))
+        dead = maybe[~_within(self.points[maybe], centre, self.radius)]
+        if len(dead):
+            self._live[dead] = False
+            self.keys = np.delete(self.keys, np.searchsorted(self.keys, self._cells[dead]))
 
     def _pack(self) -> None:
         """Only the live rows kept, sorted by cell (neighbours close in memory too), under
         a new k-d tree (row numbers change)."""
         keep = np.flatnonzero(self.live)
-        keep = keep[np.argsort(self.cells[keep])]
-        self.points, self.variance = self.points[keep], self.variance[keep]
-        self.cells, self.live = self.cells[keep], self.live[keep]
+        keep = keep[np.argsort(self._cells[keep])]
+        self._points, self._variance = self._points[keep], self._variance[keep]
+        self._cells, self._live = self._cells[keep], self._live[keep]
+        self._reach, self.rows = self._reach[keep], len(keep)
         self.index = SplitTree(self.points, self.live)
         self._memo.clear()
 
