@@ -36,8 +36,9 @@ lint: bootstrap
 	$(PY) -m ruff check alte tests bench docs plugins
 	$(PY) -m mypy
 
-# mypy and the compilation of the mappers' numba kernels (`alte warmup`, cached for every
-# later process) run side by side on the two cores, then the tests.
+# Lint, types and the fast tests (.ci/test): ruff; then `alte warmup` (numba's kernels
+# compiled into the package cache once, for every later process), mypy and the docs site's
+# tests side by side on the two cores; then the other tests on two pytest workers.
 # The tests start a hundred or so Python processes (workers, notebook kernels, CLI runs);
 # with PYTHONDONTWRITEBYTECODE set in the caller's environment each of them compiled
 # numpy, pandas, alte ... from source again (about 4 of its 6 CPU seconds of imports),
@@ -48,9 +49,7 @@ lint: bootstrap
 PYTEST := $(PY) -m pytest -n 2 --dist loadfile --no-loadscope-reorder tests plugins/alte-elevation/tests notebooks --nbval-lax
 test: export PYTHONDONTWRITEBYTECODE :=
 test: bootstrap
-	$(PY) -m ruff check alte tests bench docs plugins
-	@$(PY) -m alte warmup & warm=$$!; $(PY) -m mypy; typed=$$?; wait $$warm && exit $$typed
-	$(PYTEST) -m "not full" $(PYTEST_ARGS)
+	@bash .ci/test $(PYTEST_ARGS)
 
 check-full: export PYTHONDONTWRITEBYTECODE :=
 check-full: bootstrap
