@@ -16,8 +16,12 @@ from collections.abc import Generator
 import pytest
 
 #: Notebooks whose headless run (nbval) is a long end-to-end check: ``make check-full``
-#: (tests/README.md: which smaller tests prove their parts in ``make test``).
-FULL_NOTEBOOKS: frozenset[str] = frozenset({"ch5_analysis.ipynb", "ch6_real_data.ipynb"})
+#: (tests/README.md: which smaller tests prove their parts in ``make test``). ``make test``
+#: executes ``ch4_terrain`` and reads every notebook's calls (tests/notebooks/test_calls.py).
+FULL_NOTEBOOKS: frozenset[str] = frozenset({
+    "ch2_test_benchmark.ipynb", "ch3_mapping_techniques.ipynb", "ch5_analysis.ipynb",
+    "ch6_real_data.ipynb", "ch7_landing.ipynb", "ch7_planning.ipynb",
+    "ch7_sensitivity.ipynb"})
 
 
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:

@@ -253,7 +253,7 @@ class LioOdometry:
             & (ranges <= self.settings.max_range)
         moved = self.deskew(points, None if frame.times is None else np.asarray(frame.times))
         scan = moved[keep]
-        if self.map.tree is not None:
+        if self.map.ready:
             self.filter.update(self._residuals(voxel_first(scan, self.settings.voxel)),
                                self.settings.plane_sigma, self.settings.iterations,
                                least=self.settings.least)

@@ -23,6 +23,7 @@ from __future__ import annotations
 import ast
 import dataclasses
 import enum
+import functools
 import importlib
 import importlib.util
 import os
@@ -87,6 +88,16 @@ def owned_names(module: str) -> list[str]:
     Read from the module's source (top-level ``def``, ``class`` and assignments), so a
     name a package or module re-exports is documented once, where it is defined.
     """
+    bound = _bound_names(module)
+    listed = getattr(importlib.import_module(module), "__all__", None)
+    names = list(listed) if listed is not None else sorted(bound)
+    return [n for n in names if n in bound and not n.startswith("_")]
+
+
+@functools.cache
+def _bound_names(module: str) -> frozenset[str]:
+    """The names the top level of ``module``'s source binds. Parsed once per module and
+    build: the API pages ask again for each name a package re-exports (about 900 times)."""
     spec = importlib.util.find_spec(module)
     origin = Path(spec.origin) if spec and spec.origin else None
     tree = ast.parse(origin.read_text()) if origin and origin.suffix == ".py" else ast.Module()
@@ -98,9 +109,7 @@ def owned_names(module: str) -> list[str]:
             bound |= {t.id for t in node.targets if isinstance(t, ast.Name)}
         elif isinstance(node, ast.AnnAssign) and isinstance(node.target, ast.Name):
             bound.add(node.target.id)
-    listed = getattr(importlib.import_module(module), "__all__", None)
-    names = list(listed) if listed is not None else sorted(bound)
-    return [n for n in names if n in bound and not n.startswith("_")]
+    return frozenset(bound)
 
 
 def _owner(module: str, name: str, modules: list[str]) -> str | None:
@@ -155,6 +164,7 @@ def write_api_pages(_app: Sphinx) -> None:
     """The API reference: an index and one page per package (module docstring)."""
     if str(REPO) not in sys.path:
         sys.path.insert(0, str(REPO))  # bench/ sits beside alte/, not installed
+    _bound_names.cache_clear()  # read afresh in each build of a long-lived process
     everything = public_modules() + public_modules("bench")
     pages = _packages(everything)
     wanted = {f"{package}.md" for package in pages} | {"index.md"}
@@ -378,14 +388,26 @@ class NearestTarget(SphinxPostTransform):
     of the site (once per reference and type, thousands of times a build)."""
 
     default_priority = 5  # before sphinx's ReferencesResolver (10)
+    _cached: ClassVar[tuple[object, int, dict[str, list[str]], set[str]] | None] = None
 
-    def run(self, **_kwargs: object) -> None:
-        """Qualify each ambiguous short target of this document."""
-        objects = self.env.get_domain("py").objects
+    @classmethod
+    def _indexes(cls, objects: dict[str, Any]) -> tuple[dict[str, list[str]], set[str]]:
+        """The documented objects by last name, and every dotted tail of theirs: built
+        once per build (the objects do not change while pages are written), not per page."""
+        cached = cls._cached
+        if cached is not None and cached[0] is objects and cached[1] == len(objects):
+            return cached[2], cached[3]
         by_last: dict[str, list[str]] = {}
         for name in objects:
             by_last.setdefault(name.rpartition(".")[2], []).append(name)
         tails = _suffixes(objects)
+        cls._cached = (objects, len(objects), by_last, tails)
+        return by_last, tails
+
+    def run(self, **_kwargs: object) -> None:
+        """Qualify each ambiguous short target of this document."""
+        objects = self.env.get_domain("py").objects
+        by_last, tails = self._indexes(objects)
         for node in self.document.findall(addnodes.pending_xref):
             target = str(node.get("reftarget", ""))
             if node.get("refdomain") != "py":

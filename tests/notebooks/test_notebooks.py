@@ -1,7 +1,9 @@
 """Every notebook is parameterisable by papermill and stored clean; nbval runs headless.
 
 The notebooks themselves are executed by ``pytest --nbval-lax notebooks/`` (``make
-test``); these tests check what that run and ``alte report`` rely on.
+test`` executes ``ch4_terrain``, ``make check-full`` every chapter; test_calls.py reads
+every notebook's calls in ``make test``); these tests check what that run and ``alte
+report`` rely on.
 """
 
 from __future__ import annotations

@@ -21,7 +21,6 @@ area whose disk the map knows (unmapped ground does not count against it).
 from __future__ import annotations
 
 import numpy as np
-import open3d as o3d
 from numpy.typing import NDArray
 from scipy.spatial import ConvexHull, QhullError
 
@@ -92,6 +91,8 @@ def top_surface(surface: TrueSurface, xy: NDArray[np.float64], z_start: float,
 
     NaN height and id -1 where the ray hits nothing.
     """
+    import open3d as o3d  # here, not at the top: importing the landing study costs no open3d
+
     scene = o3d.t.geometry.RaycastingScene()
     scene.add_triangles(to_tensor(surface.vertices), to_tensor(surface.triangles, np.uint32))
     rays = np.zeros((len(xy), 6), dtype=np.float32)
