@@ -66,5 +66,17 @@ def free_space_share(cells: Cells,
     if free.size <= max_cells:
         truly = ~inside(free)
         return float(volume[truly].sum() / volume.sum())
-    pick = np.random.default_rng(seed).choice(free, size=max_cells, p=volume / volume.sum())
-    return float(np.mean(~inside(pick)))
+    return float(np.mean(~inside(_draw(free, volume, max_cells, seed))))
+
+
+def _draw(free: NDArray[np.int64], volume: NDArray[np.float64], size: int, seed: int,
+          ) -> NDArray[np.int64]:
+    """``size`` of ``free`` drawn with replacement, with probability proportional to
+    ``volume``: the draws of ``Generator.choice(free, size, p=...)`` (inverse CDF of the
+    same uniforms), sorted. Searching sorted uniforms walks the CDF of millions of
+    leaves in order, 3-4x faster than ``choice``'s random order; the share is order-free."""
+    cdf = (volume / volume.sum()).cumsum()
+    cdf /= cdf[-1]
+    uniform = np.random.default_rng(seed).random(size)
+    uniform.sort()
+    return free[cdf.searchsorted(uniform, side="right")]

@@ -101,6 +101,18 @@ def _file_table(root: Path) -> dict[str, dict[str, int | str]]:
     return table
 
 
+#: Folders whose files matched their scenario's hashes in this process, with the files'
+#: (path, size, mtime) then: a sweep asks for the same terrain once per map, and hashing a
+#: whole UAV mission's bag (57 MB) each time cost more than mapping it.
+_VERIFIED: dict[Path, tuple[tuple[str, int, int], ...]] = {}
+
+
+def _file_stats(root: Path) -> tuple[tuple[str, int, int], ...]:
+    """(relative path, size, mtime in ns) of every file under ``root``, sorted."""
+    return tuple((p.relative_to(root).as_posix(), st.st_size, st.st_mtime_ns)
+                 for p in sorted(root.rglob("*")) if p.is_file() for st in (p.stat(),))
+
+
 def _mount_dict(mount: Mount) -> MountMeta:
     return {"translation": mount.translation.tolist(), "quaternion": mount.quaternion.tolist(),
             "xyz_rpy_deg": mount.to_string()}
@@ -185,7 +197,13 @@ def is_current(folder: Path, key: str, seed: int) -> bool:
         return False
     if meta.get("spec_hash") != key or meta.get("seed") != seed or not meta.get("files"):
         return False
-    return bool(_file_table(folder) == meta["files"])
+    stats = _file_stats(folder)
+    if _VERIFIED.get(folder.resolve()) == stats:
+        return True
+    current = bool(_file_table(folder) == meta["files"])
+    if current:
+        _VERIFIED[folder.resolve()] = stats
+    return current
 
 
 def terrain_folder(out_dir: str | os.PathLike[str], name: str, frames: int | None = None,

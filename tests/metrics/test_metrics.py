@@ -315,3 +315,12 @@ def test_free_space_truth_estimate_from_a_volume_weighted_sample():
     exact = free_space_truth(cells, surf)
     assert 0.9 < exact < 1.0  # the box holds 8 of the 300 m^3 sampled
     assert free_space_truth(cells, surf, max_cells=2000) == pytest.approx(exact, abs=0.03)
+
+
+def test_free_space_draws_are_numpy_choice_draws_sorted():
+    from alte.metrics.freespace import _draw
+
+    rng = np.random.default_rng(3)
+    volume, free = rng.random(50_000) ** 3, np.arange(7, 50_007)
+    want = np.random.default_rng(11).choice(free, size=4000, p=volume / volume.sum())
+    np.testing.assert_array_equal(_draw(free, volume, 4000, 11), np.sort(want))

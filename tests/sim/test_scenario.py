@@ -7,6 +7,7 @@ import pytest
 
 from alte.errors import ParameterError, SimulationError
 from alte.sim import TERRAINS, ensure_terrain, get_terrain, load_scenario, simulate
+from alte.sim.groundtruth import GROUND_TRUTH_FILE
 from alte.sim.mission import scan_indices
 from alte.sim.scenario import terrain_folder, update_terrain
 
@@ -65,6 +66,14 @@ def test_cache_is_reused_only_when_spec_seed_and_files_match(tmp_path):
     assert update_terrain("sim_lan_1", tmp_path, seed=1, frames=5)[1]
     assert update_terrain("sim_lan_1", tmp_path, seed=1, frames=5, force=True)[1]
     assert not list(tmp_path.glob(".*part*"))  # no temporary folders left behind
+
+
+def test_a_file_changed_after_a_check_is_found(tmp_path):
+    folder, _ = update_terrain("sim_lan_1", tmp_path, seed=0, frames=3)
+    assert update_terrain("sim_lan_1", tmp_path, seed=0, frames=3) == (folder, False)
+    assert update_terrain("sim_lan_1", tmp_path, seed=0, frames=3) == (folder, False)  # memo
+    (folder / GROUND_TRUTH_FILE).write_bytes(b"not the mesh")  # after the checks
+    assert update_terrain("sim_lan_1", tmp_path, seed=0, frames=3)[1]
 
 
 def test_subset_scans_equal_the_full_missions_scans():
