@@ -79,4 +79,5 @@ def _draw(free: NDArray[np.int64], volume: NDArray[np.float64], size: int, seed:
     cdf /= cdf[-1]
     uniform = np.random.default_rng(seed).random(size)
     uniform.sort()
-    return free[cdf.searchsorted(uniform, side="right")]
+    drawn: NDArray[np.int64] = free[cdf.searchsorted(uniform, side="right")]
+    return drawn
