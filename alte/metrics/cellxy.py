@@ -17,6 +17,8 @@ import numba
 import numpy as np
 from numpy.typing import NDArray
 
+from alte.mappers._rows import row_groups
+
 __all__ = ["cell_at_xy", "lattice_keys", "size_groups"]
 
 #: Lattice indices are clipped to +-2**30 before they are packed into one int64 key.
@@ -27,7 +29,7 @@ _SLACK = 1e-9
 
 def size_groups(half: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.intp]]:
     """Distinct half sizes and, per cell, the index of its group (trees have few sizes)."""
-    return np.unique(np.round(half, 9), axis=0, return_inverse=True)
+    return row_groups(np.round(half, 9))
 
 
 def lattice_keys(ij: NDArray[np.int64]) -> NDArray[np.int64]:

@@ -19,6 +19,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 
+from alte.mappers._rows import unique_sorted
 from alte.metrics.truth import TruthValues, accuracy_of, size_groups
 
 if TYPE_CHECKING:
@@ -48,7 +49,7 @@ class PerLeaf(Generic[_V]):
         sorted rows not known yet and returns their values."""
         pos, have = self._positions(rows)
         if not have.all():
-            new = np.unique(rows[~have])
+            new = unique_sorted(rows[~have])
             keys = np.concatenate([self.rows, new])
             order = np.argsort(keys, kind="stable")
             self.rows = keys[order]

@@ -8,7 +8,7 @@ import pytest
 
 from alte.errors import MapperError, ParameterError
 from alte.mappers import make_mapper
-from alte.mappers._rows import unique_rows
+from alte.mappers._rows import row_groups, unique_rows
 from alte.mappers.domain import Domain
 
 DOMAIN = Domain(-5.0, -5.0, -2.0, 64.0)
@@ -115,3 +115,14 @@ def test_unique_rows_is_numpys_unique():
     corners[3:7] *= -1.0  # -0.0 rows: one row with them
     for pts in (corners, np.rint(corners * 8).astype(np.int64), corners[:1], corners[:0]):
         assert np.array_equal(unique_rows(pts), np.unique(pts, axis=0).reshape(-1, 3))
+
+
+def test_row_groups_is_numpys_unique_with_inverse():
+    rng = np.random.default_rng(5)
+    half = 0.25 * (1 << rng.integers(0, 4, (3000, 3))).astype(np.float64)
+    half[::7] = [0.5, 0.25, 1.0]
+    for pts in (half, half[:1], half[:0], half[:, :2], np.rint(half * 4).astype(np.int64)):
+        rows, inverse = row_groups(pts)
+        want, where = np.unique(pts, axis=0, return_inverse=True)
+        assert np.array_equal(rows, want.reshape(-1, pts.shape[1]))
+        assert np.array_equal(inverse, where.reshape(-1)) and inverse.shape == (len(pts),)
