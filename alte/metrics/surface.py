@@ -142,9 +142,13 @@ class TrueSurface:
         """
         points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
         out = np.zeros(len(points), dtype=bool)
+        by_x = np.argsort(points[:, 0], kind="stable")  # an object's x range: one slice
+        xs = points[by_x, 0]
         for lo, hi, scene in self._object_scenes():  # one pass per object, not per point
-            cand = np.flatnonzero(np.all((points[:, :2] >= lo[:2]) & (points[:, :2] <= hi[:2]),
-                                         axis=1) & (points[:, 2] <= hi[2]) & ~out)
+            rows = by_x[np.searchsorted(xs, lo[0], "left"):np.searchsorted(xs, hi[0], "right")]
+            near = points[rows]
+            cand = rows[(near[:, 1] >= lo[1]) & (near[:, 1] <= hi[1]) & (near[:, 2] <= hi[2])
+                        & ~out[rows]]
             if cand.size == 0:
                 continue
             rays = np.hstack([points[cand], np.broadcast_to(_UP, (cand.size, 3))])
