@@ -10,9 +10,9 @@ __all__ = ["FULL_PARAMETERS", "KEY_TABLES", "SENSOR_SEEDS", "SENSOR_SEEDS_ALL", 
 #: The simulated UAV missions (the realistic sensor's table in chapter 5).
 UAV_MISSIONS: tuple[str, ...] = ("sim_nav_1", "sim_nav_2", "sim_lan_1", "sim_lan_2")
 #: Simulation seeds of the sensor study in a full report: seed 0 alone (its whole UAV
-#: missions cost ~75 CPU s each, KISS-ICP and LIO over every scan; the grid's uav_lio
-#: ablation has aligned two of them already, see :mod:`alte.pipeline.posecache`), so that
-#: ``make report`` stays within 10 minutes on 2 cores; ``make report-full`` (or
+#: missions cost ~60 CPU s each, KISS-ICP and LIO over every scan; two of them are the
+#: grid's uav_lio missions, aligned once for both, see :mod:`alte.pipeline.posecache`), to
+#: keep ``make report`` short on 2 cores; ``make report-full`` (or
 #: ``--param SENSOR_SEEDS=[0,1,2]``) runs :data:`SENSOR_SEEDS_ALL` for the worst seed.
 SENSOR_SEEDS: tuple[int, ...] = (0,)
 SENSOR_SEEDS_ALL: tuple[int, ...] = (0, 1, 2)
