@@ -58,7 +58,18 @@ def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) 
         "in one batch, so numba compiles and caches every kernel now instead of during the "
         "first scans of a real flight.",
     )
+    p.add_argument("--part", type=_part, default=(1, 1), metavar="K/N",
+                   help="compile the K-th of N parts (the mappers dealt round-robin): "
+                   "`alte report` runs the parts side by side (default: all, 1/1)")
     p.set_defaults(func=run_warmup)
+
+
+def _part(text: str) -> tuple[int, int]:
+    """``K/N`` as (K, N) with 1 <= K <= N; argparse names ``--part`` in the error."""
+    k, _, n = text.partition("/")
+    if not (k.isdigit() and n.isdigit() and 1 <= int(k) <= int(n)):
+        raise argparse.ArgumentTypeError(f"expected K/N with 1 <= K <= N, got {text!r}")
+    return int(k), int(n)
 
 
 def _touch(mapper: Mapper) -> int:
@@ -86,11 +97,12 @@ def _others() -> None:
     scan_cost(np.ones((4, 3), np.float32), np.zeros(3, np.float32), 0.1, 10.0)
 
 
-def warm_kernels() -> dict[str, int]:
+def warm_kernels(part: tuple[int, int] = (1, 1)) -> dict[str, int]:
     """Map the flight with every mapper (plugins included) and feed; returns
-    ``mapper/feed -> cells``."""
+    ``mapper/feed -> cells``. ``part = (K, N)``: the K-th of N round-robin shares of the
+    mappers (the first also compiles the kernels no map reaches)."""
     cells: dict[str, int] = {}
-    mappers = registry.classes()
+    mappers = registry.classes()[part[0] - 1::part[1]]
     with tempfile.TemporaryDirectory(prefix="alte-warmup-") as tmp:
         folder = ensure_terrain(TERRAIN, Path(tmp), frames=SCANS)
         for kind in mappers:
@@ -98,9 +110,10 @@ def warm_kernels() -> dict[str, int]:
                 result = run(folder, MapSettings(kind, feed=feed), cloud=True)
                 cells[f"{kind.name}/{feed.value}"] = _touch(result.mapper)
             _measure(result, folder)  # one feed: the metrics' kernels see the cells alone
-    corners = result.mapper.corners()
-    hausdorff(corners, corners[::3])
-    _others()
+    if part[0] == 1:
+        corners = result.mapper.corners()
+        hausdorff(corners, corners[::3])
+        _others()
     cloud = np.random.default_rng(0).uniform((0.0, 0.0, -1.0), (50.0, 50.0, 3.0), (CLOUD_MIN, 3))
     for kind in mappers:
         if kind.dims == 2:
@@ -115,9 +128,10 @@ def warm_kernels() -> dict[str, int]:
 def run_warmup(args: argparse.Namespace) -> int:
     """Entry point of ``alte warmup``."""
     start = time.perf_counter()
-    cells = warm_kernels()
+    cells = warm_kernels(args.part)
     runs = ", ".join(f"{run} {count}" for run, count in cells.items())
     mappers = len({run.split("/")[0] for run in cells})
-    print(f"compiled and cached the kernels of {mappers} mappers in "
+    share = "" if args.part == (1, 1) else f" (part {args.part[0]} of {args.part[1]})"
+    print(f"compiled and cached the kernels of {mappers} mappers{share} in "
           f"{time.perf_counter() - start:.1f} s; cells per run: {runs}")
     return 0

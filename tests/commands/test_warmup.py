@@ -73,3 +73,20 @@ def test_every_kernel_is_compiled(warmed: str) -> None:
     cold = sorted(name for name, kernel in kernels.items()
                   if kernel.targetoptions.get("inline") != "always" and not _cached(kernel))
     assert not cold, f"kernels alte warmup does not compile: {cold}"
+
+
+def test_a_part_compiles_its_share_of_the_mappers(warmed: str,
+                                                  capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["warmup", "--part", "2/2"]) == 0
+    out = capsys.readouterr().out
+    share = registry.names()[1::2]
+    assert f"kernels of {len(share)} mappers (part 2 of 2) in " in out
+    assert {run.split("/")[0] for run in re.findall(r"(\w+)/\w+ \d+", out)} == set(share)
+
+
+@pytest.mark.parametrize("bad", ["0/2", "3/2", "2", "a/b", "1/0"])
+def test_a_bad_part_names_the_flag(bad: str, capsys: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(SystemExit, match="2"):
+        main(["warmup", "--part", bad])
+    assert re.search(r"argument --part: expected K/N with 1 <= K <= N, got '"
+                     + re.escape(bad) + "'", capsys.readouterr().err)
