@@ -22,6 +22,7 @@ from bench.catalog import TITLES
 from bench.clouds import cloud_stages, hausdorff_speed
 from bench.core import BenchSettings, Context, Result
 from bench.ground import ground_speed
+from bench.lio import lio_speed
 from bench.maps import batch_builds, insert_latency, octomap_memory, octomap_speed
 from bench.memory import map_memory
 from bench.poses import pose_speed
@@ -42,7 +43,7 @@ _MEASURES: dict[int, Row] = {
     1: octomap_speed, 2: octomap_memory, 3: batch_builds, 4: hausdorff_speed,
     5: insert_latency, 6: cloud_stages, 7: scaling, 8: report_wall_time, 9: map_memory,
     10: streaming_chain, 11: scan_peer, 12: pose_speed, 13: sweep_throughput,
-    14: real_terrain, 15: ground_speed,
+    14: real_terrain, 15: ground_speed, 16: lio_speed,
 }
 ROWS: dict[int, tuple[str, Row]] = {n: (TITLES[n], fn) for n, fn in sorted(_MEASURES.items())}
 

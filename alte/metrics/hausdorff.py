@@ -19,9 +19,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from alte.errors import MetricsError
-from alte.metrics.nearest import nearest_distances
+from alte.metrics.nearest import NearestIndex, nearest_distances
 
-__all__ = ["HausdorffResult", "directed_distances", "hausdorff", "summarise"]
+__all__ = ["HausdorffResult", "directed_distances", "hausdorff", "summarise", "target_index"]
 
 
 @dataclass(frozen=True)
@@ -56,10 +56,20 @@ def _as_set(points: object, name: str) -> NDArray[np.float64]:
     return arr
 
 
-def directed_distances(source: object, target: object) -> NDArray[np.float64]:
+def directed_distances(source: object, target: object | NearestIndex) -> NDArray[np.float64]:
     """Distance from every point of ``source`` (N, 3) to its nearest point of ``target``
-    (M, 3); empty or non-finite sets raise :class:`MetricsError`."""
-    return nearest_distances(_as_set(source, "source"), _as_set(target, "target"))
+    (M, 3, or its :func:`target_index` for many sources); empty or non-finite sets raise
+    :class:`MetricsError`."""
+    points = _as_set(source, "source")
+    if isinstance(target, NearestIndex):
+        return target.distances(points)
+    return nearest_distances(points, _as_set(target, "target"))
+
+
+def target_index(target: object) -> NearestIndex:
+    """``target`` (M, 3) checked as :func:`directed_distances` checks it and prepared once
+    for many sources (one search structure, not one per call)."""
+    return NearestIndex(_as_set(target, "target"))
 
 
 def hausdorff(a: object, b: object) -> HausdorffResult:

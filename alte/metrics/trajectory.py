@@ -25,6 +25,7 @@ from numpy.typing import NDArray
 
 from alte.errors import MetricsError
 from alte.metrics.hausdorff import directed_distances
+from alte.metrics.nearest import NearestIndex
 
 __all__ = ["CloudDistance", "TrajectoryErrors", "cloud_distance", "rigid_alignment",
            "trajectory_errors"]
@@ -107,9 +108,10 @@ def trajectory_errors(stamps: NDArray[np.int64], positions: NDArray[np.float64],
     return TrajectoryErrors(ate, 100.0 * trans / delta_m, rot / delta_m, delta_m, pairs)
 
 
-def cloud_distance(cloud: NDArray[np.float64], reference: NDArray[np.float64],
+def cloud_distance(cloud: NDArray[np.float64], reference: NDArray[np.float64] | NearestIndex,
                    ) -> CloudDistance:
-    """Median and p90 distance of every ``cloud`` point to its nearest ``reference`` point."""
+    """Median and p90 distance of every ``cloud`` point to its nearest ``reference`` point
+    (``reference``: the points, or their :func:`~alte.metrics.hausdorff.target_index`)."""
     distances = directed_distances(cloud, reference)
     median, p90 = np.percentile(distances, [50, 90])
     return CloudDistance(float(median), float(p90))

@@ -202,7 +202,7 @@ def quick_bench(tmp_path_factory):
 @pytest.mark.slow
 def test_quick_bench_runs_every_row_and_writes_its_outputs(quick_bench):
     assert quick_bench.errors == {}
-    rows = set(range(1, 12)) | {13}
+    rows = set(range(1, 12)) | {13, 16}
     rows |= {12} if (REALDATA / "balm_seq").exists() else set()
     rows |= {14} if (REALDATA / "als").exists() else set()
     rows |= {15} if (REALDATA / "isprs_terrain").exists() else set()
@@ -226,6 +226,9 @@ def test_quick_bench_runs_every_row_and_writes_its_outputs(quick_bench):
     assert [r.detail["frames"] for r in quick_bench.results if r.row == 11] == [3]
     poses = [r for r in quick_bench.results if r.row == 12]
     assert len(poses) in (0, 4) and all(r.detail["scans"] == 20 and r.peer > 0 for r in poses)
+    lio = [r for r in quick_bench.results if r.row == 16]
+    assert [r.case.split(",")[1] for r in lio] == [" mean", " median"]
+    assert all(r.detail["scans"] == 60 and r.ours > 0 and r.peer > 0 for r in lio)
     sweeps = [r for r in quick_bench.results if r.row == 13]
     assert [r.case.split(" (")[0] for r in sweeps] == [
         "sweep runs per core-second, 20 scans", "sweep runs per core-second, whole missions"]

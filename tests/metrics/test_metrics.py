@@ -21,6 +21,7 @@ from alte.metrics import (
     hausdorff,
     height_metrics_2d,
 )
+from alte.metrics.hausdorff import target_index
 
 coords = st.floats(-10, 10, allow_nan=False, width=64)
 point_sets = st.integers(1, 25).flatmap(lambda n: arrays(np.float64, (n, 3), elements=coords))
@@ -106,6 +107,17 @@ def test_hausdorff_rejects_bad_sets(a, b, match):
 def test_directed_distances_rejects_bad_sets(source, target, match):
     with pytest.raises(MetricsError, match=match):
         directed_distances(source, target)
+    with pytest.raises(MetricsError, match=match):  # the same checks with a prepared target
+        directed_distances(source, target_index(target))
+
+
+def test_a_prepared_target_gives_the_same_distances():
+    rng = np.random.default_rng(2)
+    target = rng.normal(0, 10, (5000, 3))
+    index = target_index(target)
+    for source in (rng.normal(0, 10, (3000, 3)), rng.normal(0, 80, (300, 3)), target[:7]):
+        assert np.array_equal(directed_distances(source, index),
+                              directed_distances(source, target))
 
 
 def test_distance_to_boxes_matches_brute_force():

@@ -37,6 +37,8 @@ from numpy.typing import NDArray
 from alte.errors import ParameterError
 from alte.lab.studies.analysis.tables import write_csv
 from alte.lab.studies.experiments import CACHE_DIR
+from alte.metrics.hausdorff import target_index
+from alte.metrics.nearest import NearestIndex
 from alte.metrics.trajectory import cloud_distance, rigid_alignment, trajectory_errors
 from alte.pipeline import FrameSettings, PoseSource, Registered, Source, open_input, prepare
 from alte.progress import bar as progress_bar
@@ -155,7 +157,7 @@ def _matched(reg: Registered, reference: Registered,
 
 
 def _score(item: BenchInput, key: str, reg: Registered, reference: Registered,
-           odometry: OdometrySettings) -> dict[str, object]:
+           near: NearestIndex, *, odometry: OdometrySettings) -> dict[str, object]:
     mine, theirs = _matched(reg, reference)
     est, ref = reg.trajectory, reference.trajectory
     if reg.spec.poses is PoseSource.ODOMETRY:
@@ -165,10 +167,9 @@ def _score(item: BenchInput, key: str, reg: Registered, reference: Registered,
         points = np.asarray(reg.cloud)
     errors = trajectory_errors(est.stamps[mine], positions, quaternions,
                                ref.positions[theirs], ref.quaternions[theirs])
-    cloud = cloud_distance(points, np.asarray(reference.cloud))
+    cloud = cloud_distance(points, near)
     align = rigid_alignment(positions, ref.positions[theirs])
-    aligned = cloud_distance(points @ align[:3, :3].T + align[:3, 3],
-                             np.asarray(reference.cloud))
+    aligned = cloud_distance(points @ align[:3, :3].T + align[:3, 3], near)
     poses = reg.counts.poses
     path = float(np.linalg.norm(np.diff(ref.positions[theirs], axis=0), axis=1).sum())
     return {"input": item.name, "source": key, "settings": _settings(key, odometry),
@@ -213,13 +214,14 @@ def pose_benchmark(item: BenchInput, sources: Sequence[str] = tuple(SOURCES), *,
                              f"valid: {', '.join(SOURCES)}")
     settings = settings or {}
     reference = prepare(item.source, _reference_spec(item), cache=cache, progress=progress)
+    near = target_index(reference.cloud)  # every source's cloud is measured against it
     rows = []
     for key in sources:
         poses, method = SOURCES[key]
         odometry = OdometrySettings.parse({"method": method or "kiss", **settings.get(key, {})})
         reg = prepare(item.source, _spec(item, poses, odometry), cache=cache,
                       progress=progress)
-        rows.append(_score(item, key, reg, reference, odometry))
+        rows.append(_score(item, key, reg, reference, near, odometry=odometry))
     return pd.DataFrame(rows, columns=list(COLUMNS))
 
 
