@@ -265,3 +265,17 @@ def test_grid_average_order_matches_lexsort_of_cell_keys():
     pts = np.random.default_rng(9).uniform(-30, 30, (2000, 3))
     keys, _sums, _counts = grid_average_with_counts(pts, 0.7)
     np.testing.assert_array_equal(keys, np.unique(np.floor(pts / 0.7).astype(np.int64), axis=0))
+
+
+@pytest.mark.parametrize("scale", [1.0, 1e12, 1e15])  # row in the key; code alone; lexsort
+def test_cell_order_is_the_stable_lexicographic_order(scale):
+    from alte.registration.grid import _sort_keys
+
+    rng = np.random.default_rng(4)
+    keys = (rng.integers(-40, 40, (20_000, 3)) * np.array([1, 1, int(scale)])).astype(np.int64)
+    order, starts = _sort_keys(keys)
+    want = np.lexsort((keys[:, 2], keys[:, 1], keys[:, 0]))  # stable: ties in row order
+    assert np.array_equal(order, want)
+    ordered = keys[want]
+    assert np.array_equal(starts, np.flatnonzero(np.r_[True, np.any(ordered[1:] != ordered[:-1],
+                                                                      axis=1)]))
