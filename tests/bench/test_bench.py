@@ -120,7 +120,7 @@ def test_config_and_row_selection_errors():
         BenchSettings(budget_s=0)
     with pytest.raises(ParameterError, match=r"unknown row\(s\) \[99\]"):
         select_rows([1, 99])
-    assert select_rows(None) == sorted(ROWS) == list(range(1, 16))
+    assert select_rows(None) == sorted(ROWS) == list(range(1, 17))
     assert BenchSettings(quick=True).scaling_sizes == (3000, 6000, 12000)
     assert BenchSettings().scaling_sizes[-1] == 10**7
 
