@@ -60,7 +60,7 @@ def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) 
     )
     p.add_argument("--part", type=_part, default=(1, 1), metavar="K/N",
                    help="compile the K-th of N parts (the mappers dealt round-robin): "
-                   "`alte report` runs the parts side by side (default: all, 1/1)")
+                   "alte report runs the parts side by side (default: all, 1/1)")
     p.set_defaults(func=run_warmup)
 
 
