@@ -8,6 +8,12 @@ export MPLBACKEND := Agg
 export PYVISTA_OFF_SCREEN := true
 export ALTE_RENDER := static
 export PATH := $(CURDIR)/$(VENV)/bin:$(PATH)
+# Every target starts many Python processes (notebook kernels, Dask and pytest workers,
+# CLI runs). With PYTHONDONTWRITEBYTECODE set in the caller's environment each of them
+# compiled numpy, pandas, matplotlib, alte ... from source again (about 4 of its 6 CPU
+# seconds of imports; uv installs no bytecode), so make writes the bytecode caches
+# (__pycache__, git-ignored) whatever the caller says.
+export PYTHONDONTWRITEBYTECODE :=
 
 REPORT_ARGS ?=
 PYTEST_ARGS ?=
@@ -39,19 +45,13 @@ lint: bootstrap
 # Lint, types and the fast tests (.ci/test): ruff; then `alte warmup` (numba's kernels
 # compiled into the package cache once, for every later process), mypy and the docs site's
 # tests side by side on the two cores; then the other tests on two pytest workers.
-# The tests start a hundred or so Python processes (workers, notebook kernels, CLI runs);
-# with PYTHONDONTWRITEBYTECODE set in the caller's environment each of them compiled
-# numpy, pandas, alte ... from source again (about 4 of its 6 CPU seconds of imports),
-# so make test writes the bytecode caches (__pycache__, git-ignored) whatever the caller says.
 # The long end-to-end checks (marker `full`: the whole quick bench, the 10-million-point
 # memory runs, chapters 5 and 6 headless, ...; tests/README.md says which smaller test
 # proves each one's parts) run in `make check-full`, which CI runs after `make test`.
 PYTEST := $(PY) -m pytest -n 2 --dist loadfile --no-loadscope-reorder tests plugins/alte-elevation/tests notebooks --nbval-lax
-test: export PYTHONDONTWRITEBYTECODE :=
 test: bootstrap
 	@bash .ci/test $(PYTEST_ARGS)
 
-check-full: export PYTHONDONTWRITEBYTECODE :=
 check-full: bootstrap
 	@$(PY) -m alte warmup
 	$(PYTEST) -m full $(PYTEST_ARGS)
