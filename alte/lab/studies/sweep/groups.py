@@ -102,8 +102,11 @@ def _reference(key: InputKey, data_dir: str, truth: TruthSettings) -> Reference:
 
 
 def _inputs(run: SweepRun, data_dir: str) -> tuple[Registered, Reference]:
-    """The run's registered input and its reference (a fresh per-leaf memory)."""
-    return input_data(run, data_dir), _reference(run.input_key(), data_dir, run.truth).fresh()
+    """The run's registered input and its reference (a fresh per-leaf memory), both from
+    this process's memo: the sweep ensured every input before its first map (``_ensure``),
+    so a map group does not build the terrain and read the registration cache again."""
+    key = run.input_key()
+    return _dataset(key, data_dir), _reference(key, data_dir, run.truth).fresh()
 
 
 def _row(run: SweepRun, data: Registered, measured: tuple[dict[str, float], JSONDict],

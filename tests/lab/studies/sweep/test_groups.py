@@ -134,3 +134,28 @@ def test_a_run_failing_alone_leaves_its_group_going(spec, tmp_path, monkeypatch)
     assert result.ran == 1 and [m for _, m in result.failed] == ["ValueError: not today"]
     table = pd.read_parquet(next(tmp_path.glob("run-*.parquet")))
     assert table["set_b"].tolist() == ["corners"]
+
+
+def test_the_groups_of_one_input_build_and_read_it_once_per_process(spec, monkeypatch):
+    """Every map group of an input takes it from the process's memo: the terrain is not
+    built again nor its registration read again from the cache per group."""
+    from alte.lab.studies.sweep import groups
+
+    calls = []
+    real = groups._registered
+
+    def counted(key, data_dir):
+        calls.append(key)
+        return real(key, data_dir)
+
+    monkeypatch.setattr(groups, "_registered", counted)
+    groups._dataset.cache_clear()
+    groups._reference.cache_clear()
+    mine = [g for g in group_runs(plan_runs(spec)) if g.runs[0].terrain == "sim_lan_2"
+            and g.runs[0].domain == "auto"][:4]
+    assert len(mine) == 4 and len({g.runs[0].input_key() for g in mine}) == 1
+    for group in mine:
+        assert all(err is None for _, _, err in run_group(group, spec.data_dir))
+    assert calls == [mine[0].runs[0].input_key()]
+    groups._dataset.cache_clear()
+    groups._reference.cache_clear()
