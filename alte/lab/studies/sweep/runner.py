@@ -21,12 +21,13 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Protocol, TypeVar
 
 import pandas as pd
+import pyarrow as pa
 
 from alte.errors import ParameterError, SimulationError
 from alte.lab.studies.sweep.groups import MapGroup, group_runs, input_data, run_group, run_one
 from alte.lab.studies.sweep.runs import SweepRun, plan_runs, plan_variants
 from alte.lab.studies.sweep.spec import SweepSettings, SweepSpec, with_plugins
-from alte.lab.studies.sweep.store import finished_ids, load_results, write_row
+from alte.lab.studies.sweep.store import finished_ids, load_results, row_table, write_row
 from alte.progress import bar as progress_bar
 
 __all__ = ["SERIAL", "MapUnordered", "SweepResult", "executor", "input_order", "override",
@@ -164,8 +165,9 @@ def _by_input(runs: Sequence[SweepRun]) -> list[MapGroup]:
 
 
 def _map_all(pool: MapUnordered, runs: Sequence[SweepRun], data_dir: str, out: Path,
-             progress: bool) -> list[tuple[SweepRun, str]]:
-    failed = []
+             progress: bool) -> tuple[list[tuple[SweepRun, str]], dict[str, pa.Table]]:
+    """Map every run; (the failed runs with their errors, run id -> the table written)."""
+    failed, written = [], {}
     groups = _by_input(runs)
     by_id = {r.run_id: r for r in runs}
     # smoothing 0: the ETA from the mean rate so far (maps of one input differ widely)
@@ -177,11 +179,12 @@ def _map_all(pool: MapUnordered, runs: Sequence[SweepRun], data_dir: str, out: P
                         else [(r.run_id, None, err) for r in groups[i].runs])
             for run_id, row, error in outcomes:
                 if error is None and row is not None:
-                    write_row(out, row)
+                    written[run_id] = row_table(row)
+                    write_row(out, written[run_id])
                 else:
                     failed.append((by_id[run_id], f"{type(error).__name__}: {error}"))
             bar.update(len(outcomes))
-    return failed
+    return failed, written
 
 
 def run_sweep(spec: SweepSpec, *, scheduler: str = "local", workers: int = 2,
@@ -200,11 +203,12 @@ def run_sweep(spec: SweepSpec, *, scheduler: str = "local", workers: int = 2,
     done = finished_ids(out)
     todo = [r for r in runs if r.run_id not in done]
     failed: list[tuple[SweepRun, str]] = []
+    written: dict[str, pa.Table] = {}
     if todo:
         with executor(scheduler, workers) as pool:
             _ensure_all(pool, todo, data_dir, progress)
-            failed = _map_all(pool, todo, data_dir, out, progress)
-    table = load_results(out, [r.run_id for r in runs])
+            failed, written = _map_all(pool, todo, data_dir, out, progress)
+    table = load_results(out, [r.run_id for r in runs], known=written)
     return SweepResult(out, table, len(todo) - len(failed), len(runs) - len(todo), failed)
 
 

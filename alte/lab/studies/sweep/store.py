@@ -19,7 +19,8 @@ import pyarrow.parquet as pq
 from alte.errors import AlteError
 from alte.fsutil import atomic_path
 
-__all__ = ["KEY_COLUMNS", "TIMING_COLUMNS", "finished_ids", "load_results", "write_row"]
+__all__ = ["KEY_COLUMNS", "TIMING_COLUMNS", "finished_ids", "load_results", "row_table",
+           "write_row"]
 
 #: Columns identifying a run (then ``p_<param>`` columns, then the metrics).
 KEY_COLUMNS = ("run_id", "terrain", "frames_requested", "seed", "mapper", "params_json")
@@ -38,10 +39,16 @@ def _part(out: Path, run_id: str) -> Path:
     return out / f"{_PREFIX}{run_id}{_SUFFIX}"
 
 
-def write_row(out: str | os.PathLike[str], row: Mapping[str, object]) -> Path:
-    """Write one run's row to its own Parquet file in ``out`` (atomic; never overwrites)."""
-    path = _part(Path(out), str(row["run_id"]))
-    table = pa.Table.from_pylist([dict(row)])
+def row_table(row: Mapping[str, object]) -> pa.Table:
+    """One run's row as the one-row table its file holds."""
+    return pa.Table.from_pylist([dict(row)])
+
+
+def write_row(out: str | os.PathLike[str], row: Mapping[str, object] | pa.Table) -> Path:
+    """Write one run's row (or its :func:`row_table`) to its own Parquet file in ``out``
+    (atomic; never overwrites)."""
+    table = row if isinstance(row, pa.Table) else row_table(row)
+    path = _part(Path(out), str(table.column("run_id")[0]))
     with atomic_path(path) as tmp:
         pq.write_table(table, tmp)
     return path
@@ -60,7 +67,8 @@ def finished_ids(out: str | os.PathLike[str]) -> set[str]:
 
 def _read(path: Path) -> pa.Table:
     try:
-        return pq.read_table(path)
+        with pq.ParquetFile(path) as file:  # no dataset discovery: ~2x read_table's speed
+            return file.read()
     except (OSError, pa.ArrowInvalid) as err:
         raise AlteError(f"sweep result {path} is unreadable ({err}); delete it to rerun "
                         "that run") from err
@@ -75,17 +83,24 @@ def _ordered_columns(columns: Iterable[str]) -> list[str]:
             + [c for c in TIMING_COLUMNS if c in cols])
 
 
-def load_results(out: str | os.PathLike[str], order: Iterable[str] | None = None
-                 ) -> pd.DataFrame:
+def load_results(out: str | os.PathLike[str], order: Iterable[str] | None = None, *,
+                 known: Mapping[str, pa.Table] | None = None) -> pd.DataFrame:
     """All rows stored in ``out`` as one table (columns unified across mappers).
 
     With ``order`` (run ids, e.g. a spec's grid order) only those runs are returned,
     in that order; otherwise every row, sorted by run id. Either way deterministic.
+    ``known``: run id -> the :func:`row_table` this process wrote to ``out``, used
+    instead of reading its file back (the same table; a sweep's thousands of files
+    took seconds to read).
     """
     files = _files(Path(out))
     if not files:
         return pd.DataFrame(columns=list(KEY_COLUMNS))
-    table = pa.concat_tables([_read(p) for p in files], promote_options="permissive")
+    known = known or {}
+    tables = [known.get(p.name[len(_PREFIX):-len(_SUFFIX)]) for p in files]
+    table = pa.concat_tables([t if t is not None else _read(p) for t, p in zip(tables, files,
+                                                                                strict=True)],
+                             promote_options="permissive")
     frame: pd.DataFrame = table.to_pandas(types_mapper={pa.int64(): pd.Int64Dtype()}.get)
     frame = frame[_ordered_columns(frame.columns)]
     for column, value in FILLED.items():

@@ -298,9 +298,10 @@ def _figures(table: pd.DataFrame) -> Iterator[tuple[str, Draw]]:
 
 
 def save_tradeoff_figures(table: pd.DataFrame, out_dir: str | os.PathLike[str], *,
-                          close: bool = True) -> dict[str, Path | str]:
+                          close: bool = True, jobs: int = 1) -> dict[str, Path | str]:
     """Draw and save every trade-off figure the front page shows (:data:`CURVES`, the
     pairs at equal size and fidelity) as ``out_dir/figures/<name>.png``; returns name -> path,
     or the reason a figure could not be drawn (e.g. a mapper absent from the table).
-    ``close=False`` leaves the figures open (a notebook then shows them)."""
-    return save_figures(_figures(table), out_dir, close)
+    ``close=False`` leaves the figures open (a notebook then shows them); ``jobs > 1``
+    draws them in that many processes (:func:`~alte.lab.plot.render.save_figures`)."""
+    return save_figures(_figures(table), out_dir, close, jobs=jobs)

@@ -232,6 +232,7 @@ def test_serial_sweep_writes_rows_and_resumes(spec, serial):
     assert (table["cpu_s"] > 0).all()
     # max_res 4 refines more than max_res 3: more basis functions
     assert table["basis_functions"][1] > table["basis_functions"][0]
+    # the first table is made of the rows as written, the second read back from the files
     again = run_sweep(spec, scheduler="none", output=out, progress=False)
     assert (again.ran, again.skipped) == (0, 6)
     pd.testing.assert_frame_equal(again.table, table, check_exact=True)
