@@ -26,6 +26,7 @@ import numba
 import numpy as np
 from numpy.typing import NDArray
 
+from alte._kernels import bounds
 from alte._numba import threads_for
 
 __all__ = ["CELLS_PER_TARGET", "COARSER", "MAX_LOAD", "PARALLEL_MIN", "RINGS", "CellIndex",
@@ -68,21 +69,6 @@ class CellIndex:
     points: Floats
     load: float
     scale: float
-
-
-@numba.njit(cache=True)
-def bounds(points: Floats) -> tuple[Floats, Floats]:
-    """Per-axis minimum and maximum of (N, 3) points, N >= 1 (one pass; numpy's axis-0
-    reductions of an (N, 3) array are several times slower)."""
-    lo, hi = points[0].copy(), points[0].copy()
-    for i in range(1, points.shape[0]):
-        for a in range(3):
-            v = points[i, a]
-            if v < lo[a]:
-                lo[a] = v
-            elif v > hi[a]:
-                hi[a] = v
-    return lo, hi
 
 
 @numba.njit(cache=True)

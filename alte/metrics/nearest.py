@@ -33,7 +33,7 @@ class NearestIndex:
 
     def __init__(self, targets: NDArray[np.float64]) -> None:
         self.targets = targets
-        self.box = bounds(targets)
+        self.box: tuple[NDArray[np.float64], NDArray[np.float64]] = bounds(targets)
         self.grids = [build_grid(targets, first_side(self.box, len(targets)), self.box)]
         self._tree: KDTree | None = None
 

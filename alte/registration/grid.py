@@ -1,8 +1,9 @@
 """Voxel grids: grid-average down-sampling and the box-grid merge (thesis 2.1.3).
 
 Points are grouped by the integer cell ``floor(p / voxel)`` of a grid anchored at the
-origin; equal keys are reduced with one sort and segmented sums (``np.add.reduceat``),
-so every operation is O(n log n) and deterministic (output sorted by cell key).
+origin; equal keys are reduced with one sort and segmented sums (``np.add.reduceat``'s,
+:mod:`~alte.registration.gridsum`), so every operation is O(n log n) and deterministic
+(output sorted by cell key).
 """
 
 from __future__ import annotations
@@ -66,27 +67,32 @@ def grid_average_with_counts(
     return _reduce(keys, pts * w[:, None], w)
 
 
-def _sort_keys(keys: NDArray[np.int64]) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
+def _sort_keys(keys: NDArray[np.int64]) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
     """Order sorting integer cell keys lexicographically, and where each run of equal keys starts.
 
     Keys are packed into one int64 when their spans allow (one argsort instead of
     a three-key lexsort: ~10x faster), with the row number too when that fits (a plain
-    sort of distinct keys is stable, and numpy's SIMD sort beats its stable argsort),
-    else sorted with ``np.lexsort``.
+    sort of distinct keys is stable, and numpy's SIMD sort beats its stable argsort;
+    packing and unpacking in :mod:`~alte.registration.gridsum`), else sorted with
+    ``np.lexsort``.
     """
-    low, high = keys.min(axis=0), keys.max(axis=0)
+    from alte._kernels import bounds
+    from alte.registration.gridsum import pack, unpack
+
+    keys = np.ascontiguousarray(keys, dtype=np.int64)
+    low: NDArray[np.int64]
+    low, high = bounds(keys)
     span = [int(h) - int(lo) + 1 for lo, h in zip(low, high, strict=True)]
     n = len(keys)
+    if span[0] * span[1] * span[2] * n < 2**62:
+        code = pack(keys, low, np.array(span, dtype=np.int64))
+        code.sort()
+        return unpack(code)
     if span[0] * span[1] * span[2] < 2**62:
         shifted = keys - low
         code = (shifted[:, 0] * span[1] + shifted[:, 1]) * span[2] + shifted[:, 2]
-        if span[0] * span[1] * span[2] * n < 2**62:  # with the row number in the key a
-            code = code * n + np.arange(n)  # plain (SIMD) sort is the stable order
-            code.sort()
-            code, order = np.divmod(code, n)
-        else:
-            order = np.argsort(code, kind="stable")
-            code = code[order]
+        order = np.argsort(code, kind="stable")
+        code = code[order]
         return order, np.flatnonzero(np.r_[True, code[1:] != code[:-1]])
     order = np.lexsort((keys[:, 2], keys[:, 1], keys[:, 0]))
     ordered = keys[order]
@@ -99,11 +105,15 @@ def _reduce(
     """Add up rows with equal integer keys; output sorted by key."""
     if len(keys) == 0:
         return np.empty((0, 3), np.int64), np.empty((0, 3)), np.empty(0)
+    from alte.registration.gridsum import segment_sums
+
     order, starts = _sort_keys(keys)
+    starts = starts.astype(np.int64, copy=False)
     return (
         keys[order[starts]],
-        np.add.reduceat(sums[order], starts, axis=0),
-        np.add.reduceat(counts[order], starts),
+        segment_sums(np.asarray(sums, dtype=np.float64)[order], starts),
+        segment_sums(np.asarray(counts, dtype=np.float64)[order].reshape(-1, 1),
+                     starts).reshape(-1),
     )
 
 

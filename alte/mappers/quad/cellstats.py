@@ -19,6 +19,8 @@ import numba
 import numpy as np
 from numpy.typing import NDArray
 
+from alte._kernels import run_total
+
 __all__ = ["Index", "aggregate_points", "combine", "fill_index", "merge_cells", "sort_keys"]
 
 #: A level's row index: dense (int32 ``row + 1`` per key) or hashed (int64 ``key, row`` pairs).
@@ -57,45 +59,6 @@ def sort_keys(keys: NDArray[np.int64], bits: int) -> tuple[NDArray[np.int64], ND
             at[d] += 1
         src_k, dst_k, src_o, dst_o = dst_k, src_k, dst_o, src_o
     return src_k, src_o
-
-
-@numba.njit(cache=True, inline="always")
-def _pairwise_block(x: NDArray[np.float64], j: int, a: int, n: int) -> float:
-    """numpy's pairwise sum of ``x[a:a + n, j]`` for ``n <= 128``: a plain loop below 8,
-    else 8 accumulators (scalars: no scratch array per call)."""
-    res = -0.0
-    if n < 8:
-        for i in range(a, a + n):
-            res += x[i, j]
-        return float(res)
-    r0, r1, r2, r3 = x[a, j], x[a + 1, j], x[a + 2, j], x[a + 3, j]
-    r4, r5, r6, r7 = x[a + 4, j], x[a + 5, j], x[a + 6, j], x[a + 7, j]
-    m = n - n % 8
-    for i in range(a + 8, a + m, 8):
-        r0, r1, r2, r3 = r0 + x[i, j], r1 + x[i + 1, j], r2 + x[i + 2, j], r3 + x[i + 3, j]
-        r4, r5, r6, r7 = r4 + x[i + 4, j], r5 + x[i + 5, j], r6 + x[i + 6, j], r7 + x[i + 7, j]
-    res = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
-    for i in range(a + m, a + n):
-        res += x[i, j]
-    return float(res)
-
-
-@numba.njit(cache=True)
-def _pairwise(x: NDArray[np.float64], j: int, a: int, n: int) -> float:
-    """numpy's pairwise sum of ``x[a:a + n, j]`` (8 accumulators, blocks of 128)."""
-    if n <= 128:
-        return _pairwise_block(x, j, a, n)
-    half = n // 2
-    half -= half % 8
-    return _pairwise(x, j, a, half) + _pairwise(x, j, a + half, n - half)
-
-
-@numba.njit(cache=True, inline="always")
-def _run_total(x: NDArray[np.float64], j: int, a: int, b: int) -> float:
-    """``np.add.reduceat`` of the run ``x[a:b, j]``."""
-    if b - a <= 129:  # the usual short run: no call
-        return float(x[a, j] + _pairwise_block(x, j, a + 1, b - a - 1) if b - a > 1 else x[a, j])
-    return float(x[a, j] + _pairwise(x, j, a + 1, b - a - 1))
 
 
 @numba.njit(cache=True)
@@ -143,14 +106,14 @@ def _cell_row(values: NDArray[np.float64], run: tuple[int, int], out: NDArray[np
     nv = values.shape[1]
     out[s, 0] = count = np.float64(b - a)
     for j in range(nv):
-        mean = _run_total(values, j, a, b) / count
+        mean = run_total(values, j, a, b) / count
         top = values[a, j]
         for i in range(a, b):
             d = values[i, j] - mean
             dev[i, j] = d * d
             top = max(top, values[i, j])
         out[s, 1 + j], out[s, 1 + 2 * nv + j] = mean, top
-        out[s, 1 + nv + j] = _run_total(dev, j, a, b)
+        out[s, 1 + nv + j] = run_total(dev, j, a, b)
 
 
 @numba.njit(cache=True)
