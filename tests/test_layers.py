@@ -25,7 +25,8 @@ from support.imports import imports
 
 #: Top-level parts of ``alte`` from the bottom layer up ("" is the package itself).
 LAYERS: tuple[tuple[str, ...], ...] = (
-    ("", "errors", "types", "params", "paths", "fsutil", "tensors", "progress", "_numba"),
+    ("", "errors", "types", "params", "paths", "fsutil", "tensors", "progress", "_numba",
+     "_kernels"),
     ("io", "registration", "ground", "mappers", "metrics", "sim"),
     ("pipeline",),
     ("export", "testing"),
