@@ -14,7 +14,7 @@ from matplotlib.figure import Figure
 
 from alte.errors import ParameterError
 from alte.lab.plot.figure import Caption, Plot, read_caption
-from alte.lab.plot.render import save_figure, show, view
+from alte.lab.plot.render import save_figure, save_figures, show, view
 
 
 def _plot(title: str = "Line", text: str = "A line over {TERRAIN}.") -> Plot:
@@ -102,3 +102,27 @@ def test_a_view_is_saved_with_its_caption_and_closed(tmp_path: Path) -> None:
     with pytest.raises(ParameterError, match="got a Plotter without a caption"):
         save_figure(plotter, tmp_path, "bare")  # type: ignore[arg-type]
     plotter.close()
+
+
+def test_figures_drawn_in_processes_are_the_same_files_in_the_same_order(tmp_path: Path,
+                                                                          ) -> None:
+    """``jobs=2`` (chapter 5's trade-off figures): every PNG byte for byte as one process
+    draws it, the captions numbered in the figures' order (each process counting from the
+    folder's captions would number them 0, 0, 1 ...), a figure not drawn said so."""
+    from functools import partial
+
+    from support.plots import line, nothing
+
+    figures = [("a", partial(line, (0.0, 1.0), "a")), ("none", partial(nothing, "no data")),
+               ("b", partial(line, (1.0, 0.0, 2.0), "b")), ("c", partial(line, (3.0,), "c"))]
+    one = save_figures(figures, tmp_path / "one")
+    two = save_figures(figures, tmp_path / "two", jobs=2)
+    assert list(two) == list(one) == ["a", "none", "b", "c"]
+    assert two["none"] == one["none"] == "not drawn: no data"
+    for name in ("a", "b", "c"):
+        png = [d / "figures" / f"{name}.png" for d in (tmp_path / "one", tmp_path / "two")]
+        assert png[0].read_bytes() == png[1].read_bytes(), name
+        assert read_caption(png[0]) == read_caption(png[1]), name
+    assert [read_caption(tmp_path / "two" / "figures" / f"{k}.png").order
+            for k in ("a", "b", "c")] == [0, 1, 2]
+

@@ -109,32 +109,6 @@ def test_save_tradeoff_figures_writes_every_captioned_figure(tmp_path):
             for k in drawn} == {k: captions[k] for k in drawn}
 
 
-@pytest.mark.slow
-def test_figures_drawn_in_processes_are_the_same_files_in_the_same_order(table, tmp_path):
-    """``jobs=2`` (the report's chapter 5): every PNG byte for byte as one process draws
-    it, the captions numbered in the figures' order (each process counting from the
-    folder's captions would number them 0, 0, 1 ...), a figure not drawn said so."""
-    from functools import partial
-
-    from alte.lab.plot.render import save_figures
-
-    figures = [("mhd", partial(tradeoff_figure, table, "mhd_m")),
-               ("none", partial(equal_size_figure, table, ("octomap", "quadtree"))),
-               ("size", partial(equal_size_figure, table, ("alte2d", "quadtree"))),
-               ("accuracy", partial(tradeoff_figure, table, "accuracy_mean_m"))]
-    one = save_figures(figures, tmp_path / "one")
-    two = save_figures(figures, tmp_path / "two", jobs=2)
-    assert list(two) == list(one) == ["mhd", "none", "size", "accuracy"]
-    assert two["none"] == one["none"] and two["none"].startswith("not drawn: ")
-    drawn = ["mhd", "size", "accuracy"]
-    for name in drawn:
-        png = [d / "figures" / f"{name}.png" for d in (tmp_path / "one", tmp_path / "two")]
-        assert png[0].read_bytes() == png[1].read_bytes(), name
-        assert read_caption(png[0]) == read_caption(png[1]), name
-    assert [read_caption(tmp_path / "two" / "figures" / f"{k}.png").order
-            for k in drawn] == [0, 1, 2]
-
-
 def test_a_further_mapper_gets_its_own_colour() -> None:
     """A plugin is never drawn in one of the thesis' four's colours (it was Quadtree's blue)."""
     from alte.lab.studies.tradeoff.figures import COLORS, mapper_color
