@@ -14,9 +14,19 @@ and the verdicts and cells of checks that compare two mappers' times (CPU times)
 listed (``timed``) but not compared; so are those read at the row the thesis' rule
 picks, whose criteria include the time. A time within one mapper is judged on its
 machine-independent cost and compared like any other figure. Every other figure must
-match to 9 significant digits (the CSV round trip) and every text exactly. After a
-deliberate change, regenerate the files with ``make reference`` (``pytest tests/reference
---update-reference``) and read the diff.
+match to :data:`RTOL` and every text exactly. After a deliberate change, regenerate the
+files with ``make reference`` (``pytest tests/reference --update-reference``) and read the
+diff.
+
+Why not to the last digit: on one machine the run is the same to the bit, but across CPUs
+the simulated scans differ in their last float32 bits (the simulator's rays are cast by
+open3d's ``RaycastingScene``, which picks its vector code by CPU), and every distance
+metric with them: on an AVX-512 machine the distances moved by up to 8.8e-7 of their
+value (``hd_m``; the cells' estimates and bounds by up to 2.5e-7), while every count,
+size, verdict and outcome stayed the same. :data:`RTOL` leaves ten times that; a
+deliberate change moves the figures it touches by far more. The cells' ``level`` (a
+distance read off the data) is matched by its rank within its claim part and terrain,
+and compared as a number.
 """
 
 from __future__ import annotations
@@ -41,7 +51,9 @@ ROW_COLUMNS = ["frames", "points", "basis_functions", "occupied_cells", "memory_
                "mhd_m", "hd_m", "mh_ab_m", "mh_ba_m", "accuracy_mean_m", "completeness",
                "height_rmse_m", "size_octaves", "cost", "cost_unit"]
 CELL_COLUMNS = ["seeds", "estimate", "low", "high", "outcome", "timed"]
-RTOL = 1e-9
+#: Relative (and absolute, for figures near zero) tolerance of every compared number
+#: (module docstring: what moves across CPUs).
+RTOL = 1e-5
 TIME_COLUMNS = {"elapsed_s"}
 
 
@@ -87,6 +99,20 @@ def _canonical(frame: pd.DataFrame, keys: list[str]) -> pd.DataFrame:
     return out.sort_values(keys, kind="stable").reset_index(drop=True)
 
 
+def _ranked(frame: pd.DataFrame, keys: list[str]) -> tuple[pd.DataFrame, list[str]]:
+    """A table keyed on ``keys``, but for a ``level`` key: the level's rank within the rest
+    of the key, the level itself a number (a distance measured on the data: module
+    docstring)."""
+    if "level" not in keys:
+        return frame, keys
+    rest = [k for k in keys if k != "level"]
+    out = frame.copy()
+    out["level"] = pd.to_numeric(out["level"].replace("", np.nan))
+    ranks = out["level"].groupby([out[k] for k in rest]).rank(method="first")
+    out["level_rank"] = ranks.fillna(0).astype(int)
+    return out, [*rest, "level_rank"]
+
+
 def _read(name: str) -> pd.DataFrame:
     return pd.read_csv(HERE / f"chapter5_{name}.csv", keep_default_na=False,
                        na_values=["nan"], dtype={"params": str, "depends_on": str})
@@ -98,8 +124,8 @@ def differences(name: str, expected: pd.DataFrame, actual: pd.DataFrame) -> list
     Rows are matched on :data:`KEYS`; numbers must agree to :data:`RTOL`, text exactly;
     in the cells and claims tables, rows marked ``timed`` are not compared.
     """
-    keys = KEYS[name]
-    exp, act = _canonical(expected, keys), _canonical(actual, keys)
+    exp, keys = _ranked(_canonical(expected, KEYS[name]), KEYS[name])
+    act, _ = _ranked(_canonical(actual, KEYS[name]), KEYS[name])
     out = []
     if list(exp.columns) != list(act.columns):
         out.append(f"{name}: columns {list(act.columns)}, expected {list(exp.columns)}")
@@ -125,7 +151,7 @@ def _same(want: object, got: object) -> bool:
     if pd.isna(want) or pd.isna(got):  # type: ignore[arg-type]
         return bool(pd.isna(want) and pd.isna(got))  # type: ignore[arg-type]
     if isinstance(want, (int, float, np.number)) and isinstance(got, (int, float, np.number)):
-        return bool(np.isclose(float(got), float(want), rtol=RTOL, atol=1e-12))
+        return bool(np.isclose(float(got), float(want), rtol=RTOL, atol=RTOL))
     return str(want) == str(got)
 
 
@@ -160,7 +186,10 @@ def test_differences_name_what_changed():
     assert differences("tradeoff", rows, doubled) == [
         "tradeoff ('t', 'm', '{}', '0'): mhd_m = 1.0, expected 0.5",
         "tradeoff ('t', 'm', '{}', '1'): mhd_m = 0.5, expected 0.25"]
-    assert differences("tradeoff", rows, rows.assign(mhd_m=rows["mhd_m"] * (1 + 1e-12))) == []
+    assert differences("tradeoff", rows, rows.assign(mhd_m=rows["mhd_m"] * (1 + 1e-6))) == []
+    assert differences("tradeoff", rows, rows.iloc[:1].assign(mhd_m=0.5 * (1 + 1e-4))) == [
+        "tradeoff: missing row ('t', 'm', '{}', '1')",
+        "tradeoff ('t', 'm', '{}', '0'): mhd_m = 0.50005, expected 0.5"]
     assert differences("tradeoff", rows, rows.iloc[:1]) == [
         "tradeoff: missing row ('t', 'm', '{}', '1')"]
     claims = pd.DataFrame({"id": ["a", "b"], "verdict": ["holds", "depends"],
@@ -168,3 +197,18 @@ def test_differences_name_what_changed():
     flipped = claims.assign(verdict=["does not hold", "holds"])
     assert differences("claims", claims, flipped) == [
         "claims ('a',): verdict = 'does not hold', expected 'holds'"]
+
+
+def test_cells_match_levels_by_rank_and_compare_them_as_numbers():
+    """A cell's level (a distance read off the data) that moved within the tolerance keeps
+    its row; a level or an estimate beyond it is named, by the level's rank."""
+    cells = pd.DataFrame({"id": ["c"] * 3, "part": [1] * 3, "terrain": ["t"] * 3,
+                          "level": [0.901889733, 0.902378007, ""], "seeds": [3] * 3,
+                          "estimate": [1.5, 2.5, 0.5], "low": [1.0] * 3, "high": [3.0] * 3,
+                          "outcome": ["holds"] * 3, "timed": [False] * 3})
+    moved = cells.assign(level=[0.901889752, 0.902378026, ""])
+    assert differences("cells", cells, moved) == []
+    off = moved.assign(level=[0.8, 0.902378026, ""], estimate=[1.5, 2.6, 0.5])
+    assert differences("cells", cells, off) == [
+        "cells ('c', '1', 't', '1'): level = 0.8, expected 0.901889733",
+        "cells ('c', '1', 't', '2'): estimate = 2.6, expected 2.5"]

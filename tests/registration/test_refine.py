@@ -50,7 +50,10 @@ def desynchronised(tmp_path_factory: pytest.TempPathFactory,
 def test_refine_turns_late_poses_back_and_keeps_positions(desynchronised) -> None:
     """Refined rotations are much closer to the truth than the late recorded ones, the
     worst scan included (alignment turns a scan before it shifts it: a full alignment
-    alone left it 11.9 deg off; measured 0.62x the recorded mean error, 0.47x the worst),
+    alone left it 11.9 deg off; measured 0.62x the recorded mean error and 0.47x the worst
+    on one machine, 0.65x and 0.48x on an AVX-512 one, whose simulated scans differ in
+    their last float32 bits (the simulator's rays: tests/reference/test_chapter5.py) and
+    so in which scans the refinement corrects; refining nothing reads 1.0x),
     and the positions stay within 3 cm of the recorded ones' error on average (measured
     +2.5 cm: scan 13, 0.8 deg late, gains 20 % and is kept under the default ``min_gain``
     of 30 %, and the map it is averaged into carries its error; at 20 % it is corrected
@@ -64,7 +67,7 @@ def test_refine_turns_late_poses_back_and_keeps_positions(desynchronised) -> Non
     rec_m, rec_deg = _errors(frames, positions, quats)
     ref_m, ref_deg = _errors(out, positions, quats)
     assert rec_deg.max() > 8.0  # the late poses are far off
-    assert ref_deg.mean() < 0.65 * rec_deg.mean() and ref_deg.max() < 0.6 * rec_deg.max()
+    assert ref_deg.mean() < 0.7 * rec_deg.mean() and ref_deg.max() < 0.6 * rec_deg.max()
     settled = slice(6, None)  # scans 1-5 meet a map of one scan (docs/results/poses.md)
     assert ref_m[settled].mean() < rec_m[settled].mean() + 0.03
     assert counts.frames == SCANS and counts.corrected > SCANS // 2
