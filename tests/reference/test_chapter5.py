@@ -18,10 +18,10 @@ match to :data:`RTOL` and every text exactly. After a deliberate change, regener
 files with ``make reference`` (``pytest tests/reference --update-reference``) and read the
 diff.
 
-Why not to the last digit: on one machine the run is the same to the bit, but across CPUs
-the simulated scans differ in their last float32 bits (the simulator's rays are cast by
-open3d's ``RaycastingScene``, which picks its vector code by CPU), and every distance
-metric with them: on an AVX-512 machine the distances moved by up to 8.8e-7 of their
+Why not to the last digit: on one machine the run is the same to the bit, but not across
+CPUs (most likely the simulator's ray casting, open3d's ``RaycastingScene`` in float32,
+whose vector code depends on the CPU: tests/README.md): on an AVX-512 machine, not the one
+the files were written on, the distances moved by up to 8.8e-7 of their
 value (``hd_m``; the cells' estimates and bounds by up to 2.5e-7), while every count,
 size, verdict and outcome stayed the same. :data:`RTOL` leaves ten times that; a
 deliberate change moves the figures it touches by far more. The cells' ``level`` (a

@@ -52,8 +52,8 @@ def test_refine_turns_late_poses_back_and_keeps_positions(desynchronised) -> Non
     worst scan included (alignment turns a scan before it shifts it: a full alignment
     alone left it 11.9 deg off; measured 0.62x the recorded mean error and 0.47x the worst
     on one machine, 0.65x and 0.48x on an AVX-512 one, whose simulated scans differ in
-    their last float32 bits (the simulator's rays: tests/reference/test_chapter5.py) and
-    so in which scans the refinement corrects; refining nothing reads 1.0x),
+    their last bits (tests/README.md, reference results) and so in which scans the
+    refinement corrects; refining nothing reads 1.0x),
     and the positions stay within 3 cm of the recorded ones' error on average (measured
     +2.5 cm: scan 13, 0.8 deg late, gains 20 % and is kept under the default ``min_gain``
     of 30 %, and the map it is averaged into carries its error; at 20 % it is corrected

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import logging
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -35,6 +36,13 @@ __all__ = ["SERIAL", "MapUnordered", "SweepResult", "executor", "input_order", "
 
 #: How long to wait for a scheduler given by address.
 CONNECT_TIMEOUT = "10s"
+#: A local cluster's worker that has not answered its scheduler for this long is restarted
+#: and its tasks run again (Dask's default: 5 minutes). A worker's event loop answers
+#: while its task runs; it stops only when the process hangs. That happened once in a
+#: report's grid: 2 runs of a few seconds each waited 5 minutes, both workers' share of
+#: the grid otherwise done, and took 4 s on the restarted worker. No task of a sweep or
+#: of the sensor study holds the interpreter for a minute.
+WORKER_TTL = "90s"
 #: ``scheduler`` values that run everything in this process.
 SERIAL = frozenset({"serial", "none"})
 
@@ -106,22 +114,45 @@ def _dask_map(client: Client) -> MapUnordered:
 
 
 @contextlib.contextmanager
+def _local_cluster(workers: int) -> Iterator[Client]:
+    """A client of a LocalCluster of ``workers`` single-threaded processes (numba's kernels
+    too: the workers are the parallelism), whose scheduler restarts a worker silent for
+    :data:`WORKER_TTL`. Once the work is done its nannies' warnings are no news: closing,
+    a nanny gives its worker 4 s to exit, then kills it and says so ("Worker process
+    still alive after 4.0 seconds, killing"), on every report run, the results all in;
+    warnings while the cluster works (a worker restarted) still show."""
+    import dask
+    from distributed import Client, LocalCluster
+
+    nanny = logging.getLogger("distributed.nanny")
+    level = nanny.level
+    try:
+        with dask.config.set({"distributed.scheduler.worker-ttl": WORKER_TTL}), \
+                LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                             dashboard_address=None, env={"NUMBA_NUM_THREADS": "1"}) as cluster:
+            try:
+                with Client(cluster) as client:
+                    yield client
+            finally:
+                nanny.setLevel(logging.ERROR)
+    finally:
+        nanny.setLevel(level)
+
+
+@contextlib.contextmanager
 def executor(scheduler: str, workers: int) -> Iterator[MapUnordered]:
     """A :class:`MapUnordered` on ``scheduler``: ``serial``/``none`` in-process; ``local`` a
     LocalCluster of ``workers`` single-threaded processes; else a scheduler address."""
     if scheduler in SERIAL:
         yield _serial_map
         return
-    from distributed import Client, LocalCluster
+    from distributed import Client
 
     if scheduler == "local":
         if workers < 1:
             raise ParameterError(f"sweep: workers={workers} out of range (workers >= 1)",
                                  setting="sweep.workers")
-        # One thread per worker, numba's kernels included: the workers are the parallelism.
-        with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                          dashboard_address=None, env={"NUMBA_NUM_THREADS": "1"},
-                          ) as cluster, Client(cluster) as client:
+        with _local_cluster(workers) as client:
             yield _dask_map(client)
         return
     if "://" not in scheduler:

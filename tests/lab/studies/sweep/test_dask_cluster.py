@@ -102,3 +102,53 @@ def test_sweep_on_a_scheduler_and_worker_processes(cluster: str, tmp_path: Path)
     assert remote.table[keep].equals(serial.table[keep])
     again = run_sweep(spec, scheduler=cluster, output=tmp_path / "remote", progress=False)
     assert (again.ran, again.skipped) == (0, 3)  # resumed: nothing left to run
+
+
+def test_a_closing_local_cluster_keeps_its_nannies_quiet_and_only_then(monkeypatch) -> None:
+    """While the work runs a nanny's warnings show (a worker restarted); while the cluster
+    closes they do not (a worker killed 4 s after the close is no news); after it the
+    logger is as it was. The scheduler restarts a silent worker after WORKER_TTL."""
+    import logging
+
+    import dask
+    import distributed
+
+    from alte.lab.studies.sweep import runner
+
+    nanny = logging.getLogger("distributed.nanny")
+    levels: dict[str, int] = {}
+    ttl: dict[str, str] = {}
+
+    class Cluster:
+        def __init__(self, **kwargs: object) -> None:
+            levels["workers"] = int(str(kwargs["n_workers"]))
+            ttl["set"] = dask.config.get("distributed.scheduler.worker-ttl")
+
+        def __enter__(self) -> Cluster:
+            return self
+
+        def __exit__(self, *exc: object) -> None:
+            levels["closing"] = nanny.getEffectiveLevel()
+
+    class Client:
+        def __init__(self, cluster: Cluster) -> None:
+            pass
+
+        def __enter__(self) -> Client:
+            return self
+
+        def __exit__(self, *exc: object) -> None:
+            pass
+
+    monkeypatch.setattr(distributed, "LocalCluster", Cluster)
+    monkeypatch.setattr(distributed, "Client", Client)
+    monkeypatch.setattr(runner, "_dask_map", lambda client: client)
+    nanny.setLevel(logging.NOTSET)
+    with runner.executor("local", 2):
+        levels["working"] = nanny.getEffectiveLevel()
+    assert levels["workers"] == 2 and levels["working"] <= logging.WARNING
+    assert levels["closing"] == logging.ERROR and nanny.level == logging.NOTSET
+    assert ttl["set"] == runner.WORKER_TTL == "90s"  # a hung worker restarted, not waited for
+    with pytest.raises(RuntimeError, match="task"), runner.executor("local", 1):
+        raise RuntimeError("task failed")
+    assert levels["closing"] == logging.ERROR and nanny.level == logging.NOTSET
