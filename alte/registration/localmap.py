@@ -25,6 +25,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from alte.registration.neighbours import SplitTree
+from alte.registration.planefit import plane_fits
 
 __all__ = ["LocalMap", "Planes", "voxel_first"]
 
@@ -256,11 +257,4 @@ class LocalMap:
                ) -> tuple[NDArray[np.bool_], NDArray[np.float64], NDArray[np.float64]]:
         """Per row of neighbour indices: whether they lie on a plane, its unit normal and
         their centroid (each row on its own: the same neighbours give the same fit)."""
-        nbrs = self.points[idx]
-        centre = nbrs.mean(axis=1)
-        centred = nbrs - centre[:, None, :]
-        values, vectors = np.linalg.eigh(np.einsum("nki,nkj->nij", centred, centred)
-                                         / idx.shape[1])
-        spread = np.sqrt(np.maximum(values, 0.0))
-        flat = (spread[:, 0] < self.thickness) & (spread[:, 1] > 3.0 * self.thickness)
-        return flat, vectors[:, :, 0], centre
+        return plane_fits(self.points, np.ascontiguousarray(idx), self.thickness)

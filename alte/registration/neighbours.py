@@ -18,6 +18,7 @@ too small to share, and a second thread spinning beside it raised the LIO's CPU 
 
 from __future__ import annotations
 
+import numba
 import numpy as np
 from numpy.typing import NDArray
 from pykdtree.kdtree import KDTree
@@ -34,8 +35,13 @@ Found = tuple[NDArray[np.float64], NDArray[np.int64]]
 _OPENMP = ThreadpoolController().select(user_api="openmp")
 
 
+#: Points per leaf of the trees: pykdtree's default 16 made the LIO's queries (20
+#: neighbours each) a quarter slower, with the same neighbours.
+LEAF = 32
+
+
 def _tree(points: NDArray[np.float64]) -> KDTree | None:
-    return KDTree(np.ascontiguousarray(points)) if len(points) else None
+    return KDTree(np.ascontiguousarray(points), leafsize=LEAF) if len(points) else None
 
 
 def _ask(tree: KDTree, live: NDArray[np.bool_], query: NDArray[np.float64], k: int,
@@ -46,6 +52,25 @@ def _ask(tree: KDTree, live: NDArray[np.bool_], query: NDArray[np.float64], k: i
         dist, found = tree.query(query, k=k, distance_upper_bound=bound, mask=~live)
     return (np.asarray(dist, dtype=np.float64).reshape(-1, k),
             np.asarray(found, dtype=np.int64).reshape(-1, k))
+
+
+@numba.njit(cache=True)
+def _merge(first: Found, second: Found) -> Found:
+    """Per row, the ``k`` nearest of two neighbour lists each sorted by distance (ties:
+    ``first``'s before ``second``'s, as a stable sort of the two side by side orders them)."""
+    (d1, i1), (d2, i2) = first, second
+    n, k = d1.shape
+    dist, idx = np.empty((n, k)), np.empty((n, k), np.int64)
+    for r in range(n):
+        a = b = 0
+        for j in range(k):
+            if d1[r, a] <= d2[r, b]:
+                dist[r, j], idx[r, j] = d1[r, a], i1[r, a]
+                a += 1
+            else:
+                dist[r, j], idx[r, j] = d2[r, b], i2[r, b]
+                b += 1
+    return dist, idx
 
 
 class SplitTree:
@@ -77,6 +102,4 @@ class SplitTree:
         if len(found) <= 1:
             return found[0] if found else (np.full((len(query), k), np.inf),
                                            np.full((len(query), k), total, np.int64))
-        dist, idx = np.hstack([f[0] for f in found]), np.hstack([f[1] for f in found])
-        order = np.argsort(dist, axis=1, kind="stable")[:, :k]
-        return np.take_along_axis(dist, order, axis=1), np.take_along_axis(idx, order, axis=1)
+        return _merge(found[0], found[1])

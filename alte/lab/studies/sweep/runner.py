@@ -31,8 +31,8 @@ from alte.lab.studies.sweep.spec import SweepSettings, SweepSpec, with_plugins
 from alte.lab.studies.sweep.store import finished_ids, load_results, row_table, write_row
 from alte.progress import bar as progress_bar
 
-__all__ = ["SERIAL", "MapUnordered", "SweepResult", "executor", "input_order", "override",
-           "run_one", "run_sweep", "variant_table"]
+__all__ = ["CLUSTER_OPTIONS", "SERIAL", "MapUnordered", "SweepResult", "executor",
+           "input_order", "override", "run_one", "run_sweep", "variant_table"]
 
 #: How long to wait for a scheduler given by address.
 CONNECT_TIMEOUT = "10s"
@@ -45,6 +45,13 @@ CONNECT_TIMEOUT = "10s"
 WORKER_TTL = "90s"
 #: ``scheduler`` values that run everything in this process.
 SERIAL = frozenset({"serial", "none"})
+#: A local cluster's options: single-threaded worker processes (numba one thread each:
+#: the workers are the parallelism); no dashboard, and the scheduler's HTTP server (health
+#: routes) on a free port: on distributed's 8787 a second cluster at once (two sweeps, two
+#: test workers) warned that the port was taken.
+CLUSTER_OPTIONS: dict[str, object] = {
+    "threads_per_worker": 1, "processes": True, "dashboard_address": None,
+    "scheduler_kwargs": {"dashboard_address": ":0"}, "env": {"NUMBA_NUM_THREADS": "1"}}
 
 if TYPE_CHECKING:
     from distributed import Client
@@ -128,8 +135,7 @@ def _local_cluster(workers: int) -> Iterator[Client]:
     level = nanny.level
     try:
         with dask.config.set({"distributed.scheduler.worker-ttl": WORKER_TTL}), \
-                LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                             dashboard_address=None, env={"NUMBA_NUM_THREADS": "1"}) as cluster:
+                LocalCluster(n_workers=workers, **CLUSTER_OPTIONS) as cluster:
             try:
                 with Client(cluster) as client:
                     yield client

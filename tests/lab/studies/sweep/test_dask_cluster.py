@@ -152,3 +152,29 @@ def test_a_closing_local_cluster_keeps_its_nannies_quiet_and_only_then(monkeypat
     with pytest.raises(RuntimeError, match="task"), runner.executor("local", 1):
         raise RuntimeError("task failed")
     assert levels["closing"] == logging.ERROR and nanny.level == logging.NOTSET
+
+
+def test_a_local_cluster_leaves_port_8787_alone() -> None:
+    """Two clusters at once (two sweeps, two test workers) do not fight over distributed's
+    default HTTP port: with 8787 taken, a cluster of the sweep's options starts without
+    the 'Port 8787 is already in use' warning."""
+    import socket
+    import warnings
+
+    from distributed import LocalCluster
+
+    from alte.lab.studies.sweep.runner import CLUSTER_OPTIONS
+
+    holder = socket.socket()
+    try:
+        holder.bind(("", 8787))
+        holder.listen()
+    except OSError:
+        pass  # taken already: the case itself
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            with LocalCluster(n_workers=0, **{**CLUSTER_OPTIONS, "processes": False}) as cluster:
+                assert cluster.scheduler.http_server.port != 8787
+    finally:
+        holder.close()

@@ -298,8 +298,10 @@ def test_local_cluster_gives_the_serial_rows(spec, serial, tmp_path):
 def test_existing_scheduler_address(spec, serial, tmp_path):
     from distributed import LocalCluster
 
-    with LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
-                      dashboard_address=None) as cluster:
+    from alte.lab.studies.sweep.runner import CLUSTER_OPTIONS
+
+    threads = {k: v for k, v in CLUSTER_OPTIONS.items() if k != "env"}  # for processes
+    with LocalCluster(n_workers=1, **{**threads, "processes": False}) as cluster:
         result = run_sweep(spec, scheduler=cluster.scheduler_address, output=tmp_path,
                            progress=False)
     table = serial[0].table
