@@ -90,11 +90,24 @@ def _measure(result: MapRun, folder: Path) -> None:
 def _others() -> None:
     """Kernels no map of the flight reaches: a PCD body's decompression (a read-only
     buffer: the file's bytes), the x/y lookup of a contiguous (N, 2) array and the ray
-    count of Octomap's reference backend (pyoctomap)."""
+    count of Octomap's reference backend (pyoctomap), the LIO's local map."""
     literal_run = np.frombuffer(bytes([3, 1, 2, 3, 4]), np.uint8)
     lzf_decompress(literal_run, 4)
     Square(0.0, 0.0, 1.0).locate(np.full((4, 2), 0.5), 2)
     scan_cost(np.ones((4, 3), np.float32), np.zeros(3, np.float32), 0.1, 10.0)
+    _lio_map()
+
+
+def _lio_map() -> None:
+    """The LIO's local map: a packed tree, a few rows appended under a second one, and the
+    plane fits of a query (the fits' kernel and the merge of both trees' neighbours)."""
+    from alte.registration.localmap import LocalMap
+
+    ground = np.random.default_rng(0).uniform((-5.0, -5.0, 0.0), (5.0, 5.0, 0.01), (400, 3))
+    local = LocalMap(0.25, 50.0)
+    local.add(ground[:380], np.zeros(3))
+    local.add(ground[380:], np.zeros(3))
+    local.planes(ground[:8], 1.0, 5, (20, 3.0))
 
 
 def warm_kernels(part: tuple[int, int] = (1, 1)) -> dict[str, int]:

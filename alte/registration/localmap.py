@@ -25,7 +25,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 from alte.registration.neighbours import SplitTree
-from alte.registration.planefit import plane_fits
 
 __all__ = ["LocalMap", "Planes", "voxel_first"]
 
@@ -257,4 +256,6 @@ class LocalMap:
                ) -> tuple[NDArray[np.bool_], NDArray[np.float64], NDArray[np.float64]]:
         """Per row of neighbour indices: whether they lie on a plane, its unit normal and
         their centroid (each row on its own: the same neighbours give the same fit)."""
+        from alte.registration.lio_kernels import plane_fits  # numba: on first use
+
         return plane_fits(self.points, np.ascontiguousarray(idx), self.thickness)

@@ -18,7 +18,6 @@ too small to share, and a second thread spinning beside it raised the LIO's CPU 
 
 from __future__ import annotations
 
-import numba
 import numpy as np
 from numpy.typing import NDArray
 from pykdtree.kdtree import KDTree
@@ -54,25 +53,6 @@ def _ask(tree: KDTree, live: NDArray[np.bool_], query: NDArray[np.float64], k: i
             np.asarray(found, dtype=np.int64).reshape(-1, k))
 
 
-@numba.njit(cache=True)
-def _merge(first: Found, second: Found) -> Found:
-    """Per row, the ``k`` nearest of two neighbour lists each sorted by distance (ties:
-    ``first``'s before ``second``'s, as a stable sort of the two side by side orders them)."""
-    (d1, i1), (d2, i2) = first, second
-    n, k = d1.shape
-    dist, idx = np.empty((n, k)), np.empty((n, k), np.int64)
-    for r in range(n):
-        a = b = 0
-        for j in range(k):
-            if d1[r, a] <= d2[r, b]:
-                dist[r, j], idx[r, j] = d1[r, a], i1[r, a]
-                a += 1
-            else:
-                dist[r, j], idx[r, j] = d2[r, b], i2[r, b]
-                b += 1
-    return dist, idx
-
-
 class SplitTree:
     """k-d trees over ``points[:base]`` (built once) and ``points[base:]`` (rebuilt on
     every :meth:`update`), queried as one tree over the ``live`` rows."""
@@ -102,4 +82,6 @@ class SplitTree:
         if len(found) <= 1:
             return found[0] if found else (np.full((len(query), k), np.inf),
                                            np.full((len(query), k), total, np.int64))
-        return _merge(found[0], found[1])
+        from alte.registration.lio_kernels import merge_nearest  # numba: on first use
+
+        return merge_nearest(found[0], found[1])

@@ -40,19 +40,3 @@ def test_an_empty_split_tree_finds_nothing():
     dist, idx = SplitTree(np.empty((0, 3)), np.empty(0, bool)).query(np.zeros((2, 3)), 5, 1.0)
     assert np.isinf(dist).all() and (idx == 0).all()
 
-
-def test_merged_neighbours_keep_the_first_trees_rows_first_on_equal_distances():
-    """Both trees' lists merged as a stable sort of them side by side orders them: equal
-    distances (a point duplicated across the two trees) give the packed tree's row
-    first, missing neighbours (inf) come last."""
-    from alte.registration.neighbours import _merge
-
-    inf = np.inf
-    first = (np.array([[0.5, 1.0, inf], [0.1, 0.2, 0.3]]), np.array([[0, 1, 9], [2, 3, 4]]))
-    second = (np.array([[0.5, 0.7, inf], [inf, inf, inf]]), np.array([[5, 6, 9], [9, 9, 9]]))
-    dist, idx = _merge(first, second)
-    both_d, both_i = np.hstack([first[0], second[0]]), np.hstack([first[1], second[1]])
-    order = np.argsort(both_d, axis=1, kind="stable")[:, :3]
-    assert np.array_equal(dist, np.take_along_axis(both_d, order, axis=1))
-    assert np.array_equal(idx, np.take_along_axis(both_i, order, axis=1))
-    assert idx.tolist() == [[0, 5, 6], [2, 3, 4]]

@@ -1,11 +1,16 @@
-"""Plane fits of many small neighbourhoods at once, for the LIO's local map
-(:mod:`alte.registration.localmap`): centroid, covariance and its eigenvectors per row.
+"""numba kernels of the LIO's local map (:mod:`alte.registration.localmap`): plane fits
+of many small neighbourhoods at once (centroid, covariance and its eigenvectors per row),
+and the merge of two k-d trees' neighbour lists (:mod:`alte.registration.neighbours`).
 
 numpy took five passes over an (N, k, 3) gather and a batched LAPACK ``eigh`` for the
-3 x 3 covariances (a third of the LIO's CPU went to its plane fits, half of that to
+3 x 3 covariances (a quarter of the LIO's CPU went to its plane fits, half of that to
 ``eigh``). Here one pass per row sums the neighbours' moments and cyclic Jacobi rotations
 diagonalise the covariance: exact to rounding for a symmetric 3 x 3 (the off-diagonal
-terms shrink quadratically, a few sweeps), with no call out per row.
+terms shrink quadratically, a few sweeps), with no call out per row. The two trees' lists
+were merged by a stable ``argsort`` of them side by side (4 % of the LIO); each is sorted
+already, so one merge pass does it.
+Imported on first use: ``alte info`` and the other commands that import the odometry's
+settings do not load numba.
 """
 
 from __future__ import annotations
@@ -14,7 +19,10 @@ import numba
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["plane_fits"]
+__all__ = ["merge_nearest", "plane_fits"]
+
+#: Neighbours' distances (N, k; inf where missing) and rows (N, k).
+_Found = tuple[NDArray[np.float64], NDArray[np.int64]]
 
 _SWEEPS = 32
 
@@ -112,3 +120,22 @@ def plane_fits(points: NDArray[np.float64], idx: NDArray[np.int64], thickness: f
             and np.sqrt(max(a[mid, mid], 0.0)) > 3.0 * thickness
         normal[i] = v[:, low]
     return flat, normal, centre
+
+
+@numba.njit(cache=True)
+def merge_nearest(first: _Found, second: _Found) -> _Found:
+    """Per row, the ``k`` nearest of two neighbour lists each sorted by distance (ties:
+    ``first``'s before ``second``'s, as a stable sort of the two side by side orders them)."""
+    (d1, i1), (d2, i2) = first, second
+    n, k = d1.shape
+    dist, idx = np.empty((n, k)), np.empty((n, k), np.int64)
+    for r in range(n):
+        a = b = 0
+        for j in range(k):
+            if d1[r, a] <= d2[r, b]:
+                dist[r, j], idx[r, j] = d1[r, a], i1[r, a]
+                a += 1
+            else:
+                dist[r, j], idx[r, j] = d2[r, b], i2[r, b]
+                b += 1
+    return dist, idx

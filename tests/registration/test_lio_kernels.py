@@ -1,10 +1,11 @@
-"""Plane fits of the LIO's local map: the same flatness, normals and centroids as numpy's
-mean, covariance and LAPACK ``eigh`` give, on planes, lines, blobs and degenerate rows."""
+"""The LIO local map's kernels: plane fits with the same flatness, normals and centroids as
+numpy's mean, covariance and LAPACK ``eigh`` give, on planes, lines, blobs and degenerate
+rows; two neighbour lists merged as a stable sort orders them."""
 
 import numpy as np
 import pytest
 
-from alte.registration.planefit import plane_fits
+from alte.registration.lio_kernels import merge_nearest, plane_fits
 
 
 def _lapack(points, idx, thickness):
@@ -65,3 +66,18 @@ def test_a_tilted_plane_gets_its_normal_and_a_line_is_not_flat():
     flat, normal, _ = plane_fits(points, np.arange(40).reshape(2, 20), 0.05)
     assert flat.tolist() == [True, False]
     assert np.allclose(np.abs(normal[0]), np.array([0.5, 0.0, 1.0]) / np.sqrt(1.25))
+
+
+def test_merged_neighbours_keep_the_first_trees_rows_first_on_equal_distances():
+    """Both trees' lists merged as a stable sort of them side by side orders them: equal
+    distances (a point duplicated across the two trees) give the packed tree's row
+    first, missing neighbours (inf) come last."""
+    inf = np.inf
+    first = (np.array([[0.5, 1.0, inf], [0.1, 0.2, 0.3]]), np.array([[0, 1, 9], [2, 3, 4]]))
+    second = (np.array([[0.5, 0.7, inf], [inf, inf, inf]]), np.array([[5, 6, 9], [9, 9, 9]]))
+    dist, idx = merge_nearest(first, second)
+    both_d, both_i = np.hstack([first[0], second[0]]), np.hstack([first[1], second[1]])
+    order = np.argsort(both_d, axis=1, kind="stable")[:, :3]
+    assert np.array_equal(dist, np.take_along_axis(both_d, order, axis=1))
+    assert np.array_equal(idx, np.take_along_axis(both_i, order, axis=1))
+    assert idx.tolist() == [[0, 5, 6], [2, 3, 4]]
