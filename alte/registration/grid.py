@@ -153,12 +153,19 @@ class GridAccumulator:
 
         Returns the number of cells the points fall in (the frame's down-sampled size).
         """
-        part = grid_average_with_counts(points, self.voxel, weights)
-        self._pending.append(part)
-        self._pending_rows += len(part[0])
+        return self.add_cells(grid_average_with_counts(points, self.voxel, weights))
+
+    def add_cells(self, cells: tuple[NDArray[np.int64], NDArray[np.float64],
+                                     NDArray[np.float64]]) -> int:
+        """Accumulate points already grouped on this grid: (keys, sums, counts) as
+        :func:`grid_average_with_counts` returns them for this ``voxel`` (a frame that is
+        down-sampled on the same grid as well groups its points once); returns the count
+        of cells."""
+        self._pending.append(cells)
+        self._pending_rows += len(cells[0])
         if self._pending_rows > max(len(self._keys), 4096):
             self._fold()
-        return len(part[0])
+        return len(cells[0])
 
     def _fold(self) -> None:
         if not self._pending:

@@ -24,7 +24,12 @@ from numpy.typing import NDArray
 
 from alte.errors import ParameterError, RegistrationError
 from alte.progress import bar as progress_bar
-from alte.registration.grid import GridAccumulator, check_voxel, grid_average
+from alte.registration.grid import (
+    GridAccumulator,
+    check_voxel,
+    grid_average,
+    grid_average_with_counts,
+)
 from alte.registration.transform import register_with_origin
 from alte.types import Counts, Frame, Mount, finite_rows, rows_all
 
@@ -163,13 +168,24 @@ def _iterate(
         if len(pts) == 0:
             counts.drop_frame("empty")
             continue
-        if merge is not None:
-            merge.add(pts)
-        if voxel is not None:
-            pts = grid_average(pts, voxel)
+        pts = _merge_and_average(pts, voxel, merge)
         counts.frames_kept += 1
         counts.points_registered += len(pts)
         yield frame, pts, origin
+
+
+def _merge_and_average(pts: NDArray[np.float64], voxel: float | None,
+                       merge: GridAccumulator | None) -> NDArray[np.float64]:
+    """The frame's points added to ``merge`` and grid-averaged at ``voxel``; on one grid
+    (the pipeline's case) the points are grouped once for both, the same values."""
+    if merge is not None and voxel is not None and merge.voxel == voxel:
+        cells = grid_average_with_counts(pts, voxel)
+        merge.add_cells(cells)
+        averaged: NDArray[np.float64] = cells[1] / cells[2][:, None]
+        return averaged
+    if merge is not None:
+        merge.add(pts)
+    return pts if voxel is None else grid_average(pts, voxel)
 
 
 def check_options(

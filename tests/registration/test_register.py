@@ -225,6 +225,22 @@ def test_register_frames_yields_per_kept_frame():
     assert counts.points_registered == sum(len(p) for _f, p, _o in out)
 
 
+@pytest.mark.parametrize("merge_voxel", [1.0, 0.7])
+def test_frames_down_sampled_and_merged_on_one_grid_equal_each_done_alone(merge_voxel):
+    """The pipeline down-samples each frame and merges it into the cloud; on one grid the
+    frame's points are grouped once for both, with the same frames and cloud as grouping
+    them twice (and on another grid, each as before)."""
+    _truth, frames, mount = scene(seed=5, frames=4, n=300)
+    merge = GridAccumulator(merge_voxel)
+    out = list(register_frames(frames, mount, voxel=1.0, merge=merge))
+    alone = GridAccumulator(merge_voxel)
+    for (_f, pts, _o), (_g, raw, _p) in zip(out, register_frames(frames, mount), strict=True):
+        assert np.array_equal(pts, grid_average(raw, 1.0))
+        alone.add(raw)
+    assert np.array_equal(merge.points(), alone.points())
+    assert np.array_equal(merge.counts(), alone.counts())
+
+
 def test_register_errors_name_the_reason():
     with pytest.raises(RegistrationError, match="no frames to register"):
         register([], Mount())

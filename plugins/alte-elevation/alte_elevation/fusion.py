@@ -126,22 +126,39 @@ def fuse(state: CellState, keys: NDArray[np.int64], z: NDArray[np.float64],
         "mean": mb, "m2": m2b, "noise": rs})
 
 
+def _places(state: CellState, ukeys: NDArray[np.int64], new: NDArray[np.bool_]
+            ) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
+    """Where the state's cells and the scan's new cells go in the merged, sorted arrays
+    (``np.insert``'s order: a new cell before the old one its key precedes)."""
+    at = np.searchsorted(state.keys, ukeys[new])
+    kept = np.arange(len(state))
+    return kept + np.searchsorted(at, kept, side="right"), at + np.arange(len(at))
+
+
 def _merge(state: CellState, ukeys: NDArray[np.int64], old: NDArray[np.bool_],
            pos: NDArray[np.intp], scan: dict[str, NDArray[np.float64]]) -> CellState:
-    """The state with the scan's cells: existing ones updated, new ones inserted in order."""
-    out = {f.name: getattr(state, f.name).copy() for f in fields(state)}
-    rows = pos[old]
-    out["height"][rows], out["variance"][rows] = scan["height"][old], scan["variance"][old]
-    out["low"][rows] = np.minimum(out["low"][rows], scan["low"][old])
-    out["high"][rows] = np.maximum(out["high"][rows], scan["high"][old])
-    na, nb = out["points"][rows], scan["points"][old]
+    """The state with the scan's cells: existing ones updated, new ones inserted in order
+    (each array written once into its merged place: no copy, no ``np.insert`` per array)."""
+    rows, new = pos[old], ~old
+    values = {f.name: getattr(state, f.name) for f in fields(state)}
+    na, nb = values["points"][rows], scan["points"][old]
     n = na + nb
-    delta = scan["mean"][old] - out["mean"][rows]
-    out["mean"][rows] = out["mean"][rows] + delta * nb / n
-    out["m2"][rows] = out["m2"][rows] + scan["m2"][old] + delta**2 * na * nb / n
-    out["points"][rows], out["noise"][rows] = n, out["noise"][rows] + scan["noise"][old]
-    new = ~old
-    at = np.searchsorted(state.keys, ukeys[new])
-    merged = {name: np.insert(values, at, scan[name][new])
-              for name, values in out.items() if name != "keys"}
-    return CellState(np.insert(state.keys, at, ukeys[new]), **merged)
+    delta = scan["mean"][old] - values["mean"][rows]
+    updated = {
+        "height": scan["height"][old], "variance": scan["variance"][old],
+        "low": np.minimum(values["low"][rows], scan["low"][old]),
+        "high": np.maximum(values["high"][rows], scan["high"][old]),
+        "points": n, "mean": values["mean"][rows] + delta * nb / n,
+        "m2": values["m2"][rows] + scan["m2"][old] + delta**2 * na * nb / n,
+        "noise": values["noise"][rows] + scan["noise"][old]}
+    kept, put = _places(state, ukeys, new)
+    merged = {"keys": ukeys[new], **{k: v[new] for k, v in scan.items()}}
+    out = {}
+    for name, before in values.items():
+        array = np.empty(len(kept) + len(put), dtype=before.dtype)
+        array[kept] = before
+        if name in updated:
+            array[kept[rows]] = updated[name]
+        array[put] = merged[name]
+        out[name] = array
+    return CellState(**out)

@@ -74,6 +74,27 @@ def test_cells_stay_sorted_and_separate() -> None:
     assert state.variance[3] == pytest.approx(0.005)
 
 
+def test_a_scan_merged_into_many_cells_keeps_each_cell_as_if_fused_alone() -> None:
+    """Scans of many cells, old and new interleaved (new keys before the first, between
+    and after the old ones): every cell holds exactly what fusing its own points alone
+    gives, so the merge put each value in its own cell's place."""
+    rng = np.random.default_rng(3)
+    scans = [rng.integers(-50, 50, 300).astype(np.int64) * 3 + offset for offset in (0, 1, -2)]
+    state = CellState.empty()
+    alone: dict[int, CellState] = {}
+    for keys in scans:
+        z, r = rng.normal(size=len(keys)), rng.uniform(0.01, 0.1, len(keys))
+        state = fuse(state, keys, z, r, GATE)
+        for key in np.unique(keys):
+            mine = keys == key
+            alone[int(key)] = fuse(alone.get(int(key), CellState.empty()),
+                                   np.zeros(int(mine.sum()), np.int64), z[mine], r[mine], GATE)
+    assert state.keys.tolist() == sorted(alone)
+    for name in ("height", "variance", "low", "high", "points", "mean", "m2", "noise"):
+        assert getattr(state, name).tolist() == pytest.approx(
+            [getattr(alone[k], name)[0] for k in state.keys.tolist()], rel=1e-12), name
+
+
 def test_spread_is_the_surface_beyond_the_noise() -> None:
     """Heights 0, 0.2, 0.4 with r = 0.001 (gated or not): sample variance 0.08/3, less the
     mean noise 0.001."""
