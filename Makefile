@@ -44,7 +44,8 @@ lint: bootstrap
 
 # Lint, types and the fast tests (.ci/test): ruff; then `alte warmup` (numba's kernels
 # compiled into the package cache once, for every later process), mypy and the docs site's
-# tests side by side on the two cores; then the other tests on two pytest workers.
+# tests side by side on the two cores; the other tests on two pytest workers as soon as
+# the kernels are cached (mypy and the docs tests finishing beside them).
 # The long end-to-end checks (marker `full`: the whole quick bench, the 10-million-point
 # memory runs, chapters 5 and 6 headless, ...; tests/README.md says which smaller test
 # proves each one's parts) run in `make check-full`, which CI runs after `make test`.

@@ -121,3 +121,16 @@ def small_terrain(small_data):
     def make(name: str, frames: int = SMALL):
         return ensure_terrain(name, small_data / f"f{frames}", seed=0, frames=frames)
     return make
+
+
+@pytest.fixture(scope="session")
+def uav_first_scans(tmp_path_factory: pytest.TempPathFactory):
+    """The first 4 scans (0.3 s, consecutive) of ``sim_lan_1`` from the uav sensor: per-point
+    time and an IMU, for LIO's tests of the pipeline: over 4 scans spread over the mission
+    a LIO run integrated 45 s of IMU between them (5 CPU s; here 1 s)."""
+    from support.missions import first_scans_folder
+
+    from alte.sim.profile import PROFILES
+
+    return first_scans_folder(tmp_path_factory.mktemp("uav_first") / "sim_lan_1", "sim_lan_1",
+                              4, profile=PROFILES["uav"])

@@ -64,13 +64,19 @@ def test_compare_backends_reports_agreement():
 
 @pytest.mark.realdata
 def test_agreement_on_real_scan_at_10_cells_per_metre():
+    """Both backends agree on a real LiDAR scan's long, crossing rays at 0.1 m.
+
+    Every 8th point of the scan (11k rays over its whole extent, the same flat grid
+    path) is enough: with occupied ends left free in the native grid the Jaccard drops
+    to 0.55, and the reference backend's per-point cost is an eighth of the whole scan's.
+    """
     path = REALDATA / "scan.dat.bz2"
     if not path.exists():
         pytest.skip("../shared/realdata/octomap_scan/scan.dat.bz2 absent")
-    with bz2.open(path) as handle:
-        points = np.loadtxt(handle)
+    with bz2.open(path) as handle:  # whitespace-separated x y z rows
+        points = np.fromstring(handle.read().decode(), sep=" ").reshape(-1, 3)
     assert points.shape == (88206, 3)
-    out = compare_backends([(points, np.zeros(3))], resolution=10)
+    out = compare_backends([(points[::8], np.zeros(3))], resolution=10)
     assert out["jaccard"] == 1.0
     assert out["leaf_count_native"] == out["leaf_count_reference"] > 0
 

@@ -16,15 +16,6 @@ def terrain(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 
 @pytest.fixture(scope="session")
-def uav(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """``sim_lan_1`` with 4 scans of the UAV sensor: per-point time and an IMU (LIO)."""
-    from alte.sim.profile import PROFILES
-
-    return ensure_terrain("sim_lan_1", tmp_path_factory.mktemp("uav"), 0, 4,
-                          profile=PROFILES["uav"])
-
-
-@pytest.fixture(scope="session")
 def bag(terrain: Path) -> Path:
     """The terrain's bag alone: no control volume, no voxel."""
     return terrain / "bag"

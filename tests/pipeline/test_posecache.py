@@ -37,9 +37,11 @@ def _same(mine: list[RegisteredFrame], theirs: list[RegisteredFrame]) -> None:
 
 
 def test_lio_poses_are_aligned_once_and_read_back_for_another_selection(
-        uav: Path, tmp_path: Path) -> None:
-    """The first run (2 of 4 scans kept) aligns every scan and keeps them; a whole-mission
-    run then reads them, and both give what an uncached run gives, counts included."""
+        uav_first_scans: Path, tmp_path: Path) -> None:
+    """The first run (2 of 4 scans kept) aligns every scan and keeps them; a run over all
+    4 then reads them, and both give what an uncached run gives, counts included (the
+    mission's first 4 scans: consecutive, the IMU between them is 0.3 s to integrate)."""
+    uav = uav_first_scans
     cache = tmp_path / "poses"
     spec = FrameSettings(poses=PoseSource.ODOMETRY, odometry=OdometrySettings(method="lio"))
     some, first = _run(uav, replace(spec, frames=2), cache)

@@ -8,6 +8,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
+from support.missions import first_scans_folder
 
 from alte.errors import ParameterError, RegistrationError
 from alte.io.bags.bag import FrameStream, ReadSettings
@@ -215,8 +216,10 @@ def test_auto_is_lio_with_an_imu_and_lio_without_one_is_refused():
 
 @pytest.fixture(scope="module")
 def uav_mission(tmp_path_factory):
-    """The whole SIM NAV 1 mission under the uav profile (scans must be consecutive)."""
-    return ensure_terrain("sim_nav_1", tmp_path_factory.mktemp("lio"), profile=PROFILES["uav"])
+    """The first 50 scans (5 s, consecutive) of the SIM NAV 1 mission under the uav
+    profile, as the whole mission simulates them (the whole one: 5 CPU s more)."""
+    return first_scans_folder(tmp_path_factory.mktemp("lio") / "sim_nav_1", "sim_nav_1", 50,
+                              profile=PROFILES["uav"])
 
 
 def test_lio_flies_the_first_five_seconds_of_the_uav_mission(uav_mission):
@@ -276,11 +279,13 @@ def test_lio_frames_carry_the_scan_the_imu_deskewed(uav_mission):
 
 def test_the_pipeline_picks_lio_for_a_bag_with_an_imu_and_says_so(tmp_path, capsys):
     """``--poses odometry`` on the uav profile's bag (it has /imu) runs LIO unasked; on the
-    thesis profile's bag (no IMU) KISS-ICP; ``alte register`` prints which."""
+    thesis profile's bag (no IMU) KISS-ICP; ``alte register`` prints which. The uav bag
+    holds the mission's first 3 scans: over 3 spread over it each LIO run integrated 50 s
+    of IMU (4 CPU s)."""
     from alte.cli import main
     from alte.pipeline import FrameSettings, PoseSource, open_input, prepare
 
-    uav = ensure_terrain("sim_lan_2", tmp_path, frames=3, profile=PROFILES["uav"])
+    uav = first_scans_folder(tmp_path / "uav", "sim_lan_2", 3, profile=PROFILES["uav"])
     thesis = ensure_terrain("sim_lan_2", tmp_path, frames=3)
     spec = FrameSettings(poses=PoseSource.ODOMETRY)
     lio, kiss = (prepare(open_input(f), spec).counts for f in (uav, thesis))

@@ -9,7 +9,7 @@ from itertools import islice
 import numpy as np
 import pytest
 
-from alte.io.bags.bag import FrameStream, read_frames
+from alte.io.bags.bag import FrameStream
 from alte.paths import realdata_dir
 from alte.registration.odometry import OdometrySettings, PoseCounts, pose_matrix, refine_frames
 from alte.registration.refalign import align
@@ -17,9 +17,11 @@ from alte.registration.refmap import DenseMap
 from alte.sim import get_terrain, simulate, true_poses, write_scenario
 from alte.types import Frame, Mount
 
-#: The first scans of exp_nav_2: the cart swings fast around scans 20-40 and 80-100,
-#: where the recorded poses run 80 ms late (up to 13 deg off in yaw).
-SCANS = 120
+#: The first scans of exp_nav_2: the cart swings fast around scans 20-40, where the
+#: recorded poses run 80 ms late (up to 12 deg off in yaw). 40 scans fail on what 120
+#: did (the turn before the shift skipped, corrected scans fed back into the map) at a
+#: third of the CPU time.
+SCANS = 40
 
 
 def _errors(frames: list[Frame], positions: np.ndarray, quats: np.ndarray,
@@ -40,27 +42,28 @@ def desynchronised(tmp_path_factory: pytest.TempPathFactory,
     terrain = get_terrain("exp_nav_2")
     folder = write_scenario(tmp_path_factory.mktemp("refine") / "exp_nav_2", terrain,
                             simulate(terrain), seed=0, frames=None)
-    read = read_frames(folder / "bag")
+    stream = FrameStream(folder / "bag")  # the first SCANS scans only are read
+    frames = list(islice(stream, SCANS))
     truth = true_poses(terrain)
-    assert np.array_equal([f.stamp for f in read.frames[:SCANS]], truth.stamps[:SCANS])
-    return (read.frames[:SCANS], read.mount, truth.positions[:SCANS],
-            truth.quaternions[:SCANS])
+    assert np.array_equal([f.stamp for f in frames], truth.stamps[:SCANS])
+    return frames, stream.mount, truth.positions[:SCANS], truth.quaternions[:SCANS]
 
 
 def test_refine_turns_late_poses_back_and_keeps_positions(desynchronised) -> None:
     """Refined rotations are much closer to the truth than the late recorded ones, the
     worst scan included (alignment turns a scan before it shifts it: a full alignment
-    alone left it 11.9 deg off; measured 0.62x the recorded mean error and 0.47x the worst
-    on one machine, 0.65x and 0.48x on an AVX-512 one, whose simulated scans differ in
-    their last bits (tests/README.md, reference results) and so in which scans the
-    refinement corrects; refining nothing reads 1.0x),
-    and the positions stay within 3 cm of the recorded ones' error on average (measured
-    +2.5 cm: scan 13, 0.8 deg late, gains 20 % and is kept under the default ``min_gain``
-    of 30 %, and the map it is averaged into carries its error; at 20 % it is corrected
-    and the positions stay within 1.4 cm, but accurate real scans gain up to 18 %:
+    alone left the worst 0.66x off, the mean 0.84x and the positions 10 cm worse;
+    measured 0.57x the recorded mean error and 0.53x the worst; over 120 scans 0.62x and
+    0.47x on one machine, 0.65x and 0.48x on an AVX-512 one, whose simulated scans differ
+    in their last bits (tests/README.md, reference results) and so in which scans the
+    refinement corrects; refining nothing reads 1.0x), and the positions stay within
+    6.5 cm of the recorded ones' error on average (measured +5.0 cm; over 120 scans
+    +2.5 cm, the map of more scans: scan 13, 0.8 deg late, gains 20 % and is kept under
+    the default ``min_gain`` of 30 %, and the map it is averaged into carries its error;
+    at 20 % it is corrected, but accurate real scans gain up to 18 %:
     docs/results/poses.md). Corrected scans only extend the map; fed back, their errors
-    let the map drift (6.7 cm against 4.5 recorded). The first five scans, aligned to a
-    map of the first scan alone, are left out of the positions."""
+    let the map drift (0.79x the mean, 0.77x the worst, +7.9 cm). The first five scans,
+    aligned to a map of the first scan alone, are left out of the positions."""
     frames, mount, positions, quats = desynchronised
     counts = PoseCounts()
     out = list(refine_frames(frames, mount, counts=counts, params=OdometrySettings()))
@@ -69,7 +72,7 @@ def test_refine_turns_late_poses_back_and_keeps_positions(desynchronised) -> Non
     assert rec_deg.max() > 8.0  # the late poses are far off
     assert ref_deg.mean() < 0.7 * rec_deg.mean() and ref_deg.max() < 0.6 * rec_deg.max()
     settled = slice(6, None)  # scans 1-5 meet a map of one scan (docs/results/poses.md)
-    assert ref_m[settled].mean() < rec_m[settled].mean() + 0.03
+    assert ref_m[settled].mean() < rec_m[settled].mean() + 0.065
     assert counts.frames == SCANS and counts.corrected > SCANS // 2
     assert len(counts.scans) == SCANS and {"free", "constraint"} <= set(counts.scans[1])
 

@@ -49,16 +49,23 @@ def test_registered_sim_cloud_is_within_mhd_5cm_of_its_mesh(small_terrain, name)
     assert mesh_distance(reg.points, scenario.ground_truth).mean() < 0.05
 
 
+#: Scans of the desync test: 70 show it as 140 did (MHD 2.8 times the calm terrain's, 2.9
+#: with 140; the filter halves it); 40 no longer do (2.2).
+DESYNC_FRAMES = 70
+
+
 def test_exp_nav_2_shows_desync_and_the_manoeuvre_filter_reduces_it(small_terrain):
+    """exp_nav_2's desynchronised poses double its MHD over exp_nav_1's; dropping the
+    fast-turning scans (max_rate) takes most of it back."""
     voxel = get_terrain("exp_nav_2").spec.registration_voxel
-    scenario, _, reg = _cloud(small_terrain("exp_nav_2", 140), voxel=voxel)
+    scenario, _, reg = _cloud(small_terrain("exp_nav_2", DESYNC_FRAMES), voxel=voxel)
     mhd = mesh_distance(reg.points, scenario.ground_truth).mean()
-    calm_scenario, _, calm = _cloud(small_terrain("exp_nav_1", 140), voxel=voxel)
+    calm_scenario, _, calm = _cloud(small_terrain("exp_nav_1", DESYNC_FRAMES), voxel=voxel)
     calm_mhd = mesh_distance(calm.points, calm_scenario.ground_truth).mean()
-    _, _, kept = _cloud(small_terrain("exp_nav_2", 140), voxel=voxel, max_rate=0.5)
+    _, _, kept = _cloud(small_terrain("exp_nav_2", DESYNC_FRAMES), voxel=voxel, max_rate=0.5)
     filtered = mesh_distance(kept.points, scenario.ground_truth).mean()
     assert mhd > 2.5 * calm_mhd
-    assert 0 < kept.counts.frames_dropped_rate < 140
+    assert 0 < kept.counts.frames_dropped_rate < DESYNC_FRAMES
     assert filtered < 0.7 * mhd
 
 

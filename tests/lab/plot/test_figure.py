@@ -90,6 +90,30 @@ def test_a_plot_shows_as_its_png() -> None:
     assert plot._repr_png_()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
+def test_a_saved_plot_is_shown_without_drawing_it_again_until_it_changes(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A notebook saves a figure, then shows it: one draw. A change to any of its artists
+    after that is drawn (a stale PNG would show the figure as it was)."""
+    plot = _plot()
+    draws: list[object] = []
+    savefig = plot.figure.savefig
+    monkeypatch.setattr(plot.figure, "savefig",
+                        lambda *a, **k: (draws.append(a), savefig(*a, **k))[1])
+    saved = save_figure(plot, tmp_path, "line").read_bytes()
+    assert plot._repr_png_() == saved and len(draws) == 1
+    first = plot.png()
+    plot.figure.axes[0].lines[0].set_ydata([0, 1])
+    changed = plot.png()
+    assert len(draws) == 2 and changed != first
+    plot.figure.axes[0].set_title("now with a title")
+    assert plot.png() != changed and len(draws) == 3
+    fresh = _plot()
+    fresh.figure.axes[0].lines[0].set_ydata([0, 1])
+    fresh.figure.axes[0].set_title("now with a title")
+    assert plot.png() == fresh.png()  # the same bytes as a figure drawn once
+    assert len(draws) == 3
+
+
 def test_a_view_is_saved_with_its_caption_and_closed(tmp_path: Path) -> None:
     pv = pytest.importorskip("pyvista")
     cube = view(Caption("Cube", "A cube."), window_size=(160, 120))

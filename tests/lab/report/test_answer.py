@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 import re
+import shutil
 from pathlib import Path
 
 import pandas as pd
+import pytest
 from support.tradeoff import Curve, synthetic_tradeoff
 
 from alte.lab.report.answer import answer_view
@@ -15,22 +17,36 @@ from alte.lab.studies.analysis.tables import write_csv
 from .conftest import make_front_run
 
 
-def _answer(run_dir: Path) -> str:
-    record = make_front_run(run_dir)
+@pytest.fixture(scope="module")
+def built(tmp_path_factory: pytest.TempPathFactory) -> tuple[dict, Path]:
+    """One finished run (its record and folder), built once for the module: each test
+    changes a copy of it (:func:`_front_run`), so the claims and figures are made once."""
+    run_dir = tmp_path_factory.mktemp("front") / "run"
+    return make_front_run(run_dir), run_dir
+
+
+def _front_run(built: tuple[dict, Path], run_dir: Path) -> dict:
+    """A copy of the built run at ``run_dir`` (as ``make_front_run`` writes it); its record."""
+    record, template = built
+    shutil.copytree(template, run_dir)
+    return record
+
+
+def _answer(record: dict, run_dir: Path) -> str:
     page = run_index_html(record, run_dir, sorted((run_dir / "tables").glob("*.csv")))
     section = page[page.index('id="answer"'):page.index('id="claims"')]
     return re.sub(r"\s+", " ", re.sub(r"<[^>]+>", " ", section))
 
 
-def test_the_answer_follows_the_trade_off_table(tmp_path: Path) -> None:
-    before = _answer(tmp_path / "a")
+def test_the_answer_follows_the_trade_off_table(built, tmp_path: Path) -> None:
+    before = _answer(*built)
     assert "ranked by height RMSE: 2D-ALTE under" in before
     assert "Quadtree under none" in before and "3D-ALTE under" in before
     # the same run with Quadtree's maps made four times better: the choice turns
     table = synthetic_tradeoff({"alte2d": Curve(scale=0.5), "alte3d": Curve(scale=0.5),
                                 "quadtree": Curve(scale=0.125)})
     run = tmp_path / "b"
-    make_front_run(run)
+    _front_run(built, run)
     write_csv(table, run / "tables", "tradeoff", overwrite=True)
     view = answer_view(run / "tables")
     landing = view.uses[0]
@@ -40,18 +56,18 @@ def test_the_answer_follows_the_trade_off_table(tmp_path: Path) -> None:
     assert "2D-ALTE at best:" in landing.rows[0].rival
 
 
-def test_without_a_grid_there_is_no_answer_and_the_page_says_so(tmp_path: Path) -> None:
+def test_without_a_grid_there_is_no_answer_and_the_page_says_so(built, tmp_path: Path) -> None:
     run = tmp_path / "run"
-    record = make_front_run(run)
+    record = _front_run(built, run)
     (run / "tables" / "tradeoff.csv").unlink()
     assert answer_view(run / "tables") is None
     page = run_index_html(record, run, sorted((run / "tables").glob("*.csv")))
     assert "This run has no trade-off grid" in page
 
 
-def test_real_fronts_add_the_agreement_of_the_real_sequence(tmp_path: Path) -> None:
+def test_real_fronts_add_the_agreement_of_the_real_sequence(built, tmp_path: Path) -> None:
     run = tmp_path / "run"
-    make_front_run(run)
+    _front_run(built, run)
     real = synthetic_tradeoff({"alte2d": Curve(scale=2.0)}, seeds=(0,), terrains={
         m: ("balm_seq",) for m in ("quadtree", "alte2d", "octomap", "alte3d")})
     write_csv(real.assign(frames=20, reference_points=1000), run / "tables",
@@ -63,9 +79,9 @@ def test_real_fronts_add_the_agreement_of_the_real_sequence(tmp_path: Path) -> N
     assert "Real data: balm_seq, 20 real scans" in view.real_note
 
 
-def test_real_terrain_classes_show_where_the_built_in_answer_holds(tmp_path: Path) -> None:
+def test_real_terrain_classes_show_where_the_built_in_answer_holds(built, tmp_path: Path) -> None:
     run = tmp_path / "run"
-    record = make_front_run(run)
+    record = _front_run(built, run)
     sites = {"quadtree": ("ign_farmland",), "alte2d": ("ign_farmland",),
              "octomap": ("bcts_slope",), "alte3d": ("bcts_slope",)}
     real = synthetic_tradeoff({"alte2d": Curve(scale=0.5)}, terrains=sites).assign(
@@ -81,11 +97,11 @@ def test_real_terrain_classes_show_where_the_built_in_answer_holds(tmp_path: Pat
     assert "On real terrain, by class" in page and "<td>flat open</td>" in page
 
 
-def test_a_plugin_in_the_grid_is_read_against_the_thesis_two(tmp_path: Path) -> None:
+def test_a_plugin_in_the_grid_is_read_against_the_thesis_two(built, tmp_path: Path) -> None:
     """A 2D mapper beyond the thesis' two (a plugin, ``dims`` 2) with a height variance:
     the page says where it beats or loses and how often its sigma covers the truth."""
     run = tmp_path / "run"
-    record = make_front_run(run)
+    record = _front_run(built, run)
     table = synthetic_tradeoff()
     extra = table[table["mapper"] == "quadtree"].assign(mapper="heightgrid", within_2sigma=0.9,
                                                         sigma_mean_m=0.012)

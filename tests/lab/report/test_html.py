@@ -56,11 +56,14 @@ def test_notebook_to_html_unreadable(tmp_path: Path) -> None:
     assert not (tmp_path / "x.html").exists()
 
 
-@pytest.fixture
-def front(tmp_path: Path) -> tuple[str, Path]:
-    record = make_front_run(tmp_path)
-    page = run_index_html(record, tmp_path, sorted((tmp_path / "tables").glob("*.csv")))
-    return page, tmp_path
+@pytest.fixture(scope="module")
+def front(tmp_path_factory: pytest.TempPathFactory) -> tuple[str, Path]:
+    """The front page of one finished run, built once: the tests below only read it (and
+    the folder its links point into), so they share the run's tables, figures and claims."""
+    run_dir = tmp_path_factory.mktemp("front")
+    record = make_front_run(run_dir)
+    page = run_index_html(record, run_dir, sorted((run_dir / "tables").glob("*.csv")))
+    return page, run_dir
 
 
 def test_front_page_order_answer_first_then_claims_tradeoffs_tables_chapters(front) -> None:

@@ -62,16 +62,19 @@ def test_tables_on_a_synthetic_folder(fake_root: Path) -> None:
     assert realdata.labelled_clouds(realdata.locate(fake_root / "absent")) == []
 
 
-#: Clouds under this many points: the real-data check `make test` runs (about 6 CPU s of
-#: the 25 the whole set costs); `make check-full` runs it on every cloud.
-SMALL_CLOUD = 300_000
+#: The ALS tile `make test` checks beside every ISPRS sample: the drone survey (17,000
+#: points), the platform this project maps from. The ISPRS samples, on which the default
+#: was chosen, are what catches a worse default (slope 0.05 or 0.20, threshold 0.3 or
+#: 1.0 m, window 9 m, cell 2 m, no slope scaling: each fails the ISPRS comparison); SMRF's
+#: cost grows with a cloud's area, not its points (the sparse 38,000-point mountains cost
+#: ten times the drone tile), so `make check-full` runs every cloud (about 55 CPU s).
+QUICK_ALS = ("dji_l1_riparian.las",)
 
 
-def _default_against_smrf(small_only: bool) -> None:
-    """The default's mean kappa at least SMRF's (published parameters) on each data set."""
-    clouds = realdata.labelled_clouds(realdata.locate(REALDATA))
-    if small_only:
-        clouds = [c for c in clouds if len(c.points) < SMALL_CLOUD]
+def _default_against_smrf(als: tuple[str, ...] | None) -> None:
+    """The default's mean kappa at least SMRF's (published parameters) on each data set:
+    every ISPRS sample and the ALS tiles ``als`` (None: all); only those are read."""
+    clouds = realdata.labelled_clouds(realdata.locate(REALDATA), als=als)
     assert {c.dataset for c in clouds} == {"isprs", "als"}
     table = realdata.filter_table(clouds, ["default", "smrf published"], progress=False)
     means = realdata.mean_table(table).set_index(["dataset", "filter"])["kappa_pct"]
@@ -84,8 +87,8 @@ def _default_against_smrf(small_only: bool) -> None:
 @pytest.mark.realdata
 @pytest.mark.skipif(not REALDATA.is_dir(), reason="../shared/realdata absent")
 def test_the_default_holds_against_published_smrf_on_the_small_clouds() -> None:
-    """Side by side on every ISPRS sample and ALS tile under 300,000 points."""
-    _default_against_smrf(small_only=True)
+    """Side by side on every ISPRS sample and the drone survey's tile."""
+    _default_against_smrf(als=QUICK_ALS)
 
 
 @pytest.mark.full
@@ -93,4 +96,4 @@ def test_the_default_holds_against_published_smrf_on_the_small_clouds() -> None:
 @pytest.mark.skipif(not REALDATA.is_dir(), reason="../shared/realdata absent")
 def test_the_default_holds_against_published_smrf_on_both_data_sets() -> None:
     """Side by side on every ISPRS sample and every ALS tile (whole)."""
-    _default_against_smrf(small_only=False)
+    _default_against_smrf(als=None)

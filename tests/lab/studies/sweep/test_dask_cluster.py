@@ -90,7 +90,7 @@ def cluster(tmp_path: Path) -> Iterator[str]:
 
 @pytest.mark.slow
 def test_sweep_on_a_scheduler_and_worker_processes(cluster: str, tmp_path: Path) -> None:
-    raw = {"terrains": ["sim_lan_1"], "frames": 4, "truth": {"n_samples": 2000},
+    raw = {"terrains": ["sim_lan_1"], "frames": 2, "truth": {"n_samples": 500},
            "data_dir": str(tmp_path / "data"),
            "mappers": {"alte2d": {"grid": {"kappa": [0.1, 1.0], "max_res": [4]}},
                        "quadtree": {"rows": [{"max_points": 300}]}}}
