@@ -39,10 +39,45 @@ def test_the_table_has_a_row_per_terrain(tmp_path):
         "CPU per scan (ms)": 30.0}]  # rounded to mm and 0.1 ms
 
 
-def test_seeds_give_a_row_each_and_the_view_their_mean_and_worst(tmp_path):
-    """Two workers give the serial rows, in the order asked (each seed its own task)."""
+@pytest.mark.full
+def test_two_worker_processes_give_the_serial_rows_in_the_order_asked(tmp_path):
+    """A local Dask cluster of two processes (chapter 5's scheduler) gives the serial rows,
+    in the order asked (each seed its own task)."""
     table = sensor_table(["sim_lan_2"], tmp_path, seeds=[1, 0], runs=("recorded",), frames=3,
                          scheduler="local", workers=2)
+    assert list(zip(table["terrain"], table["seed"], strict=True)) == [("sim_lan_2", 1),
+                                                                         ("sim_lan_2", 0)]
+    serial = sensor_table(["sim_lan_2"], tmp_path, seeds=[1, 0], runs=("recorded",), frames=3)
+    assert list(table["mesh_recorded_m"]) == list(serial["mesh_recorded_m"])
+
+
+def test_seeds_give_a_row_each_and_the_view_their_mean_and_worst(tmp_path, monkeypatch):
+    """Each seed is its own task and its row lands in the order asked, whatever order the
+    tasks end in (here: the last first, as a worker pool may finish them; the pool itself:
+    the sweep's Dask tests, and the two-process run above in ``make check-full``)."""
+    from contextlib import contextmanager
+
+    from alte.lab.studies.sweep import runner
+
+    tasks, serial_executor = [], runner.executor
+
+    @contextmanager
+    def last_first(scheduler, workers):
+        if scheduler == "serial":
+            with serial_executor(scheduler, workers) as pool:
+                yield pool
+            return
+        assert (scheduler, workers) == ("local", 2)
+
+        def pool(fn, items, data_dir):
+            tasks.extend(items)
+            yield from reversed(list(runner._serial_map(fn, items, data_dir)))
+        yield pool
+
+    monkeypatch.setattr(runner, "executor", last_first)
+    table = sensor_table(["sim_lan_2"], tmp_path, seeds=[1, 0], runs=("recorded",), frames=3,
+                         scheduler="local", workers=2)
+    assert [(name, seed) for name, seed, *_ in tasks] == [("sim_lan_2", 1), ("sim_lan_2", 0)]
     assert list(zip(table["terrain"], table["seed"], strict=True)) == [("sim_lan_2", 1),
                                                                          ("sim_lan_2", 0)]
     serial = sensor_table(["sim_lan_2"], tmp_path, seeds=[1, 0], runs=("recorded",), frames=3)
