@@ -100,7 +100,8 @@ def _others() -> None:
 
 def _lio_map() -> None:
     """The LIO's local map: a packed tree, a few rows appended under a second one, and the
-    plane fits of a query (the fits' kernel and the merge of both trees' neighbours)."""
+    plane fits of a query (the fits' kernel and the merge of both trees' neighbours),
+    asked again from points moved a little (the neighbours kept between iterations)."""
     from alte.registration.localmap import LocalMap
 
     ground = np.random.default_rng(0).uniform((-5.0, -5.0, 0.0), (5.0, 5.0, 0.01), (400, 3))
@@ -108,6 +109,7 @@ def _lio_map() -> None:
     local.add(ground[:380], np.zeros(3))
     local.add(ground[380:], np.zeros(3))
     local.planes(ground[:8], 1.0, 5, (20, 3.0))
+    local.planes(ground[:8] + 1e-3, 1.0, 5, (20, 3.0))
 
 
 def warm_kernels(part: tuple[int, int] = (1, 1)) -> dict[str, int]:

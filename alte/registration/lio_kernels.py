@@ -8,7 +8,8 @@ numpy took five passes over an (N, k, 3) gather and a batched LAPACK ``eigh`` fo
 diagonalise the covariance: exact to rounding for a symmetric 3 x 3 (the off-diagonal
 terms shrink quadratically, a few sweeps), with no call out per row. The two trees' lists
 were merged by a stable ``argsort`` of them side by side (4 % of the LIO); each is sorted
-already, so one merge pass does it.
+already, so one merge pass does it. Between the filter's iterations a row keeps the neighbours
+it was searched with when they provably have not changed (:func:`kept_nearest`).
 Imported on first use: ``alte info`` and the other commands that import the odometry's
 settings do not load numba.
 """
@@ -19,12 +20,15 @@ import numba
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["merge_nearest", "plane_fits"]
+__all__ = ["kept_nearest", "merge_nearest", "plane_fits"]
 
 #: Neighbours' distances (N, k; inf where missing) and rows (N, k).
 _Found = tuple[NDArray[np.float64], NDArray[np.int64]]
 
 _SWEEPS = 32
+#: Margin (m) by which a kept row's neighbours must be nearer than any other point can
+#: be: the rounding of distances measured in double precision is far below it.
+MARGIN = 1e-9
 
 
 @numba.njit(cache=True)
@@ -139,3 +143,55 @@ def merge_nearest(first: _Found, second: _Found) -> _Found:
                 dist[r, j], idx[r, j] = d2[r, b], i2[r, b]
                 b += 1
     return dist, idx
+
+
+@numba.njit(cache=True)
+def _measured(points: NDArray[np.float64], query: NDArray[np.float64], rows: NDArray[np.int64],
+              bound: float, out: _Found) -> None:
+    """The candidate ``rows`` sorted by their distance to ``query`` (a stable insertion
+    sort) into ``out`` (distances, rows); beyond ``bound`` or missing: inf. Summed as
+    pykdtree sums, so that a distance is the very one it returns."""
+    dist, idx = out
+    for j in range(len(rows)):
+        e = np.inf
+        if rows[j] < len(points):
+            s = 0.0
+            for c in range(3):
+                d = query[c] - points[rows[j], c]
+                s += d * d
+            e = np.sqrt(s)
+            if e >= bound:
+                e = np.inf
+        t = j - 1
+        while t >= 0 and dist[t] > e:
+            dist[t + 1], idx[t + 1] = dist[t], idx[t]
+            t -= 1
+        dist[t + 1], idx[t + 1] = e, rows[j]
+
+
+@numba.njit(cache=True)
+def kept_nearest(points: NDArray[np.float64], query: NDArray[np.float64],
+                 last: tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.int64]],
+                 bound: float, k: int) -> tuple[NDArray[np.bool_], NDArray[np.float64],
+                                                NDArray[np.int64]]:
+    """Per query row, whether its ``k`` nearest are among the candidates of ``last``
+    (per row the point searched from, the distances and rows of its ``m > k`` nearest),
+    and then which, in order (:mod:`alte.registration.neighbours`): every other point was
+    at least the last candidate's distance (or ``bound``) from there, so at least that
+    minus the row's shift away now (less :data:`MARGIN`); equal distances are not kept."""
+    anchor, near, rows = last
+    n, m = rows.shape
+    keep = np.zeros(n, np.bool_)
+    dist, idx = np.empty((n, m)), np.empty((n, m), np.int64)
+    for r in range(n):
+        s = 0.0
+        for c in range(3):
+            d = query[r, c] - anchor[r, c]
+            s += d * d
+        far = (near[r, m - 1] if np.isfinite(near[r, m - 1]) else bound) - np.sqrt(s) - MARGIN
+        _measured(points, query[r], rows[r], bound, (dist[r], idx[r]))
+        ok = dist[r, k - 1] < far
+        for j in range(k):
+            ok = ok and dist[r, j + 1] > dist[r, j]
+        keep[r] = ok
+    return keep, dist[:, :k], idx[:, :k]
