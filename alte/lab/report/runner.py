@@ -34,7 +34,8 @@ from alte.types import JSONDict
 if TYPE_CHECKING:
     from traitlets.config import Config
 
-__all__ = ["Report", "RunResult", "cpu_seconds", "ensure_terrains", "execute_run", "run_report"]
+__all__ = ["THREAD_VARIABLES", "Report", "RunResult", "cpu_seconds", "ensure_terrains",
+           "execute_run", "kernel_threads", "run_report"]
 
 class EnsureTerrain(Protocol):
     """``ensure(name, out_dir=..., seed=..., frames=...)`` makes a terrain's data exist
@@ -141,6 +142,31 @@ def _kernel_config() -> Config:
                   else {})
 
 
+#: Thread pools a kernel's libraries size from these (OpenMP: pykdtree, Open3D; OpenBLAS
+#: and MKL: numpy's linear algebra; numba's parallel kernels). Beside other kernels each
+#: gets its share of the cores, as Dask gives its workers one thread: idle threads of a
+#: pool spin while they wait, and with every core busy that was CPU taken from the other
+#: notebooks (chapter 6's pose table: 140 CPU s with two OpenBLAS and OpenMP threads, 87
+#: with one, on an otherwise idle 2-core machine, in 95 and 87 s). Variables the user set
+#: are kept.
+THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS",
+                    "NUMBA_NUM_THREADS")
+
+
+@contextlib.contextmanager
+def kernel_threads(jobs: int) -> Iterator[dict[str, str]]:
+    """The :data:`THREAD_VARIABLES` the user left unset, set for the kernels started
+    meanwhile to the cores over ``jobs`` (at least one); yields what was set."""
+    share = str(max(1, (os.cpu_count() or 1) // max(1, jobs)))
+    given = {name: share for name in THREAD_VARIABLES if name not in os.environ}
+    os.environ.update(given)
+    try:
+        yield given
+    finally:
+        for name in given:
+            os.environ.pop(name, None)
+
+
 #: The kernel logs only what is critical: jupyter_client interrupts every kernel before it
 #: shuts it down, and ipykernel then logs "KeyboardInterrupt caught in kernel", noise a
 #: report's reader cannot act on (a cell's error is in the notebook, a dead kernel in the
@@ -189,7 +215,7 @@ def _execute_all(runs: Sequence[Run], run_dir: Path, data_dir: Path, skip: dict[
             done[run.name] = RunResult(run.name, "skipped", error="; ".join(missing))
         else:
             todo.append(run)
-    with (ThreadPoolExecutor(max_workers=max(1, jobs)) as pool,
+    with (kernel_threads(jobs), ThreadPoolExecutor(max_workers=max(1, jobs)) as pool,
           tqdm(total=len(todo), desc="notebooks", unit="run", disable=not progress) as bar,
           _kernel_bars(bar, progress)):
         # the runs marked first start first (the longest: the others fill the other

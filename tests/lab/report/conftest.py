@@ -31,6 +31,9 @@ fig, ax = plt.subplots()
 ax.plot(values[:, 0])
 save_figure(Plot(fig, Caption("Curve", "The first column, row by row.")), OUT_DIR, "curve")
 print("rows", ROWS)
+import json, os
+names = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS")
+(Path(OUT_DIR) / "threads.json").write_text(json.dumps({n: os.environ.get(n) for n in names}))
 """
 BAD_PARAMS = 'OUT_DIR = "reports/scratch/bad"\nMESSAGE = "boom"\n'
 BAD_BODY = 'print("before the failure")\nraise ValueError(MESSAGE)\n'

@@ -11,7 +11,13 @@ import pytest
 
 from alte.errors import ReportError, SimulationError
 from alte.lab.report.plan import Entry, Run, build_plan
-from alte.lab.report.runner import ensure_terrains, execute_run, run_report
+from alte.lab.report.runner import (
+    THREAD_VARIABLES,
+    ensure_terrains,
+    execute_run,
+    kernel_threads,
+    run_report,
+)
 
 from .conftest import BAD_BODY, BAD_PARAMS, GOOD_BODY, GOOD_PARAMS, make_notebook
 
@@ -64,6 +70,33 @@ def test_record_and_index(two_reports: tuple[Path, Any, Any]) -> None:
     assert set(record["load_average"]) == {"start", "end"}
     again = json.loads((second.run_dir / "run.json").read_text())
     assert [r["cpu_s"] for r in again["runs"]] == [None, None] and again["cpu_s"] > 0
+
+
+@pytest.mark.slow
+def test_kernels_side_by_side_get_their_share_of_the_cores(
+        two_reports: tuple[Path, Any, Any]) -> None:
+    """One job: every core for its kernel's thread pools; two: half each (what the user
+    set stays)."""
+    _, first, second = two_reports
+    cores = os.cpu_count() or 1
+    for report, share in ((first, cores), (second, max(1, cores // 2))):
+        seen = json.loads((report.run_dir / "good" / "threads.json").read_text())
+        assert seen == {n: os.environ.get(n, str(share)) for n in THREAD_VARIABLES}
+
+
+def test_kernel_threads_sets_only_what_the_user_left_unset(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    for name in THREAD_VARIABLES:
+        monkeypatch.delenv(name, raising=False)
+    monkeypatch.setenv("OMP_NUM_THREADS", "3")
+    monkeypatch.setattr(os, "cpu_count", lambda: 8)
+    with kernel_threads(4) as given:
+        assert given == {n: "2" for n in THREAD_VARIABLES if n != "OMP_NUM_THREADS"}
+        assert os.environ["OPENBLAS_NUM_THREADS"] == "2" and os.environ["OMP_NUM_THREADS"] == "3"
+    assert os.environ["OMP_NUM_THREADS"] == "3"
+    assert not {n for n in THREAD_VARIABLES if n != "OMP_NUM_THREADS"} & set(os.environ)
+    with kernel_threads(16) as given:
+        assert set(given.values()) == {"1"}
 
 
 @pytest.mark.slow
