@@ -122,7 +122,8 @@ def plane_fits(points: NDArray[np.float64], idx: NDArray[np.int64], thickness: f
         low, mid = _order(a[0, 0], a[1, 1], a[2, 2])
         flat[i] = np.sqrt(max(a[low, low], 0.0)) < thickness \
             and np.sqrt(max(a[mid, mid], 0.0)) > 3.0 * thickness
-        normal[i] = v[:, low]
+        for c in range(3):  # element by element: no shape check to compile
+            normal[i, c] = v[c, low]
     return flat, normal, centre
 
 

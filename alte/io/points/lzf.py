@@ -22,7 +22,8 @@ def lzf_decompress(src: NDArray[np.uint8],  # pragma: no cover - compiled
             n = ctrl + 1
             if ip + n > src.size or op + n > size:
                 return out[:0]
-            out[op : op + n] = src[ip : ip + n]
+            for k in range(n):  # element by element: no shape check to compile
+                out[op + k] = src[ip + k]
             ip += n
             op += n
             continue

@@ -83,9 +83,11 @@ def reserve(table: Table, n_blocks: int, need: int) -> Table:
     if n_blocks + need > blocks.size:
         cap = max(2 * blocks.size, n_blocks + need)
         grown = np.zeros((cap, 2 * WORDS), dtype=np.uint64)
-        grown[:n_blocks] = bits[:n_blocks]
         grown_blocks = np.zeros(cap, dtype=np.uint64)
-        grown_blocks[:n_blocks] = blocks[:n_blocks]
+        for b in range(n_blocks):  # element by element: no shape check to compile
+            for w in range(2 * WORDS):
+                grown[b, w] = bits[b, w]
+            grown_blocks[b] = blocks[b]
         bits, blocks = grown, grown_blocks
     if 2 * (n_blocks + need) > slots.size:
         size = slots.size

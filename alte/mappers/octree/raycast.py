@@ -121,7 +121,7 @@ def _ends(points: NDArray[np.float32], origin: NDArray[np.float32], max_range: f
         dz = points[i, 2] - origin[2]
         length = _norm(dx, dy, dz)
         if max_range < 0.0 or length <= max_range:
-            ends[i] = points[i]
+            ends[i, 0], ends[i, 1], ends[i, 2] = points[i, 0], points[i, 1], points[i, 2]
             hit[i] = True
         else:  # origin + (p - origin).normalized() * (float) maxrange
             lf = np.float32(length)

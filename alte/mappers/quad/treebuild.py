@@ -113,7 +113,8 @@ def _tree_counts(packed: NDArray[np.int64], shift: int, depth: int,
         firsts.append(lo.copy())
     joined, at = np.empty(counts.sum(), np.int64), 0
     for level_firsts in firsts:
-        joined[at:at + level_firsts.size] = level_firsts
+        for f in range(level_firsts.size):  # element by element: no shape check to compile
+            joined[at + f] = level_firsts[f]
         at += level_firsts.size
     return counts, joined
 
@@ -159,7 +160,9 @@ def _walk(points: Sorted, span: tuple[int, int, int], flags: tuple[int, float], 
             if rows[s, 0] > split_above:
                 _emit((rows, keys), (kid, kid + m), level + 1, flags, out)
         i = j
-    root[0][root[2]], root[1][root[2]] = rows[4 * floor], keys[4 * floor]
+    for c in range(rows.shape[1]):
+        root[0][root[2], c] = rows[4 * floor, c]
+    root[1][root[2]] = keys[4 * floor]
 
 
 @numba.njit(cache=True, error_model="numpy")
@@ -178,7 +181,8 @@ def _walk_top(cells: tuple[NDArray[np.float64], NDArray[np.int64]], floor: int,
         low = _coarsest_change(key, cell_keys[t + 1], floor) if t + 1 < cell_keys.size else 0
         top = max(before, low) if cell_rows[t, 0] == 1.0 else floor
         s, before = 4 * top + count[top], low
-        rows[s, :] = cell_rows[t]
+        for c in range(rows.shape[1]):  # element by element: no shape check to compile
+            rows[s, c] = cell_rows[t, c]
         keys[s], count[top] = key >> (2 * (floor - top)), count[top] + 1
         for level in range(top - 1, low - 1, -1):
             m, s, kid = count[level + 1], 4 * level + count[level], 4 * level + 4
