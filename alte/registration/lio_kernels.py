@@ -160,9 +160,8 @@ def _measured(points: NDArray[np.float64], query: NDArray[np.float64], rows: NDA
             for c in range(3):
                 d = query[c] - points[rows[j], c]
                 s += d * d
-            e = np.sqrt(s)
-            if e >= bound:
-                e = np.inf
+            if s < bound * bound:  # pykdtree's test, on squared distances
+                e = np.sqrt(s)
         t = j - 1
         while t >= 0 and dist[t] > e:
             dist[t + 1], idx[t + 1] = dist[t], idx[t]
