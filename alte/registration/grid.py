@@ -105,16 +105,14 @@ def _reduce(
     """Add up rows with equal integer keys; output sorted by key."""
     if len(keys) == 0:
         return np.empty((0, 3), np.int64), np.empty((0, 3)), np.empty(0)
-    from alte.registration.gridsum import segment_sums
+    from alte.registration.gridsum import gathered_sums
 
     order, starts = _sort_keys(keys)
     starts = starts.astype(np.int64, copy=False)
-    return (
-        keys[order[starts]],
-        segment_sums(np.asarray(sums, dtype=np.float64)[order], starts),
-        segment_sums(np.asarray(counts, dtype=np.float64)[order].reshape(-1, 1),
-                     starts).reshape(-1),
-    )
+    cell_sums, cell_counts = gathered_sums(
+        np.ascontiguousarray(sums, dtype=np.float64),
+        np.ascontiguousarray(counts, dtype=np.float64), order, starts)
+    return keys[order[starts]], cell_sums, cell_counts
 
 
 def grid_average(points: NDArray[np.float64], voxel: float) -> NDArray[np.float64]:

@@ -5,9 +5,10 @@ these steps run on every point of every bag: the keys' bounds, their packing int
 sortable integer, the cell boundaries after the sort and the per-cell sums. numpy did
 each in several passes over temporary arrays (the bounds as strided reductions, now
 :func:`alte._kernels.bounds`; the unpacking as an int64 ``divmod``; the sums with
-``np.add.reduceat``); here each is one pass. The sums are ``np.add.reduceat``'s to the
-last bit (:mod:`alte._kernels`), so the registered clouds, and every pose fitted to them,
-do not move.
+``np.add.reduceat`` of the rows gathered in sorted order); here each is one pass, the sums
+read through the order. The sums are ``np.add.reduceat``'s to the last bit
+(:mod:`alte._kernels`), so the registered clouds, and every pose fitted to them, do not
+move.
 """
 
 from __future__ import annotations
@@ -18,7 +19,7 @@ from numpy.typing import NDArray
 
 from alte._kernels import run_total
 
-__all__ = ["pack", "segment_sums", "unpack"]
+__all__ = ["gathered_sums", "pack", "unpack"]
 
 
 @numba.njit(cache=True)
@@ -52,13 +53,33 @@ def unpack(code: NDArray[np.int64]) -> tuple[NDArray[np.int64], NDArray[np.int64
 
 
 @numba.njit(cache=True)
-def segment_sums(ordered: NDArray[np.float64], starts: NDArray[np.int64]) -> NDArray[np.float64]:
-    """``np.add.reduceat(ordered, starts, axis=0)`` for ``ordered`` (N, D) and increasing
-    ``starts`` (the first at 0), to the last bit (:func:`alte._kernels.run_total`)."""
-    k, n = starts.shape[0], ordered.shape[0]
-    out = np.empty((k, ordered.shape[1]))
+def gathered_sums(sums: NDArray[np.float64], counts: NDArray[np.float64],
+                  order: NDArray[np.int64], starts: NDArray[np.int64],
+                  ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """``np.add.reduceat`` of ``sums[order]`` (N, D) and ``counts[order]`` (N,) at the
+    increasing ``starts`` (the first at 0), without gathering them first: a one-row cell
+    is copied, a longer run gathered into a scratch block and summed there by the same
+    :func:`~alte._kernels.run_total`, so the bits are the same."""
+    k, n, d = starts.shape[0], order.shape[0], sums.shape[1]
+    longest = 1
     for s in range(k):
-        end = starts[s + 1] if s + 1 < k else n
-        for column in range(ordered.shape[1]):
-            out[s, column] = run_total(ordered, column, starts[s], end)
-    return out
+        longest = max(longest, (starts[s + 1] if s + 1 < k else n) - starts[s])
+    out, total = np.empty((k, d)), np.empty(k)
+    block, weights = np.empty((longest, d)), np.empty((longest, 1))
+    for s in range(k):
+        a = starts[s]
+        size = (starts[s + 1] if s + 1 < k else n) - a
+        if size == 1:
+            for column in range(d):
+                out[s, column] = sums[order[a], column]
+            total[s] = counts[order[a]]
+            continue
+        for i in range(size):
+            row = order[a + i]
+            for column in range(d):
+                block[i, column] = sums[row, column]
+            weights[i, 0] = counts[row]
+        for column in range(d):
+            out[s, column] = run_total(block, column, 0, size)
+        total[s] = run_total(weights, 0, 0, size)
+    return out, total

@@ -14,7 +14,7 @@ import pytest
 
 from alte._kernels import bounds
 from alte.registration.grid import GridAccumulator, grid_average_with_counts
-from alte.registration.gridsum import pack, segment_sums, unpack
+from alte.registration.gridsum import gathered_sums, pack, unpack
 
 
 def _cells(rng: np.random.Generator, sizes: list[int]) -> np.ndarray:
@@ -53,28 +53,10 @@ def test_packed_sort_is_numpys(seed: int) -> None:
     assert np.array_equal(order, expected[0]) and np.array_equal(starts, expected[1])
 
 
-@pytest.mark.parametrize("seed", range(4))
-def test_segment_sums_are_reduceat_to_the_last_bit(seed: int) -> None:
-    rng = np.random.default_rng(seed)
-    sizes = [1, 2, 7, 8, 9, 15, 16, 17, 127, 128, 129, 130, 255, 256, 257, 600,
-             *rng.integers(1, 300, 40)]
-    keys = _cells(rng, sizes)
-    n = len(keys)
-    values = rng.normal(size=(n, 3)) * 10.0 ** rng.integers(-6, 7, (n, 3))
-    values[rng.random((n, 3)) < 0.05] = -0.0
-    order, starts = _numpy_sort(keys)
-    got = segment_sums(values[order], starts)
-    want = np.add.reduceat(values[order], starts, axis=0)
-    assert np.array_equal(_bits(got), _bits(want))
-    counts = rng.integers(1, 5, n).astype(np.float64)
-    got_counts = segment_sums(counts[order].reshape(-1, 1), starts).reshape(-1)
-    assert np.array_equal(_bits(got_counts), _bits(np.add.reduceat(counts[order], starts)))
-
-
 def test_negative_zeros_keep_their_sign() -> None:
     """A one-row cell is copied, and numpy's sums start from -0.0, not 0.0."""
     values = np.array([[-0.0, 1.0, -0.0], [5.0, 1.0, -0.0], [-0.0, -0.0, -0.0]])
-    out = segment_sums(values, np.array([0, 1], np.int64))
+    out, _ = gathered_sums(values, np.ones(3), np.arange(3), np.array([0, 1], np.int64))
     assert np.signbit(out).tolist() == [[True, False, True], [False, False, True]]
     assert np.array_equal(_bits(out), _bits(np.add.reduceat(values, [0, 1], axis=0)))
 
@@ -102,3 +84,20 @@ def test_a_registered_cloud_is_the_numpy_grids() -> None:
     assert np.array_equal(_bits(sums_one), _bits(np.add.reduceat(frames[0][order], starts,
                                                                  axis=0)))
     assert np.array_equal(counts_one, np.add.reduceat(np.ones(3000)[order], starts))
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_gathered_sums_are_reduceat_of_the_gathered_rows(seed: int) -> None:
+    """Summing through the order (no gathered copy) gives ``np.add.reduceat`` of the
+    gathered rows to the last bit, for every run length numpy's summation changes at."""
+    rng = np.random.default_rng(seed)
+    sizes = [1, 2, 7, 8, 9, 16, 17, 128, 129, 130, 257, 600, *rng.integers(1, 300, 40)]
+    keys = _cells(rng, sizes)
+    n = len(keys)
+    values = rng.normal(size=(n, 3)) * 10.0 ** rng.integers(-6, 7, (n, 3))
+    values[rng.random((n, 3)) < 0.05] = -0.0
+    counts = rng.integers(1, 5, n) * 10.0 ** rng.integers(-3, 4, n)
+    order, starts = _numpy_sort(keys)
+    got, got_counts = gathered_sums(values, counts, order, starts)
+    assert np.array_equal(_bits(got), _bits(np.add.reduceat(values[order], starts, axis=0)))
+    assert np.array_equal(_bits(got_counts), _bits(np.add.reduceat(counts[order], starts)))
